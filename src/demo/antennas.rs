@@ -1,0 +1,1 @@
+//! Antenna path generators (placeholder).

@@ -1,0 +1,1 @@
+//! The paper's test part (placeholder).

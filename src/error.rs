@@ -1,0 +1,31 @@
+//! The crate's error: one variant per pipeline stage, each wrapping that
+//! stage's own typed error (which carries the file, line or point at fault).
+
+use crate::{mesh::MeshError, registration::RegistrationError, svg::SvgError};
+
+/// Any fatal error of the planning core. Recoverable oddities are not errors:
+/// they become warnings in the plan's report.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scan could not be read.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The fiducials do not define a rigid transform.
+    #[error(transparent)]
+    Registration(#[from] RegistrationError),
+    /// The drawn path could not be read.
+    #[error(transparent)]
+    Svg(#[from] SvgError),
+    /// A parameter is out of its valid range (names the parameter and value).
+    #[error("invalid parameter {name} = {value}: {reason}")]
+    Parameter {
+        name: &'static str,
+        value: String,
+        reason: String,
+    },
+    /// Planning could not produce a tool path (names the path and point).
+    #[error("{0}")]
+    Plan(String),
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,51 @@
+//! # pcpp: point-cloud-based conformal tool-path planning
+//!
+//! Plans the tool path of a microextrusion nozzle on a 3-axis stage that
+//! prints a flat drawn path (an SVG antenna, say) onto a scanned, non-flat
+//! substrate, following the PCPP method (`pcpp-spec.md` in the shared folder,
+//! after the paper's Algorithms 1-5).
+//!
+//! ## Features
+//! - Scan import from bytes: OBJ, PLY (ascii and binary), STL (ascii and
+//!   binary), glTF 2.0 (`.gltf` with embedded buffers, `.glb`), in mm, cm, m
+//!   or inches ([`mesh`]).
+//! - Fiducial holes found as boundary loops ([`fiducials`]) and rigid
+//!   registration scanner -> printer, the paper's three-point construction or
+//!   a least-squares fit ([`registration`]).
+//! - SVG paths through `usvg`: every shape, transforms, `use`, physical units
+//!   ([`svg`]); sampling at two points per nozzle diameter ([`sampling`]).
+//! - Projection along -Z onto the highest surface ([`projection`]), cubic
+//!   interpolating B-spline and local geometry ([`spline`]).
+//! - Four planners side by side ([`planners`]) and the predicted print
+//!   quality ([`quality`]) and path statistics ([`stats`]).
+//! - Built-in demo inputs: the paper's test part and antenna generators
+//!   ([`demo`]).
+//!
+//! ## Limitations
+//! - A 3-axis stage only: the nozzle stays vertical, paths are projected along Z.
+//! - glTF buffers must be embedded (data URIs or the GLB binary chunk): the
+//!   core takes bytes and never opens other files.
+//! - SVG text is not converted to paths (no fonts are loaded).
+//!
+//! The core takes bytes and `&str`, never file paths, and knows nothing of
+//! the DOM; `src/wasm.rs` and `src/bin/pcpp.rs` are thin adapters over it.
+
+pub mod demo;
+mod error;
+pub mod fiducials;
+pub mod mesh;
+pub mod params;
+pub mod pipeline;
+pub mod planners;
+pub mod projection;
+pub mod quality;
+pub mod registration;
+pub mod sampling;
+pub mod spline;
+pub mod stats;
+pub mod surface;
+pub mod svg;
+
+pub use error::{Error, Result};
+pub use glam::{DMat4, DVec2, DVec3};
+pub use params::{Nozzle, Process};

@@ -1,0 +1,188 @@
+//! Scan import: OBJ, PLY, STL and glTF/GLB bytes into one [`TriMesh`] in
+//! millimetres, printer convention +Z up (spec "Inputs").
+//!
+//! Each format has its own parser file that reads the file's own units and
+//! axes; [`import_mesh`] sniffs the format, validates (finite coordinates,
+//! indices in range), drops degenerate triangles with a warning, and applies
+//! the scan units and up axis.
+
+use std::{fmt, str::FromStr};
+
+use glam::{DMat4, DVec3};
+use serde::{Deserialize, Serialize};
+
+mod error;
+mod gltf;
+mod import;
+mod obj;
+mod ply;
+mod stl;
+
+pub use error::MeshError;
+pub use import::{detect_format, import_mesh};
+
+/// An indexed triangle mesh, f64 millimetres once imported.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMesh {
+    pub vertices: Vec<DVec3>,
+    /// Counter-clockwise vertex indices into `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corners of triangle `i`.
+    #[inline]
+    pub fn triangle(&self, i: usize) -> [DVec3; 3] {
+        let [a, b, c] = self.triangles[i];
+        [
+            self.vertices[a as usize],
+            self.vertices[b as usize],
+            self.vertices[c as usize],
+        ]
+    }
+
+    /// Axis-aligned bounds of the vertices used by triangles, `None` when empty.
+    pub fn bbox(&self) -> Option<(DVec3, DVec3)> {
+        let mut it = self.triangles.iter().flatten();
+        let first = self.vertices[*it.next()? as usize];
+        let (mut lo, mut hi) = (first, first);
+        for &i in it {
+            let v = self.vertices[i as usize];
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        Some((lo, hi))
+    }
+
+    /// Applies an affine transform to every vertex.
+    pub fn transform(&mut self, m: &DMat4) {
+        for v in &mut self.vertices {
+            *v = m.transform_point3(*v);
+        }
+    }
+}
+
+/// Length unit of a scan file's coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ScanUnits {
+    Mm,
+    Cm,
+    M,
+    In,
+}
+
+impl ScanUnits {
+    pub fn to_mm(self) -> f64 {
+        match self {
+            ScanUnits::Mm => 1.0,
+            ScanUnits::Cm => 10.0,
+            ScanUnits::M => 1000.0,
+            ScanUnits::In => 25.4,
+        }
+    }
+}
+
+impl FromStr for ScanUnits {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "mm" => Ok(ScanUnits::Mm),
+            "cm" => Ok(ScanUnits::Cm),
+            "m" => Ok(ScanUnits::M),
+            "in" | "inch" | "inches" => Ok(ScanUnits::In),
+            other => Err(format!(
+                "unknown scan units '{other}' (expected mm, cm, m or in)"
+            )),
+        }
+    }
+}
+
+impl fmt::Display for ScanUnits {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ScanUnits::Mm => "mm",
+            ScanUnits::Cm => "cm",
+            ScanUnits::M => "m",
+            ScanUnits::In => "in",
+        })
+    }
+}
+
+/// Which axis of the scan file points up (becomes the printer's +Z).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum UpAxis {
+    Z,
+    /// +Y up (glTF's convention): turned +90 deg about X, (x, y, z) -> (x, -z, y).
+    Y,
+}
+
+impl FromStr for UpAxis {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "z" | "+z" => Ok(UpAxis::Z),
+            "y" | "+y" => Ok(UpAxis::Y),
+            other => Err(format!("unknown up axis '{other}' (expected z or y)")),
+        }
+    }
+}
+
+/// The file formats [`import_mesh`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MeshFormat {
+    Obj,
+    Ply,
+    Stl,
+    Gltf,
+    Glb,
+}
+
+impl MeshFormat {
+    /// glTF is metres and +Y up by its specification; the others carry no
+    /// convention and default to mm, +Z up (spec "Inputs").
+    pub fn default_units(self) -> ScanUnits {
+        match self {
+            MeshFormat::Gltf | MeshFormat::Glb => ScanUnits::M,
+            _ => ScanUnits::Mm,
+        }
+    }
+
+    pub fn default_up_axis(self) -> UpAxis {
+        match self {
+            MeshFormat::Gltf | MeshFormat::Glb => UpAxis::Y,
+            _ => UpAxis::Z,
+        }
+    }
+}
+
+/// Options of [`import_mesh`]; `None` means the format's default.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImportOptions {
+    pub units: Option<ScanUnits>,
+    pub up_axis: Option<UpAxis>,
+}
+
+impl ImportOptions {
+    pub const DEFAULT: ImportOptions = ImportOptions {
+        units: None,
+        up_axis: None,
+    };
+}
+
+/// A scan read into millimetres, +Z up, with what was noticed on the way.
+#[derive(Debug, Clone)]
+pub struct ImportedMesh {
+    pub mesh: TriMesh,
+    pub format: MeshFormat,
+    pub units: ScanUnits,
+    pub up_axis: UpAxis,
+    /// Recoverable oddities (degenerate triangles skipped, ...), for the report.
+    pub warnings: Vec<String>,
+}

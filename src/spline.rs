@@ -1,0 +1,1 @@
+//! spline (in progress)
