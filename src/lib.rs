@@ -33,6 +33,7 @@
 pub mod demo;
 mod error;
 pub mod fiducials;
+pub mod gcode;
 pub mod mesh;
 pub mod params;
 pub mod pipeline;

@@ -1,0 +1,1 @@
+//! G-code writer (placeholder: the G-code helper replaces this).

@@ -1,0 +1,6 @@
+//! All integration tests in one binary, a module per area (as parry does).
+mod gcode;
+mod importers;
+mod planning;
+mod registration;
+mod svg;
