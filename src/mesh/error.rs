@@ -18,4 +18,62 @@ pub enum MeshError {
     Invalid { file: String, message: String },
     #[error("{file}: the mesh has no triangles")]
     Empty { file: String },
+    /// A vertex coordinate is NaN or infinite; fix or remove that vertex in
+    /// the scanning software (lyon's `PositionIsNaN`: never plan on it).
+    #[error(
+        "{file}{}: vertex {vertex} has a non-finite coordinate ({value})",
+        line_suffix(*.line)
+    )]
+    NonFiniteVertex {
+        file: String,
+        /// The vertex as the file numbers it (1-based for OBJ, else 0-based).
+        vertex: usize,
+        line: Option<usize>,
+        value: f64,
+    },
+    /// A face refers to a vertex that does not exist.
+    #[error(
+        "{file}{}: face {face} refers to vertex index {index}, but only {vertex_count} vertices are defined",
+        line_suffix(*.line)
+    )]
+    IndexOutOfRange {
+        file: String,
+        /// The face as the file numbers it (0-based; OBJ names its line instead).
+        face: usize,
+        line: Option<usize>,
+        index: i64,
+        vertex_count: usize,
+    },
+    /// glTF buffers outside the file: the core takes bytes and never opens
+    /// other files, so re-export as `.glb` or with embedded (data URI) buffers.
+    #[error(
+        "{file}: buffer {buffer} refers to the external file '{uri}', which is not read; \
+         export a .glb or embed the buffers as data URIs"
+    )]
+    ExternalBuffer {
+        file: String,
+        buffer: usize,
+        uri: String,
+    },
+}
+
+fn line_suffix(line: Option<usize>) -> String {
+    line.map(|l| format!(":{l}")).unwrap_or_default()
+}
+
+impl MeshError {
+    pub(crate) fn invalid(file: &str, message: impl Into<String>) -> Self {
+        MeshError::Invalid {
+            file: file.into(),
+            message: message.into(),
+        }
+    }
+
+    pub(crate) fn syntax(file: &str, line: usize, message: impl Into<String>) -> Self {
+        MeshError::Syntax {
+            file: file.into(),
+            line,
+            message: message.into(),
+        }
+    }
 }

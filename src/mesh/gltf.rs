@@ -1,1 +1,493 @@
-//! placeholder, replaced by the importer
+//! glTF 2.0 (`.gltf` with data-URI buffers, `.glb`): every triangle
+//! primitive the default scene draws, placed by the node hierarchy.
+//!
+//! The `gltf` crate parses and validates the JSON; the accessor bytes are
+//! read here with checked offsets instead of its reader, whose slicing
+//! assumes a well-formed file (a hostile scan must give an error, not a
+//! panic). Buffers come only from the file itself: the core never opens
+//! other files or fetches URIs.
+
+use std::borrow::Cow;
+
+use base64::engine::{general_purpose::GeneralPurpose, DecodePaddingMode, GeneralPurposeConfig};
+use base64::Engine as _;
+use glam::{DMat4, DQuat, DVec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::{Mode, Semantic};
+use gltf::scene::Transform;
+use gltf::{Accessor, Gltf, Mesh, Node};
+
+use super::import::{Parsed, Welder};
+use super::MeshError;
+
+/// Data URIs from some exporters omit the base64 padding.
+const BASE64: GeneralPurpose = GeneralPurpose::new(
+    &base64::alphabet::STANDARD,
+    GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
+);
+
+pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let gltf = Gltf::from_slice(bytes)
+        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
+    let buffers = load_buffers(&gltf, file)?;
+    let mut scene = SceneReader {
+        file,
+        buffers,
+        welder: Welder::default(),
+        triangles: Vec::new(),
+        warnings: Vec::new(),
+        skipped_primitives: 0,
+    };
+    match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(root) => {
+            let mut visited = vec![false; gltf.nodes().len()];
+            let mut stack: Vec<(Node, DMat4)> =
+                root.nodes().map(|n| (n, DMat4::IDENTITY)).collect();
+            while let Some((node, parent)) = stack.pop() {
+                // glTF requires the node hierarchy to be a forest; a node
+                // reached twice is a cycle or a shared child, which would
+                // loop forever or draw the same surface twice.
+                match visited.get_mut(node.index()) {
+                    Some(seen) if !*seen => *seen = true,
+                    _ => {
+                        return Err(MeshError::invalid(
+                            file,
+                            format!(
+                                "node {} is reached twice: the node hierarchy must be a tree",
+                                node.index()
+                            ),
+                        ))
+                    }
+                }
+                let world = parent * local_transform(&node);
+                if let Some(mesh) = node.mesh() {
+                    scene.draw(&mesh, &world)?;
+                }
+                stack.extend(node.children().map(|c| (c, world)));
+            }
+        }
+        None => {
+            for mesh in gltf.meshes() {
+                scene.draw(&mesh, &DMat4::IDENTITY)?;
+            }
+        }
+    }
+    let mut warnings = scene.warnings;
+    if scene.skipped_primitives > 0 {
+        warnings.push(format!(
+            "{file}: skipped {} primitive(s) of points or lines (only triangles describe a surface)",
+            scene.skipped_primitives
+        ));
+    }
+    Ok(Parsed {
+        vertices: scene.welder.vertices,
+        triangles: scene.triangles,
+        warnings,
+    })
+}
+
+fn load_buffers<'a>(gltf: &'a Gltf, file: &str) -> Result<Vec<Cow<'a, [u8]>>, MeshError> {
+    gltf.buffers()
+        .map(|buffer| {
+            let index = buffer.index();
+            let data: Cow<[u8]> = match buffer.source() {
+                gltf::buffer::Source::Bin => Cow::Borrowed(gltf.blob.as_deref().ok_or_else(|| {
+                    MeshError::invalid(
+                        file,
+                        format!("buffer {index} refers to the GLB binary chunk, but there is none"),
+                    )
+                })?),
+                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                    let (_, payload) = uri.split_once(";base64,").ok_or_else(|| {
+                        MeshError::invalid(
+                            file,
+                            format!("buffer {index}: only base64 data URIs are supported"),
+                        )
+                    })?;
+                    Cow::Owned(BASE64.decode(payload).map_err(|e| {
+                        MeshError::invalid(file, format!("buffer {index}: bad base64 data: {e}"))
+                    })?)
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    return Err(MeshError::ExternalBuffer {
+                        file: file.into(),
+                        buffer: index,
+                        uri: uri.into(),
+                    })
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(MeshError::invalid(
+                    file,
+                    format!(
+                        "buffer {index} holds {} bytes but declares byteLength {} (truncated file?)",
+                        data.len(),
+                        buffer.length()
+                    ),
+                ));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+fn local_transform(node: &Node) -> DMat4 {
+    match node.transform() {
+        Transform::Matrix { matrix } => {
+            DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)))
+        }
+        Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let q = DQuat::from_array(rotation.map(f64::from));
+            // The spec requires unit quaternions; exporters round them.
+            let q = if q.length() > 0.0 {
+                q.normalize()
+            } else {
+                DQuat::IDENTITY
+            };
+            DMat4::from_scale_rotation_translation(
+                DVec3::from_array(scale.map(f64::from)),
+                q,
+                DVec3::from_array(translation.map(f64::from)),
+            )
+        }
+    }
+}
+
+/// The bytes of one accessor, bounds-checked once so each element read
+/// afterwards cannot fail.
+struct Elements<'b> {
+    data: &'b [u8],
+    stride: usize,
+    size: usize,
+    count: usize,
+    ty: DataType,
+    normalized: bool,
+}
+
+impl Elements<'_> {
+    fn get(&self, i: usize) -> &[u8] {
+        let start = i.saturating_mul(self.stride);
+        self.data
+            .get(start..start.saturating_add(self.size))
+            .unwrap_or_default()
+    }
+}
+
+struct SceneReader<'f, 'b> {
+    file: &'f str,
+    buffers: Vec<Cow<'b, [u8]>>,
+    welder: Welder,
+    triangles: Vec<[u32; 3]>,
+    warnings: Vec<String>,
+    skipped_primitives: usize,
+}
+
+impl SceneReader<'_, '_> {
+    fn err(&self, message: String) -> MeshError {
+        MeshError::invalid(self.file, message)
+    }
+
+    fn elements(&self, accessor: &Accessor, what: &str) -> Result<Elements<'_>, MeshError> {
+        let index = accessor.index();
+        if accessor.sparse().is_some() {
+            return Err(self.err(format!(
+                "{what} accessor {index} is sparse, which this importer does not read"
+            )));
+        }
+        let view = accessor.view().ok_or_else(|| {
+            self.err(format!(
+                "{what} accessor {index} has no bufferView (no data)"
+            ))
+        })?;
+        let buffer = self
+            .buffers
+            .get(view.buffer().index())
+            .ok_or_else(|| self.err(format!("bufferView {} has no buffer", view.index())))?;
+        let view_bytes = view
+            .offset()
+            .checked_add(view.length())
+            .and_then(|end| buffer.get(view.offset()..end))
+            .ok_or_else(|| {
+                self.err(format!(
+                    "bufferView {} (offset {}, length {}) lies outside buffer {} of {} bytes",
+                    view.index(),
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index(),
+                    buffer.len()
+                ))
+            })?;
+        let ty = accessor.data_type();
+        let size = ty.size() * accessor.dimensions().multiplicity();
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(self.err(format!(
+                "bufferView {} has byteStride {stride}, smaller than one {what} element ({size} bytes)",
+                view.index()
+            )));
+        }
+        let count = accessor.count();
+        // The last element need not be padded to a full stride.
+        let needed = match count {
+            0 => Some(0),
+            n => (n - 1)
+                .checked_mul(stride)
+                .and_then(|b| b.checked_add(size))
+                .and_then(|b| b.checked_add(accessor.offset())),
+        };
+        let data = needed
+            .filter(|&n| n <= view_bytes.len())
+            .and_then(|_| view_bytes.get(accessor.offset()..))
+            .ok_or_else(|| {
+                self.err(format!(
+                    "{what} accessor {index} declares {count} elements, more than the {} bytes \
+                     of bufferView {} hold (wrong count or truncated buffer?)",
+                    view_bytes.len(),
+                    view.index()
+                ))
+            })?;
+        Ok(Elements {
+            data,
+            stride,
+            size,
+            count,
+            ty,
+            normalized: accessor.normalized(),
+        })
+    }
+
+    fn draw(&mut self, mesh: &Mesh, world: &DMat4) -> Result<(), MeshError> {
+        for primitive in mesh.primitives() {
+            let at = format!("mesh {} primitive {}", mesh.index(), primitive.index());
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.skipped_primitives += 1;
+                continue;
+            }
+            let Some(accessor) = primitive.get(&Semantic::Positions) else {
+                self.warnings.push(format!(
+                    "{}: {at} has no POSITION attribute and was skipped",
+                    self.file
+                ));
+                continue;
+            };
+            let corners = self.positions(&accessor, world, &at)?;
+            let indices = match primitive.indices() {
+                Some(accessor) => self.indices(&accessor, corners.len(), &at)?,
+                None => (0..corners.len()).collect(),
+            };
+            let n = indices.len();
+            let mut local: Vec<[usize; 3]> = match mode {
+                Mode::TriangleStrip => (0..n.saturating_sub(2))
+                    // Every other strip triangle is reversed to keep the
+                    // winding (glTF spec 3.7.2.1).
+                    .map(|i| {
+                        if i % 2 == 0 {
+                            [i, i + 1, i + 2]
+                        } else {
+                            [i + 1, i, i + 2]
+                        }
+                    })
+                    .collect(),
+                Mode::TriangleFan => (1..n.saturating_sub(1)).map(|i| [0, i, i + 1]).collect(),
+                _ => {
+                    if n % 3 != 0 {
+                        self.warnings.push(format!(
+                            "{}: {at} has {n} indices, not a multiple of 3; the last {} ignored",
+                            self.file,
+                            n % 3
+                        ));
+                    }
+                    (0..n / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect()
+                }
+            };
+            // A mirroring transform turns counter-clockwise faces clockwise
+            // (glTF spec 3.5.2): swap to keep outward normals.
+            if world.determinant() < 0.0 {
+                local.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            self.triangles.extend(local.into_iter().filter_map(|t| {
+                let [a, b, c] = t.map(|k| indices.get(k).and_then(|&i| corners.get(i)));
+                Some([*a?, *b?, *c?])
+            }));
+        }
+        Ok(())
+    }
+
+    /// POSITION values placed in the scene and welded; element `i` becomes
+    /// vertex `result[i]`.
+    fn positions(
+        &mut self,
+        accessor: &Accessor,
+        world: &DMat4,
+        at: &str,
+    ) -> Result<Vec<u32>, MeshError> {
+        let e = self.elements(accessor, "POSITION")?;
+        if accessor.dimensions() != Dimensions::Vec3 {
+            return Err(self.err(format!(
+                "{at}: POSITION accessor {} is not VEC3",
+                accessor.index()
+            )));
+        }
+        let points: Vec<DVec3> = (0..e.count)
+            .map(|i| {
+                let b = e.get(i);
+                let c = e.ty.size();
+                DVec3::new(
+                    component(b, 0, e.ty, e.normalized),
+                    component(b, c, e.ty, e.normalized),
+                    component(b, 2 * c, e.ty, e.normalized),
+                )
+            })
+            .collect();
+        let mut out = Vec::with_capacity(points.len());
+        for (i, p) in points.into_iter().enumerate() {
+            let placed = world.transform_point3(p);
+            if !p.is_finite() || !placed.is_finite() {
+                return Err(self.err(format!(
+                    "{at}: POSITION element {i} has a non-finite coordinate ({p} in the file, \
+                     {placed} after node transforms)"
+                )));
+            }
+            let v = self
+                .welder
+                .index(placed)
+                .ok_or_else(|| self.err("more than 2^32 distinct vertices".into()))?;
+            out.push(v);
+        }
+        Ok(out)
+    }
+
+    fn indices(
+        &self,
+        accessor: &Accessor,
+        vertex_count: usize,
+        at: &str,
+    ) -> Result<Vec<usize>, MeshError> {
+        let e = self.elements(accessor, "index")?;
+        if accessor.dimensions() != Dimensions::Scalar
+            || !matches!(e.ty, DataType::U8 | DataType::U16 | DataType::U32)
+        {
+            return Err(self.err(format!(
+                "{at}: index accessor {} must be unsigned byte, short or int scalars",
+                accessor.index()
+            )));
+        }
+        (0..e.count)
+            .map(|i| {
+                let index = component(e.get(i), 0, e.ty, false) as usize;
+                if index < vertex_count {
+                    Ok(index)
+                } else {
+                    Err(self.err(format!(
+                        "{at}: index {i} refers to vertex {index}, but POSITION has {vertex_count} elements"
+                    )))
+                }
+            })
+            .collect()
+    }
+}
+
+/// One component at byte `at` of an element, as the value it stands for:
+/// KHR_mesh_quantization allows integer positions, normalized or not.
+fn component(element: &[u8], at: usize, ty: DataType, normalized: bool) -> f64 {
+    fn take<const N: usize>(b: &[u8], at: usize) -> [u8; N] {
+        b.get(at..at + N)
+            .and_then(|s| s.try_into().ok())
+            .unwrap_or([0; N])
+    }
+    let (raw, max) = match ty {
+        DataType::I8 => (f64::from(i8::from_le_bytes(take(element, at))), 127.0),
+        DataType::U8 => (f64::from(u8::from_le_bytes(take(element, at))), 255.0),
+        DataType::I16 => (f64::from(i16::from_le_bytes(take(element, at))), 32767.0),
+        DataType::U16 => (f64::from(u16::from_le_bytes(take(element, at))), 65535.0),
+        DataType::U32 => (
+            f64::from(u32::from_le_bytes(take(element, at))),
+            4294967295.0,
+        ),
+        DataType::F32 => return f64::from(f32::from_le_bytes(take(element, at))),
+    };
+    if normalized {
+        (raw / max).max(-1.0)
+    } else {
+        raw
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use base64::engine::general_purpose::STANDARD;
+
+    fn triangle_gltf(extra_node: &str, uri: &str) -> String {
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0{extra_node}}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                "min":[0,0,0],"max":[1,1,0]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
+        )
+    }
+
+    fn triangle_uri() -> String {
+        let bytes: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        format!(
+            "data:application/octet-stream;base64,{}",
+            STANDARD.encode(bytes)
+        )
+    }
+
+    #[test]
+    fn reads_a_data_uri_triangle() {
+        let p = parse(triangle_gltf("", &triangle_uri()).as_bytes(), "t.gltf").unwrap();
+        assert_eq!(p.vertices.len(), 3);
+        assert_eq!(p.triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn mirrored_nodes_keep_the_winding() {
+        let json = triangle_gltf(r#","scale":[-1,1,1]"#, &triangle_uri());
+        let p = parse(json.as_bytes(), "t.gltf").unwrap();
+        assert_eq!(p.triangles, vec![[0, 2, 1]]);
+        assert_eq!(p.vertices[1], DVec3::new(-1.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn external_buffers_are_named() {
+        let e = parse(triangle_gltf("", "scan.bin").as_bytes(), "t.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'scan.bin'"), "{e}");
+    }
+
+    #[test]
+    fn short_buffers_are_rejected() {
+        let uri = "data:application/octet-stream;base64,AAAA";
+        let e = parse(triangle_gltf("", uri).as_bytes(), "t.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("holds 3 bytes but declares byteLength 36"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn normalized_components() {
+        assert_eq!(component(&[255], 0, DataType::U8, true), 1.0);
+        assert_eq!(component(&[0x80], 0, DataType::I8, true), -1.0);
+        assert_eq!(component(&[0, 1], 0, DataType::U16, false), 256.0);
+    }
+}

@@ -1,16 +1,337 @@
-//! Format detection and the shared import steps (placeholder until the
-//! importers land).
-use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat};
+//! Format detection and the import steps every format shares: validation,
+//! degenerate-triangle removal, units and up axis (spec "Inputs").
 
-pub fn detect_format(_bytes: &[u8], _file: &str) -> Option<MeshFormat> {
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+use glam::DVec3;
+
+use super::{gltf, obj, ply, stl};
+use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, TriMesh, UpAxis};
+
+/// What a format parser hands to the shared steps: positions in the file's
+/// own units and axes, indices already resolved to 0-based.
+#[derive(Debug, Default)]
+pub(super) struct Parsed {
+    pub vertices: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub warnings: Vec<String>,
+}
+
+/// Guesses the format: the file name's extension first, then the content.
+///
+/// `file` is only a display name; nothing is opened.
+pub fn detect_format(bytes: &[u8], file: &str) -> Option<MeshFormat> {
+    from_extension(file).or_else(|| sniff(bytes))
+}
+
+fn from_extension(file: &str) -> Option<MeshFormat> {
+    let (_, ext) = file.rsplit_once('.')?;
+    match ext.to_ascii_lowercase().as_str() {
+        "obj" => Some(MeshFormat::Obj),
+        "ply" => Some(MeshFormat::Ply),
+        "stl" => Some(MeshFormat::Stl),
+        "gltf" => Some(MeshFormat::Gltf),
+        "glb" => Some(MeshFormat::Glb),
+        _ => None,
+    }
+}
+
+fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
+    if bytes.starts_with(b"glTF") {
+        return Some(MeshFormat::Glb);
+    }
+    // Binary STL has no magic; its exact size is the best evidence, checked
+    // before the text forms because its free header may say "solid".
+    if stl::is_binary_size(bytes) {
+        return Some(MeshFormat::Stl);
+    }
+    let text = skip_bom_and_space(bytes);
+    if text.starts_with(b"ply\n") || text.starts_with(b"ply\r\n") {
+        return Some(MeshFormat::Ply);
+    }
+    if text.starts_with(b"solid") {
+        return Some(MeshFormat::Stl);
+    }
+    if text.starts_with(b"{") {
+        let head = &text[..text.len().min(1 << 16)];
+        return head
+            .windows(7)
+            .any(|w| w == b"\"asset\"")
+            .then_some(MeshFormat::Gltf);
+    }
+    if looks_like_obj(text) {
+        return Some(MeshFormat::Obj);
+    }
     None
 }
 
+fn skip_bom_and_space(bytes: &[u8]) -> &[u8] {
+    let b = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let start = b
+        .iter()
+        .position(|c| !c.is_ascii_whitespace())
+        .unwrap_or(b.len());
+    &b[start..]
+}
+
+/// The first statements (up to 64 lines) are all OBJ keywords or comments,
+/// and at least one is a vertex or face.
+fn looks_like_obj(text: &[u8]) -> bool {
+    const KEYWORDS: &[&[u8]] = &[
+        b"v", b"vt", b"vn", b"vp", b"f", b"o", b"g", b"s", b"l", b"p", b"usemtl", b"mtllib",
+    ];
+    let mut saw_geometry = false;
+    for line in text.split(|&c| c == b'\n').take(64) {
+        let line = line.trim_ascii();
+        if line.is_empty() || line.starts_with(b"#") {
+            continue;
+        }
+        let word = line
+            .split(|c| c.is_ascii_whitespace())
+            .next()
+            .unwrap_or_default();
+        if !KEYWORDS.contains(&word) {
+            return false;
+        }
+        saw_geometry |= word == b"v" || word == b"f";
+    }
+    saw_geometry
+}
+
+/// Reads a scan from bytes into millimetres, +Z up.
+///
+/// `file` names the scan in messages and selects the format by extension
+/// (content sniffing otherwise). Units and up axis default to the format's
+/// convention ([`MeshFormat::default_units`]); degenerate triangles are
+/// dropped with a warning, everything else wrong is an error.
 pub fn import_mesh(
     bytes: &[u8],
     file: &str,
-    _options: &ImportOptions,
+    options: &ImportOptions,
 ) -> Result<ImportedMesh, MeshError> {
-    let _ = bytes;
-    Err(MeshError::UnknownFormat { file: file.into() })
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(MeshError::invalid(file, "the file is empty"));
+    }
+    let format =
+        detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
+    let parsed = match format {
+        MeshFormat::Obj => obj::parse(bytes, file)?,
+        MeshFormat::Ply => ply::parse(bytes, file)?,
+        MeshFormat::Stl => stl::parse(bytes, file)?,
+        MeshFormat::Gltf | MeshFormat::Glb => gltf::parse(bytes, file)?,
+    };
+    let units = options.units.unwrap_or(format.default_units());
+    let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
+    let (mesh, warnings) = finish(parsed, file, units.to_mm(), up_axis)?;
+    Ok(ImportedMesh {
+        mesh,
+        format,
+        units,
+        up_axis,
+        warnings,
+    })
+}
+
+/// The shared steps after parsing. Parsers already report bad values with
+/// their line or element; these checks are the backstop that guarantees the
+/// invariants downstream stages rely on (finite, in range, non-degenerate).
+fn finish(
+    parsed: Parsed,
+    file: &str,
+    scale: f64,
+    up_axis: UpAxis,
+) -> Result<(TriMesh, Vec<String>), MeshError> {
+    let Parsed {
+        mut vertices,
+        triangles,
+        mut warnings,
+    } = parsed;
+    if let Some((vertex, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        let value = v.to_array().into_iter().find(|c| !c.is_finite());
+        return Err(MeshError::NonFiniteVertex {
+            file: file.into(),
+            vertex,
+            line: None,
+            value: value.unwrap_or(f64::NAN),
+        });
+    }
+    let n = vertices.len();
+    let mut kept = Vec::with_capacity(triangles.len());
+    let mut degenerate = 0usize;
+    for (face, tri) in triangles.into_iter().enumerate() {
+        if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
+            return Err(MeshError::IndexOutOfRange {
+                file: file.into(),
+                face,
+                line: None,
+                index: i64::from(bad),
+                vertex_count: n,
+            });
+        }
+        let [a, b, c] = tri.map(|i| vertices[i as usize]);
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c) {
+            degenerate += 1;
+        } else {
+            kept.push(tri);
+        }
+    }
+    if degenerate > 0 {
+        warnings.push(format!(
+            "{file}: skipped {degenerate} degenerate triangle(s) (repeated vertex or zero area)"
+        ));
+    }
+    if kept.is_empty() {
+        return Err(MeshError::Empty { file: file.into() });
+    }
+    for v in &mut vertices {
+        let p = *v * scale;
+        *v = match up_axis {
+            UpAxis::Z => p,
+            // +90 deg about X takes the file's +Y to the printer's +Z.
+            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+        };
+    }
+    Ok((
+        TriMesh {
+            vertices,
+            triangles: kept,
+        },
+        warnings,
+    ))
+}
+
+/// Zero area relative to the triangle's size: the sine of its largest angle
+/// vanishes to round-off, so scaling the scan never changes the verdict.
+fn zero_area(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let (ab, ac, bc) = (b - a, c - a, c - b);
+    let longest = ab
+        .length_squared()
+        .max(ac.length_squared())
+        .max(bc.length_squared());
+    ab.cross(ac).length() <= 1e-12 * longest
+}
+
+/// FxHash (rustc's hasher): welding hashes millions of positions, and the
+/// keys are not attacker-chosen collisions we need SipHash against.
+#[derive(Default)]
+struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, n: usize) {
+        self.write_u64(n as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// Merges bit-identical positions into one vertex. STL stores each facet's
+/// corners separately and glTF exporters split vertices at normal/UV seams;
+/// unwelded, every edge would look like a boundary to the fiducial detector.
+#[derive(Default)]
+pub(super) struct Welder {
+    map: HashMap<[u64; 3], u32, BuildHasherDefault<FxHasher>>,
+    pub vertices: Vec<DVec3>,
+}
+
+impl Welder {
+    pub fn with_capacity(n: usize) -> Self {
+        Welder {
+            map: HashMap::with_capacity_and_hasher(n, Default::default()),
+            vertices: Vec::with_capacity(n),
+        }
+    }
+
+    /// The index of `p`, `None` once more than `u32::MAX` vertices exist.
+    pub fn index(&mut self, p: DVec3) -> Option<u32> {
+        // +0.0 makes -0.0 and 0.0 the same key: the same point in space.
+        let key = (p + DVec3::ZERO).to_array().map(f64::to_bits);
+        if let Some(&i) = self.map.get(&key) {
+            return Some(i);
+        }
+        let i = u32::try_from(self.vertices.len()).ok()?;
+        self.vertices.push(p);
+        self.map.insert(key, i);
+        Some(i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extension_wins_over_content() {
+        assert_eq!(detect_format(b"solid x", "a.OBJ"), Some(MeshFormat::Obj));
+        assert_eq!(detect_format(b"", "scan.glb"), Some(MeshFormat::Glb));
+    }
+
+    #[test]
+    fn sniffs_each_format() {
+        assert_eq!(detect_format(b"glTF\x02\0\0\0", "x"), Some(MeshFormat::Glb));
+        assert_eq!(
+            detect_format(b" {\"asset\":{\"version\":\"2.0\"}}", "x"),
+            Some(MeshFormat::Gltf)
+        );
+        assert_eq!(
+            detect_format(b"ply\nformat ascii 1.0\n", "x"),
+            Some(MeshFormat::Ply)
+        );
+        assert_eq!(
+            detect_format(b"solid a\nendsolid a\n", "x"),
+            Some(MeshFormat::Stl)
+        );
+        assert_eq!(
+            detect_format(b"# scan\nmtllib a.mtl\nv 0 0 0\n", "x"),
+            Some(MeshFormat::Obj)
+        );
+        let mut binary = vec![0u8; 84 + 50];
+        binary[80] = 1;
+        assert_eq!(detect_format(&binary, "x"), Some(MeshFormat::Stl));
+        assert_eq!(detect_format(b"hello world", "x"), None);
+        assert_eq!(detect_format(b"{\"a\":1}", "x"), None);
+    }
+
+    #[test]
+    fn degenerate_triangles_are_counted_in_one_warning() {
+        let parsed = Parsed {
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(2.0, 0.0, 0.0)],
+            triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
+            warnings: vec![],
+        };
+        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z).unwrap();
+        assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        assert_eq!(warnings.len(), 1);
+        assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
+    }
+
+    #[test]
+    fn up_axis_y_turns_y_into_z() {
+        let parsed = Parsed {
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            triangles: vec![[0, 1, 2]],
+            warnings: vec![],
+        };
+        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
+        assert_eq!(mesh.vertices[2], DVec3::new(0.0, 0.0, 2.0));
+    }
+
+    #[test]
+    fn welder_merges_signed_zeros() {
+        let mut w = Welder::default();
+        assert_eq!(w.index(DVec3::new(0.0, 1.0, 2.0)), Some(0));
+        assert_eq!(w.index(DVec3::new(-0.0, 1.0, 2.0)), Some(0));
+        assert_eq!(w.index(DVec3::new(0.0, 1.0, 3.0)), Some(1));
+    }
 }

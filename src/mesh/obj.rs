@@ -1,1 +1,275 @@
-//! placeholder, replaced by the importer
+//! Wavefront OBJ: `v` and `f` statements only; everything else (texture
+//! coordinates, normals, groups, materials, lines) says nothing about the
+//! surface the nozzle follows and is skipped.
+//!
+//! Byte-level on purpose: scans run to millions of triangles, so no line is
+//! copied into a `String` and numbers are parsed from borrowed slices.
+
+use glam::DVec3;
+
+use super::import::Parsed;
+use super::MeshError;
+
+pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let mut vertices: Vec<DVec3> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut polygon: Vec<u32> = Vec::with_capacity(8);
+    let mut faces = 0usize;
+    let mut line_no = 0usize;
+    let mut rest = bytes;
+    while !rest.is_empty() {
+        line_no += 1;
+        let (line, next) = match rest.iter().position(|&c| c == b'\n') {
+            Some(i) => rest.split_at(i + 1),
+            None => (rest, &[][..]),
+        };
+        rest = next;
+        let mut cur = Cursor { line, pos: 0 };
+        cur.skip_space();
+        match (cur.peek(0), cur.peek(1)) {
+            (Some(b'v'), Some(c)) if is_space(c) => {
+                cur.pos += 1;
+                let mut xyz = [0.0f64; 3];
+                for (axis, slot) in xyz.iter_mut().enumerate() {
+                    let token = cur.token().ok_or_else(|| {
+                        MeshError::syntax(
+                            file,
+                            line_no,
+                            format!("vertex has {axis} coordinate(s), needs x y z"),
+                        )
+                    })?;
+                    *slot = parse_f64(token).ok_or_else(|| {
+                        MeshError::syntax(
+                            file,
+                            line_no,
+                            format!("'{}' is not a number", String::from_utf8_lossy(token)),
+                        )
+                    })?;
+                }
+                // Extra values (w, or the vertex colours some scanners
+                // append) carry no geometry.
+                let v = DVec3::from_array(xyz);
+                if !v.is_finite() {
+                    return Err(MeshError::NonFiniteVertex {
+                        file: file.into(),
+                        vertex: vertices.len() + 1,
+                        line: Some(line_no),
+                        value: xyz.into_iter().find(|c| !c.is_finite()).unwrap_or(f64::NAN),
+                    });
+                }
+                vertices.push(v);
+            }
+            (Some(b'f'), Some(c)) if is_space(c) => {
+                cur.pos += 1;
+                polygon.clear();
+                while let Some(token) = cur.token() {
+                    let index = resolve(token, vertices.len()).map_err(|e| match e {
+                        IndexError::Syntax(message) => MeshError::syntax(file, line_no, message),
+                        IndexError::Range(index) => MeshError::IndexOutOfRange {
+                            file: file.into(),
+                            face: faces,
+                            line: Some(line_no),
+                            index,
+                            vertex_count: vertices.len(),
+                        },
+                    })?;
+                    polygon.push(index);
+                }
+                if polygon.len() < 3 {
+                    return Err(MeshError::syntax(
+                        file,
+                        line_no,
+                        format!("face has {} vertices, needs at least 3", polygon.len()),
+                    ));
+                }
+                // Fan triangulation: scanner polygons are small and convex.
+                for pair in polygon.windows(2).skip(1) {
+                    triangles.push([polygon[0], pair[0], pair[1]]);
+                }
+                faces += 1;
+            }
+            _ => {}
+        }
+    }
+    Ok(Parsed {
+        vertices,
+        triangles,
+        warnings: Vec::new(),
+    })
+}
+
+enum IndexError {
+    Syntax(String),
+    Range(i64),
+}
+
+/// A face corner `v`, `v/vt`, `v/vt/vn` or `v//vn` to a 0-based vertex index.
+/// Negative indices count back from the last vertex defined so far.
+fn resolve(token: &[u8], defined: usize) -> Result<u32, IndexError> {
+    let head = token.split(|&c| c == b'/').next().unwrap_or_default();
+    let index = parse_i64(head).ok_or_else(|| {
+        IndexError::Syntax(format!(
+            "'{}' is not a vertex index",
+            String::from_utf8_lossy(token)
+        ))
+    })?;
+    let resolved = match index {
+        0 => {
+            return Err(IndexError::Syntax(
+                "vertex index 0 is invalid (OBJ counts vertices from 1)".into(),
+            ))
+        }
+        i if i > 0 => i - 1,
+        i => i64::try_from(defined).unwrap_or(i64::MAX).saturating_add(i),
+    };
+    // OBJ refers to vertices defined before the face; forward references
+    // are rejected like other readers do.
+    if resolved < 0 || resolved >= i64::try_from(defined).unwrap_or(i64::MAX) {
+        return Err(IndexError::Range(index));
+    }
+    u32::try_from(resolved).map_err(|_| IndexError::Range(index))
+}
+
+fn is_space(c: u8) -> bool {
+    matches!(c, b' ' | b'\t' | b'\r' | b'\n' | b'\x0c' | b'\x0b')
+}
+
+struct Cursor<'a> {
+    line: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn peek(&self, ahead: usize) -> Option<u8> {
+        self.line.get(self.pos + ahead).copied()
+    }
+
+    fn skip_space(&mut self) {
+        while self.peek(0).is_some_and(is_space) {
+            self.pos += 1;
+        }
+    }
+
+    /// The next whitespace-separated token; `None` at the end of the line
+    /// or at a trailing comment.
+    fn token(&mut self) -> Option<&'a [u8]> {
+        self.skip_space();
+        let start = self.pos;
+        if self.peek(0).is_none_or(|c| c == b'#') {
+            return None;
+        }
+        while self.peek(0).is_some_and(|c| !is_space(c)) {
+            self.pos += 1;
+        }
+        self.line.get(start..self.pos)
+    }
+}
+
+pub(super) fn parse_f64(token: &[u8]) -> Option<f64> {
+    std::str::from_utf8(token).ok()?.parse().ok()
+}
+
+/// A signed decimal integer, `None` on anything else or overflow.
+pub(super) fn parse_i64(token: &[u8]) -> Option<i64> {
+    let (negative, digits) = match token {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        _ => (false, token),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut value: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        value = value.checked_mul(10)?.checked_add(i64::from(d - b'0'))?;
+    }
+    Some(if negative { -value } else { value })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_str(s: &str) -> Result<Parsed, MeshError> {
+        parse(s.as_bytes(), "t.obj")
+    }
+
+    #[test]
+    fn faces_in_every_corner_form() {
+        let p = parse_str(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n\
+             f 1/1/1 2/1/1 3/1/1\nf 1//1 3//1 4//1\nf 1/1 2/1 3/1\n",
+        )
+        .unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+    }
+
+    #[test]
+    fn negative_indices_count_back_from_the_last_vertex() {
+        let p = parse_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\nv 0 1 0\nf -4 -2 -1\n").unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn quads_and_pentagons_are_fanned() {
+        let p = parse_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 1 0\nf 1 2 3 4 5 # pentagon\n")
+            .unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+    }
+
+    #[test]
+    fn other_statements_are_ignored() {
+        let p = parse_str(
+            "mtllib a.mtl\no thing\ng grp\nusemtl red\ns 1\n\tv 0 0 0 1\r\nv 1 0 0\r\n\
+             v 0 1 0 0.5 0.5 0.5\nl 1 2\nvp 0.1\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(p.vertices.len(), 3);
+        assert_eq!(p.triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = parse_str("v 0 0 0\nv 1 0\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.obj:2:") && e.contains("needs x y z"),
+            "{e}"
+        );
+        let e = parse_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 5\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:4:") && e.contains("vertex index 5"),
+            "{e}"
+        );
+        let e = parse_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 2 3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("vertex index -4"), "{e}");
+        let e = parse_str("v 0 0 0\nf 0 1 1\n").unwrap_err().to_string();
+        assert!(e.contains("index 0 is invalid"), "{e}");
+        let e = parse_str("v 0 nan 0\n").unwrap_err().to_string();
+        assert!(e.starts_with("t.obj:1:") && e.contains("non-finite"), "{e}");
+        let e = parse_str("v 0 0 0\nv 1 x 0\n").unwrap_err().to_string();
+        assert!(e.contains("'x' is not a number"), "{e}");
+        let e = parse_str("v 0 0 0\nf 1 1\n").unwrap_err().to_string();
+        assert!(e.contains("needs at least 3"), "{e}");
+        let e = parse_str("v 0 0 0\nf 1 a 1\n").unwrap_err().to_string();
+        assert!(e.contains("not a vertex index"), "{e}");
+        let e = parse_str("v 0 0 0\nf 99999999999999999999 1 1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a vertex index"), "{e}");
+    }
+
+    #[test]
+    fn integers() {
+        assert_eq!(parse_i64(b"-12"), Some(-12));
+        assert_eq!(parse_i64(b"+7"), Some(7));
+        assert_eq!(parse_i64(b"-"), None);
+        assert_eq!(parse_i64(b"1.5"), None);
+    }
+}

@@ -1,1 +1,684 @@
-//! placeholder, replaced by the importer
+//! Stanford PLY: ascii, binary_little_endian and binary_big_endian.
+//!
+//! Only `vertex` x/y/z and the `face` index list are read; every other
+//! property and element (normals, colours, confidence, range grids, edges) is
+//! skipped by its declared type, so scanner-specific extras never stop an
+//! import. Declared counts are checked against the bytes that follow the
+//! header before anything is allocated from them.
+
+use glam::DVec3;
+
+use super::import::Parsed;
+use super::obj::{parse_f64, parse_i64};
+use super::MeshError;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn from_name(name: &str) -> Option<Scalar> {
+        Some(match name {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    fn is_float(self) -> bool {
+        matches!(self, Scalar::F32 | Scalar::F64)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    Scalar(Scalar),
+    List { count: Scalar, item: Scalar },
+}
+
+#[derive(Debug)]
+struct Property {
+    name: String,
+    kind: Kind,
+}
+
+#[derive(Debug)]
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<Property>,
+    /// Header line declaring the element, for messages.
+    line: usize,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Encoding {
+    Ascii,
+    Binary { big_endian: bool },
+}
+
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    /// Lines in the header, so ascii body lines can be numbered.
+    lines: usize,
+    body_start: usize,
+}
+
+pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let header = parse_header(bytes, file)?;
+    let body = bytes.get(header.body_start..).unwrap_or_default();
+    let vertex_count = header
+        .elements
+        .iter()
+        .find(|e| e.name == "vertex")
+        .map_or(0, |e| e.count);
+    let mut out = Body {
+        file,
+        vertex_count,
+        vertices: Vec::new(),
+        triangles: Vec::new(),
+        short_faces: 0,
+    };
+    match header.encoding {
+        Encoding::Ascii => out.read_ascii(&header, body)?,
+        Encoding::Binary { big_endian } => out.read_binary(&header, body, big_endian)?,
+    }
+    let mut warnings = Vec::new();
+    if out.short_faces > 0 {
+        warnings.push(format!(
+            "{file}: skipped {} face(s) with fewer than 3 vertices",
+            out.short_faces
+        ));
+    }
+    Ok(Parsed {
+        vertices: out.vertices,
+        triangles: out.triangles,
+        warnings,
+    })
+}
+
+fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
+    let mut pos = 0usize;
+    let mut line_no = 0usize;
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    loop {
+        let rest = bytes.get(pos..).unwrap_or_default();
+        let Some(end) = rest.iter().position(|&c| c == b'\n') else {
+            return Err(MeshError::invalid(
+                file,
+                "PLY header has no 'end_header' line (truncated file?)",
+            ));
+        };
+        line_no += 1;
+        let raw = rest.get(..end).unwrap_or_default();
+        pos += end + 1;
+        let text = std::str::from_utf8(raw)
+            .map_err(|_| MeshError::syntax(file, line_no, "PLY header line is not text"))?;
+        let mut words = text.split_ascii_whitespace();
+        let keyword = words.next().unwrap_or_default();
+        let bad = |message: String| MeshError::syntax(file, line_no, message);
+        if line_no == 1 {
+            if keyword != "ply" {
+                return Err(bad("not a PLY file (first line must be 'ply')".into()));
+            }
+            continue;
+        }
+        match keyword {
+            "format" => {
+                encoding = Some(match words.next() {
+                    Some("ascii") => Encoding::Ascii,
+                    Some("binary_little_endian") => Encoding::Binary { big_endian: false },
+                    Some("binary_big_endian") => Encoding::Binary { big_endian: true },
+                    other => {
+                        return Err(bad(format!(
+                            "unknown PLY format '{}'",
+                            other.unwrap_or_default()
+                        )))
+                    }
+                });
+            }
+            "element" => {
+                let name = words.next().unwrap_or_default();
+                let count = words
+                    .next()
+                    .and_then(|c| c.parse::<u64>().ok())
+                    .ok_or_else(|| bad(format!("element '{name}' needs a count")))?;
+                elements.push(Element {
+                    name: name.into(),
+                    count,
+                    props: Vec::new(),
+                    line: line_no,
+                });
+            }
+            "property" => {
+                let element = elements
+                    .last_mut()
+                    .ok_or_else(|| bad("property before any element".into()))?;
+                let ty = words.next().unwrap_or_default();
+                let scalar = |name: &str| {
+                    Scalar::from_name(name)
+                        .ok_or_else(|| bad(format!("unknown property type '{name}'")))
+                };
+                let kind = if ty == "list" {
+                    let count = scalar(words.next().unwrap_or_default())?;
+                    let item = scalar(words.next().unwrap_or_default())?;
+                    if count.is_float() {
+                        return Err(bad("a list count must have an integer type".into()));
+                    }
+                    Kind::List { count, item }
+                } else {
+                    Kind::Scalar(scalar(ty)?)
+                };
+                let name = words
+                    .next()
+                    .ok_or_else(|| bad("property needs a name".into()))?;
+                element.props.push(Property {
+                    name: name.into(),
+                    kind,
+                });
+            }
+            "end_header" => break,
+            // comment, obj_info and blank lines carry no geometry.
+            _ => {}
+        }
+    }
+    let encoding =
+        encoding.ok_or_else(|| MeshError::invalid(file, "PLY header has no 'format' line"))?;
+    Ok(Header {
+        encoding,
+        elements,
+        lines: line_no,
+        body_start: pos,
+    })
+}
+
+/// What the reader does with each property of an element.
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    Skip,
+    Axis(usize),
+    FaceIndices,
+}
+
+fn roles(element: &Element, file: &str) -> Result<Vec<Role>, MeshError> {
+    let roles: Vec<Role> = element
+        .props
+        .iter()
+        .map(|p| match (element.name.as_str(), p.name.as_str(), p.kind) {
+            ("vertex", "x", Kind::Scalar(_)) => Role::Axis(0),
+            ("vertex", "y", Kind::Scalar(_)) => Role::Axis(1),
+            ("vertex", "z", Kind::Scalar(_)) => Role::Axis(2),
+            ("face", "vertex_indices" | "vertex_index", Kind::List { .. }) => Role::FaceIndices,
+            _ => Role::Skip,
+        })
+        .collect();
+    if element.name == "vertex" {
+        for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+            if !roles.contains(&Role::Axis(axis)) {
+                return Err(MeshError::Syntax {
+                    file: file.into(),
+                    line: element.line,
+                    message: format!("element 'vertex' has no scalar property '{name}'"),
+                });
+            }
+        }
+    }
+    if element.name == "face" && element.count > 0 && !roles.contains(&Role::FaceIndices) {
+        return Err(MeshError::Syntax {
+            file: file.into(),
+            line: element.line,
+            message: "element 'face' has no list property 'vertex_indices'".into(),
+        });
+    }
+    Ok(roles)
+}
+
+/// Checks a declared element count against the bytes left, so a header that
+/// claims billions of elements fails here instead of in the allocator.
+fn check_count(
+    file: &str,
+    element: &Element,
+    min_element_bytes: usize,
+    available: usize,
+    what: &str,
+) -> Result<usize, MeshError> {
+    let needed = element.count.checked_mul(min_element_bytes as u64);
+    match (needed, usize::try_from(element.count)) {
+        (Some(needed), Ok(count)) if needed <= available as u64 => Ok(count),
+        _ => Err(MeshError::invalid(
+            file,
+            format!(
+                "PLY header declares {} '{}' elements, which need at least {} bytes of {what}, \
+                 but only {available} bytes follow (truncated file or wrong count?)",
+                element.count,
+                element.name,
+                needed.map_or_else(|| "more than 2^64".to_string(), |n| n.to_string()),
+            ),
+        )),
+    }
+}
+
+struct Body<'f> {
+    file: &'f str,
+    vertex_count: u64,
+    vertices: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    short_faces: usize,
+}
+
+impl Body<'_> {
+    fn index(&self, face: usize, value: i64, line: Option<usize>) -> Result<u32, MeshError> {
+        match u32::try_from(value) {
+            Ok(i) if u64::from(i) < self.vertex_count => Ok(i),
+            _ => Err(MeshError::IndexOutOfRange {
+                file: self.file.into(),
+                face,
+                line,
+                index: value,
+                vertex_count: usize::try_from(self.vertex_count).unwrap_or(usize::MAX),
+            }),
+        }
+    }
+
+    fn push_vertex(&mut self, xyz: [f64; 3], line: Option<usize>) -> Result<(), MeshError> {
+        let v = DVec3::from_array(xyz);
+        if !v.is_finite() {
+            return Err(MeshError::NonFiniteVertex {
+                file: self.file.into(),
+                vertex: self.vertices.len(),
+                line,
+                value: xyz.into_iter().find(|c| !c.is_finite()).unwrap_or(f64::NAN),
+            });
+        }
+        self.vertices.push(v);
+        Ok(())
+    }
+
+    /// Fan triangulation of a face polygon (scanner faces are convex).
+    fn push_polygon(&mut self, polygon: &[u32]) {
+        match polygon {
+            [first, rest @ ..] if rest.len() >= 2 => {
+                for pair in rest.windows(2) {
+                    self.triangles.push([*first, pair[0], pair[1]]);
+                }
+            }
+            _ => self.short_faces += 1,
+        }
+    }
+
+    fn read_binary(
+        &mut self,
+        header: &Header,
+        body: &[u8],
+        big_endian: bool,
+    ) -> Result<(), MeshError> {
+        let file = self.file;
+        let mut r = BinReader {
+            bytes: body,
+            pos: 0,
+            big_endian,
+        };
+        let mut polygon = Vec::new();
+        for element in &header.elements {
+            let roles = roles(element, file)?;
+            if element.props.is_empty() {
+                continue;
+            }
+            let min_bytes: usize = element
+                .props
+                .iter()
+                .map(|p| match p.kind {
+                    Kind::Scalar(s) => s.size(),
+                    Kind::List { count, .. } => count.size(),
+                })
+                .sum();
+            let count = check_count(file, element, min_bytes, r.remaining(), "binary data")?;
+            let truncated = |i: usize| {
+                MeshError::invalid(
+                    file,
+                    format!(
+                        "PLY data ends inside '{}' element {i} of {} (truncated file or wrong count?)",
+                        element.name, element.count
+                    ),
+                )
+            };
+            match element.name.as_str() {
+                "vertex" => self.vertices.reserve_exact(count),
+                "face" => self.triangles.reserve(count),
+                _ => {}
+            }
+            for i in 0..count {
+                let mut xyz = [0.0; 3];
+                for (prop, role) in element.props.iter().zip(&roles) {
+                    match (prop.kind, role) {
+                        (Kind::Scalar(s), Role::Axis(axis)) => {
+                            xyz[*axis] = r.f64(s).ok_or_else(|| truncated(i))?;
+                        }
+                        (Kind::Scalar(s), _) => r.skip(s.size()).ok_or_else(|| truncated(i))?,
+                        (Kind::List { count, item }, role) => {
+                            let n = r.int(count).ok_or_else(|| truncated(i))?;
+                            let n = usize::try_from(n).map_err(|_| {
+                                MeshError::invalid(
+                                    file,
+                                    format!(
+                                        "'{}' element {i}: list '{}' has negative length {n}",
+                                        element.name, prop.name
+                                    ),
+                                )
+                            })?;
+                            if *role == Role::FaceIndices {
+                                polygon.clear();
+                                for _ in 0..n {
+                                    let v = r.index(item).ok_or_else(|| truncated(i))?;
+                                    polygon.push(self.index(i, v, None)?);
+                                }
+                                self.push_polygon(&polygon);
+                            } else {
+                                let len = n.checked_mul(item.size()).ok_or_else(|| truncated(i))?;
+                                r.skip(len).ok_or_else(|| truncated(i))?;
+                            }
+                        }
+                    }
+                }
+                if element.name == "vertex" {
+                    self.push_vertex(xyz, None)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn read_ascii(&mut self, header: &Header, body: &[u8]) -> Result<(), MeshError> {
+        let file = self.file;
+        let mut t = Tokens::new(body, header.lines + 1);
+        let mut polygon = Vec::new();
+        for element in &header.elements {
+            let roles = roles(element, file)?;
+            if element.props.is_empty() {
+                continue;
+            }
+            // Each value takes at least one digit and one separator.
+            let min_bytes = 2 * element.props.len();
+            let count = check_count(file, element, min_bytes, t.remaining() + 1, "text")?;
+            for i in 0..count {
+                let mut xyz = [0.0; 3];
+                t.skip_space();
+                let line = t.line;
+                for (prop, role) in element.props.iter().zip(&roles) {
+                    let missing = |t: &Tokens| {
+                        MeshError::syntax(
+                            file,
+                            t.line,
+                            format!(
+                                "'{}' element {i} of {} ends before property '{}' \
+                                 (truncated file or wrong count?)",
+                                element.name, element.count, prop.name
+                            ),
+                        )
+                    };
+                    let not_number = |t: &Tokens, token: &[u8]| {
+                        MeshError::syntax(
+                            file,
+                            t.line,
+                            format!(
+                                "'{}' element {i}: property '{}' is '{}', not a number",
+                                element.name,
+                                prop.name,
+                                String::from_utf8_lossy(token)
+                            ),
+                        )
+                    };
+                    match (prop.kind, role) {
+                        (Kind::Scalar(_), Role::Axis(axis)) => {
+                            let token = t.next().ok_or_else(|| missing(&t))?;
+                            xyz[*axis] = parse_f64(token).ok_or_else(|| not_number(&t, token))?;
+                        }
+                        (Kind::Scalar(_), _) => {
+                            t.next().ok_or_else(|| missing(&t))?;
+                        }
+                        (Kind::List { .. }, role) => {
+                            let token = t.next().ok_or_else(|| missing(&t))?;
+                            let n = ascii_int(token)
+                                .and_then(|n| usize::try_from(n).ok())
+                                .ok_or_else(|| not_number(&t, token))?;
+                            if *role == Role::FaceIndices {
+                                polygon.clear();
+                                for _ in 0..n {
+                                    let token = t.next().ok_or_else(|| missing(&t))?;
+                                    let v =
+                                        ascii_int(token).ok_or_else(|| not_number(&t, token))?;
+                                    polygon.push(self.index(i, v, Some(t.line))?);
+                                }
+                                self.push_polygon(&polygon);
+                            } else {
+                                for _ in 0..n {
+                                    t.next().ok_or_else(|| missing(&t))?;
+                                }
+                            }
+                        }
+                    }
+                }
+                if element.name == "vertex" {
+                    self.push_vertex(xyz, Some(line))?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Integers in ascii PLY, tolerating the "3.0" some writers emit for them.
+fn ascii_int(token: &[u8]) -> Option<i64> {
+    parse_i64(token).or_else(|| {
+        let f = parse_f64(token)?;
+        (f.fract() == 0.0 && f.abs() < 9.0e15).then_some(f as i64)
+    })
+}
+
+/// Whitespace-separated tokens that keep count of lines (ascii PLY and STL
+/// put no meaning in line breaks, but messages need them).
+pub(super) struct Tokens<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    pub line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    pub fn new(bytes: &'a [u8], first_line: usize) -> Self {
+        Tokens {
+            bytes,
+            pos: 0,
+            line: first_line,
+        }
+    }
+
+    /// Skips to the start of the next line (STL solid names are free text).
+    pub fn skip_line(&mut self) {
+        match self
+            .bytes
+            .get(self.pos..)
+            .and_then(|r| r.iter().position(|&c| c == b'\n'))
+        {
+            Some(i) => {
+                self.pos += i + 1;
+                self.line += 1;
+            }
+            None => self.pos = self.bytes.len(),
+        }
+    }
+
+    fn remaining(&self) -> usize {
+        self.bytes.len().saturating_sub(self.pos)
+    }
+
+    /// Moves to the next token, so `line` is the line it is on.
+    pub fn skip_space(&mut self) {
+        while let Some(&c) = self.bytes.get(self.pos) {
+            if !c.is_ascii_whitespace() {
+                break;
+            }
+            if c == b'\n' {
+                self.line += 1;
+            }
+            self.pos += 1;
+        }
+    }
+
+    pub fn next(&mut self) -> Option<&'a [u8]> {
+        self.skip_space();
+        let start = self.pos;
+        while self
+            .bytes
+            .get(self.pos)
+            .is_some_and(|c| !c.is_ascii_whitespace())
+        {
+            self.pos += 1;
+        }
+        (self.pos > start)
+            .then(|| self.bytes.get(start..self.pos))
+            .flatten()
+    }
+}
+
+struct BinReader<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    big_endian: bool,
+}
+
+impl BinReader<'_> {
+    fn remaining(&self) -> usize {
+        self.bytes.len().saturating_sub(self.pos)
+    }
+
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let end = self.pos.checked_add(N)?;
+        let mut out: [u8; N] = self.bytes.get(self.pos..end)?.try_into().ok()?;
+        self.pos = end;
+        if self.big_endian {
+            out.reverse();
+        }
+        Some(out)
+    }
+
+    fn skip(&mut self, n: usize) -> Option<()> {
+        let end = self.pos.checked_add(n)?;
+        (end <= self.bytes.len()).then(|| self.pos = end)
+    }
+
+    fn f64(&mut self, s: Scalar) -> Option<f64> {
+        Some(match s {
+            Scalar::F32 => f64::from(f32::from_le_bytes(self.take()?)),
+            Scalar::F64 => f64::from_le_bytes(self.take()?),
+            _ => self.int(s)? as f64,
+        })
+    }
+
+    fn int(&mut self, s: Scalar) -> Option<i64> {
+        Some(match s {
+            Scalar::I8 => i64::from(i8::from_le_bytes(self.take()?)),
+            Scalar::U8 => i64::from(u8::from_le_bytes(self.take()?)),
+            Scalar::I16 => i64::from(i16::from_le_bytes(self.take()?)),
+            Scalar::U16 => i64::from(u16::from_le_bytes(self.take()?)),
+            Scalar::I32 => i64::from(i32::from_le_bytes(self.take()?)),
+            Scalar::U32 => i64::from(u32::from_le_bytes(self.take()?)),
+            // A float-typed count is rejected in the header.
+            Scalar::F32 | Scalar::F64 => return None,
+        })
+    }
+
+    /// An index of any declared type; float indices must be whole numbers.
+    fn index(&mut self, s: Scalar) -> Option<i64> {
+        if s.is_float() {
+            let f = self.f64(s)?;
+            // Non-integral or huge float indices map to -1: out of range.
+            return Some(if f.fract() == 0.0 && f.abs() < 9.0e15 {
+                f as i64
+            } else {
+                -1
+            });
+        }
+        self.int(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII: &str = "ply\nformat ascii 1.0\ncomment made by hand\nobj_info x\n\
+        element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+        property uchar red\nproperty list uchar float weird\n\
+        element face 1\nproperty list uchar int vertex_indices\nproperty int flags\n\
+        element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n\
+        0 0 0 255 2 0.5 0.5\n1 0 0 255 0\n1 1 0 255 1 3\n0 1 0 255 0\n\
+        4 0 1 2 3 7\n0 1\n";
+
+    #[test]
+    fn ascii_with_extra_properties_and_elements() {
+        let p = parse(ASCII.as_bytes(), "t.ply").unwrap();
+        assert_eq!(p.vertices.len(), 4);
+        assert_eq!(p.vertices[2], DVec3::new(1.0, 1.0, 0.0));
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn ascii_errors_name_the_line() {
+        let bad = ASCII.replace("1 1 0 255 1 3", "1 1 nan 255 1 3");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.starts_with("t.ply:20:") && e.contains("vertex 2"), "{e}");
+        let bad = ASCII.replace("4 0 1 2 3 7", "4 0 1 2 9 7");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.contains("face 0 refers to vertex index 9"), "{e}");
+        let bad = ASCII.replace("0 1 0 255 0\n4 0 1 2 3 7\n0 1\n", "0 1 0 255 0\n4 0 1\n");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.contains("truncated"), "{e}");
+        let bad = ASCII.replace("element face 1", "element face 4000000000");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.contains("declares 4000000000 'face'"), "{e}");
+        let bad = ASCII.replace("property float z\n", "");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.contains("no scalar property 'z'"), "{e}");
+        let e = parse(b"ply\nformat ascii 1.0\nelement vertex 3\n", "t.ply")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("end_header"), "{e}");
+    }
+
+    #[test]
+    fn big_endian_scalars() {
+        let mut r = BinReader {
+            bytes: &[0x3f, 0x80, 0, 0, 0xff, 0xfe],
+            pos: 0,
+            big_endian: true,
+        };
+        assert_eq!(r.f64(Scalar::F32), Some(1.0));
+        assert_eq!(r.int(Scalar::I16), Some(-2));
+        assert_eq!(r.int(Scalar::U8), None);
+    }
+}

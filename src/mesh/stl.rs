@@ -1,1 +1,313 @@
-//! placeholder, replaced by the importer
+//! STL, ascii and binary. STL stores every facet's corners separately;
+//! bit-identical corners are welded into one indexed vertex so edges shared
+//! by two facets are not mistaken for hole boundaries downstream.
+
+use glam::DVec3;
+
+use super::import::{Parsed, Welder};
+use super::obj::parse_f64;
+use super::ply::Tokens;
+use super::MeshError;
+
+const HEADER: usize = 80;
+const PREAMBLE: usize = HEADER + 4;
+const FACET: usize = 50;
+
+fn declared_triangles(bytes: &[u8]) -> Option<u32> {
+    let count: [u8; 4] = bytes.get(HEADER..PREAMBLE)?.try_into().ok()?;
+    Some(u32::from_le_bytes(count))
+}
+
+fn binary_size(triangles: u32) -> u64 {
+    PREAMBLE as u64 + FACET as u64 * u64::from(triangles)
+}
+
+/// The file is exactly as long as its binary header says: the only reliable
+/// sign of binary STL, whose free 80-byte header may itself begin "solid".
+pub(super) fn is_binary_size(bytes: &[u8]) -> bool {
+    declared_triangles(bytes).is_some_and(|n| binary_size(n) == bytes.len() as u64)
+}
+
+pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let start = bytes
+        .iter()
+        .position(|c| !c.is_ascii_whitespace())
+        .unwrap_or(bytes.len());
+    if bytes.get(start..).is_some_and(|t| t.starts_with(b"solid")) {
+        return match parse_ascii(bytes, file) {
+            Err(_) if is_binary_size(bytes) || looks_binary(bytes) => parse_binary(bytes, file),
+            result => result,
+        };
+    }
+    parse_binary(bytes, file)
+}
+
+/// NUL bytes never occur in ascii STL but fill most binary facets; this
+/// names the real problem (a size mismatch) for a damaged binary file whose
+/// header says "solid".
+fn looks_binary(bytes: &[u8]) -> bool {
+    bytes.iter().take(4096).any(|&b| b == 0)
+}
+
+fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let n = declared_triangles(bytes).ok_or_else(|| {
+        MeshError::invalid(
+            file,
+            format!(
+                "binary STL is truncated: {} bytes, the header alone needs {PREAMBLE}",
+                bytes.len()
+            ),
+        )
+    })?;
+    let needed = binary_size(n);
+    let mut warnings = Vec::new();
+    if (bytes.len() as u64) < needed {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "binary STL header declares {n} triangles, which need {needed} bytes, \
+                 but the file has {} bytes (truncated file or wrong count?)",
+                bytes.len()
+            ),
+        ));
+    }
+    if (bytes.len() as u64) > needed {
+        warnings.push(format!(
+            "{file}: ignored {} bytes after the {n} triangles the binary STL header declares",
+            bytes.len() as u64 - needed
+        ));
+    }
+    // The size check above bounds `n` by the bytes present, so these
+    // allocations are proportional to the input.
+    let n = n as usize;
+    let mut welder = Welder::with_capacity(n);
+    let mut triangles = Vec::with_capacity(n);
+    let facets = bytes
+        .get(PREAMBLE..)
+        .unwrap_or_default()
+        .chunks_exact(FACET);
+    for (facet, chunk) in facets.take(n).enumerate() {
+        let mut tri = [0u32; 3];
+        for (corner, slot) in tri.iter_mut().enumerate() {
+            // 12 bytes of facet normal first, which is recomputed downstream.
+            let at = 12 + 12 * corner;
+            let mut xyz = [0.0f64; 3];
+            for (axis, c) in xyz.iter_mut().enumerate() {
+                let b = chunk
+                    .get(at + 4 * axis..at + 4 * axis + 4)
+                    .and_then(|b| <[u8; 4]>::try_from(b).ok())
+                    .unwrap_or_default();
+                *c = f64::from(f32::from_le_bytes(b));
+            }
+            *slot = weld(&mut welder, xyz, file, facet, corner, None)?;
+        }
+        triangles.push(tri);
+    }
+    Ok(Parsed {
+        vertices: welder.vertices,
+        triangles,
+        warnings,
+    })
+}
+
+fn weld(
+    welder: &mut Welder,
+    xyz: [f64; 3],
+    file: &str,
+    facet: usize,
+    corner: usize,
+    line: Option<usize>,
+) -> Result<u32, MeshError> {
+    let p = DVec3::from_array(xyz);
+    if !p.is_finite() {
+        let message = format!("facet {facet} vertex {corner} has a non-finite coordinate ({p})");
+        return Err(match line {
+            Some(line) => MeshError::syntax(file, line, message),
+            None => MeshError::invalid(file, message),
+        });
+    }
+    welder
+        .index(p)
+        .ok_or_else(|| MeshError::invalid(file, "more than 2^32 distinct vertices"))
+}
+
+fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let mut t = Tokens::new(bytes, 1);
+    let mut welder = Welder::default();
+    let mut triangles = Vec::new();
+    let mut polygon: Vec<u32> = Vec::with_capacity(3);
+    let mut facet = 0usize;
+    let expect = |t: &mut Tokens, word: &str| -> Result<(), MeshError> {
+        match t.next() {
+            Some(w) if w == word.as_bytes() => Ok(()),
+            Some(w) => Err(MeshError::syntax(
+                file,
+                t.line,
+                format!("expected '{word}', found '{}'", String::from_utf8_lossy(w)),
+            )),
+            None => Err(MeshError::syntax(
+                file,
+                t.line,
+                format!("file ends where '{word}' was expected (truncated file?)"),
+            )),
+        }
+    };
+    // Some exporters write several solids into one file: read them all.
+    while let Some(word) = t.next() {
+        if word != b"solid" {
+            return Err(MeshError::syntax(
+                file,
+                t.line,
+                format!(
+                    "expected 'solid', found '{}'",
+                    String::from_utf8_lossy(word)
+                ),
+            ));
+        }
+        t.skip_line();
+        loop {
+            match t.next() {
+                Some(b"endsolid") => {
+                    t.skip_line();
+                    break;
+                }
+                Some(b"facet") => {}
+                Some(w) => {
+                    return Err(MeshError::syntax(
+                        file,
+                        t.line,
+                        format!(
+                            "expected 'facet' or 'endsolid', found '{}'",
+                            String::from_utf8_lossy(w)
+                        ),
+                    ))
+                }
+                None => {
+                    return Err(MeshError::syntax(
+                        file,
+                        t.line,
+                        "file ends before 'endsolid' (truncated file?)",
+                    ))
+                }
+            }
+            expect(&mut t, "normal")?;
+            for _ in 0..3 {
+                number(&mut t, file)?;
+            }
+            expect(&mut t, "outer")?;
+            expect(&mut t, "loop")?;
+            polygon.clear();
+            loop {
+                match t.next() {
+                    Some(b"vertex") => {
+                        let line = t.line;
+                        let xyz = [
+                            number(&mut t, file)?,
+                            number(&mut t, file)?,
+                            number(&mut t, file)?,
+                        ];
+                        let corner = polygon.len();
+                        polygon.push(weld(&mut welder, xyz, file, facet, corner, Some(line))?);
+                    }
+                    Some(b"endloop") => break,
+                    Some(w) => {
+                        return Err(MeshError::syntax(
+                            file,
+                            t.line,
+                            format!(
+                                "expected 'vertex' or 'endloop', found '{}'",
+                                String::from_utf8_lossy(w)
+                            ),
+                        ))
+                    }
+                    None => {
+                        return Err(MeshError::syntax(
+                            file,
+                            t.line,
+                            "file ends inside a facet (truncated file?)",
+                        ))
+                    }
+                }
+            }
+            expect(&mut t, "endfacet")?;
+            if polygon.len() < 3 {
+                return Err(MeshError::syntax(
+                    file,
+                    t.line,
+                    format!("facet {facet} has {} vertices, needs 3", polygon.len()),
+                ));
+            }
+            for pair in polygon.windows(2).skip(1) {
+                triangles.push([polygon[0], pair[0], pair[1]]);
+            }
+            facet += 1;
+        }
+    }
+    Ok(Parsed {
+        vertices: welder.vertices,
+        triangles,
+        warnings: Vec::new(),
+    })
+}
+
+fn number(t: &mut Tokens, file: &str) -> Result<f64, MeshError> {
+    let token = t.next().ok_or_else(|| {
+        MeshError::syntax(
+            file,
+            t.line,
+            "file ends where a number was expected (truncated file?)",
+        )
+    })?;
+    parse_f64(token).ok_or_else(|| {
+        MeshError::syntax(
+            file,
+            t.line,
+            format!("'{}' is not a number", String::from_utf8_lossy(token)),
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TWO: &str = "solid two\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   \
+        vertex 1 0 0\n   vertex 1 1 0\n  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n   \
+        vertex 0 0 0\n   vertex 1 1 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid two\n";
+
+    #[test]
+    fn ascii_is_welded() {
+        let p = parse(TWO.as_bytes(), "t.stl").unwrap();
+        assert_eq!(p.vertices.len(), 4);
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn ascii_errors_name_the_line() {
+        let e = parse(
+            TWO.replace("vertex 1 0 0", "vertex 1 inf 0").as_bytes(),
+            "t.stl",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("t.stl:5:") && e.contains("non-finite"), "{e}");
+        let e = parse(&TWO.as_bytes()[..100], "t.stl")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated"), "{e}");
+        let e = parse(TWO.replace("outer loop", "outer lop").as_bytes(), "t.stl")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("expected 'loop', found 'lop'"), "{e}");
+    }
+
+    #[test]
+    fn binary_size_must_match() {
+        let mut b = vec![0u8; 84];
+        b[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+        let e = parse(&b, "t.stl").unwrap_err().to_string();
+        assert!(e.contains("declares 4294967295 triangles"), "{e}");
+        let e = parse(&b[..40], "t.stl").unwrap_err().to_string();
+        assert!(e.contains("truncated"), "{e}");
+    }
+}
