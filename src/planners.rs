@@ -1,1 +1,239 @@
-//! planners (in progress)
+//! Tool-path planners (spec section 6): from the surface path Ta and its
+//! local geometry to the points T* the nozzle follows.
+//!
+//! - `constant`: T* = Ta + d Z (paper Algorithm 2).
+//! - `slope`: T* = Ta + d N + (do/2) V (Algorithm 3, eq. 2).
+//! - `pcpp`: the paper's one-pass correction (Algorithm 4, eq. 6-14).
+//! - `pcpp-guarded` (beyond the paper): `pcpp`, then re-tested until the
+//!   nozzle clears the surface by at least tol.
+
+use std::{fmt, str::FromStr};
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::params::{Nozzle, Process};
+use crate::spline::LocalGeometry;
+use crate::surface::Surface;
+
+/// Which planner computes T*.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlannerKind {
+    Constant,
+    Slope,
+    Pcpp,
+    #[default]
+    PcppGuarded,
+}
+
+impl PlannerKind {
+    /// All four, in the order the paper compares them.
+    pub const ALL: [PlannerKind; 4] = [
+        PlannerKind::Constant,
+        PlannerKind::Slope,
+        PlannerKind::Pcpp,
+        PlannerKind::PcppGuarded,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PlannerKind::Constant => "constant",
+            PlannerKind::Slope => "slope",
+            PlannerKind::Pcpp => "pcpp",
+            PlannerKind::PcppGuarded => "pcpp-guarded",
+        }
+    }
+}
+
+impl fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for PlannerKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        PlannerKind::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                format!("unknown planner '{s}' (expected constant, slope, pcpp or pcpp-guarded)")
+            })
+    }
+}
+
+/// The guarded planner's push iterations before it falls back to lifting.
+pub const GUARD_MAX_PUSHES: usize = 4;
+
+/// T* of one subpath, with what the guarded planner had to do.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlannedPoints {
+    pub toolpath: Vec<DVec3>,
+    /// Points the guarded planner had to lift above the paper's correction,
+    /// with the lift in mm (the nozzle is wider than the feature there).
+    pub lifted: Vec<(usize, f64)>,
+    /// Points the guarded planner could not clear.
+    pub uncleared: Vec<usize>,
+}
+
+/// M_j of eq. 8-9: the forward shift on descents, from the profile curvature.
+fn forward_shift(d: f64, kappa: f64) -> f64 {
+    if kappa <= 1.0 / d {
+        0.5 * d * (1.0 + d * kappa)
+    } else {
+        d
+    }
+}
+
+/// One point of the paper's Algorithm 4.
+fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, tol: f64) -> DVec3 {
+    let d = nozzle.inner_diameter_mm;
+    let r = 0.5 * nozzle.outer_diameter_mm;
+    let mut t = ta + d * DVec3::Z;
+    let descending = g.tangent.z < 0.0;
+    let m = forward_shift(d, g.kappa);
+    if let Some(c) = surface.disk_contact(t, r) {
+        // Cases 1-2: push away from the centroid of C ∩ S (eq. 6-7, 10).
+        let away = t - c.centroid;
+        let dist = away.length();
+        let q = if dist > 1e-9 { away / dist } else { g.n };
+        t += (r - dist + tol) * q;
+        if descending {
+            t += m * g.v; // eq. 11
+        }
+    } else if descending {
+        // Case 3: surface behind the tip within d (eq. 12-14).
+        if let Some(hit) = surface.segment_first_hit(t, t - d * g.v) {
+            let m2 = r - t.distance(hit) + m;
+            t += m2 * g.v;
+        }
+    }
+    t
+}
+
+/// The guarded clearance: no surface within the footprint of the nozzle
+/// (radius do/2 + tol) higher than tol below the tip. This covers the tip
+/// disk and the nozzle body above it (a vertical cylinder of diameter do).
+fn clears(surface: &Surface, t: DVec3, r_clear: f64, tol: f64) -> Option<f64> {
+    match surface.max_height_in_disk(t.truncate(), r_clear) {
+        Some(h) if h > t.z - tol + 1e-9 => Some(h),
+        _ => None,
+    }
+}
+
+/// Plans one subpath. `ta` and `geometry` have the same length.
+pub fn plan_points(
+    kind: PlannerKind,
+    surface: &Surface,
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    nozzle: &Nozzle,
+    process: &Process,
+) -> PlannedPoints {
+    let d = nozzle.inner_diameter_mm;
+    let r = 0.5 * nozzle.outer_diameter_mm;
+    let tol = process.tolerance_mm;
+    let mut out = PlannedPoints {
+        toolpath: Vec::with_capacity(ta.len()),
+        ..Default::default()
+    };
+    for (j, (&p, g)) in ta.iter().zip(geometry).enumerate() {
+        let t = match kind {
+            PlannerKind::Constant => p + d * DVec3::Z,
+            PlannerKind::Slope => p + d * g.n + r * g.v,
+            PlannerKind::Pcpp => pcpp_point(surface, p, g, nozzle, tol),
+            PlannerKind::PcppGuarded => {
+                let start = pcpp_point(surface, p, g, nozzle, tol);
+                let r_clear = r + tol;
+                let mut t = start;
+                for _ in 0..GUARD_MAX_PUSHES {
+                    if clears(surface, t, r_clear, tol).is_none() {
+                        break;
+                    }
+                    // Re-apply eq. 6-10 with the clearance radius.
+                    let Some(c) = surface.disk_contact(t, r_clear) else {
+                        break;
+                    };
+                    let away = t - c.centroid;
+                    let dist = away.length();
+                    let q = if dist > 1e-9 { away / dist } else { g.n };
+                    t += (r_clear - dist + 1e-6) * q;
+                }
+                // Pushing sideways must not carry the tip off the path.
+                if (t - p).truncate().length() > nozzle.outer_diameter_mm {
+                    t = start;
+                }
+                if let Some(h) = clears(surface, t, r_clear, tol) {
+                    let lift = h + tol - t.z;
+                    t.z = h + tol;
+                    out.lifted.push((j, lift));
+                }
+                if !t.is_finite() || clears(surface, t, r_clear, tol).is_some() {
+                    out.uncleared.push(j);
+                }
+                t
+            }
+        };
+        out.toolpath.push(t);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriMesh;
+
+    #[test]
+    fn names_round_trip() {
+        for k in PlannerKind::ALL {
+            assert_eq!(k.name().parse::<PlannerKind>().unwrap(), k);
+        }
+        assert!("fast".parse::<PlannerKind>().is_err());
+    }
+
+    #[test]
+    fn forward_shift_follows_eq_8_9() {
+        let d = 0.603;
+        assert!((forward_shift(d, 0.0) - 0.3015).abs() < 1e-12);
+        assert_eq!(forward_shift(d, 10.0), d);
+        assert!(forward_shift(d, -1.0) < 0.3015);
+    }
+
+    fn flat() -> Surface {
+        let mut m = TriMesh::default();
+        m.vertices = vec![
+            DVec3::new(-10.0, -10.0, 0.0),
+            DVec3::new(10.0, -10.0, 0.0),
+            DVec3::new(10.0, 10.0, 0.0),
+            DVec3::new(-10.0, 10.0, 0.0),
+        ];
+        m.triangles = vec![[0, 1, 2], [0, 2, 3]];
+        Surface::new(m).unwrap()
+    }
+
+    #[test]
+    fn all_planners_agree_on_a_flat_surface() {
+        let s = flat();
+        let ta: Vec<DVec3> = (0..5)
+            .map(|i| DVec3::new(i as f64 * 0.3, 0.0, 0.0))
+            .collect();
+        let g = crate::spline::local_geometry(&ta).unwrap();
+        let n = Nozzle::DEFAULT;
+        for k in [
+            PlannerKind::Constant,
+            PlannerKind::Pcpp,
+            PlannerKind::PcppGuarded,
+        ] {
+            let p = plan_points(k, &s, &ta, &g, &n, &Process::DEFAULT);
+            for (t, a) in p.toolpath.iter().zip(&ta) {
+                assert!((*t - (*a + 0.603 * DVec3::Z)).length() < 1e-12, "{k}");
+            }
+            assert!(p.lifted.is_empty() && p.uncleared.is_empty());
+        }
+        let p = plan_points(PlannerKind::Slope, &s, &ta, &g, &n, &Process::DEFAULT);
+        assert!((p.toolpath[2] - (ta[2] + DVec3::new(0.454, 0.0, 0.603))).length() < 1e-12);
+    }
+}

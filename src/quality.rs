@@ -1,1 +1,302 @@
-//! quality (in progress)
+//! Predicted print quality (spec section 7, the paper's Algorithm 5): per
+//! point tool-surface contact, filament thickness D_j and error e_j = D_j - d,
+//! with flattening and floating flags, and a summary per planner (the paper's
+//! Figure 3e-f).
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::params::{Nozzle, Process};
+use crate::spline::{LocalGeometry, Spline};
+use crate::surface::Surface;
+
+/// The predicted defect at a point, worst first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Defect {
+    /// The tip disk C_j meets the surface.
+    Contact,
+    /// D_j < d - tol.
+    Flattening,
+    /// D_j > d + tol (or no filament reaches the surface within 2d).
+    Floating,
+    Good,
+}
+
+/// The prediction at one point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PointQuality {
+    pub defect: Defect,
+    /// Filament thickness D_j; `None` at a contact (no estimate) or where the
+    /// filament curve does not meet the normal within 2d (floating).
+    pub thickness_mm: Option<f64>,
+    /// e_j = D_j - d; `None` at a contact. Where no intersection exists the
+    /// error is counted as d (its lower bound D_j > 2d), see [`predict`].
+    pub error_mm: Option<f64>,
+}
+
+/// A planner's summary over all its points (the paper's Figure 3e-f).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct QualitySummary {
+    pub points: usize,
+    /// Mean |e| over the points with an estimate (no contact).
+    pub mean_abs_error_mm: f64,
+    /// Mean of the negative errors (0 if none).
+    pub mean_negative_error_mm: f64,
+    /// Mean of the positive errors (0 if none).
+    pub mean_positive_error_mm: f64,
+    pub contact_pct: f64,
+    pub flattening_pct: f64,
+    pub floating_pct: f64,
+}
+
+impl QualitySummary {
+    /// Defective points (contact, flattening or floating), in percent.
+    pub fn defect_pct(&self) -> f64 {
+        self.contact_pct + self.flattening_pct + self.floating_pct
+    }
+}
+
+/// The back of the nozzle tip F_j (spec section 7, decision: the text's
+/// "back of the nozzle", not Algorithm 5's + (d/2) V_j).
+fn nozzle_back(t: DVec3, g: &LocalGeometry, nozzle: &Nozzle) -> DVec3 {
+    let k = if g.tangent.z < 0.0 {
+        0.5 * nozzle.outer_diameter_mm
+    } else {
+        0.5 * nozzle.inner_diameter_mm
+    };
+    t - k * g.v
+}
+
+/// How many neighbours either side are searched for the crossing of the
+/// filament curve with the normal line; F_j lies at most do/2 + d behind
+/// T*_j, a few samples at d/2 spacing.
+const SEARCH: usize = 8;
+
+/// Predicts the quality along one subpath planned as `toolpath`.
+pub fn predict(
+    surface: &Surface,
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    toolpath: &[DVec3],
+    nozzle: &Nozzle,
+    process: &Process,
+) -> Vec<PointQuality> {
+    let d = nozzle.inner_diameter_mm;
+    let r = 0.5 * nozzle.outer_diameter_mm;
+    let tol = process.tolerance_mm;
+    let back: Vec<DVec3> = toolpath
+        .iter()
+        .zip(geometry)
+        .map(|(&t, g)| nozzle_back(t, g, nozzle))
+        .collect();
+    // c(t): the cubic spline through the F_j. Where consecutive F_j coincide
+    // (the planner stopped the tip), fall back to the polyline.
+    let curve = Spline::interpolate(&back).ok();
+    let params: Vec<f64> = match &curve {
+        Some(c) => c.params().to_vec(),
+        None => (0..back.len()).map(|i| i as f64).collect(),
+    };
+    let eval = |u: f64| -> DVec3 {
+        match &curve {
+            Some(c) => c.eval(u),
+            None => {
+                let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
+                let f = u - i as f64;
+                back[i].lerp(back[(i + 1).min(back.len() - 1)], f)
+            }
+        }
+    };
+
+    let mut out = Vec::with_capacity(ta.len());
+    for j in 0..ta.len() {
+        if surface.disk_contact(toolpath[j], r).is_some() {
+            out.push(PointQuality {
+                defect: Defect::Contact,
+                thickness_mm: None,
+                error_mm: None,
+            });
+            continue;
+        }
+        let (a, g) = (ta[j], &geometry[j]);
+        // p_j: where c crosses the plane through Ta_j normal to t_j, which
+        // holds the normal line {Ta_j + lambda N_j}; nearest crossing to j.
+        let f = |u: f64| (eval(u) - a).dot(g.tangent);
+        let lo = j.saturating_sub(SEARCH);
+        let hi = (j + SEARCH).min(back.len() - 1);
+        let mut best: Option<(usize, f64)> = None;
+        for k in lo..hi {
+            let (u0, u1) = (params[k], params[k + 1]);
+            let (f0, f1) = (f(u0), f(u1));
+            if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
+                let dist = k.abs_diff(j).min((k + 1).abs_diff(j));
+                if best.is_none_or(|(bd, _)| dist < bd) {
+                    best = Some((dist, bisect(&f, u0, u1, f0)));
+                }
+            }
+        }
+        // At the path's end the curve of F_j stops short of the last normals:
+        // the filament runs on to the tip, so extend c along its last chord.
+        let end_point = || -> Option<DVec3> {
+            let m = back.len();
+            let last = back[m - 1];
+            let dir = last - back[m.checked_sub(2)?];
+            let den = dir.dot(g.tangent);
+            let s = (a - last).dot(g.tangent) / den;
+            (den.abs() > 1e-12 && s > 0.0 && s.is_finite()).then(|| last + dir * s)
+        };
+        let crossing = match best {
+            Some((_, u)) => Some(eval(u)),
+            None if j + SEARCH >= back.len() => end_point(),
+            None => None,
+        };
+        let thickness = crossing.and_then(|p| {
+            let lambda = (p - a).dot(g.n);
+            if lambda > 2.0 * d {
+                None
+            } else if lambda < 0.0 {
+                Some(0.0) // the filament's top is under the surface: crushed
+            } else {
+                Some(p.distance(a))
+            }
+        });
+        let (defect, error) = match thickness {
+            None => (Defect::Floating, d),
+            Some(t) if t < d - tol => (Defect::Flattening, t - d),
+            Some(t) if t > d + tol => (Defect::Floating, t - d),
+            Some(t) => (Defect::Good, t - d),
+        };
+        out.push(PointQuality {
+            defect,
+            thickness_mm: thickness,
+            error_mm: Some(error),
+        });
+    }
+    out
+}
+
+fn bisect(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64) -> f64 {
+    if fa == 0.0 {
+        return a;
+    }
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        let fm = f(m);
+        if fm == 0.0 {
+            return m;
+        }
+        if (fm < 0.0) == (fa < 0.0) {
+            a = m;
+            fa = fm;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Summarises predictions (spec section 7).
+pub fn summarize<'a>(points: impl IntoIterator<Item = &'a PointQuality>) -> QualitySummary {
+    let (mut n, mut contact, mut flat, mut float) = (0usize, 0usize, 0usize, 0usize);
+    let (mut abs_sum, mut est) = (0.0, 0usize);
+    let (mut neg_sum, mut neg) = (0.0, 0usize);
+    let (mut pos_sum, mut pos) = (0.0, 0usize);
+    for q in points {
+        n += 1;
+        match q.defect {
+            Defect::Contact => contact += 1,
+            Defect::Flattening => flat += 1,
+            Defect::Floating => float += 1,
+            Defect::Good => {}
+        }
+        if let Some(e) = q.error_mm {
+            abs_sum += e.abs();
+            est += 1;
+            if e < 0.0 {
+                neg_sum += e;
+                neg += 1;
+            } else if e > 0.0 {
+                pos_sum += e;
+                pos += 1;
+            }
+        }
+    }
+    let pct = |k: usize| {
+        if n == 0 {
+            0.0
+        } else {
+            100.0 * k as f64 / n as f64
+        }
+    };
+    let mean = |s: f64, k: usize| if k == 0 { 0.0 } else { s / k as f64 };
+    QualitySummary {
+        points: n,
+        mean_abs_error_mm: mean(abs_sum, est),
+        mean_negative_error_mm: mean(neg_sum, neg),
+        mean_positive_error_mm: mean(pos_sum, pos),
+        contact_pct: pct(contact),
+        flattening_pct: pct(flat),
+        floating_pct: pct(float),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriMesh;
+    use crate::planners::{plan_points, PlannerKind};
+
+    fn flat() -> Surface {
+        let mut m = TriMesh::default();
+        m.vertices = vec![
+            DVec3::new(-10.0, -10.0, 0.0),
+            DVec3::new(10.0, -10.0, 0.0),
+            DVec3::new(10.0, 10.0, 0.0),
+            DVec3::new(-10.0, 10.0, 0.0),
+        ];
+        m.triangles = vec![[0, 1, 2], [0, 2, 3]];
+        Surface::new(m).unwrap()
+    }
+
+    fn line() -> Vec<DVec3> {
+        (0..20)
+            .map(|i| DVec3::new(-3.0 + i as f64 * 0.3, 0.0, 0.0))
+            .collect()
+    }
+
+    #[test]
+    fn constant_offset_on_flat_is_exact() {
+        let s = flat();
+        let ta = line();
+        let g = crate::spline::local_geometry(&ta).unwrap();
+        let (n, p) = (Nozzle::DEFAULT, Process::DEFAULT);
+        let tp = plan_points(PlannerKind::Constant, &s, &ta, &g, &n, &p).toolpath;
+        let q = predict(&s, &ta, &g, &tp, &n, &p);
+        // Interior points: D = d exactly (the back of the tip is at height d).
+        for qj in &q[3..q.len() - 3] {
+            assert_eq!(qj.defect, Defect::Good);
+            assert!(qj.error_mm.unwrap().abs() < 1e-9, "{qj:?}");
+        }
+    }
+
+    #[test]
+    fn too_low_flattens_too_high_floats_below_contacts() {
+        let s = flat();
+        let ta = line();
+        let g = crate::spline::local_geometry(&ta).unwrap();
+        let (n, p) = (Nozzle::DEFAULT, Process::DEFAULT);
+        let at = |h: f64| -> Vec<PointQuality> {
+            let tp: Vec<DVec3> = ta.iter().map(|a| *a + h * DVec3::Z).collect();
+            predict(&s, &ta, &g, &tp, &n, &p)
+        };
+        assert_eq!(at(0.3)[10].defect, Defect::Flattening);
+        assert_eq!(at(0.9)[10].defect, Defect::Floating);
+        assert_eq!(at(2.0)[10].defect, Defect::Floating);
+        assert_eq!(at(2.0)[10].thickness_mm, None);
+        assert_eq!(at(0.0)[10].defect, Defect::Contact);
+        let s = summarize(&at(0.3));
+        assert_eq!(s.points, 20);
+        assert!(s.mean_negative_error_mm < -0.2 && s.mean_positive_error_mm == 0.0);
+        assert!(s.flattening_pct > 50.0);
+    }
+}

@@ -1,1 +1,426 @@
-//! spline (in progress)
+//! Curve fit and local geometry (spec section 5): a cubic interpolating
+//! B-spline through the points of each subpath with chord-length parameters
+//! and averaged knots (The NURBS Book, section 9.2.1, eq. 9.5 and 9.8), and
+//! at each point the tangent t, the horizontal printing direction V, the
+//! profile normal N, the signed profile curvature kappa, the slope angle
+//! alpha and the 3-D curvature.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// A non-rational B-spline curve (unit weights) interpolating given points.
+#[derive(Debug, Clone)]
+pub struct Spline {
+    degree: usize,
+    knots: Vec<f64>,
+    ctrl: Vec<DVec3>,
+    params: Vec<f64>,
+}
+
+impl Spline {
+    /// Interpolates `points` with a cubic (degree min(3, n-1) for fewer than
+    /// four points). Consecutive points must be distinct.
+    pub fn interpolate(points: &[DVec3]) -> Result<Spline> {
+        let n = points.len();
+        if n < 2 {
+            return Err(Error::Plan(format!(
+                "a spline needs at least 2 points, got {n}"
+            )));
+        }
+        if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+            return Err(Error::Plan(format!(
+                "point {i} of the path is not finite: {:?}",
+                points[i]
+            )));
+        }
+        let p = 3.min(n - 1);
+        // Chord-length parameters (NURBS Book eq. 9.5).
+        let mut params = Vec::with_capacity(n);
+        params.push(0.0);
+        let mut total = 0.0;
+        for w in points.windows(2) {
+            total += w[0].distance(w[1]);
+            params.push(total);
+        }
+        for (i, w) in params.windows(2).enumerate() {
+            if w[1] - w[0] <= 1e-12 * total.max(1.0) {
+                return Err(Error::Plan(format!(
+                    "points {i} and {} of the path coincide at {:?}",
+                    i + 1,
+                    points[i]
+                )));
+            }
+        }
+        for u in &mut params {
+            *u /= total;
+        }
+        params[n - 1] = 1.0;
+        // Averaged knots (eq. 9.8).
+        let mut knots = vec![0.0; n + p + 1];
+        for j in 1..n - p {
+            knots[j + p] = params[j..j + p].iter().sum::<f64>() / p as f64;
+        }
+        for k in &mut knots[n..] {
+            *k = 1.0;
+        }
+        let mut s = Spline {
+            degree: p,
+            knots,
+            ctrl: Vec::new(),
+            params,
+        };
+        s.ctrl = s.solve_control_points(points)?;
+        Ok(s)
+    }
+
+    /// The parameter u_k at which the spline passes through point k.
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// Solves N P = Q (NURBS Book eq. 9.7): a banded, totally positive
+    /// system, so Gaussian elimination without pivoting is stable (9.2.1).
+    fn solve_control_points(&self, q: &[DVec3]) -> Result<Vec<DVec3>> {
+        let n = q.len();
+        let p = self.degree;
+        // Band storage: a[k][c - k + p] for columns c in [k - p, k + p].
+        let w = 2 * p + 1;
+        let mut a = vec![0.0; n * w];
+        let mut rhs = q.to_vec();
+        let mut basis = [0.0; 4];
+        for k in 0..n {
+            let span = self.find_span(self.params[k]);
+            self.basis_funs(span, self.params[k], &mut basis);
+            for (r, &b) in basis.iter().enumerate().take(p + 1) {
+                let col = span - p + r;
+                let off = (col + p)
+                    .checked_sub(k)
+                    .filter(|&o| o < w)
+                    .ok_or_else(|| Error::Plan("spline system is not banded".into()))?;
+                a[k * w + off] = b;
+            }
+        }
+        for k in 0..n {
+            let pivot = a[k * w + p];
+            if pivot.abs() < 1e-300 {
+                return Err(Error::Plan(format!(
+                    "spline system is singular at point {k}"
+                )));
+            }
+            for i in k + 1..(k + p + 1).min(n) {
+                let f = a[i * w + (k + p - i)] / pivot;
+                if f == 0.0 {
+                    continue;
+                }
+                for c in k..(k + p + 1).min(n) {
+                    a[i * w + (c + p - i)] -= f * a[k * w + (c + p - k)];
+                }
+                let rk = rhs[k];
+                rhs[i] -= rk * f;
+            }
+        }
+        for k in (0..n).rev() {
+            let mut v = rhs[k];
+            for c in k + 1..(k + p + 1).min(n) {
+                v -= rhs[c] * a[k * w + (c + p - k)];
+            }
+            rhs[k] = v / a[k * w + p];
+        }
+        Ok(rhs)
+    }
+
+    /// Knot span index (NURBS Book A2.1).
+    fn find_span(&self, u: f64) -> usize {
+        let p = self.degree;
+        let n = self.ctrl.len().max(self.params.len()) - 1;
+        if u >= self.knots[n + 1] {
+            return n;
+        }
+        if u <= self.knots[p] {
+            return p;
+        }
+        let (mut lo, mut hi) = (p, n + 1);
+        let mut mid = (lo + hi) / 2;
+        while u < self.knots[mid] || u >= self.knots[mid + 1] {
+            if u < self.knots[mid] {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+            mid = (lo + hi) / 2;
+        }
+        mid
+    }
+
+    /// Non-vanishing basis functions (NURBS Book A2.2).
+    fn basis_funs(&self, span: usize, u: f64, out: &mut [f64; 4]) {
+        let p = self.degree;
+        let mut left = [0.0; 4];
+        let mut right = [0.0; 4];
+        out[0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - self.knots[span + 1 - j];
+            right[j] = self.knots[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let temp = out[r] / (right[r + 1] + left[j - r]);
+                out[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            out[j] = saved;
+        }
+    }
+
+    /// Basis functions and their first two derivatives (NURBS Book A2.3).
+    fn ders_basis_funs(&self, span: usize, u: f64) -> [[f64; 4]; 3] {
+        let p = self.degree;
+        let mut ndu = [[0.0; 4]; 4];
+        let mut left = [0.0; 4];
+        let mut right = [0.0; 4];
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - self.knots[span + 1 - j];
+            right[j] = self.knots[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        let mut ders = [[0.0; 4]; 3];
+        for j in 0..=p {
+            ders[0][j] = ndu[j][p];
+        }
+        let nd = 2.min(p);
+        for r in 0..=p {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            let mut a = [[0.0; 4]; 2];
+            a[0][0] = 1.0;
+            for k in 1..=nd {
+                let mut d = 0.0;
+                let rk = r as isize - k as isize;
+                let pk = p - k;
+                if r >= k {
+                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                    d = a[s2][0] * ndu[rk as usize][pk];
+                }
+                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2 = if r as isize - 1 <= pk as isize {
+                    k - 1
+                } else {
+                    p - r
+                };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                    d += a[s2][k] * ndu[r][pk];
+                }
+                ders[k][r] = d;
+                std::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut f = p as f64;
+        for (k, row) in ders.iter_mut().enumerate().skip(1).take(nd) {
+            for v in row.iter_mut().take(p + 1) {
+                *v *= f;
+            }
+            f *= (p - k) as f64;
+        }
+        ders
+    }
+
+    /// The point at parameter `u` (clamped to [0, 1]).
+    pub fn eval(&self, u: f64) -> DVec3 {
+        self.derivs(u)[0]
+    }
+
+    /// C(u), C'(u), C''(u).
+    pub fn derivs(&self, u: f64) -> [DVec3; 3] {
+        let u = u.clamp(0.0, 1.0);
+        let p = self.degree;
+        let span = self.find_span(u);
+        let d = self.ders_basis_funs(span, u);
+        let mut out = [DVec3::ZERO; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            for j in 0..=p {
+                *o += self.ctrl[span - p + j] * d[k][j];
+            }
+        }
+        out
+    }
+}
+
+/// The local geometry of a path at one of its points (spec section 5).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LocalGeometry {
+    /// Unit tangent t_j of the spline, in the printing direction.
+    pub tangent: DVec3,
+    /// Horizontal printing direction V_j (unit, z = 0).
+    pub v: DVec3,
+    /// Profile normal N_j: perpendicular to t_j in the vertical plane of V_j
+    /// and Z, with N_j,z >= 0.
+    pub n: DVec3,
+    /// Signed curvature of the height profile along the horizontal arc
+    /// length, 1/mm: positive concave-up, negative concave-down.
+    pub kappa: f64,
+    /// Slope angle alpha_j = atan2(t_z, |t_xy|), radians (negative = downhill).
+    pub slope_rad: f64,
+    /// Curvature of the 3-D curve |r' x r''| / |r'|^3, 1/mm.
+    pub curvature_3d: f64,
+}
+
+/// Fits the spline through `points` and evaluates the local geometry at
+/// each of them.
+pub fn local_geometry(points: &[DVec3]) -> Result<Vec<LocalGeometry>> {
+    let spline = Spline::interpolate(points)?;
+    Ok(geometry_of(&spline))
+}
+
+/// The local geometry at each interpolated point of `spline`.
+pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
+    let mut out: Vec<LocalGeometry> = Vec::with_capacity(spline.params.len());
+    let mut vertical = Vec::new();
+    for (j, &u) in spline.params.iter().enumerate() {
+        let [_, d1, d2] = spline.derivs(u);
+        let len = d1.length();
+        let tangent = if len > 0.0 { d1 / len } else { DVec3::Z };
+        let h = d1.truncate().length();
+        let v = if h > 1e-9 * len {
+            DVec3::new(d1.x / h, d1.y / h, 0.0)
+        } else {
+            vertical.push(j);
+            DVec3::X
+        };
+        out.push(LocalGeometry {
+            tangent,
+            v,
+            n: DVec3::ZERO,
+            kappa: 0.0,
+            slope_rad: tangent.z.atan2(tangent.truncate().length()),
+            curvature_3d: if len > 0.0 {
+                d1.cross(d2).length() / (len * len * len)
+            } else {
+                0.0
+            },
+        });
+    }
+    // Where t is vertical, V is the neighbour's (spec section 5).
+    for &j in &vertical {
+        let from = (0..j)
+            .rev()
+            .chain(j + 1..out.len())
+            .find(|k| vertical.binary_search(k).is_err());
+        if let Some(k) = from {
+            out[j].v = out[k].v;
+        }
+    }
+    for (g, &u) in out.iter_mut().zip(&spline.params) {
+        let [_, d1, d2] = spline.derivs(u);
+        let a = g.tangent.truncate().length();
+        g.n = (-g.tangent.z * g.v + a * DVec3::Z).normalize_or(DVec3::Z);
+        // Signed curvature of the profile curve (s(u), z(u)) in the plane of V
+        // and Z: (s' z'' - z' s'') / (s'^2 + z'^2)^(3/2), which equals
+        // z_ss / (1 + z_s^2)^(3/2) of spec section 5 and stays finite where
+        // the path is vertical.
+        let (s1, z1) = (d1.dot(g.v), d1.z);
+        let (s2, z2) = (d2.dot(g.v), d2.z);
+        let den = (s1 * s1 + z1 * z1).powf(1.5);
+        g.kappa = if den > 0.0 {
+            (s1 * z2 - z1 * s2) / den
+        } else {
+            0.0
+        };
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolates_its_points() {
+        let pts: Vec<DVec3> = (0..20)
+            .map(|i| {
+                let x = i as f64 * 0.3;
+                DVec3::new(x, 0.1 * x * x, (x * 1.3).sin())
+            })
+            .collect();
+        let s = Spline::interpolate(&pts).unwrap();
+        for (p, &u) in pts.iter().zip(s.params()) {
+            assert!(
+                (s.eval(u) - *p).length() < 1e-10,
+                "{p:?} vs {:?}",
+                s.eval(u)
+            );
+        }
+    }
+
+    #[test]
+    fn two_and_three_points_work() {
+        let g = local_geometry(&[DVec3::ZERO, DVec3::new(1.0, 0.0, 1.0)]).unwrap();
+        assert!((g[0].slope_rad - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+        assert_eq!(g[0].kappa, 0.0);
+        let g = local_geometry(&[DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)]).unwrap();
+        assert!(g.iter().all(|g| g.kappa.abs() < 1e-12));
+    }
+
+    fn arc(r: f64, concave_up: bool) -> Vec<DVec3> {
+        // A circle of radius r in the x-z plane sampled every 0.3 mm of x.
+        (0..=20)
+            .map(|i| {
+                let x = -3.0 + i as f64 * 0.3;
+                let dz = r - (r * r - x * x).sqrt();
+                DVec3::new(x, 2.0, if concave_up { dz } else { -dz })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn curvature_sign_and_size_on_circular_arcs() {
+        for r in [5.0, 10.0] {
+            let up = local_geometry(&arc(r, true)).unwrap();
+            let down = local_geometry(&arc(r, false)).unwrap();
+            // Interior points: within 1% of +-1/R.
+            for j in 3..up.len() - 3 {
+                assert!((up[j].kappa * r - 1.0).abs() < 0.01, "{}", up[j].kappa * r);
+                assert!((down[j].kappa * r + 1.0).abs() < 0.01);
+                assert!((up[j].curvature_3d * r - 1.0).abs() < 0.01);
+                assert!(up[j].n.z > 0.0 && down[j].n.z > 0.0);
+                assert!((up[j].n.dot(up[j].tangent)).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn vertical_tangent_borrows_neighbours_direction() {
+        let pts = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 1.0),
+            DVec3::new(0.0, 1.0, 2.0),
+            DVec3::new(0.0, 2.0, 2.0),
+        ];
+        let g = local_geometry(&pts).unwrap();
+        for gj in &g {
+            assert!((gj.v.length() - 1.0).abs() < 1e-12);
+            assert_eq!(gj.v.z, 0.0);
+            assert!(gj.kappa.is_finite());
+        }
+    }
+
+    #[test]
+    fn coincident_points_are_an_error() {
+        let e = Spline::interpolate(&[DVec3::ZERO, DVec3::ZERO, DVec3::X]).unwrap_err();
+        assert!(e.to_string().contains("coincide"), "{e}");
+    }
+}

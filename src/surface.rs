@@ -1,1 +1,475 @@
-//! surface (in progress)
+//! The registered scan Sa with its acceleration structure: a parry3d BVH
+//! over the triangles, built once and shared by projection (spec section 4),
+//! the planners' disk and segment tests (section 6) and the quality
+//! prediction (section 7).
+//!
+//! The BVH holds f32 boxes rounded outward, so it only ever prunes; every
+//! exact test runs in f64 on the mesh's own vertices (projection must land
+//! within 1e-6 mm of the surface).
+
+use glam::{DVec2, DVec3, Vec3};
+use parry3d::bounding_volume::Aabb;
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode};
+
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// A scan in the printer frame, ready for queries.
+pub struct Surface {
+    mesh: TriMesh,
+    bvh: Bvh,
+    bbox: (DVec3, DVec3),
+}
+
+/// Where the horizontal tip disk C_j cuts the surface (spec section 6c).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiskContact {
+    /// The length-weighted centroid p_j of C_j ∩ S (lies in the disk's plane).
+    pub centroid: DVec3,
+    /// Total length of the cut inside the disk (0 for a touch at one point).
+    pub length_mm: f64,
+}
+
+impl std::fmt::Debug for Surface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Surface")
+            .field("triangles", &self.mesh.triangles.len())
+            .field("bbox", &self.bbox)
+            .finish()
+    }
+}
+
+/// f64 -> f32 rounded towards -inf / +inf, so an f32 box always contains
+/// the f64 triangle.
+fn f32_down(v: f64) -> f32 {
+    let f = v as f32;
+    if f as f64 > v {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn f32_up(v: f64) -> f32 {
+    let f = v as f32;
+    if (f as f64) < v {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+/// A query box in f64; `hits` tests it against a BVH node's f32 box.
+#[derive(Clone, Copy)]
+struct QueryBox {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl QueryBox {
+    #[inline]
+    fn hits(&self, node: &BvhNode) -> bool {
+        let (mins, maxs) = (node.mins(), node.maxs());
+        (mins.x as f64) <= self.hi.x
+            && (maxs.x as f64) >= self.lo.x
+            && (mins.y as f64) <= self.hi.y
+            && (maxs.y as f64) >= self.lo.y
+            && (mins.z as f64) <= self.hi.z
+            && (maxs.z as f64) >= self.lo.z
+    }
+}
+
+impl Surface {
+    /// Builds the BVH. The mesh must be non-empty with finite vertices (the
+    /// importers guarantee both; this re-checks for meshes built in code).
+    pub fn new(mesh: TriMesh) -> Result<Surface> {
+        let Some(bbox) = mesh.bbox() else {
+            return Err(Error::Plan("the scan has no triangles".into()));
+        };
+        if !(bbox.0.is_finite() && bbox.1.is_finite()) {
+            return Err(Error::Plan(
+                "the scan has a non-finite vertex coordinate".into(),
+            ));
+        }
+        let n = mesh.vertices.len();
+        let mut leaves = Vec::with_capacity(mesh.triangles.len());
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            if t.iter().any(|&k| k as usize >= n) {
+                return Err(Error::Plan(format!(
+                    "triangle {i} refers to a vertex past the {n} the scan has"
+                )));
+            }
+            let [a, b, c] = mesh.triangle(i);
+            let lo = a.min(b).min(c);
+            let hi = a.max(b).max(c);
+            leaves.push(Aabb::new(
+                Vec3::new(f32_down(lo.x), f32_down(lo.y), f32_down(lo.z)),
+                Vec3::new(f32_up(hi.x), f32_up(hi.y), f32_up(hi.z)),
+            ));
+        }
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
+        Ok(Surface { mesh, bvh, bbox })
+    }
+
+    pub fn mesh(&self) -> &TriMesh {
+        &self.mesh
+    }
+
+    /// Bounds of the scan in the printer frame.
+    pub fn bbox(&self) -> (DVec3, DVec3) {
+        self.bbox
+    }
+
+    /// Highest point of the scan: the G-code's safe height builds on it.
+    pub fn top_z(&self) -> f64 {
+        self.bbox.1.z
+    }
+
+    fn candidates(&self, q: QueryBox) -> impl Iterator<Item = usize> + '_ {
+        self.bvh.leaves(move |n| q.hits(n)).map(|i| i as usize)
+    }
+
+    /// z of the highest intersection of the vertical line through `xy` with
+    /// the scan (spec section 4), `None` if the line misses it.
+    pub fn highest_hit(&self, xy: DVec2) -> Option<f64> {
+        let q = QueryBox {
+            lo: DVec3::new(xy.x, xy.y, f64::NEG_INFINITY),
+            hi: DVec3::new(xy.x, xy.y, f64::INFINITY),
+        };
+        let mut best: Option<f64> = None;
+        for i in self.candidates(q) {
+            if let Some(z) = vertical_hit(self.mesh.triangle(i), xy) {
+                best = Some(best.map_or(z, |b: f64| b.max(z)));
+            }
+        }
+        best
+    }
+
+    /// The cut of the horizontal disk (centre `center`, `radius`) with the
+    /// scan: `None` when they do not meet (spec section 6c, C_j ∩ S).
+    pub fn disk_contact(&self, center: DVec3, radius: f64) -> Option<DiskContact> {
+        let q = QueryBox {
+            lo: center - DVec3::new(radius, radius, 0.0),
+            hi: center + DVec3::new(radius, radius, 0.0),
+        };
+        let mut weighted = DVec3::ZERO;
+        let mut length = 0.0;
+        let mut touches = DVec3::ZERO;
+        let mut touch_count = 0usize;
+        for i in self.candidates(q) {
+            for (p, s, w) in plane_cut(self.mesh.triangle(i), center.z) {
+                if let Some((a, b)) = clip_to_circle(p, s, center, radius) {
+                    let l = a.distance(b) * w;
+                    weighted += (a + b) * 0.5 * l;
+                    length += l;
+                    touches += a;
+                    touch_count += 1;
+                }
+            }
+        }
+        if touch_count == 0 {
+            return None;
+        }
+        let centroid = if length > 1e-12 {
+            weighted / length
+        } else {
+            touches / touch_count as f64
+        };
+        Some(DiskContact {
+            centroid,
+            length_mm: length,
+        })
+    }
+
+    /// The intersection of the segment [a, b] with the scan nearest to `a`
+    /// (spec eq. 12).
+    pub fn segment_first_hit(&self, a: DVec3, b: DVec3) -> Option<DVec3> {
+        let q = QueryBox {
+            lo: a.min(b),
+            hi: a.max(b),
+        };
+        let dir = b - a;
+        let mut best: Option<f64> = None;
+        for i in self.candidates(q) {
+            if let Some(t) = segment_triangle(a, dir, self.mesh.triangle(i)) {
+                if best.is_none_or(|b| t < b) {
+                    best = Some(t);
+                }
+            }
+        }
+        best.map(|t| a + dir * t)
+    }
+
+    /// The highest z of the scan over the horizontal disk of `radius` around
+    /// `xy` (the footprint of a vertical nozzle there), `None` if the scan has
+    /// nothing under it. The guarded planner's clearance rests on this.
+    pub fn max_height_in_disk(&self, xy: DVec2, radius: f64) -> Option<f64> {
+        let q = QueryBox {
+            lo: DVec3::new(xy.x - radius, xy.y - radius, f64::NEG_INFINITY),
+            hi: DVec3::new(xy.x + radius, xy.y + radius, f64::INFINITY),
+        };
+        let mut best: Option<f64> = None;
+        for i in self.candidates(q) {
+            if let Some(z) = triangle_max_z_in_disk(self.mesh.triangle(i), xy, radius) {
+                best = Some(best.map_or(z, |b: f64| b.max(z)));
+            }
+        }
+        best
+    }
+}
+
+/// Relative tolerance of the inclusive point-in-triangle tests, so a line
+/// through a shared edge or vertex is caught by at least one triangle.
+const EDGE_EPS: f64 = 1e-12;
+
+/// Barycentric weights of `p` in the XY projection of the triangle, `None`
+/// outside it or when the projection is degenerate (vertical triangle).
+fn barycentric_xy(t: [DVec3; 3], p: DVec2) -> Option<[f64; 3]> {
+    let [a, b, c] = t.map(|v| v.truncate());
+    let area = (b - a).perp_dot(c - a);
+    let scale = (b - a).length_squared().max((c - a).length_squared());
+    if area.abs() <= 1e-14 * scale || scale == 0.0 {
+        return None;
+    }
+    let w0 = (b - p).perp_dot(c - p) / area;
+    let w1 = (c - p).perp_dot(a - p) / area;
+    let w2 = 1.0 - w0 - w1;
+    let eps = EDGE_EPS * (1.0 + scale.sqrt());
+    (w0 >= -eps && w1 >= -eps && w2 >= -eps).then_some([w0, w1, w2])
+}
+
+fn vertical_hit(t: [DVec3; 3], xy: DVec2) -> Option<f64> {
+    let w = barycentric_xy(t, xy)?;
+    // Clamp so an inclusive edge hit never extrapolates past the edge.
+    let w = w.map(|x| x.clamp(0.0, 1.0));
+    let s = w[0] + w[1] + w[2];
+    Some((w[0] * t[0].z + w[1] * t[1].z + w[2] * t[2].z) / s)
+}
+
+/// The cut of a triangle by the plane z = `z`: zero, one point (a touch) or
+/// one segment, with a weight. An edge lying in the plane is cut by both
+/// triangles that share it, so each counts it half; a triangle lying in the
+/// plane gives its three edges, each at half weight.
+fn plane_cut(t: [DVec3; 3], z: f64) -> impl Iterator<Item = (DVec3, DVec3, f64)> {
+    let d = t.map(|v| v.z - z);
+    let mut out: [Option<(DVec3, DVec3, f64)>; 3] = [None; 3];
+    if d.iter().all(|&x| x == 0.0) {
+        for (k, slot) in out.iter_mut().enumerate() {
+            *slot = Some((t[k], t[(k + 1) % 3], 0.5));
+        }
+    } else if !(d.iter().all(|&x| x > 0.0) || d.iter().all(|&x| x < 0.0)) {
+        let mut pts: [DVec3; 3] = [DVec3::ZERO; 3];
+        let mut n = 0;
+        let on_plane = d.iter().filter(|&&x| x == 0.0).count();
+        for k in 0..3 {
+            let (i, j) = (k, (k + 1) % 3);
+            if d[i] == 0.0 {
+                pts[n] = t[i];
+                n += 1;
+            } else if (d[i] < 0.0) != (d[j] < 0.0) && d[j] != 0.0 {
+                let s = d[i] / (d[i] - d[j]);
+                let mut p = t[i] + (t[j] - t[i]) * s;
+                p.z = z;
+                pts[n] = p;
+                n += 1;
+            }
+            if n == 3 {
+                break;
+            }
+        }
+        let w = if on_plane == 2 { 0.5 } else { 1.0 };
+        match n {
+            1 => out[0] = Some((pts[0], pts[0], 1.0)),
+            2 | 3 => out[0] = Some((pts[0], pts[1], w)),
+            _ => {}
+        }
+    }
+    out.into_iter().flatten()
+}
+
+/// The part of the horizontal segment [p, q] within `radius` of `c` in XY.
+fn clip_to_circle(p: DVec3, q: DVec3, c: DVec3, radius: f64) -> Option<(DVec3, DVec3)> {
+    let d = (q - p).truncate();
+    let f = (p - c).truncate();
+    let a = d.length_squared();
+    if a == 0.0 {
+        return (f.length_squared() <= radius * radius).then_some((p, p));
+    }
+    let b = 2.0 * f.dot(d);
+    let cc = f.length_squared() - radius * radius;
+    let disc = b * b - 4.0 * a * cc;
+    if disc < 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    let t0 = ((-b - sq) / (2.0 * a)).max(0.0);
+    let t1 = ((-b + sq) / (2.0 * a)).min(1.0);
+    if t0 > t1 {
+        return None;
+    }
+    Some((p + (q - p) * t0, p + (q - p) * t1))
+}
+
+/// Two-sided Möller-Trumbore: parameter t in [0, 1] along `dir` from `o`.
+fn segment_triangle(o: DVec3, dir: DVec3, t: [DVec3; 3]) -> Option<f64> {
+    let e1 = t[1] - t[0];
+    let e2 = t[2] - t[0];
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    let scale = e1.length() * e2.length() * dir.length();
+    if det.abs() <= 1e-14 * scale || scale == 0.0 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - t[0];
+    let u = s.dot(p) * inv;
+    let qv = s.cross(e1);
+    let v = dir.dot(qv) * inv;
+    let eps = 1e-12;
+    if u < -eps || v < -eps || u + v > 1.0 + eps {
+        return None;
+    }
+    let tt = e2.dot(qv) * inv;
+    (-eps..=1.0 + eps).contains(&tt).then(|| tt.clamp(0.0, 1.0))
+}
+
+/// Highest z of the triangle over the XY disk: a linear function on the
+/// convex set triangle ∩ cylinder peaks at a triangle vertex inside the disk,
+/// where an edge crosses the circle, or where the circle meets the plane's
+/// steepest ascent (if that point lies in the triangle).
+fn triangle_max_z_in_disk(t: [DVec3; 3], c: DVec2, r: f64) -> Option<f64> {
+    let r2 = r * r;
+    let mut best: Option<f64> = None;
+    let mut take = |z: f64| best = Some(best.map_or(z, |b: f64| b.max(z)));
+    for k in 0..3 {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        if (a.truncate() - c).length_squared() <= r2 {
+            take(a.z);
+        }
+        let d = (b - a).truncate();
+        let f = a.truncate() - c;
+        let qa = d.length_squared();
+        if qa > 0.0 {
+            let qb = 2.0 * f.dot(d);
+            let qc = f.length_squared() - r2;
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let sq = disc.sqrt();
+                for s in [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] {
+                    if (0.0..=1.0).contains(&s) {
+                        take(a.z + (b.z - a.z) * s);
+                    }
+                }
+            }
+        }
+    }
+    // Interior candidates need a non-vertical plane z = g . xy + z0.
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    if n.z.abs() > 1e-14 * n.length() {
+        let g = DVec2::new(-n.x / n.z, -n.y / n.z);
+        let z_at = |p: DVec2| t[0].z + g.dot(p - t[0].truncate());
+        if barycentric_xy(t, c).is_some() {
+            take(z_at(c));
+        }
+        let gl = g.length();
+        if gl > 0.0 {
+            let p = c + g / gl * r;
+            if barycentric_xy(t, p).is_some() {
+                take(z_at(p));
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A height field z = f(x, y) on a regular grid, for tests.
+    pub(crate) fn grid(n: usize, size: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh {
+        let mut m = TriMesh::default();
+        let h = size / n as f64;
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, y) = (i as f64 * h, j as f64 * h);
+                m.vertices.push(DVec3::new(x, y, f(x, y)));
+            }
+        }
+        let w = (n + 1) as u32;
+        for j in 0..n as u32 {
+            for i in 0..n as u32 {
+                let a = j * w + i;
+                m.triangles.push([a, a + 1, a + w + 1]);
+                m.triangles.push([a, a + w + 1, a + w]);
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn highest_hit_on_a_plane_and_outside() {
+        let s = Surface::new(grid(10, 10.0, |x, y| 0.5 * x + 0.25 * y + 1.0)).unwrap();
+        let z = s.highest_hit(DVec2::new(3.3, 4.4)).unwrap();
+        assert!((z - (0.5 * 3.3 + 0.25 * 4.4 + 1.0)).abs() < 1e-12);
+        // On a grid vertex and on shared edges: still hit.
+        assert!(s.highest_hit(DVec2::new(5.0, 5.0)).is_some());
+        assert!(s.highest_hit(DVec2::new(5.0, 2.5)).is_some());
+        assert!(s.highest_hit(DVec2::new(-0.1, 5.0)).is_none());
+    }
+
+    #[test]
+    fn highest_of_two_layers_wins() {
+        let mut m = grid(2, 2.0, |_, _| 0.0);
+        let top = grid(2, 2.0, |_, _| 3.0);
+        let off = m.vertices.len() as u32;
+        m.vertices.extend(top.vertices);
+        m.triangles
+            .extend(top.triangles.iter().map(|t| t.map(|k| k + off)));
+        let s = Surface::new(m).unwrap();
+        assert_eq!(s.highest_hit(DVec2::new(1.2, 0.7)), Some(3.0));
+    }
+
+    #[test]
+    fn disk_contact_centroid_on_a_slope() {
+        // z = x: the plane z = 5 cuts along x = 5, a chord through a disk
+        // centred at (5.3, 5): centroid at x = 5, y = 5.
+        let s = Surface::new(grid(20, 10.0, |x, _| x)).unwrap();
+        let c = s.disk_contact(DVec3::new(5.3, 5.0, 5.0), 0.45).unwrap();
+        assert!((c.centroid - DVec3::new(5.0, 5.0, 5.0)).length() < 1e-9);
+        let chord = 2.0 * (0.45f64 * 0.45 - 0.3 * 0.3).sqrt();
+        assert!((c.length_mm - chord).abs() < 1e-9, "{}", c.length_mm);
+        assert!(s.disk_contact(DVec3::new(5.5, 5.0, 5.0), 0.45).is_none());
+    }
+
+    #[test]
+    fn segment_hit_nearest_first() {
+        let s = Surface::new(grid(10, 10.0, |x, _| x)).unwrap();
+        let p = s
+            .segment_first_hit(DVec3::new(2.0, 5.0, 5.0), DVec3::new(8.0, 5.0, 5.0))
+            .unwrap();
+        assert!((p - DVec3::new(5.0, 5.0, 5.0)).length() < 1e-9);
+        assert!(s
+            .segment_first_hit(DVec3::new(2.0, 5.0, 5.0), DVec3::new(4.0, 5.0, 5.0))
+            .is_none());
+    }
+
+    #[test]
+    fn max_height_over_a_footprint() {
+        let s = Surface::new(grid(20, 10.0, |x, y| 0.5 * x + 0.0 * y)).unwrap();
+        let z = s.max_height_in_disk(DVec2::new(5.0, 5.0), 1.0).unwrap();
+        assert!((z - 3.0).abs() < 1e-9, "{z}");
+        // A cone-ish bump: peak inside the disk dominates.
+        let s = Surface::new(grid(40, 10.0, |x, y| {
+            2.0 - ((x - 5.0).powi(2) + (y - 5.0).powi(2)).sqrt()
+        }))
+        .unwrap();
+        let z = s.max_height_in_disk(DVec2::new(5.2, 5.0), 0.5).unwrap();
+        assert!((z - 2.0).abs() < 1e-9, "{z}");
+    }
+
+    #[test]
+    fn empty_mesh_is_an_error() {
+        assert!(Surface::new(TriMesh::default()).is_err());
+    }
+}
