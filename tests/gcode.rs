@@ -1,1 +1,488 @@
-//! Integration tests: gcode.
+//! Integration tests: gcode. A small G-code reader reads each dialect's
+//! program back and checks what a machine would do with it: where the
+//! nozzle goes, at which feed, and whether the valve is open.
+
+use pcpp::gcode::{write_gcode, FeedUnits, GcodeError, GcodeJob, MachineProfile};
+use pcpp::DVec3;
+
+/// Half a unit in the last written digit at 3 decimals, plus float noise.
+const PRECISION_MM: f64 = 0.0005 + 1e-9;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Motion {
+    Rapid,
+    Linear,
+}
+
+/// Axes the program has not set yet are `None`.
+type Position = [Option<f64>; 3];
+
+#[derive(Debug, Clone)]
+struct Move {
+    motion: Motion,
+    from: Position,
+    to: Position,
+    /// The explicit F word of this line, if any.
+    feed_word: Option<f64>,
+    /// The modal feed in force for this move.
+    feed: Option<f64>,
+    line: usize,
+}
+
+#[derive(Debug, Clone)]
+enum Event {
+    Move(Move),
+    DispenseOn,
+    DispenseOff,
+}
+
+#[derive(Debug, Default)]
+struct Readback {
+    events: Vec<Event>,
+    comments: Vec<String>,
+    /// Lines that are neither motion, dispense blocks nor comments.
+    other: Vec<String>,
+}
+
+impl Readback {
+    /// The points of each print: the position at dispense-on, then the end
+    /// of every move made while dispensing.
+    fn prints(&self) -> Vec<Vec<DVec3>> {
+        let mut prints = Vec::new();
+        let mut current: Option<Vec<DVec3>> = None;
+        let mut position: Position = [None; 3];
+        for event in &self.events {
+            match event {
+                Event::DispenseOn => current = Some(vec![known(position)]),
+                Event::DispenseOff => prints.extend(current.take()),
+                Event::Move(m) => {
+                    position = m.to;
+                    if let Some(points) = current.as_mut() {
+                        points.push(known(position));
+                    }
+                }
+            }
+        }
+        assert!(current.is_none(), "program ends with the valve open");
+        prints
+    }
+
+    /// Moves made with the valve open.
+    fn print_moves(&self) -> Vec<&Move> {
+        let mut on = false;
+        let mut moves = Vec::new();
+        for event in &self.events {
+            match event {
+                Event::DispenseOn => on = true,
+                Event::DispenseOff => on = false,
+                Event::Move(m) if on => moves.push(m),
+                Event::Move(_) => {}
+            }
+        }
+        moves
+    }
+}
+
+fn known(p: Position) -> DVec3 {
+    match p {
+        [Some(x), Some(y), Some(z)] => DVec3::new(x, y, z),
+        _ => panic!("dispensing at an unknown position {p:?}"),
+    }
+}
+
+/// A G-code number as the writer must produce it: optional minus, digits,
+/// optional fraction; no exponent, no NaN or infinity.
+fn number(text: &str) -> Result<f64, String> {
+    let digits = text.strip_prefix('-').unwrap_or(text);
+    let plain = !digits.is_empty()
+        && digits.bytes().all(|b| b.is_ascii_digit() || b == b'.')
+        && digits.bytes().filter(|&b| b == b'.').count() <= 1
+        && !digits.starts_with('.')
+        && !digits.ends_with('.');
+    if !plain {
+        return Err(format!("not a plain decimal number: {text:?}"));
+    }
+    text.parse().map_err(|e| format!("{text:?}: {e}"))
+}
+
+/// Reads a program: G0/G1 with X Y Z F words and modal state, the profile's
+/// dispense blocks (matched line for line) and its comments.
+fn read(text: &str, profile: &MachineProfile) -> Result<Readback, String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let on: Vec<&str> = profile.dispense_on.iter().map(String::as_str).collect();
+    let off: Vec<&str> = profile.dispense_off.iter().map(String::as_str).collect();
+    let (prefix, suffix) = (&profile.comment.prefix, &profile.comment.suffix);
+    let mut out = Readback::default();
+    let mut position: Position = [None; 3];
+    let mut motion: Option<Motion> = None;
+    let mut feed: Option<f64> = None;
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if lines[i..].starts_with(&on) {
+            out.events.push(Event::DispenseOn);
+            i += on.len();
+            continue;
+        }
+        if lines[i..].starts_with(&off) {
+            out.events.push(Event::DispenseOff);
+            i += off.len();
+            continue;
+        }
+        if let Some(body) = line.strip_prefix(prefix.as_str()) {
+            let body = body
+                .strip_suffix(suffix.as_str())
+                .ok_or_else(|| format!("line {i}: unclosed comment {line:?}"))?;
+            if !suffix.is_empty()
+                && (body.contains(prefix.as_str()) || body.contains(suffix.as_str()))
+            {
+                return Err(format!("line {i}: nested comment {line:?}"));
+            }
+            out.comments.push(body.trim().to_string());
+            i += 1;
+            continue;
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let is_motion_line = words
+            .iter()
+            .any(|w| matches!(*w, "G0" | "G1" | "G00" | "G01") || w.starts_with(['X', 'Y', 'Z']));
+        if !is_motion_line {
+            out.other.push(line.to_string());
+            i += 1;
+            continue;
+        }
+        let mut to = position;
+        let mut feed_word = None;
+        for word in words {
+            let (letter, value) = word.split_at(1);
+            match letter {
+                "G" => match value {
+                    "0" | "00" => motion = Some(Motion::Rapid),
+                    "1" | "01" => motion = Some(Motion::Linear),
+                    _ => return Err(format!("line {i}: G{value} mixed with motion")),
+                },
+                "X" => to[0] = Some(number(value)?),
+                "Y" => to[1] = Some(number(value)?),
+                "Z" => to[2] = Some(number(value)?),
+                "F" => feed_word = Some(number(value)?),
+                _ => return Err(format!("line {i}: unexpected word {word:?}")),
+            }
+        }
+        feed = feed_word.or(feed);
+        let motion = motion.ok_or_else(|| format!("line {i}: axis words before G0/G1"))?;
+        out.events.push(Event::Move(Move {
+            motion,
+            from: position,
+            to,
+            feed_word,
+            feed,
+            line: i,
+        }));
+        position = to;
+        i += 1;
+    }
+    Ok(out)
+}
+
+/// Three subpaths over hills, a dot and an empty subpath.
+fn hills() -> Vec<Vec<DVec3>> {
+    let hill = |x: f64, y: f64| {
+        2.0 + 3.0 * (-((x - 30.0).powi(2) + (y - 25.0).powi(2)) / 60.0).exp()
+            + 0.4 * (x * 0.7).sin()
+    };
+    let line = |y: f64, n: usize| -> Vec<DVec3> {
+        (0..n)
+            .map(|i| {
+                let x = 10.0 + 40.0 * i as f64 / (n - 1) as f64 + 1e-4 / 3.0;
+                DVec3::new(x, y, hill(x, y))
+            })
+            .collect()
+    };
+    let mut back = line(25.123_456, 37);
+    back.reverse();
+    vec![
+        line(20.0, 41),
+        back,
+        vec![],
+        vec![DVec3::new(45.0, 40.0, hill(45.0, 40.0))],
+        line(31.000_49, 9),
+    ]
+}
+
+fn job<'a>(paths: &'a [Vec<DVec3>], header: &'a [(String, String)], dwell_s: f64) -> GcodeJob<'a> {
+    GcodeJob {
+        toolpaths: paths,
+        speed_mm_s: 5.0,
+        dwell_s,
+        header,
+        scan_top_z_mm: 6.0,
+    }
+}
+
+fn header() -> Vec<(String, String)> {
+    vec![
+        ("planner".into(), "tip-collision-free".into()),
+        ("nozzle".into(), "d = 0.603 mm, do = 0.908 mm".into()),
+        ("registration residual (mm)".into(), "0.012".into()),
+    ]
+}
+
+/// Everything the task asks of a program, for one profile.
+fn check_program(profile: &MachineProfile, dwell_s: f64) {
+    let paths = hills();
+    let header = header();
+    let job = job(&paths, &header, dwell_s);
+    let text = write_gcode(&job, profile).unwrap();
+    let name = &profile.name;
+    let lower = text.to_ascii_lowercase();
+    assert!(
+        !lower.contains("nan") && !lower.contains("inf"),
+        "{name}: NaN text\n{text}"
+    );
+    let back = read(&text, profile).unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+
+    // Provenance header: program and version, the job's pairs in order, the
+    // profile name.
+    let version = format!("pcpp {}", env!("CARGO_PKG_VERSION"));
+    assert_eq!(back.comments[0], version, "{name}");
+    let pairs: Vec<String> = header.iter().map(|(k, v)| format!("{k}: {v}")).collect();
+    let pairs: Vec<String> = match profile.comment.suffix.as_str() {
+        "" => pairs,
+        // Parenthesized comments do not nest and keep no commas.
+        _ => pairs
+            .iter()
+            .map(|p| p.replace(',', " ").replace('(', "[").replace(')', "]"))
+            .collect(),
+    };
+    assert_eq!(back.comments[1..4], pairs[..], "{name}");
+    assert_eq!(back.comments[4], format!("profile: {name}"), "{name}");
+
+    // The tool path is recovered to the written precision.
+    let expected: Vec<&Vec<DVec3>> = paths.iter().filter(|p| !p.is_empty()).collect();
+    let prints = back.prints();
+    assert_eq!(
+        prints.len(),
+        expected.len(),
+        "{name}: one print per subpath"
+    );
+    for (k, (got, want)) in prints.iter().zip(&expected).enumerate() {
+        assert_eq!(got.len(), want.len(), "{name}: print {k} point count");
+        for (j, (g, w)) in got.iter().zip(want.iter()).enumerate() {
+            let err = (*g - *w).abs().max_element();
+            assert!(
+                err <= PRECISION_MM,
+                "{name}: print {k} point {j}: {g} vs {w}"
+            );
+        }
+    }
+
+    // Print moves are linear at the print speed in the profile's units, and
+    // the first of each print carries the F word.
+    let print_feed = match profile.feed_units {
+        FeedUnits::MmPerMin => 300.0,
+        FeedUnits::MmPerS => 5.0,
+    };
+    let print_moves = back.print_moves();
+    assert_eq!(
+        print_moves.len(),
+        expected.iter().map(|p| p.len() - 1).sum::<usize>(),
+        "{name}"
+    );
+    for m in &print_moves {
+        assert_eq!(m.motion, Motion::Linear, "{name}: line {}", m.line);
+        assert_eq!(m.feed, Some(print_feed), "{name}: line {}", m.line);
+    }
+    let mut on = false;
+    let mut first = false;
+    for event in &back.events {
+        match event {
+            Event::DispenseOn => (on, first) = (true, true),
+            Event::DispenseOff => on = false,
+            Event::Move(m) if on => {
+                if first {
+                    assert_eq!(m.feed_word, Some(print_feed), "{name}: line {}", m.line);
+                }
+                first = false;
+            }
+            Event::Move(_) => {}
+        }
+    }
+
+    // Travel (valve closed): XY only changes at the safe height; the only
+    // moves below it are the descent straight into a print and the lift.
+    let top = paths
+        .iter()
+        .flatten()
+        .map(|p| p.z)
+        .fold(job.scan_top_z_mm, f64::max);
+    let safe = top + profile.safe_travel_clearance_mm;
+    let at_safe = |z: Option<f64>| z.is_some_and(|z| z >= safe - PRECISION_MM);
+    let mut on = false;
+    let mut travel_moves = 0;
+    for (k, event) in back.events.iter().enumerate() {
+        match event {
+            Event::DispenseOn => on = true,
+            Event::DispenseOff => on = false,
+            Event::Move(m) if !on => {
+                travel_moves += 1;
+                let xy_changes = m.from[0] != m.to[0] || m.from[1] != m.to[1];
+                if xy_changes {
+                    assert!(
+                        at_safe(m.from[2]) && at_safe(m.to[2]),
+                        "{name}: line {}: XY travel below the safe height {safe}: {m:?}",
+                        m.line
+                    );
+                }
+                if !at_safe(m.to[2]) {
+                    assert!(
+                        matches!(back.events.get(k + 1), Some(Event::DispenseOn)),
+                        "{name}: line {}: travel ends below the safe height",
+                        m.line
+                    );
+                }
+            }
+            Event::Move(_) => {}
+        }
+    }
+    assert!(travel_moves >= 3 * expected.len(), "{name}");
+    let last = back.events.iter().rev().find_map(|e| match e {
+        Event::Move(m) => Some(m),
+        _ => None,
+    });
+    assert!(
+        last.is_some_and(|m| at_safe(m.to[2])),
+        "{name}: ends at the safe height"
+    );
+
+    // Dwells: after each dispense-on and before each dispense-off.
+    let dwells = back
+        .other
+        .iter()
+        .filter(|l| l.starts_with("G4") || l.starts_with("DWELL"))
+        .count();
+    let expected_dwells = if dwell_s > 0.0 { 2 * expected.len() } else { 0 };
+    assert_eq!(dwells, expected_dwells, "{name}\n{text}");
+}
+
+#[test]
+fn every_builtin_dialect_reads_back_without_dwell() {
+    for name in MachineProfile::builtin_names() {
+        check_program(&MachineProfile::builtin(name).unwrap(), 0.0);
+    }
+}
+
+#[test]
+fn every_builtin_dialect_reads_back_with_dwell() {
+    for name in MachineProfile::builtin_names() {
+        check_program(&MachineProfile::builtin(name).unwrap(), 0.2);
+    }
+}
+
+#[test]
+fn feed_units_differ_by_dialect() {
+    let paths = hills();
+    let job = job(&paths, &[], 0.0);
+    let first_print_line = |name: &str| {
+        let profile = MachineProfile::builtin(name).unwrap();
+        let text = write_gcode(&job, &profile).unwrap();
+        let on = &profile.dispense_on[0];
+        let after_on = text.split(on.as_str()).nth(1).unwrap().to_string();
+        after_on.lines().nth(1).unwrap().to_string()
+    };
+    assert!(first_print_line("marlin").ends_with(" F300"));
+    assert!(first_print_line("grbl").ends_with(" F300"));
+    assert!(first_print_line("aerotech").ends_with(" F5"));
+}
+
+#[test]
+fn a_user_profile_with_spindle_valve_and_more_decimals_reads_back() {
+    // The documented alternative for Grbl: a valve on the spindle enable.
+    let mut json: serde_json::Value =
+        serde_json::from_str(&MachineProfile::builtin("grbl").unwrap().to_json().unwrap()).unwrap();
+    json["name"] = "grbl-spindle".into();
+    json["dispense_on"] = serde_json::json!(["M3 S1000", "G4 P0.05"]);
+    json["dispense_off"] = serde_json::json!(["M5"]);
+    json["comment"] = serde_json::json!({ "prefix": ";" });
+    json["decimals"] = 6.into();
+    let profile = MachineProfile::from_json(&json.to_string(), "grbl-spindle.json").unwrap();
+    check_program(&profile, 0.0);
+    check_program(&profile, 1.5);
+}
+
+#[test]
+fn out_of_volume_names_the_point_and_writes_nothing() {
+    for name in MachineProfile::builtin_names() {
+        let profile = MachineProfile::builtin(name).unwrap();
+        let mut paths = hills();
+        paths[4][3].x = profile.build_volume.max_mm.x + 1.0;
+        let result = write_gcode(&job(&paths, &header(), 0.0), &profile);
+        let Err(e) = result else {
+            panic!("{name}: an out-of-volume job was written");
+        };
+        assert!(
+            matches!(
+                e,
+                GcodeError::OutOfVolume {
+                    subpath: 4,
+                    point: 3,
+                    ..
+                }
+            ),
+            "{name}: {e:?}"
+        );
+        let message = e.to_string();
+        assert!(message.contains("subpath 4, point 3"), "{message}");
+        assert!(
+            message.contains(&profile.build_volume.to_string()),
+            "{message}"
+        );
+        assert!(message.contains(&format!("{}", paths[4][3].x)), "{message}");
+    }
+}
+
+#[test]
+fn nan_and_infinite_points_name_the_point_and_write_nothing() {
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        for name in MachineProfile::builtin_names() {
+            let profile = MachineProfile::builtin(name).unwrap();
+            let mut paths = hills();
+            paths[1][17].z = bad;
+            let Err(e) = write_gcode(&job(&paths, &[], 0.0), &profile) else {
+                panic!("{name}: a job with {bad} was written");
+            };
+            assert!(
+                matches!(
+                    e,
+                    GcodeError::NonFinitePoint {
+                        subpath: 1,
+                        point: 17,
+                        ..
+                    }
+                ),
+                "{name}: {e:?}"
+            );
+            assert!(e.to_string().contains("subpath 1, point 17"), "{e}");
+        }
+    }
+}
+
+#[test]
+fn the_reader_catches_what_it_is_meant_to_catch() {
+    // Guard against a reader that accepts anything.
+    let profile = MachineProfile::builtin("marlin").unwrap();
+    assert!(read("G1 X1e3 Y0 Z0", &profile).is_err());
+    assert!(read("G1 XNaN Y0 Z0", &profile).is_err());
+    assert!(read("X1 Y2", &profile).is_err());
+    let grbl = MachineProfile::builtin("grbl").unwrap();
+    assert!(read("( a ( b )", &grbl).is_err());
+    let back = read(
+        "G0 Z10\nG0 X5 Y5\nG1 Z1 F600\nM106 S255\nG1 X6 F300\nM107\nG0 Z10",
+        &profile,
+    )
+    .unwrap();
+    assert_eq!(
+        back.prints(),
+        [vec![DVec3::new(5.0, 5.0, 1.0), DVec3::new(6.0, 5.0, 1.0)]]
+    );
+    assert_eq!(back.print_moves()[0].feed, Some(300.0));
+}

@@ -1,0 +1,603 @@
+//! Machine profiles as data: one JSON file per controller dialect.
+//!
+//! Spec section 9: dialects differ in dispense commands, feed units, dwell
+//! and comments, so everything that differs lives in a profile a user can
+//! copy and edit, and the writer only knows G0/G1 with X Y Z F words, which
+//! all supported controllers share. The built-in profiles are the JSON files
+//! in `src/gcode/profiles/`, compiled in, so they go through the same loader
+//! and checks as a user's file.
+
+use glam::DVec3;
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+use super::template::{self, TemplateError};
+use super::GcodeError;
+
+/// Tokens the start, end and dispense blocks may use.
+pub const BLOCK_TOKENS: &[&str] = &["safe_z", "travel_f", "print_f"];
+/// Tokens the dwell template may use: the dwell in milliseconds (integer)
+/// and in seconds (3 decimals).
+pub const DWELL_TOKENS: &[&str] = &["ms", "s"];
+
+/// Digits after the decimal point when a profile does not say.
+pub const DEFAULT_DECIMALS: u32 = 3;
+
+/// Slowest and fastest feed a profile or job may ask for, in mm/s: below
+/// 0.001 mm/s the feed word rounds to zero, and no microextrusion stage
+/// travels at more than a metre a second.
+pub(crate) const FEED_RANGE_MM_S: (f64, f64) = (0.001, 1000.0);
+
+const BUILTINS: &[(&str, &str)] = &[
+    ("marlin", include_str!("profiles/marlin.json")),
+    ("aerotech", include_str!("profiles/aerotech.json")),
+    ("grbl", include_str!("profiles/grbl.json")),
+];
+
+/// The unit of the `F` word.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeedUnits {
+    /// RepRap/Marlin, Grbl, LinuxCNC (G94): 5 mm/s is `F300`.
+    MmPerMin,
+    /// Aerotech A3200 under `G76` (seconds time base): 5 mm/s is `F5`.
+    MmPerS,
+}
+
+impl FeedUnits {
+    /// `speed_mm_s` in this unit.
+    pub fn from_mm_s(self, speed_mm_s: f64) -> f64 {
+        match self {
+            FeedUnits::MmPerMin => speed_mm_s * 60.0,
+            FeedUnits::MmPerS => speed_mm_s,
+        }
+    }
+
+    /// `mm/min` or `mm/s`.
+    pub fn label(self) -> &'static str {
+        match self {
+            FeedUnits::MmPerMin => "mm/min",
+            FeedUnits::MmPerS => "mm/s",
+        }
+    }
+}
+
+/// How a comment is written: `prefix text suffix`, e.g. `;` and nothing, `'`
+/// and nothing, or `(` and `)`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CommentStyle {
+    pub prefix: String,
+    /// Empty for comments that run to the end of the line.
+    #[serde(default)]
+    pub suffix: String,
+}
+
+/// The axis-aligned box the nozzle may reach, in mm, printer frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildVolume {
+    pub min_mm: DVec3,
+    pub max_mm: DVec3,
+}
+
+impl BuildVolume {
+    /// Inclusive on every face.
+    pub fn contains(&self, p: DVec3) -> bool {
+        p.cmpge(self.min_mm).all() && p.cmple(self.max_mm).all()
+    }
+}
+
+impl std::fmt::Display for BuildVolume {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (a, b) = (self.min_mm, self.max_mm);
+        write!(
+            f,
+            "x {}..{}, y {}..{}, z {}..{} mm",
+            a.x, b.x, a.y, b.y, a.z, b.z
+        )
+    }
+}
+
+/// One controller dialect. Load with [`MachineProfile::from_json`] or
+/// [`MachineProfile::builtin`]; both validate. Block templates are lists of
+/// lines that may use the [`BLOCK_TOKENS`]; the dwell template may use the
+/// [`DWELL_TOKENS`]. Write `{{` and `}}` for literal braces.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MachineProfile {
+    pub name: String,
+    /// Free text for people choosing a profile (wiring, units, caveats).
+    pub description: String,
+    pub feed_units: FeedUnits,
+    /// Lines written after the header, e.g. units and absolute mode.
+    pub start: Vec<String>,
+    /// Lines written after the last lift.
+    pub end: Vec<String>,
+    /// Lines that open the dispenser valve.
+    pub dispense_on: Vec<String>,
+    /// Lines that close it.
+    pub dispense_off: Vec<String>,
+    /// One line, e.g. `G4 P{ms}`, `DWELL {s}` or `G4 P{s}`.
+    pub dwell: String,
+    pub comment: CommentStyle,
+    /// Travel height above the scan's highest point (and above the highest
+    /// tool-path point), so that travel cannot touch the part.
+    pub safe_travel_clearance_mm: f64,
+    /// Feed of the descent to each path start (and of G0 moves when
+    /// `rapid_feed_word` is set).
+    pub travel_feed_mm_s: f64,
+    /// Write the travel feed on G0 moves: Marlin moves G0 at the modal feed
+    /// rate, which would otherwise still be the slow print feed.
+    pub rapid_feed_word: bool,
+    pub build_volume: BuildVolume,
+    /// Digits after the decimal point of coordinates, 3 to 6.
+    pub decimals: u32,
+}
+
+impl MachineProfile {
+    /// Names accepted by [`MachineProfile::builtin`].
+    pub fn builtin_names() -> Vec<&'static str> {
+        BUILTINS.iter().map(|(name, _)| *name).collect()
+    }
+
+    /// A built-in profile by name (`marlin`, `aerotech`, `grbl`).
+    pub fn builtin(name: &str) -> Option<MachineProfile> {
+        let (_, text) = BUILTINS.iter().find(|(n, _)| *n == name)?;
+        // The files are compiled in and a unit test loads each one, so this
+        // cannot fail in a released build.
+        MachineProfile::from_json(text, &format!("{name}.json")).ok()
+    }
+
+    /// Reads and validates a profile. `file_name` only labels errors.
+    ///
+    /// Every field is required except `description` (empty), `suffix` of
+    /// `comment` (empty), `rapid_feed_word` (false) and `decimals` (3);
+    /// unknown fields are errors so that a misspelt field is not silently
+    /// ignored.
+    pub fn from_json(text: &str, file_name: &str) -> Result<MachineProfile, GcodeError> {
+        let value: Value = serde_json::from_str(text).map_err(|e| GcodeError::ProfileSyntax {
+            file: file_name.into(),
+            message: e.to_string(),
+        })?;
+        let Value::Object(map) = value else {
+            return Err(GcodeError::ProfileSyntax {
+                file: file_name.into(),
+                message: "expected a JSON object of profile fields".into(),
+            });
+        };
+        // Field by field rather than one derived Deserialize, so that a type
+        // error names the field instead of only a line and column.
+        let mut fields = Fields {
+            map,
+            file: file_name,
+        };
+        let profile = MachineProfile {
+            name: fields.required("name")?,
+            description: fields.optional("description")?.unwrap_or_default(),
+            feed_units: fields.required("feed_units")?,
+            start: fields.required("start")?,
+            end: fields.required("end")?,
+            dispense_on: fields.required("dispense_on")?,
+            dispense_off: fields.required("dispense_off")?,
+            dwell: fields.required("dwell")?,
+            comment: fields.required("comment")?,
+            safe_travel_clearance_mm: fields.required("safe_travel_clearance_mm")?,
+            travel_feed_mm_s: fields.required("travel_feed_mm_s")?,
+            rapid_feed_word: fields.optional("rapid_feed_word")?.unwrap_or(false),
+            build_volume: fields.required("build_volume")?,
+            decimals: fields.optional("decimals")?.unwrap_or(DEFAULT_DECIMALS),
+        };
+        fields.finish()?;
+        profile.validate(file_name)?;
+        Ok(profile)
+    }
+
+    /// The profile as pretty JSON that [`MachineProfile::from_json`] reads
+    /// back unchanged: the starting point for a user's own profile.
+    pub fn to_json(&self) -> Result<String, GcodeError> {
+        serde_json::to_string_pretty(self).map_err(|e| GcodeError::ProfileSyntax {
+            file: format!("{}.json", self.name),
+            message: e.to_string(),
+        })
+    }
+
+    /// Checks every field; `source` (a file name) labels the errors. The
+    /// writer calls this too, because the fields are public.
+    pub fn validate(&self, source: &str) -> Result<(), GcodeError> {
+        let bad = |field: &str, message: String| GcodeError::ProfileField {
+            file: source.into(),
+            field: field.into(),
+            message,
+        };
+        if self.name.trim().is_empty() || self.name.chars().any(char::is_control) {
+            return Err(bad("name", "must be non-empty text on one line".into()));
+        }
+        if !(3..=6).contains(&self.decimals) {
+            return Err(bad(
+                "decimals",
+                format!(
+                    "must be 3 to 6 (digits after the decimal point), got {}",
+                    self.decimals
+                ),
+            ));
+        }
+        let clearance = self.safe_travel_clearance_mm;
+        if !(clearance.is_finite() && clearance >= 0.0) {
+            return Err(bad(
+                "safe_travel_clearance_mm",
+                format!("must be a finite number >= 0 mm, got {clearance}"),
+            ));
+        }
+        let (lo, hi) = FEED_RANGE_MM_S;
+        let travel = self.travel_feed_mm_s;
+        if !(travel.is_finite() && (lo..=hi).contains(&travel)) {
+            return Err(bad(
+                "travel_feed_mm_s",
+                format!("must be between {lo} and {hi} mm/s, got {travel}"),
+            ));
+        }
+        let v = &self.build_volume;
+        if !(v.min_mm.is_finite() && v.max_mm.is_finite()) {
+            return Err(bad("build_volume", "must be finite".into()));
+        }
+        if !v.min_mm.cmplt(v.max_mm).all() {
+            return Err(bad(
+                "build_volume",
+                format!(
+                    "min_mm must be below max_mm on every axis, got {:?} and {:?}",
+                    v.min_mm.to_array(),
+                    v.max_mm.to_array()
+                ),
+            ));
+        }
+        let c = &self.comment;
+        if c.prefix.is_empty() {
+            return Err(bad("comment.prefix", "must not be empty".into()));
+        }
+        if c.prefix
+            .chars()
+            .chain(c.suffix.chars())
+            .any(char::is_control)
+        {
+            return Err(bad(
+                "comment",
+                "prefix and suffix must not contain line breaks or control characters".into(),
+            ));
+        }
+        if self.dispense_on.is_empty() {
+            return Err(bad("dispense_on", "needs at least one line".into()));
+        }
+        if self.dispense_off.is_empty() {
+            return Err(bad("dispense_off", "needs at least one line".into()));
+        }
+        let blocks = [
+            ("start", &self.start),
+            ("end", &self.end),
+            ("dispense_on", &self.dispense_on),
+            ("dispense_off", &self.dispense_off),
+        ];
+        for (field, lines) in blocks {
+            for (i, line) in lines.iter().enumerate() {
+                check_template(source, &format!("{field}[{i}]"), line, BLOCK_TOKENS)?;
+            }
+        }
+        if self.dwell.trim().is_empty() {
+            return Err(bad("dwell", "must not be empty".into()));
+        }
+        check_template(source, "dwell", &self.dwell, DWELL_TOKENS)
+    }
+}
+
+/// One template line: a single line (a line break would split one command
+/// into two, behind the writer's back) using only `known` tokens.
+fn check_template(source: &str, field: &str, line: &str, known: &[&str]) -> Result<(), GcodeError> {
+    if line.contains(['\n', '\r']) {
+        return Err(GcodeError::ProfileField {
+            file: source.into(),
+            field: field.into(),
+            message: "must be one line (use one list entry per line)".into(),
+        });
+    }
+    template::check(line, known).map_err(|e| template_error(source, field, e, known))
+}
+
+pub(crate) fn template_error(
+    source: &str,
+    field: &str,
+    error: TemplateError,
+    known: &[&str],
+) -> GcodeError {
+    let known_list = || {
+        known
+            .iter()
+            .map(|t| format!("{{{t}}}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    match error {
+        TemplateError::UnknownToken(token) => GcodeError::UnknownToken {
+            file: source.into(),
+            field: field.into(),
+            token,
+            known: known_list(),
+        },
+        TemplateError::UnclosedBrace => GcodeError::ProfileField {
+            file: source.into(),
+            field: field.into(),
+            message: "has a `{` without a matching `}` (write `{{` for a literal brace)".into(),
+        },
+        TemplateError::StrayCloseBrace => GcodeError::ProfileField {
+            file: source.into(),
+            field: field.into(),
+            message: "has a `}` without a matching `{` (write `}}` for a literal brace)".into(),
+        },
+    }
+}
+
+/// The fields of a profile object, taken one by one.
+struct Fields<'a> {
+    map: Map<String, Value>,
+    file: &'a str,
+}
+
+impl Fields<'_> {
+    fn optional<T: DeserializeOwned>(&mut self, key: &str) -> Result<Option<T>, GcodeError> {
+        let Some(value) = self.map.remove(key) else {
+            return Ok(None);
+        };
+        serde_json::from_value(value)
+            .map(Some)
+            .map_err(|e| GcodeError::ProfileField {
+                file: self.file.into(),
+                field: key.into(),
+                message: e.to_string(),
+            })
+    }
+
+    fn required<T: DeserializeOwned>(&mut self, key: &str) -> Result<T, GcodeError> {
+        self.optional(key)?.ok_or_else(|| GcodeError::ProfileField {
+            file: self.file.into(),
+            field: key.into(),
+            message: "missing".into(),
+        })
+    }
+
+    fn finish(self) -> Result<(), GcodeError> {
+        match self.map.keys().next() {
+            Some(key) => Err(GcodeError::ProfileField {
+                file: self.file.into(),
+                field: key.clone(),
+                message: "not a profile field (misspelt?)".into(),
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn marlin_json() -> Value {
+        serde_json::from_str(include_str!("profiles/marlin.json")).unwrap()
+    }
+
+    fn load(value: &Value) -> Result<MachineProfile, GcodeError> {
+        MachineProfile::from_json(&value.to_string(), "my.json")
+    }
+
+    fn load_err(edit: impl FnOnce(&mut Map<String, Value>)) -> String {
+        let mut v = marlin_json();
+        edit(v.as_object_mut().unwrap());
+        let e = load(&v).unwrap_err().to_string();
+        assert!(e.contains("my.json"), "error must name the file: {e}");
+        e
+    }
+
+    #[test]
+    fn every_builtin_loads() {
+        assert_eq!(
+            MachineProfile::builtin_names(),
+            ["marlin", "aerotech", "grbl"]
+        );
+        for name in MachineProfile::builtin_names() {
+            let text = BUILTINS.iter().find(|(n, _)| *n == name).unwrap().1;
+            let p = MachineProfile::from_json(text, name).unwrap();
+            assert_eq!(p.name, name);
+            assert_eq!(MachineProfile::builtin(name), Some(p));
+        }
+        assert_eq!(MachineProfile::builtin("makerbot"), None);
+    }
+
+    #[test]
+    fn builtin_dialects_match_their_controllers() {
+        let m = MachineProfile::builtin("marlin").unwrap();
+        assert_eq!(m.feed_units, FeedUnits::MmPerMin);
+        assert_eq!(m.dispense_on, ["M106 S255"]);
+        assert_eq!(m.dispense_off, ["M107"]);
+        assert_eq!(m.dwell, "G4 P{ms}");
+        assert!(m.start.starts_with(&["G21".into(), "G90".into()]));
+        let a = MachineProfile::builtin("aerotech").unwrap();
+        assert_eq!(a.feed_units, FeedUnits::MmPerS);
+        assert_eq!(a.dispense_on, ["$DO[0].X = 1"]);
+        assert_eq!(a.dwell, "DWELL {s}");
+        assert_eq!(a.comment.prefix, "'");
+        assert_eq!(a.end.last().map(String::as_str), Some("M2"));
+        let g = MachineProfile::builtin("grbl").unwrap();
+        assert_eq!(
+            (g.dispense_on[0].as_str(), g.dispense_off[0].as_str()),
+            ("M8", "M9")
+        );
+        assert_eq!(g.dwell, "G4 P{s}");
+        assert_eq!(
+            (g.comment.prefix.as_str(), g.comment.suffix.as_str()),
+            ("(", ")")
+        );
+    }
+
+    #[test]
+    fn json_round_trip_is_lossless() {
+        for name in MachineProfile::builtin_names() {
+            let p = MachineProfile::builtin(name).unwrap();
+            let text = p.to_json().unwrap();
+            assert_eq!(MachineProfile::from_json(&text, "copy.json").unwrap(), p);
+        }
+    }
+
+    #[test]
+    fn optional_fields_take_their_defaults() {
+        let mut v = marlin_json();
+        let map = v.as_object_mut().unwrap();
+        for key in ["description", "rapid_feed_word", "decimals"] {
+            map.remove(key);
+        }
+        map.insert("comment".into(), serde_json::json!({ "prefix": ";" }));
+        let p = load(&v).unwrap();
+        assert_eq!(p.description, "");
+        assert!(!p.rapid_feed_word);
+        assert_eq!(p.decimals, DEFAULT_DECIMALS);
+        assert_eq!(p.comment.suffix, "");
+    }
+
+    #[test]
+    fn validation_errors_name_file_and_field() {
+        let e = load_err(|m| {
+            m.insert("decimals".into(), 9.into());
+        });
+        assert!(e.contains("`decimals`") && e.contains("3 to 6"), "{e}");
+        let e = load_err(|m| {
+            m.insert("decimals".into(), 2.into());
+        });
+        assert!(e.contains("`decimals`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("safe_travel_clearance_mm".into(), (-1.0).into());
+        });
+        assert!(e.contains("`safe_travel_clearance_mm`"), "{e}");
+        let e = load_err(|m| {
+            m.insert(
+                "build_volume".into(),
+                serde_json::json!({ "min_mm": [0, 0, 10], "max_mm": [100, 100, 10] }),
+            );
+        });
+        assert!(e.contains("`build_volume`") && e.contains("below"), "{e}");
+        let e = load_err(|m| {
+            m.insert("feed_units".into(), "mm_per_hour".into());
+        });
+        assert!(
+            e.contains("`feed_units`") && e.contains("mm_per_hour"),
+            "{e}"
+        );
+        let e = load_err(|m| {
+            m.insert("travel_feed_mm_s".into(), 0.0.into());
+        });
+        assert!(e.contains("`travel_feed_mm_s`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("dispense_on".into(), serde_json::json!([]));
+        });
+        assert!(e.contains("`dispense_on`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("comment".into(), serde_json::json!({ "prefix": "" }));
+        });
+        assert!(e.contains("`comment.prefix`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("start".into(), serde_json::json!(["G21\nM3"]));
+        });
+        assert!(e.contains("`start[0]`") && e.contains("one line"), "{e}");
+    }
+
+    #[test]
+    fn type_errors_and_unknown_or_missing_fields_name_the_field() {
+        let e = load_err(|m| {
+            m.insert("decimals".into(), "three".into());
+        });
+        assert!(
+            e.contains("`decimals`") && e.contains("invalid type"),
+            "{e}"
+        );
+        let e = load_err(|m| {
+            m.insert("decimals".into(), (-1).into());
+        });
+        assert!(e.contains("`decimals`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("safe_clearance".into(), 5.into());
+        });
+        assert!(
+            e.contains("`safe_clearance`") && e.contains("not a profile field"),
+            "{e}"
+        );
+        let e = load_err(|m| {
+            m.remove("dwell");
+        });
+        assert!(e.contains("`dwell`") && e.contains("missing"), "{e}");
+        let e = load_err(|m| {
+            m.insert(
+                "comment".into(),
+                serde_json::json!({ "prefix": ";", "sufix": "" }),
+            );
+        });
+        assert!(e.contains("`comment`") && e.contains("sufix"), "{e}");
+    }
+
+    #[test]
+    fn unknown_template_tokens_fail_at_load_time() {
+        let e = load_err(|m| {
+            m.insert("dwell".into(), "G4 P{msec}".into());
+        });
+        assert!(e.contains("{msec}") && e.contains("`dwell`"), "{e}");
+        assert!(e.contains("{ms}"), "the error lists the known tokens: {e}");
+        // {ms} is a dwell token, not a block token.
+        let e = load_err(|m| {
+            m.insert(
+                "dispense_on".into(),
+                serde_json::json!(["M106 S255", "G4 P{ms}"]),
+            );
+        });
+        assert!(e.contains("{ms}") && e.contains("`dispense_on[1]`"), "{e}");
+        let e = load_err(|m| {
+            m.insert("end".into(), serde_json::json!(["G0 Z{safe_z"]));
+        });
+        assert!(
+            e.contains("`end[0]`") && e.contains("without a matching"),
+            "{e}"
+        );
+        // Known tokens and escaped braces load.
+        let mut v = marlin_json();
+        let map = v.as_object_mut().unwrap();
+        map.insert(
+            "end".into(),
+            serde_json::json!(["G0 Z{safe_z} F{travel_f}", "M117 {{done}}"]),
+        );
+        assert!(load(&v).is_ok());
+    }
+
+    #[test]
+    fn hostile_json_is_an_error_not_a_panic() {
+        for text in [
+            "",
+            "null",
+            "[]",
+            "{",
+            "{\"name\": 1e999}",
+            "\u{0}",
+            "{\"name\": \"x\", \"name\": \"y\"}",
+            &"[".repeat(10_000),
+        ] {
+            let e = MachineProfile::from_json(text, "evil.json").unwrap_err();
+            assert!(e.to_string().contains("evil.json"), "{e}");
+        }
+    }
+
+    #[test]
+    fn volume_contains_its_faces() {
+        let v = BuildVolume {
+            min_mm: DVec3::ZERO,
+            max_mm: DVec3::splat(10.0),
+        };
+        assert!(v.contains(DVec3::ZERO));
+        assert!(v.contains(DVec3::splat(10.0)));
+        assert!(!v.contains(DVec3::new(5.0, 10.001, 5.0)));
+        assert!(!v.contains(DVec3::new(-0.001, 5.0, 5.0)));
+        assert!(!v.contains(DVec3::new(f64::NAN, 5.0, 5.0)));
+        assert_eq!(v.to_string(), "x 0..10, y 0..10, z 0..10 mm");
+    }
+}

@@ -1,0 +1,529 @@
+//! The program: header, start block, one print per subpath, end block.
+
+use glam::DVec3;
+
+use super::format::{comment_line, fixed, trimmed};
+use super::profile::{template_error, MachineProfile, BLOCK_TOKENS, DWELL_TOKENS, FEED_RANGE_MM_S};
+use super::template;
+use super::GcodeError;
+
+/// Longest dwell a job may ask for, as in `Process::validate`.
+const MAX_DWELL_S: f64 = 600.0;
+
+/// What to write: the planned tool paths and the process, decoupled from
+/// the planner's own types.
+#[derive(Debug, Clone, Copy)]
+pub struct GcodeJob<'a> {
+    /// One array per subpath: the tool-path points T* (x, y, z) in mm,
+    /// printer frame. Empty subpaths are skipped; a single point prints a
+    /// dot (dispense on, dwell, off).
+    pub toolpaths: &'a [Vec<DVec3>],
+    /// Print speed, 0.001 to 1000 mm/s (the paper prints at 2.5-5 mm/s).
+    pub speed_mm_s: f64,
+    /// Dwell after dispense-on and before dispense-off, 0 to 600 s; 0 writes
+    /// no dwell.
+    pub dwell_s: f64,
+    /// Provenance key/value pairs, written as comments in this order.
+    pub header: &'a [(String, String)],
+    /// Highest point of the registered scan, printer frame: travel happens
+    /// at this plus the profile's clearance (spec section 9: "a safe height
+    /// above the highest point of Sa").
+    pub scan_top_z_mm: f64,
+}
+
+/// Writes the job as one program in the dialect of `profile`.
+///
+/// Checks first (profile fields, speed, dwell, every point finite and inside
+/// the build volume, the safe height too) and writes nothing on error. The
+/// output depends only on the inputs, so it can be compared with golden
+/// files.
+pub fn write_gcode(job: &GcodeJob, profile: &MachineProfile) -> Result<String, GcodeError> {
+    let source = format!("{} (in memory)", profile.name);
+    profile.validate(&source)?;
+    check_job(job)?;
+    let safe_z = checked_safe_height(job, profile)?;
+
+    let mut w = Program {
+        out: String::new(),
+        profile,
+        source,
+        decimals: profile.decimals,
+        safe_z: fixed(safe_z, profile.decimals),
+        travel_f: feed_word(profile, profile.travel_feed_mm_s),
+        print_f: feed_word(profile, job.speed_mm_s),
+    };
+    w.header(job, safe_z);
+    w.block("start", &profile.start)?;
+
+    let dwell = w.dwell_line(job.dwell_s)?;
+    // The writer does not know where the head is when the program starts,
+    // so the first motion is a pure rise; every print ends with a lift, so
+    // later travel starts at the safe height.
+    let mut at_safe_height = false;
+    let paths = job.toolpaths.iter().enumerate();
+    for (index, points) in paths.filter(|(_, p)| !p.is_empty()) {
+        if !at_safe_height {
+            w.rapid_z();
+            at_safe_height = true;
+        }
+        w.print(index, points, dwell.as_deref())?;
+    }
+    w.block("end", &profile.end)?;
+    Ok(w.out)
+}
+
+fn check_job(job: &GcodeJob) -> Result<(), GcodeError> {
+    let (lo, hi) = FEED_RANGE_MM_S;
+    if !(job.speed_mm_s.is_finite() && (lo..=hi).contains(&job.speed_mm_s)) {
+        return Err(GcodeError::Parameter {
+            name: "print speed (mm/s)",
+            value: job.speed_mm_s,
+            reason: format!("must be between {lo} and {hi} mm/s"),
+        });
+    }
+    if !(job.dwell_s.is_finite() && (0.0..=MAX_DWELL_S).contains(&job.dwell_s)) {
+        return Err(GcodeError::Parameter {
+            name: "dwell (s)",
+            value: job.dwell_s,
+            reason: format!("must be between 0 and {MAX_DWELL_S} s"),
+        });
+    }
+    if !job.scan_top_z_mm.is_finite() {
+        return Err(GcodeError::Parameter {
+            name: "scan top z (mm)",
+            value: job.scan_top_z_mm,
+            reason: "must be finite".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Checks every point, then returns the travel height: above the scan and
+/// above every tool-path point by the clearance, so that travel can touch
+/// neither the part nor a path planned above it.
+fn checked_safe_height(job: &GcodeJob, profile: &MachineProfile) -> Result<f64, GcodeError> {
+    let volume = profile.build_volume;
+    let mut top = job.scan_top_z_mm;
+    for (subpath, points) in job.toolpaths.iter().enumerate() {
+        for (point, &position) in points.iter().enumerate() {
+            if !position.is_finite() {
+                return Err(GcodeError::NonFinitePoint {
+                    subpath,
+                    point,
+                    position,
+                });
+            }
+            if !volume.contains(position) {
+                return Err(GcodeError::OutOfVolume {
+                    subpath,
+                    point,
+                    position,
+                    volume,
+                    profile: profile.name.clone(),
+                });
+            }
+            top = top.max(position.z);
+        }
+    }
+    let safe_z = top + profile.safe_travel_clearance_mm;
+    if !(volume.min_mm.z..=volume.max_mm.z).contains(&safe_z) {
+        return Err(GcodeError::SafeHeightOutOfVolume {
+            safe_z_mm: safe_z,
+            scan_top_z_mm: job.scan_top_z_mm,
+            clearance_mm: profile.safe_travel_clearance_mm,
+            volume,
+            profile: profile.name.clone(),
+        });
+    }
+    Ok(safe_z)
+}
+
+fn feed_word(profile: &MachineProfile, speed_mm_s: f64) -> String {
+    trimmed(profile.feed_units.from_mm_s(speed_mm_s), profile.decimals)
+}
+
+struct Program<'p> {
+    out: String,
+    profile: &'p MachineProfile,
+    /// Labels template errors (which cannot happen after `validate`).
+    source: String,
+    decimals: u32,
+    safe_z: String,
+    travel_f: String,
+    print_f: String,
+}
+
+impl Program<'_> {
+    fn line(&mut self, text: &str) {
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    fn comment(&mut self, text: &str) {
+        let line = comment_line(&self.profile.comment, text);
+        self.line(&line);
+    }
+
+    fn header(&mut self, job: &GcodeJob, safe_z: f64) {
+        self.comment(&format!("pcpp {}", env!("CARGO_PKG_VERSION")));
+        for (key, value) in job.header {
+            self.comment(&format!("{key}: {value}"));
+        }
+        self.comment(&format!("profile: {}", self.profile.name));
+        let units = self.profile.feed_units.label();
+        let print = format!(
+            "print feed: F{} {units} ({} mm/s)",
+            self.print_f, job.speed_mm_s
+        );
+        self.comment(&print);
+        self.comment(&format!("safe travel height: {} mm", fixed(safe_z, 3)));
+    }
+
+    fn fill(&self, field: &str, line: &str, extra: &[(&str, &str)]) -> Result<String, GcodeError> {
+        template::fill(line, |token| match token {
+            "safe_z" => Some(self.safe_z.clone()),
+            "travel_f" => Some(self.travel_f.clone()),
+            "print_f" => Some(self.print_f.clone()),
+            _ => extra
+                .iter()
+                .find(|(name, _)| *name == token)
+                .map(|(_, value)| value.to_string()),
+        })
+        .map_err(|e| {
+            let known = if field == "dwell" {
+                DWELL_TOKENS
+            } else {
+                BLOCK_TOKENS
+            };
+            template_error(&self.source, field, e, known)
+        })
+    }
+
+    fn block(&mut self, field: &str, lines: &[String]) -> Result<(), GcodeError> {
+        for (i, line) in lines.iter().enumerate() {
+            let text = self.fill(&format!("{field}[{i}]"), line, &[])?;
+            self.line(&text);
+        }
+        Ok(())
+    }
+
+    fn dwell_line(&self, dwell_s: f64) -> Result<Option<String>, GcodeError> {
+        if dwell_s <= 0.0 {
+            return Ok(None);
+        }
+        let ms = fixed(dwell_s * 1000.0, 0);
+        let s = fixed(dwell_s, 3);
+        self.fill("dwell", &self.profile.dwell, &[("ms", &ms), ("s", &s)])
+            .map(Some)
+    }
+
+    fn xyz(&self, p: DVec3) -> String {
+        let d = self.decimals;
+        format!("X{} Y{} Z{}", fixed(p.x, d), fixed(p.y, d), fixed(p.z, d))
+    }
+
+    /// `G0`, with the travel feed where the controller moves G0 at the modal
+    /// feed rate (Marlin).
+    fn rapid(&mut self, words: &str) {
+        let line = if self.profile.rapid_feed_word {
+            format!("G0 {words} F{}", self.travel_f)
+        } else {
+            format!("G0 {words}")
+        };
+        self.line(&line);
+    }
+
+    fn rapid_z(&mut self) {
+        let words = format!("Z{}", self.safe_z);
+        self.rapid(&words);
+    }
+
+    fn print(
+        &mut self,
+        index: usize,
+        points: &[DVec3],
+        dwell: Option<&str>,
+    ) -> Result<(), GcodeError> {
+        let [first, rest @ ..] = points else {
+            return Ok(());
+        };
+        let count = match points.len() {
+            1 => "1 point".to_string(),
+            n => format!("{n} points"),
+        };
+        self.comment(&format!("subpath {index}: {count}"));
+        // Travel over the first point at the safe height, then a vertical
+        // descent: XY only ever changes at the safe height while the valve
+        // is closed.
+        let over = format!(
+            "X{} Y{} Z{}",
+            fixed(first.x, self.decimals),
+            fixed(first.y, self.decimals),
+            self.safe_z
+        );
+        self.rapid(&over);
+        let descend = format!("G1 {} F{}", self.xyz(*first), self.travel_f);
+        self.line(&descend);
+        let profile = self.profile;
+        self.block("dispense_on", &profile.dispense_on)?;
+        if let Some(dwell) = dwell {
+            self.line(dwell);
+        }
+        for (i, p) in rest.iter().enumerate() {
+            let line = if i == 0 {
+                format!("G1 {} F{}", self.xyz(*p), self.print_f)
+            } else {
+                format!("G1 {}", self.xyz(*p))
+            };
+            self.line(&line);
+        }
+        if let Some(dwell) = dwell {
+            self.line(dwell);
+        }
+        self.block("dispense_off", &profile.dispense_off)?;
+        self.rapid_z();
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn job<'a>(paths: &'a [Vec<DVec3>], header: &'a [(String, String)]) -> GcodeJob<'a> {
+        GcodeJob {
+            toolpaths: paths,
+            speed_mm_s: 5.0,
+            dwell_s: 0.0,
+            header,
+            scan_top_z_mm: 10.0,
+        }
+    }
+
+    fn marlin() -> MachineProfile {
+        MachineProfile::builtin("marlin").unwrap()
+    }
+
+    fn line_path() -> Vec<Vec<DVec3>> {
+        vec![vec![
+            DVec3::new(10.0, 20.0, 1.0),
+            DVec3::new(11.0, 20.0, 1.5),
+            DVec3::new(12.0, 20.0, 1.25),
+        ]]
+    }
+
+    #[test]
+    fn marlin_program_reads_as_expected() {
+        let paths = line_path();
+        let header = [("planner".to_string(), "constant offset".to_string())];
+        let text = write_gcode(&job(&paths, &header), &marlin()).unwrap();
+        let version = env!("CARGO_PKG_VERSION");
+        let expected = format!(
+            "; pcpp {version}
+; planner: constant offset
+; profile: marlin
+; print feed: F300 mm/min (5 mm/s)
+; safe travel height: 15.000 mm
+G21
+G90
+M107
+G0 Z15.000 F3000
+; subpath 0: 3 points
+G0 X10.000 Y20.000 Z15.000 F3000
+G1 X10.000 Y20.000 Z1.000 F3000
+M106 S255
+G1 X11.000 Y20.000 Z1.500 F300
+G1 X12.000 Y20.000 Z1.250
+M107
+G0 Z15.000 F3000
+M107
+M84
+"
+        );
+        assert_eq!(text, expected);
+    }
+
+    #[test]
+    fn dwell_templates_per_dialect() {
+        let paths = line_path();
+        for (name, line) in [
+            ("marlin", "G4 P250"),
+            ("aerotech", "DWELL 0.250"),
+            ("grbl", "G4 P0.250"),
+        ] {
+            let mut j = job(&paths, &[]);
+            j.dwell_s = 0.25;
+            let text = write_gcode(&j, &MachineProfile::builtin(name).unwrap()).unwrap();
+            assert_eq!(
+                text.lines().filter(|l| *l == line).count(),
+                2,
+                "{name}\n{text}"
+            );
+        }
+    }
+
+    #[test]
+    fn block_tokens_are_filled() {
+        let paths = line_path();
+        let mut p = marlin();
+        p.end = vec!["G0 Z{safe_z} F{travel_f} ; then {print_f} {{x}}".into()];
+        let text = write_gcode(&job(&paths, &[]), &p).unwrap();
+        assert!(
+            text.ends_with("G0 Z15.000 F3000 ; then 300 {x}\n"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn safe_height_clears_points_above_the_scan() {
+        let paths = vec![vec![DVec3::new(10.0, 10.0, 12.0)]];
+        let text = write_gcode(&job(&paths, &[]), &marlin()).unwrap();
+        assert!(text.contains("G0 Z17.000"), "{text}");
+        assert!(!text.contains("Z15.000"), "{text}");
+    }
+
+    #[test]
+    fn a_single_point_is_a_dot_and_empty_subpaths_are_skipped() {
+        let paths = vec![vec![], vec![DVec3::new(10.0, 10.0, 1.0)], vec![]];
+        let mut j = job(&paths, &[]);
+        j.dwell_s = 0.5;
+        let text = write_gcode(&j, &marlin()).unwrap();
+        assert!(
+            text.contains("G1 X10.000 Y10.000 Z1.000 F3000\nM106 S255\nG4 P500\nG4 P500\nM107\n"),
+            "{text}"
+        );
+        assert_eq!(text.matches("; subpath").count(), 1, "{text}");
+    }
+
+    #[test]
+    fn no_paths_is_a_program_without_motion() {
+        let text = write_gcode(&job(&[], &[]), &marlin()).unwrap();
+        assert!(!text.contains("G0") && !text.contains("G1"), "{text}");
+        assert!(text.ends_with("M107\nM84\n"));
+    }
+
+    #[test]
+    fn out_of_volume_names_subpath_point_coordinates_and_volume() {
+        let mut paths = line_path();
+        paths.push(vec![
+            DVec3::new(10.0, 10.0, 1.0),
+            DVec3::new(-3.5, 10.0, 1.0),
+        ]);
+        let e = write_gcode(&job(&paths, &[]), &marlin()).unwrap_err();
+        assert!(matches!(
+            e,
+            GcodeError::OutOfVolume {
+                subpath: 1,
+                point: 1,
+                ..
+            }
+        ));
+        let m = e.to_string();
+        assert!(
+            m.contains("subpath 1, point 1") && m.contains("(-3.5, 10, 1)"),
+            "{m}"
+        );
+        assert!(m.contains("x 0..220, y 0..220, z 0..250"), "{m}");
+    }
+
+    #[test]
+    fn safe_height_above_the_volume_is_an_error() {
+        let paths = line_path();
+        let mut j = job(&paths, &[]);
+        j.scan_top_z_mm = 248.0;
+        let e = write_gcode(&j, &marlin()).unwrap_err();
+        assert!(matches!(e, GcodeError::SafeHeightOutOfVolume { .. }), "{e}");
+        assert!(e.to_string().contains("253"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_inputs_are_errors() {
+        let mut paths = line_path();
+        paths[0][2].y = f64::NAN;
+        let e = write_gcode(&job(&paths, &[]), &marlin()).unwrap_err();
+        assert!(matches!(
+            e,
+            GcodeError::NonFinitePoint {
+                subpath: 0,
+                point: 2,
+                ..
+            }
+        ));
+        assert!(e.to_string().contains("subpath 0, point 2"), "{e}");
+        let paths = line_path();
+        for (speed, dwell, top) in [
+            (f64::NAN, 0.0, 0.0),
+            (0.0, 0.0, 0.0),
+            (-5.0, 0.0, 0.0),
+            (f64::INFINITY, 0.0, 0.0),
+            (5.0, -1.0, 0.0),
+            (5.0, f64::NAN, 0.0),
+            (5.0, 0.0, f64::NEG_INFINITY),
+        ] {
+            let j = GcodeJob {
+                speed_mm_s: speed,
+                dwell_s: dwell,
+                scan_top_z_mm: top,
+                ..job(&paths, &[])
+            };
+            let e = write_gcode(&j, &marlin()).unwrap_err();
+            assert!(matches!(e, GcodeError::Parameter { .. }), "{e}");
+        }
+    }
+
+    #[test]
+    fn header_values_cannot_inject_commands() {
+        let paths = line_path();
+        let header = [
+            ("note\nM3".to_string(), "x\r\nG0 Z-50".to_string()),
+            ("paren".to_string(), "a) M3 (b".to_string()),
+        ];
+        for name in MachineProfile::builtin_names() {
+            let p = MachineProfile::builtin(name).unwrap();
+            let text = write_gcode(&job(&paths, &header), &p).unwrap();
+            for line in text.lines() {
+                assert!(
+                    !line.starts_with("M3") && !line.starts_with("G0 Z-50"),
+                    "{text}"
+                );
+            }
+        }
+        let grbl = MachineProfile::builtin("grbl").unwrap();
+        let text = write_gcode(&job(&paths, &header), &grbl).unwrap();
+        assert!(text.contains("( paren: a] M3 [b )"), "{text}");
+    }
+
+    #[test]
+    fn hand_built_invalid_profiles_are_rejected() {
+        let paths = line_path();
+        let mut p = marlin();
+        p.dwell = "G4 P{seconds}".into();
+        let e = write_gcode(&job(&paths, &[]), &p).unwrap_err();
+        assert!(e.to_string().contains("{seconds}"), "{e}");
+        let mut p = marlin();
+        p.decimals = 12;
+        assert!(write_gcode(&job(&paths, &[]), &p).is_err());
+    }
+
+    #[test]
+    fn negative_zero_and_rounding_noise_do_not_leak() {
+        let paths = vec![vec![
+            DVec3::new(-0.0, -0.0001, 1.0),
+            DVec3::new(1e-12, 2.0, 1.0),
+        ]];
+        let mut p = MachineProfile::builtin("grbl").unwrap();
+        p.decimals = 3;
+        let text = write_gcode(&job(&paths, &[]), &p).unwrap();
+        assert!(!text.contains("-0.000"), "{text}");
+        assert!(text.contains("G1 X0.000 Y0.000 Z1.000"), "{text}");
+        assert!(!text.contains("NaN"), "{text}");
+    }
+
+    #[test]
+    fn output_is_deterministic() {
+        let paths = line_path();
+        let a = write_gcode(&job(&paths, &[]), &marlin()).unwrap();
+        let b = write_gcode(&job(&paths, &[]), &marlin()).unwrap();
+        assert_eq!(a, b);
+    }
+}
