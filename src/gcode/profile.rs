@@ -28,6 +28,9 @@ pub const DEFAULT_DECIMALS: u32 = 3;
 /// travels at more than a metre a second.
 pub(crate) const FEED_RANGE_MM_S: (f64, f64) = (0.001, 1000.0);
 
+/// Largest build-volume coordinate magnitude, mm.
+const MAX_VOLUME_MM: f64 = 1.0e6;
+
 const BUILTINS: &[(&str, &str)] = &[
     ("marlin", include_str!("profiles/marlin.json")),
     ("aerotech", include_str!("profiles/aerotech.json")),
@@ -237,8 +240,14 @@ impl MachineProfile {
             ));
         }
         let v = &self.build_volume;
-        if !(v.min_mm.is_finite() && v.max_mm.is_finite()) {
-            return Err(bad("build_volume", "must be finite".into()));
+        // A kilometre bounds every real stage and keeps every coordinate
+        // the volume admits short when written in fixed notation.
+        let bounded = |p: DVec3| p.is_finite() && p.abs().max_element() <= MAX_VOLUME_MM;
+        if !(bounded(v.min_mm) && bounded(v.max_mm)) {
+            return Err(bad(
+                "build_volume",
+                format!("coordinates must be finite and within ±{MAX_VOLUME_MM} mm"),
+            ));
         }
         if !v.min_mm.cmplt(v.max_mm).all() {
             return Err(bad(
@@ -480,6 +489,13 @@ mod tests {
             );
         });
         assert!(e.contains("`build_volume`") && e.contains("below"), "{e}");
+        let e = load_err(|m| {
+            m.insert(
+                "build_volume".into(),
+                serde_json::json!({ "min_mm": [0, 0, 0], "max_mm": [1e300, 100, 10] }),
+            );
+        });
+        assert!(e.contains("`build_volume`") && e.contains("within"), "{e}");
         let e = load_err(|m| {
             m.insert("feed_units".into(), "mm_per_hour".into());
         });
