@@ -1,7 +1,10 @@
 //! The crate's error: one variant per pipeline stage, each wrapping that
 //! stage's own typed error (which carries the file, line or point at fault).
 
-use crate::{mesh::MeshError, registration::RegistrationError, svg::SvgError};
+use crate::{
+    gcode::GcodeError, mesh::MeshError, registration::RegistrationError, sampling::SamplingError,
+    svg::SvgError,
+};
 
 /// Any fatal error of the planning core. Recoverable oddities are not errors:
 /// they become warnings in the plan's report.
@@ -16,6 +19,12 @@ pub enum Error {
     /// The drawn path could not be read.
     #[error(transparent)]
     Svg(#[from] SvgError),
+    /// The drawn path could not be sampled.
+    #[error(transparent)]
+    Sampling(#[from] SamplingError),
+    /// The G-code could not be written (names the subpath and point).
+    #[error(transparent)]
+    Gcode(#[from] GcodeError),
     /// A parameter is out of its valid range (names the parameter and value).
     #[error("invalid parameter {name} = {value}: {reason}")]
     Parameter {

@@ -1,1 +1,278 @@
-//! pipeline (in progress)
+//! The pipeline, one function per stage, top to bottom:
+//! scan bytes -> [`load_scan`] -> (fiducials, registration) ->
+//! [`registered_surface`] -> SVG bytes -> [`load_path`] -> [`surface_path`]
+//! (placement, sampling, projection, spline) -> [`plan_surface_path`]
+//! (planner, quality, statistics) -> G-code.
+//!
+//! The planner-independent work ([`SurfacePath`]) is kept apart so that the
+//! four planners of a comparison, or a change of planner or tolerance, reuse
+//! it; the [`Surface`] (mesh + BVH) is only rebuilt when the scan or its
+//! registration changes.
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, TriMesh};
+use crate::params::{Nozzle, Process};
+use crate::planners::{plan_points, PlannerKind};
+use crate::projection::project_subpath;
+use crate::quality::{predict, summarize, PointQuality, QualitySummary};
+use crate::registration::Registration;
+use crate::sampling::try_sample_subpath;
+use crate::spline::{local_geometry, LocalGeometry};
+use crate::stats::{path_stats, PathStats};
+use crate::surface::Surface;
+use crate::svg::{import_svg_with_notes, Placement, Subpath2};
+
+/// What the user sets besides the two files. Defaults: the paper's.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PlanSettings {
+    pub nozzle: Nozzle,
+    pub process: Process,
+    pub planner: PlannerKind,
+    pub placement: Placement,
+}
+
+impl PlanSettings {
+    pub fn validate(&self) -> Result<()> {
+        self.nozzle.validate()?;
+        self.process.validate()?;
+        self.placement.validate()?;
+        Ok(())
+    }
+}
+
+/// Stage 1: the scan's bytes into a mesh in mm, +Z up (scanner frame).
+pub fn load_scan(bytes: &[u8], file: &str, options: &ImportOptions) -> Result<ImportedMesh> {
+    Ok(import_mesh(bytes, file, options)?)
+}
+
+/// Stage 2: Sa = G S, and the acceleration structure over it.
+pub fn registered_surface(mesh: &TriMesh, registration: &Registration) -> Result<Surface> {
+    let mut m = mesh.clone();
+    if registration.matrix != glam::DMat4::IDENTITY {
+        m.transform(&registration.matrix);
+    }
+    Surface::new(m)
+}
+
+/// A drawn path read from an SVG, with notes on what was skipped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DrawnPath {
+    pub subpaths: Vec<Subpath2>,
+    pub notes: Vec<String>,
+}
+
+/// Stage 3: the SVG's bytes into subpaths in mm (SVG frame, y up).
+pub fn load_path(bytes: &[u8], file: &str) -> Result<DrawnPath> {
+    let import = import_svg_with_notes(bytes, file)?;
+    Ok(DrawnPath {
+        subpaths: import.subpaths,
+        notes: import.notes,
+    })
+}
+
+/// One continuous piece of the surface path Ta with its local geometry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SurfacePiece {
+    pub source: String,
+    pub ta: Vec<DVec3>,
+    pub geometry: Vec<LocalGeometry>,
+}
+
+/// The planner-independent part of a plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SurfacePath {
+    pub pieces: Vec<SurfacePiece>,
+    pub warnings: Vec<String>,
+}
+
+/// Stage 4: placement, sampling at d/2 (spec section 3), projection
+/// (section 4) and the spline's local geometry (section 5).
+pub fn surface_path(
+    surface: &Surface,
+    drawn: &[Subpath2],
+    nozzle: &Nozzle,
+    placement: &Placement,
+) -> Result<SurfacePath> {
+    nozzle.validate()?;
+    placement.validate()?;
+    if drawn.is_empty() {
+        return Err(Error::Plan("the drawing has no path to print".into()));
+    }
+    let spacing = 0.5 * nozzle.inner_diameter_mm;
+    let mut warnings = Vec::new();
+    let mut pieces = Vec::new();
+    let mut any_sample = false;
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for sub in drawn {
+        // Sampled after placement so the spacing is d/2 in printer mm.
+        let placed = placement.apply_subpath(sub);
+        let samples = try_sample_subpath(&placed, spacing)?;
+        any_sample |= !samples.is_empty();
+        for p in &samples {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        for piece in project_subpath(
+            surface,
+            &sub.source,
+            &samples,
+            nozzle.outer_diameter_mm,
+            &mut warnings,
+        ) {
+            let geometry = local_geometry(&piece.points)
+                .map_err(|e| Error::Plan(format!("path '{}': {e}", piece.source)))?;
+            pieces.push(SurfacePiece {
+                source: piece.source,
+                ta: piece.points,
+                geometry,
+            });
+        }
+    }
+    if pieces.is_empty() {
+        let (slo, shi) = surface.bbox();
+        return Err(Error::Plan(if any_sample {
+            format!(
+                "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
+                 but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
+                 placement offset and the registration",
+                lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
+            )
+        } else {
+            "the drawing has no path to print".into()
+        }));
+    }
+    Ok(SurfacePath { pieces, warnings })
+}
+
+/// One planned piece: Ta, its geometry, T* and the predicted quality.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlannedPiece {
+    pub source: String,
+    pub surface_path: Vec<DVec3>,
+    pub toolpath: Vec<DVec3>,
+    pub geometry: Vec<LocalGeometry>,
+    pub quality: Vec<PointQuality>,
+}
+
+/// A planned tool path with its predicted quality and statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    pub planner: PlannerKind,
+    pub pieces: Vec<PlannedPiece>,
+    pub quality: QualitySummary,
+    pub stats: PathStats,
+    pub warnings: Vec<String>,
+    /// Points (piece, index, x, y, z) where the nozzle still meets the
+    /// surface; always empty for `pcpp-guarded` unless it failed.
+    pub uncleared: Vec<(usize, usize, DVec3)>,
+}
+
+/// Stage 5: a planner over a surface path, then quality (spec section 7)
+/// and statistics (section 8).
+pub fn plan_surface_path(
+    surface: &Surface,
+    sp: &SurfacePath,
+    planner: PlannerKind,
+    nozzle: &Nozzle,
+    process: &Process,
+) -> Plan {
+    let mut warnings = sp.warnings.clone();
+    let mut pieces = Vec::with_capacity(sp.pieces.len());
+    let mut uncleared = Vec::new();
+    let mut lifted = 0usize;
+    let mut max_lift: (f64, DVec3) = (0.0, DVec3::ZERO);
+    for (k, piece) in sp.pieces.iter().enumerate() {
+        let planned = plan_points(
+            planner,
+            surface,
+            &piece.ta,
+            &piece.geometry,
+            nozzle,
+            process,
+        );
+        for &(j, lift) in &planned.lifted {
+            // A lift of more than d leaves the filament floating: the nozzle is
+            // wider than the feature it must pass there.
+            if lift > nozzle.inner_diameter_mm {
+                lifted += 1;
+                if lift > max_lift.0 {
+                    max_lift = (lift, piece.ta[j]);
+                }
+            }
+        }
+        for &j in &planned.uncleared {
+            uncleared.push((k, j, planned.toolpath[j]));
+        }
+        let quality = predict(
+            surface,
+            &piece.ta,
+            &piece.geometry,
+            &planned.toolpath,
+            nozzle,
+            process,
+        );
+        pieces.push(PlannedPiece {
+            source: piece.source.clone(),
+            surface_path: piece.ta.clone(),
+            toolpath: planned.toolpath,
+            geometry: piece.geometry.clone(),
+            quality,
+        });
+    }
+    if lifted > 0 {
+        let p = max_lift.1;
+        warnings.push(format!(
+            "{lifted} point(s) where the nozzle (outer diameter {:.3} mm) is wider than the \
+             feature it must pass were lifted clear of the surface by more than d; the largest \
+             lift, {:.3} mm, is at ({:.3}, {:.3}, {:.3}); expect floating filament there",
+            nozzle.outer_diameter_mm, max_lift.0, p.x, p.y, p.z
+        ));
+    }
+    let quality = summarize(pieces.iter().flat_map(|p| &p.quality));
+    let stats = path_stats(
+        pieces
+            .iter()
+            .map(|p| (p.toolpath.as_slice(), p.geometry.as_slice())),
+        process.speed_mm_s,
+    );
+    Plan {
+        planner,
+        pieces,
+        quality,
+        stats,
+        warnings,
+        uncleared,
+    }
+}
+
+/// The whole plan from a registered surface and a drawn path.
+pub fn plan(surface: &Surface, drawn: &[Subpath2], settings: &PlanSettings) -> Result<Plan> {
+    settings.validate()?;
+    let sp = surface_path(surface, drawn, &settings.nozzle, &settings.placement)?;
+    Ok(plan_surface_path(
+        surface,
+        &sp,
+        settings.planner,
+        &settings.nozzle,
+        &settings.process,
+    ))
+}
+
+/// All four planners side by side (the paper's Figure 3e-f), sharing one
+/// surface path.
+pub fn compare(
+    surface: &Surface,
+    drawn: &[Subpath2],
+    settings: &PlanSettings,
+) -> Result<Vec<Plan>> {
+    settings.validate()?;
+    let sp = surface_path(surface, drawn, &settings.nozzle, &settings.placement)?;
+    Ok(PlannerKind::ALL
+        .iter()
+        .map(|&k| plan_surface_path(surface, &sp, k, &settings.nozzle, &settings.process))
+        .collect())
+}
