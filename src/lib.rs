@@ -34,6 +34,7 @@ pub mod demo;
 mod error;
 pub mod fiducials;
 pub mod gcode;
+pub mod job;
 pub mod mesh;
 pub mod params;
 pub mod pipeline;

@@ -1,0 +1,559 @@
+//! A whole planning job, bytes in, G-code and a JSON report out: the one
+//! entry the CLI and the page both call, so that for the same inputs and
+//! settings they write identical bytes.
+
+use glam::{DMat4, DVec3};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::error::{Error, Result};
+use crate::fiducials::find_fiducials;
+use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
+use crate::mesh::{ImportOptions, ImportedMesh};
+use crate::pipeline::{self, Plan, PlanSettings};
+use crate::planners::PlannerKind;
+use crate::quality::QualitySummary;
+use crate::registration::{register, Registration, RegistrationError, RegistrationMethod};
+use crate::stats::PathStats;
+use crate::surface::Surface;
+
+/// Where the scan's fiducials come from.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FiducialSource {
+    /// The scan is already in the printer frame: no registration.
+    #[default]
+    None,
+    /// The holes found in the scan, matched to the printer points in the
+    /// order that fits best.
+    Auto,
+    /// Points typed or picked by the user, scanner frame, in P's order.
+    Points(Vec<DVec3>),
+}
+
+/// How the scan is put in the printer frame.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RegistrationSettings {
+    pub fiducials: FiducialSource,
+    /// P: the fiducials in the printer frame (read off the controller).
+    pub printer_points: Vec<DVec3>,
+    pub method: RegistrationMethod,
+}
+
+/// Everything a job needs besides the bytes of its two files.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct JobSettings {
+    pub scan: ImportOptions,
+    pub registration: RegistrationSettings,
+    pub plan: PlanSettings,
+}
+
+/// Finds the registration the settings ask for.
+pub fn registration_for(
+    mesh: &ImportedMesh,
+    settings: &RegistrationSettings,
+) -> Result<Registration> {
+    let p = &settings.printer_points;
+    let scan_points: Vec<DVec3> = match &settings.fiducials {
+        FiducialSource::None if p.is_empty() => return Ok(Registration::identity()),
+        FiducialSource::None => {
+            return Err(Error::Registration(RegistrationError::TooFew(0)));
+        }
+        FiducialSource::Points(s) => s.clone(),
+        FiducialSource::Auto => {
+            return best_auto_match(mesh, p, settings.method);
+        }
+    };
+    Ok(register(&scan_points, p, settings.method)?)
+}
+
+/// How many hole candidates "auto" considers (smallest/roundest first).
+const AUTO_CANDIDATES: usize = 6;
+
+/// Tries every ordered choice of the best hole candidates against P and
+/// keeps the one with the lowest RMS: the user need not order the holes.
+fn best_auto_match(
+    mesh: &ImportedMesh,
+    printer: &[DVec3],
+    method: RegistrationMethod,
+) -> Result<Registration> {
+    let k = printer.len();
+    if k < 3 {
+        return Err(Error::Registration(RegistrationError::TooFew(k)));
+    }
+    let found = find_fiducials(&mesh.mesh);
+    let cands: Vec<DVec3> = found
+        .iter()
+        .take(AUTO_CANDIDATES.max(k))
+        .map(|f| f.centroid)
+        .collect();
+    if cands.len() < k {
+        return Err(Error::Plan(format!(
+            "fiducials auto: the scan has {} hole(s) that could be fiducials, but {k} printer \
+             points were given; give the scan points explicitly",
+            cands.len()
+        )));
+    }
+    let mut best: Option<Registration> = None;
+    let mut chosen = Vec::with_capacity(k);
+    let mut used = vec![false; cands.len()];
+    permute(&cands, k, &mut used, &mut chosen, &mut |scan| {
+        if let Ok(r) = register(scan, printer, method) {
+            if best.as_ref().is_none_or(|b| r.rms_mm < b.rms_mm) {
+                best = Some(r);
+            }
+        }
+    });
+    best.ok_or_else(|| {
+        Error::Plan(
+            "fiducials auto: no choice of the scan's holes registers onto the printer points"
+                .into(),
+        )
+    })
+}
+
+fn permute(
+    c: &[DVec3],
+    k: usize,
+    used: &mut [bool],
+    chosen: &mut Vec<DVec3>,
+    f: &mut impl FnMut(&[DVec3]),
+) {
+    if chosen.len() == k {
+        f(chosen);
+        return;
+    }
+    for i in 0..c.len() {
+        if !used[i] {
+            used[i] = true;
+            chosen.push(c[i]);
+            permute(c, k, used, chosen, f);
+            chosen.pop();
+            used[i] = false;
+        }
+    }
+}
+
+/// A file as the report names it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InputFile {
+    pub name: String,
+    pub bytes: usize,
+    pub sha256: String,
+}
+
+impl InputFile {
+    pub fn new(name: &str, bytes: &[u8]) -> Self {
+        let digest = Sha256::digest(bytes);
+        InputFile {
+            name: name.to_string(),
+            bytes: bytes.len(),
+            sha256: digest.iter().map(|b| format!("{b:02x}")).collect(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshReport {
+    pub triangles: usize,
+    /// [[minx, miny, minz], [maxx, maxy, maxz]], printer frame.
+    pub bbox_mm: [[f64; 3]; 2],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RegistrationReport {
+    pub method: RegistrationMethod,
+    /// 4 x 4, row-major, scanner -> printer.
+    pub matrix: [[f64; 4]; 4],
+    pub residuals_mm: Vec<f64>,
+    pub rms_mm: f64,
+}
+
+/// Per point of the plot of error against slope and curvature (Figure 3d).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PointSeries {
+    pub slope_deg: f64,
+    pub kappa_per_mm: f64,
+    /// `null` at a contact.
+    pub error_mm: Option<f64>,
+}
+
+/// The JSON report of one plan (the CLI's `--report`, the page's download).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    pub program: String,
+    pub version: String,
+    pub inputs: Vec<InputFile>,
+    pub mesh: MeshReport,
+    pub registration: RegistrationReport,
+    pub planner: PlannerKind,
+    pub settings: PlanSettings,
+    pub quality: QualitySummary,
+    pub stats: PathStats,
+    pub warnings: Vec<String>,
+    /// Ta, one array per printed piece.
+    pub surface_path: Vec<Vec<[f64; 3]>>,
+    /// T*, one array per printed piece.
+    pub toolpath: Vec<Vec<[f64; 3]>>,
+    /// (slope, curvature, error) per point, one array per piece.
+    pub series: Vec<Vec<PointSeries>>,
+    /// Defect per point ("good", "contact", ...), one array per piece.
+    pub defects: Vec<Vec<crate::quality::Defect>>,
+}
+
+fn row_major(m: &DMat4) -> [[f64; 4]; 4] {
+    let c = m.to_cols_array_2d();
+    std::array::from_fn(|r| std::array::from_fn(|k| c[k][r]))
+}
+
+fn arr(p: &DVec3) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+/// A scan loaded and registered: reused while only the path or the
+/// settings change.
+pub struct PreparedScan {
+    pub file: InputFile,
+    pub imported: ImportedMesh,
+    pub registration: Registration,
+    pub method: RegistrationMethod,
+    pub surface: Surface,
+}
+
+/// Import, register and index a scan.
+pub fn prepare_scan(
+    bytes: &[u8],
+    name: &str,
+    scan: &ImportOptions,
+    registration: &RegistrationSettings,
+) -> Result<PreparedScan> {
+    let imported = pipeline::load_scan(bytes, name, scan)?;
+    let reg = registration_for(&imported, registration)?;
+    let surface = pipeline::registered_surface(&imported.mesh, &reg)?;
+    Ok(PreparedScan {
+        file: InputFile::new(name, bytes),
+        imported,
+        registration: reg,
+        method: registration.method,
+        surface,
+    })
+}
+
+/// The result of a job: the plan, its report, and the G-code text.
+pub struct JobOutput {
+    pub plan: Plan,
+    pub report: Report,
+    pub gcode: String,
+}
+
+/// Builds the report of a plan.
+pub fn report(
+    scan: &PreparedScan,
+    path_file: &InputFile,
+    plan: &Plan,
+    settings: &PlanSettings,
+) -> Report {
+    let (lo, hi) = scan.surface.bbox();
+    let mut warnings = scan.imported.warnings.clone();
+    warnings.extend(scan.registration.notes.iter().cloned());
+    warnings.extend(plan.warnings.iter().cloned());
+    Report {
+        program: "pcpp".into(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        inputs: vec![scan.file.clone(), path_file.clone()],
+        mesh: MeshReport {
+            triangles: scan.imported.mesh.triangle_count(),
+            bbox_mm: [arr(&lo), arr(&hi)],
+        },
+        registration: RegistrationReport {
+            method: scan.method,
+            matrix: row_major(&scan.registration.matrix),
+            residuals_mm: scan.registration.residuals_mm.clone(),
+            rms_mm: scan.registration.rms_mm,
+        },
+        planner: plan.planner,
+        settings: *settings,
+        quality: plan.quality,
+        stats: plan.stats,
+        warnings,
+        surface_path: plan
+            .pieces
+            .iter()
+            .map(|p| p.surface_path.iter().map(arr).collect())
+            .collect(),
+        toolpath: plan
+            .pieces
+            .iter()
+            .map(|p| p.toolpath.iter().map(arr).collect())
+            .collect(),
+        series: plan
+            .pieces
+            .iter()
+            .map(|p| {
+                p.geometry
+                    .iter()
+                    .zip(&p.quality)
+                    .map(|(g, q)| PointSeries {
+                        slope_deg: g.slope_rad.to_degrees(),
+                        kappa_per_mm: g.kappa,
+                        error_mm: q.error_mm,
+                    })
+                    .collect()
+            })
+            .collect(),
+        defects: plan
+            .pieces
+            .iter()
+            .map(|p| p.quality.iter().map(|q| q.defect).collect())
+            .collect(),
+    }
+}
+
+fn fmt_summary(q: &QualitySummary) -> String {
+    format!(
+        "mean |e| {:.4} mm, mean e- {:.4} mm, mean e+ {:.4} mm, contact {:.2}%, flattening {:.2}%, floating {:.2}%",
+        q.mean_abs_error_mm,
+        q.mean_negative_error_mm,
+        q.mean_positive_error_mm,
+        q.contact_pct,
+        q.flattening_pct,
+        q.floating_pct
+    )
+}
+
+/// The provenance header of the G-code (spec section 9).
+pub fn provenance(report: &Report) -> Vec<(String, String)> {
+    let s = &report.settings;
+    let mut h: Vec<(String, String)> = Vec::new();
+    for (k, f) in ["scan", "path"].iter().zip(&report.inputs) {
+        h.push((
+            format!("{k} file"),
+            format!("{} ({} bytes, sha256 {})", f.name, f.bytes, f.sha256),
+        ));
+    }
+    h.push((
+        "nozzle".into(),
+        format!(
+            "d {} mm, do {} mm",
+            s.nozzle.inner_diameter_mm, s.nozzle.outer_diameter_mm
+        ),
+    ));
+    h.push((
+        "process".into(),
+        format!(
+            "tol {} mm, speed {} mm/s, dwell {} s",
+            s.process.tolerance_mm, s.process.speed_mm_s, s.process.dwell_s
+        ),
+    ));
+    h.push((
+        "placement".into(),
+        format!(
+            "offset ({}, {}) mm, rotation {} deg, scale {}",
+            s.placement.offset_mm.x,
+            s.placement.offset_mm.y,
+            s.placement.rotation_deg,
+            s.placement.scale
+        ),
+    ));
+    h.push(("planner".into(), report.planner.name().into()));
+    let m = &report.registration.matrix;
+    h.push((
+        "registration".into(),
+        format!(
+            "{} [{}]",
+            report.registration.method.name(),
+            m.iter()
+                .map(|r| r
+                    .iter()
+                    .map(|v| format!("{v:.6}"))
+                    .collect::<Vec<_>>()
+                    .join(" "))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ),
+    ));
+    h.push((
+        "residuals".into(),
+        format!(
+            "[{}] mm, rms {:.4} mm",
+            report
+                .registration
+                .residuals_mm
+                .iter()
+                .map(|r| format!("{r:.4}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            report.registration.rms_mm
+        ),
+    ));
+    let st = &report.stats;
+    h.push((
+        "path".into(),
+        format!(
+            "{} piece(s), {} points, {:.3} mm, height change {:.3} mm, max inclination {:.1} deg, \
+             min radius {:.3} mm, print time {:.1} s",
+            st.subpaths,
+            st.points,
+            st.length_mm,
+            st.height_change_mm,
+            st.max_inclination_deg,
+            st.min_radius_mm,
+            st.print_time_s
+        ),
+    ));
+    h.push(("predicted quality".into(), fmt_summary(&report.quality)));
+    h.push(("warnings".into(), report.warnings.len().to_string()));
+    h
+}
+
+/// Plans on a prepared scan and writes the G-code. Refuses (no G-code) when
+/// the guarded planner could not clear some point, unless `accept_risk`.
+pub fn run_on(
+    scan: &PreparedScan,
+    svg: &[u8],
+    svg_name: &str,
+    settings: &PlanSettings,
+    profile: &MachineProfile,
+    accept_risk: bool,
+) -> Result<JobOutput> {
+    settings.validate()?;
+    let drawn = pipeline::load_path(svg, svg_name)?;
+    let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
+    if !plan.uncleared.is_empty() && !accept_risk {
+        let list: Vec<String> = plan
+            .uncleared
+            .iter()
+            .take(10)
+            .map(|(k, j, p)| {
+                format!(
+                    "piece {k} point {j} at ({:.3}, {:.3}, {:.3})",
+                    p.x, p.y, p.z
+                )
+            })
+            .collect();
+        return Err(Error::Plan(format!(
+            "the nozzle would still touch the surface at {} point(s): {}; no G-code written",
+            plan.uncleared.len(),
+            list.join("; ")
+        )));
+    }
+    let path_file = InputFile::new(svg_name, svg);
+    let mut report = report(scan, &path_file, &plan, settings);
+    report.warnings.extend(drawn.notes);
+    let header = provenance(&report);
+    let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.toolpath.clone()).collect();
+    let gcode = write_gcode(
+        &GcodeJob {
+            toolpaths: &toolpaths,
+            speed_mm_s: settings.process.speed_mm_s,
+            dwell_s: settings.process.dwell_s,
+            header: &header,
+            scan_top_z_mm: scan.surface.top_z(),
+        },
+        profile,
+    )?;
+    Ok(JobOutput {
+        plan,
+        report,
+        gcode,
+    })
+}
+
+/// Plans from bytes: the CLI's `plan` and the page's Plan button.
+pub fn run(
+    scan: &[u8],
+    scan_name: &str,
+    svg: &[u8],
+    svg_name: &str,
+    settings: &JobSettings,
+    profile: &MachineProfile,
+    accept_risk: bool,
+) -> Result<JobOutput> {
+    settings.plan.validate()?;
+    let prepared = prepare_scan(scan, scan_name, &settings.scan, &settings.registration)?;
+    run_on(
+        &prepared,
+        svg,
+        svg_name,
+        &settings.plan,
+        profile,
+        accept_risk,
+    )
+}
+
+/// The four planners' summaries side by side (the paper's Figure 3e-f).
+pub fn compare_on(
+    scan: &PreparedScan,
+    svg: &[u8],
+    svg_name: &str,
+    settings: &PlanSettings,
+) -> Result<Vec<(PlannerKind, QualitySummary)>> {
+    let drawn = pipeline::load_path(svg, svg_name)?;
+    let plans = pipeline::compare(&scan.surface, &drawn.subpaths, settings)?;
+    Ok(plans.into_iter().map(|p| (p.planner, p.quality)).collect())
+}
+
+/// The comparison as a plain-text table.
+pub fn comparison_table(rows: &[(PlannerKind, QualitySummary)]) -> String {
+    let mut s = format!(
+        "{:<13} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8}\n",
+        "planner", "mean|e|", "mean e-", "mean e+", "contact", "flatten", "floating"
+    );
+    for (k, q) in rows {
+        s.push_str(&format!(
+            "{:<13} {:>9.4} {:>9.4} {:>9.4} {:>7.2}% {:>7.2}% {:>7.2}%\n",
+            k.name(),
+            q.mean_abs_error_mm,
+            q.mean_negative_error_mm,
+            q.mean_positive_error_mm,
+            q.contact_pct,
+            q.flattening_pct,
+            q.floating_pct
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::demo::test_part;
+
+    #[test]
+    fn matrix_is_row_major() {
+        let m = DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0));
+        let r = row_major(&m);
+        assert_eq!(r[0][3], 1.0);
+        assert_eq!(r[2][3], 3.0);
+        assert_eq!(r[3], [0.0, 0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn auto_fiducials_find_the_demo_holes_in_any_order() {
+        let mut mesh = test_part::test_part();
+        // Put the scan in a "scanner frame": turned and moved.
+        let g = DMat4::from_translation(DVec3::new(-30.0, 12.0, 4.0)) * DMat4::from_rotation_z(0.7);
+        mesh.transform(&g);
+        let imported = ImportedMesh {
+            mesh,
+            format: crate::mesh::MeshFormat::Obj,
+            units: crate::mesh::ScanUnits::Mm,
+            up_axis: crate::mesh::UpAxis::Z,
+            warnings: vec![],
+        };
+        let mut p = test_part::FIDUCIALS_MM.to_vec();
+        p.swap(0, 2);
+        let settings = RegistrationSettings {
+            fiducials: FiducialSource::Auto,
+            printer_points: p.clone(),
+            method: RegistrationMethod::Lsq,
+        };
+        let r = registration_for(&imported, &settings).unwrap();
+        assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
+        // The recovered G is the inverse of the turn applied.
+        let back = r.matrix * g;
+        assert!(back.abs_diff_eq(DMat4::IDENTITY, 1e-2), "{back:?}");
+    }
+}
