@@ -15,7 +15,7 @@ use glam::{DMat4, DQuat, DVec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
-use gltf::{Accessor, Gltf, Mesh, Node};
+use gltf::{Accessor, Document, Mesh, Node};
 
 use super::import::{Parsed, Welder};
 use super::MeshError;
@@ -27,9 +27,18 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
 );
 
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
-    let gltf = Gltf::from_slice(bytes)
-        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
-    let buffers = load_buffers(&gltf, file)?;
+    let not_gltf = |e: &dyn std::fmt::Display| {
+        MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}"))
+    };
+    let (json, blob) = if bytes.starts_with(b"glTF") {
+        split_glb(bytes, file)?
+    } else {
+        (bytes, None)
+    };
+    let root = gltf::json::Root::from_slice(json).map_err(|e| not_gltf(&e))?;
+    check_position_accessors(&root, file)?;
+    let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
+    let buffers = load_buffers(&gltf, blob, file)?;
     let mut scene = SceneReader {
         file,
         buffers,
@@ -86,12 +95,94 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     })
 }
 
-fn load_buffers<'a>(gltf: &'a Gltf, file: &str) -> Result<Vec<Cow<'a, [u8]>>, MeshError> {
+/// The JSON and BIN chunks of a GLB container. Split here with checked
+/// lengths: `gltf::Glb::from_slice` subtracts an unchecked header length,
+/// which overflows on a hostile file.
+fn split_glb<'b>(bytes: &'b [u8], file: &str) -> Result<(&'b [u8], Option<&'b [u8]>), MeshError> {
+    let bad =
+        |message: String| MeshError::invalid(file, format!("not a valid GLB file: {message}"));
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .and_then(|b| <[u8; 4]>::try_from(b).ok())
+            .map(u32::from_le_bytes)
+    };
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err(bad(format!("{} bytes, the header needs 12", bytes.len())));
+    };
+    if version != 2 {
+        return Err(bad(format!("version {version}, only glTF 2.0 is read")));
+    }
+    if length as usize > bytes.len() {
+        return Err(bad(format!(
+            "the header declares {length} bytes, the file has {} (truncated file?)",
+            bytes.len()
+        )));
+    }
+    let mut at = 12usize;
+    let mut json = None;
+    let mut bin = None;
+    while at < length as usize {
+        let (Some(chunk_length), Some(kind)) = (word(at), word(at + 4)) else {
+            return Err(bad(format!("chunk header at byte {at} is truncated")));
+        };
+        let start = at + 8;
+        let data = start
+            .checked_add(chunk_length as usize)
+            .filter(|&end| end <= length as usize)
+            .and_then(|end| bytes.get(start..end))
+            .ok_or_else(|| {
+                bad(format!(
+                    "chunk at byte {at} declares {chunk_length} bytes, past the end of the file \
+                     (truncated file?)"
+                ))
+            })?;
+        match &kind.to_le_bytes() {
+            b"JSON" if json.is_none() => json = Some(data),
+            b"BIN\0" if json.is_some() && bin.is_none() => bin = Some(data),
+            // Unknown chunks must be ignored (glTF spec 4.4.3.1).
+            _ => {}
+        }
+        at = start + data.len();
+    }
+    let json = json.ok_or_else(|| bad("no JSON chunk".into()))?;
+    Ok((json, bin))
+}
+
+/// `gltf-json`'s validation indexes the accessor list with each POSITION
+/// attribute's index before checking it (a panic on a hostile file), so
+/// those indices are checked first.
+fn check_position_accessors(root: &gltf::json::Root, file: &str) -> Result<(), MeshError> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    return Err(MeshError::invalid(
+                        file,
+                        format!(
+                            "mesh {m} primitive {p}: attribute {semantic:?} refers to accessor {}, \
+                             but there are {} accessors",
+                            accessor.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn load_buffers<'a>(
+    gltf: &Document,
+    blob: Option<&'a [u8]>,
+    file: &str,
+) -> Result<Vec<Cow<'a, [u8]>>, MeshError> {
     gltf.buffers()
         .map(|buffer| {
             let index = buffer.index();
             let data: Cow<[u8]> = match buffer.source() {
-                gltf::buffer::Source::Bin => Cow::Borrowed(gltf.blob.as_deref().ok_or_else(|| {
+                gltf::buffer::Source::Bin => Cow::Borrowed(blob.ok_or_else(|| {
                     MeshError::invalid(
                         file,
                         format!("buffer {index} refers to the GLB binary chunk, but there is none"),
