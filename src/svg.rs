@@ -232,10 +232,27 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut out = Vec::new();
     let mut budget = MAX_POINTS;
     let mut unpainted = 0usize;
-    let mut marker_paths = 0usize;
     let mut images = 0usize;
     let mut non_finite = 0usize;
     let cos_corner = CORNER_ANGLE_DEG.to_radians().cos();
+
+    // The hidden copies: their usvg geometry names the shape of each
+    // id-less path usvg makes for a `use` instance.
+    let mut fingerprints: Vec<(&tiny_skia_path::Path, usize)> = Vec::new();
+    let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
+    while let Some(node) = stack.pop() {
+        match node {
+            usvg::Node::Group(g) => stack.extend(g.children().iter().rev()),
+            usvg::Node::Path(p) => {
+                if let Some(i) = p.id().strip_prefix(prepared.copy_prefix.as_str()) {
+                    if let Ok(i) = i.parse::<usize>() {
+                        fingerprints.push((p.data(), i));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
 
     let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
     while let Some(node) = stack.pop() {
@@ -251,21 +268,30 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             }
             _ => continue,
         };
+        let id = path.id();
+        if id.starts_with(prepared.copy_prefix.as_str()) {
+            continue;
+        }
         // usvg marks paths with neither fill nor stroke, and
         // `visibility: hidden` ones, as invisible: they draw nothing.
         if !path.is_visible() {
             unpainted += 1;
             continue;
         }
-        let id = path.id();
-        if id.is_empty() {
-            // Only marker instances lose their id in usvg; markers are
-            // decoration (arrowheads), not part of the drawn path.
-            marker_paths += 1;
-            continue;
-        }
-        let shape = prepared.shapes.get(id);
-        let label = shape.map_or_else(|| id.to_string(), |s| s.label.clone());
+        let shape_index = if id.is_empty() {
+            fingerprints
+                .iter()
+                .find(|(data, _)| *data == path.data())
+                .map(|&(_, i)| i)
+        } else {
+            prepared.ids.get(id).copied()
+        };
+        let shape = shape_index.and_then(|i| prepared.shapes.get(i));
+        let label = match shape {
+            Some(s) => s.label.clone(),
+            None if id.is_empty() => "use instance".to_string(),
+            None => id.to_string(),
+        };
         let local = shape
             .and_then(|s| exact_geometry(s, path.data()))
             .unwrap_or_else(|| from_tiny_skia(path.data()));
@@ -301,11 +327,6 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     if unpainted > 0 {
         notes.push(format!(
             "{unpainted} shape(s) with no stroke and no fill, or hidden, were not printed"
-        ));
-    }
-    if marker_paths > 0 {
-        notes.push(format!(
-            "{marker_paths} marker shape(s) (arrowheads etc.) were not printed"
         ));
     }
     if images > 0 {
@@ -356,10 +377,43 @@ struct ShapeInfo {
 }
 
 struct Prepared {
-    /// The document with an id on every shape (usvg keeps ids on paths).
+    /// The document with an id on every shape (usvg keeps ids on paths),
+    /// without markers, and with a hidden copy (id `{copy_prefix}{index}`)
+    /// of every shape a `use` instantiates.
     text: String,
-    shapes: HashMap<String, ShapeInfo>,
+    shapes: Vec<ShapeInfo>,
+    /// Shape index by the id it carries in `text`.
+    ids: HashMap<String, usize>,
+    copy_prefix: String,
     notes: Vec<String>,
+}
+
+/// Attributes that define a shape's geometry (SVG 1.1 chapters 8 and 9).
+const GEOMETRY_ATTRIBUTES: [&str; 16] = [
+    "d",
+    "points",
+    "x",
+    "y",
+    "width",
+    "height",
+    "rx",
+    "ry",
+    "cx",
+    "cy",
+    "r",
+    "x1",
+    "y1",
+    "x2",
+    "y2",
+    "pathLength",
+];
+
+const XLINK_NS: &str = "http://www.w3.org/1999/xlink";
+
+fn escape_xml(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('"', "&quot;")
 }
 
 const SHAPES: [&str; 7] = [
@@ -434,17 +488,45 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     }
 
     let root_start = root.range().start;
-    let mut shapes = HashMap::new();
+    // Ids that `use` elements point at: usvg drops ids inside use instances,
+    // so shapes under them also get a hidden, id-carrying copy whose usvg
+    // geometry identifies the instances (see `Prepared::copies`).
+    let referenced: HashSet<&str> = root
+        .descendants()
+        .filter(|n| n.is_element() && is_svg(n) && n.tag_name().name() == "use")
+        .filter_map(|n| n.attribute("href").or(n.attribute((XLINK_NS, "href"))))
+        .filter_map(|href| href.strip_prefix('#'))
+        .collect();
+    let in_marker = |n: &roxmltree::Node| {
+        n.ancestors()
+            .any(|a| a.is_element() && is_svg(&a) && a.tag_name().name() == "marker")
+    };
+    let mut shapes = Vec::new();
+    let mut ids = HashMap::new();
+    let mut copies = String::new();
     let mut seen: HashSet<&str> = HashSet::new();
     let mut index = 0usize;
     let mut texts = 0usize;
+    let mut markers = 0usize;
     for node in root.descendants().filter(|n| n.is_element() && is_svg(n)) {
         let name = node.tag_name().name();
+        // Nodes expanded from DTD entities point into the DTD: no edits there.
+        let in_body = node.range().start >= root_start;
+        if name == "marker" && in_body && !in_marker(&node.parent().unwrap_or(root)) {
+            // Markers (arrowheads, dots at vertices) decorate a path; they
+            // are not part of what the user drew to be printed.
+            let range = node.range();
+            if text.get(range.clone()).is_some() {
+                edits.push((range.start, range.len(), String::new()));
+                markers += 1;
+            }
+            continue;
+        }
         if name == "text" {
             texts += 1;
             continue;
         }
-        if !SHAPES.contains(&name) {
+        if !SHAPES.contains(&name) || in_marker(&node) {
             continue;
         }
         index += 1;
@@ -456,8 +538,6 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             _ => ShapeKind::Other,
         };
         let fallback_label = format!("{name} #{index}");
-        // Nodes expanded from DTD entities point into the DTD: no edits there.
-        let in_body = node.range().start >= root_start;
         let key = match node.attribute_node("id") {
             Some(attr) if !attr.value().is_empty() && seen.insert(attr.value()) => {
                 Some((attr.value().to_string(), attr.value().to_string()))
@@ -483,11 +563,40 @@ fn prepare(text: &str) -> Result<Prepared, String> {
                 }
             }
         };
-        if let Some((id, label)) = key {
-            let d = (kind == ShapeKind::Path)
-                .then(|| node.attribute("d").map(str::to_string))
-                .flatten();
-            shapes.insert(id, ShapeInfo { label, kind, d });
+        let label = key.as_ref().map_or(fallback_label, |k| k.1.clone());
+        let d = (kind == ShapeKind::Path)
+            .then(|| node.attribute("d").map(str::to_string))
+            .flatten();
+        let shape = shapes.len();
+        shapes.push(ShapeInfo { label, kind, d });
+        if let Some((id, _)) = key {
+            ids.insert(id, shape);
+        }
+        let under_use = node
+            .ancestors()
+            .any(|a| a.attribute("id").is_some_and(|id| referenced.contains(id)));
+        if under_use {
+            // Only un-namespaced geometry attributes: prefixed ones might
+            // need declarations that do not reach the end of the document.
+            copies.push_str(&format!("<{name} id=\"{prefix}copy-{shape}\""));
+            for attr in node.attributes() {
+                if attr.namespace().is_none() && GEOMETRY_ATTRIBUTES.contains(&attr.name()) {
+                    copies.push_str(&format!(
+                        " {}=\"{}\"",
+                        attr.name(),
+                        escape_xml(attr.value())
+                    ));
+                }
+            }
+            copies.push_str("/>");
+        }
+    }
+    if !copies.is_empty() {
+        let end = root.range().end;
+        if let Some(at) = text.get(..end).and_then(|t| t.rfind("</")) {
+            if at > root_start {
+                edits.push((at, 0, format!("<g visibility=\"hidden\">{copies}</g>")));
+            }
         }
     }
 
@@ -496,6 +605,11 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         notes.push(format!(
             "{texts} text element(s) skipped: text is not converted to paths (no fonts are loaded); \
              convert text to paths in the drawing program"
+        ));
+    }
+    if markers > 0 {
+        notes.push(format!(
+            "{markers} marker definition(s) ignored: markers decorate a path and are not printed"
         ));
     }
 
@@ -515,6 +629,8 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     Ok(Prepared {
         text: out,
         shapes,
+        ids,
+        copy_prefix: format!("{prefix}copy-"),
         notes,
     })
 }

@@ -1,1 +1,756 @@
-//! Integration tests: svg.
+//! Integration tests: SVG import (spec "Inputs", T2D), sampling (section 3)
+//! and the antenna generators.
+use pcpp::demo::antennas::{
+    archimedean_spiral_svg, hilbert_loop_svg, paper_spiral_svg, triangular_monopole_svg,
+    PAPER_SPIRAL_LENGTH_MM,
+};
+use pcpp::sampling::{sample_subpath, try_sample_subpath_marked};
+use pcpp::svg::{import_svg, import_svg_with_notes, Placement, Subpath2, SvgError};
+use pcpp::DVec2;
+
+// Coordinates carry usvg's f32 transforms (about 1e-7 relative): 1e-5 mm
+// is the tolerance for positions in a 100 mm drawing.
+const MM: &str = r#"width="100mm" height="100mm" viewBox="0 0 100 100""#;
+
+fn doc(size: &str, body: &str) -> String {
+    format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" {size}>{body}</svg>"#
+    )
+}
+
+fn import(text: &str) -> Vec<Subpath2> {
+    match import_svg(text.as_bytes(), "test.svg") {
+        Ok(v) => v,
+        Err(e) => panic!("import failed: {e}\n{text}"),
+    }
+}
+
+fn v(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+fn assert_near(a: DVec2, b: DVec2, tol: f64) {
+    assert!(a.distance(b) <= tol, "{a} vs {b} (tol {tol})");
+}
+
+fn corner_points(s: &Subpath2) -> Vec<DVec2> {
+    s.points
+        .iter()
+        .zip(&s.corner)
+        .filter(|(_, &c)| c)
+        .map(|(&p, _)| p)
+        .collect()
+}
+
+// ---------------------------------------------------------------- shapes
+
+#[test]
+fn circle_is_exact_round_and_smooth() {
+    let subs = import(&doc(
+        MM,
+        r#"<circle cx="30" cy="20" r="5" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    let c = &subs[0];
+    assert!(c.closed);
+    assert!(c.points.len() > 100);
+    assert_eq!(c.points.first(), c.points.last());
+    assert_near(c.points[0], v(35.0, -20.0), 1e-5);
+    for p in &c.points {
+        assert!((p.distance(v(30.0, -20.0)) - 5.0).abs() <= 1e-4, "{p}");
+    }
+    // Chord midpoints too: the flattening error, not just the vertices.
+    for w in c.points.windows(2) {
+        let m = (w[0] + w[1]) * 0.5;
+        assert!(5.0 - m.distance(v(30.0, -20.0)) <= 1e-4);
+    }
+    assert!(c.corner.iter().all(|&k| !k), "a circle has no corners");
+    assert_eq!(c.source, "circle #1");
+}
+
+#[test]
+fn ellipse_points_satisfy_its_equation() {
+    let subs = import(&doc(
+        MM,
+        r#"<ellipse id="e" cx="50" cy="50" rx="10" ry="4" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert_eq!(subs[0].source, "e");
+    for p in &subs[0].points {
+        let q = *p - v(50.0, -50.0);
+        let f = (q.x / 10.0).powi(2) + (q.y / 4.0).powi(2);
+        assert!((f - 1.0).abs() < 1e-6, "{p}");
+    }
+    assert!(subs[0].corner.iter().all(|&k| !k));
+}
+
+#[test]
+fn rect_in_a_scaled_viewbox_is_in_mm_with_four_corners() {
+    let subs = import(&doc(
+        r#"width="20mm" height="10mm" viewBox="0 0 200 100""#,
+        r#"<rect x="10" y="10" width="20" height="10" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    let r = &subs[0];
+    assert!(r.closed);
+    assert_eq!(r.points.len(), 5, "4 corners + the closing point");
+    assert_eq!(r.corner, vec![true; 5]);
+    let expect = [
+        v(1.0, -1.0),
+        v(3.0, -1.0),
+        v(3.0, -2.0),
+        v(1.0, -2.0),
+        v(1.0, -1.0),
+    ];
+    for (p, e) in r.points.iter().zip(expect) {
+        assert_near(*p, e, 1e-5);
+    }
+    assert!((r.length_mm() - 6.0).abs() < 1e-6);
+}
+
+#[test]
+fn rounded_rect_has_exact_quarter_circles_and_no_corners() {
+    let subs = import(&doc(
+        MM,
+        r#"<rect x="10" y="10" width="30" height="20" rx="4" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    let r = &subs[0];
+    assert!(r.closed && r.corner.iter().all(|&k| !k));
+    // Every point is on a straight side or on a corner circle of radius 4.
+    let centres = [
+        v(14.0, -14.0),
+        v(36.0, -14.0),
+        v(36.0, -26.0),
+        v(14.0, -26.0),
+    ];
+    for p in &r.points {
+        let on_side = (p.x - 10.0).abs() < 1e-5
+            || (p.x - 40.0).abs() < 1e-5
+            || (p.y + 10.0).abs() < 1e-5
+            || (p.y + 30.0).abs() < 1e-5;
+        let on_arc = centres
+            .iter()
+            .any(|c| (p.distance(*c) - 4.0).abs() < 1e-4 && (p.x - c.x).abs() <= 4.0);
+        assert!(on_side || on_arc, "{p}");
+    }
+    let expected = 2.0 * (22.0 + 12.0) + std::f64::consts::TAU * 4.0;
+    // The polyline is shorter than the true curve by its chord error only.
+    assert!((r.length_mm() - expected).abs() < 1e-3);
+}
+
+#[test]
+fn polygon_polyline_and_line() {
+    let subs = import(&doc(
+        MM,
+        r#"<polygon points="0,0 10,0 10,10" stroke="black" fill="none"/>
+           <polyline points="20,0 30,0 40,0 40,10" stroke="black" fill="none"/>
+           <line x1="0" y1="50" x2="10" y2="50" stroke="black"/>"#,
+    ));
+    assert_eq!(subs.len(), 3);
+    assert!(subs[0].closed);
+    assert_eq!(subs[0].points.len(), 4);
+    assert_eq!(subs[0].corner, vec![true; 4]);
+    let pl = &subs[1];
+    assert!(!pl.closed);
+    // The collinear middle vertex (30, 0) is not a corner; the ends are.
+    assert_eq!(pl.corner, vec![true, false, true, true]);
+    assert_near(subs[2].points[0], v(0.0, -50.0), 1e-5);
+    assert_near(subs[2].points[1], v(10.0, -50.0), 1e-5);
+    assert_eq!(subs[2].corner, vec![true, true]);
+    assert_eq!(subs[2].source, "line #3");
+}
+
+// ---------------------------------------------------------- path commands
+
+const ABSOLUTE: &str = "M 10 10 L 20 10 H 30 V 20 C 30 30 20 30 20 25 S 10 20 10 25 \
+                        Q 5 30 0 25 T -10 25 A 5 5 0 0 1 -20 25 Z M 50 50 L 60 60";
+const RELATIVE: &str = "m 10 10 l 10 0 h 10 v 10 c 0 10 -10 10 -10 5 s -10 -5 -10 0 \
+                        q -5 5 -10 0 t -10 0 a 5 5 0 0 1 -10 0 z m 40 40 l 10 10";
+
+#[test]
+fn relative_and_absolute_commands_agree() {
+    let body = |d: &str| format!(r#"<path d="{d}" stroke="black" fill="none"/>"#);
+    let a = import(&doc(MM, &body(ABSOLUTE)));
+    let r = import(&doc(MM, &body(RELATIVE)));
+    assert_eq!(a.len(), 2, "each M starts a subpath");
+    assert_eq!(r.len(), 2);
+    for (sa, sr) in a.iter().zip(&r) {
+        assert_eq!(sa.points.len(), sr.points.len());
+        assert_eq!(sa.corner, sr.corner);
+        for (p, q) in sa.points.iter().zip(&sr.points) {
+            assert_near(*p, *q, 1e-9);
+        }
+    }
+    assert!(a[0].closed && !a[1].closed);
+    assert_eq!(a[0].points.first(), a[0].points.last());
+}
+
+#[test]
+fn corner_flags_follow_the_drawn_tangent() {
+    let subs = import(&doc(
+        MM,
+        &format!(r#"<path d="{ABSOLUTE}" stroke="black" fill="none"/>"#),
+    ));
+    let s = &subs[0];
+    let corners = corner_points(s);
+    let is_corner = |p: DVec2| corners.iter().any(|c| c.distance(p) < 1e-5);
+    let is_point = |p: DVec2| s.points.iter().any(|c| c.distance(p) < 1e-5);
+    // Real kinks: H -> V, S -> Q (45 deg), T -> A, A -> the closing line,
+    // and the closing line -> the first L at the start.
+    for p in [
+        v(10.0, -10.0),
+        v(30.0, -10.0),
+        v(10.0, -25.0),
+        v(-10.0, -25.0),
+        v(-20.0, -25.0),
+    ] {
+        assert!(is_corner(p), "{p} should be a corner");
+    }
+    // A vertex on a straight run, V into a C leaving the same way, and the
+    // S and T joins (which reflect the previous control point) are smooth.
+    for p in [
+        v(20.0, -10.0),
+        v(30.0, -20.0),
+        v(20.0, -25.0),
+        v(0.0, -25.0),
+    ] {
+        assert!(is_point(p) && !is_corner(p), "{p} should be smooth");
+    }
+    // Only the joins are corners, never points inside a curve; the closed
+    // start counts twice (first and repeated last point).
+    assert_eq!(corners.len(), 6, "{corners:?}");
+}
+
+#[test]
+fn arcs_are_exact_including_large_and_rotated() {
+    let subs = import(&doc(
+        MM,
+        r#"<path d="M 0 0 A 10 10 0 0 1 20 0" stroke="black" fill="none"/>
+           <path d="M 0 50 A 10 10 0 1 0 10 60" stroke="black" fill="none"/>
+           <path d="M 50 50 a 20 10 30 1 1 10 5" stroke="black" fill="none"/>
+           <path d="M 80 80 A 1 1 0 0 1 90 80" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 4);
+    // Half circle, sweep flag 1 (clockwise on screen): it bulges to -y in
+    // SVG, so +y after the flip.
+    for p in &subs[0].points {
+        assert!((p.distance(v(10.0, 0.0)) - 10.0).abs() < 1e-4);
+        assert!(p.y >= -1e-5);
+    }
+    // Large arc: three quarters of a circle around (0, 60) in SVG.
+    let l = &subs[1];
+    for p in &l.points {
+        assert!((p.distance(v(0.0, -60.0)) - 10.0).abs() < 1e-4);
+    }
+    let quarter = std::f64::consts::FRAC_PI_2 * 10.0;
+    assert!((l.length_mm() - 3.0 * quarter).abs() < 1e-3);
+    // Rotated ellipse: every point satisfies the rotated ellipse equation
+    // for some centre; check the end points are exact and it is smooth.
+    let e = &subs[2];
+    assert_near(e.points[0], v(50.0, -50.0), 1e-5);
+    assert_near(
+        *e.points.last().unwrap_or(&DVec2::NAN),
+        v(60.0, -55.0),
+        1e-5,
+    );
+    assert_eq!(corner_points(e).len(), 2);
+    // Radii too small: scaled up to a half circle of radius 5 (SVG F.6.6).
+    let s = &subs[3];
+    for p in &s.points {
+        assert!((p.distance(v(85.0, -80.0)) - 5.0).abs() < 1e-4);
+    }
+}
+
+// ----------------------------------------------------------- structure
+
+#[test]
+fn transforms_on_nested_groups() {
+    let subs = import(&doc(
+        MM,
+        r#"<g transform="translate(10,5)">
+             <g transform="rotate(90)">
+               <g transform="scale(2)"><path d="M 0 0 L 1 0" stroke="black"/></g>
+             </g>
+           </g>
+           <g transform="matrix(1 0 0 1 3 4)"><path d="M 0 0 L 1 0" stroke="black" transform="skewX(45) translate(0 1)"/></g>"#,
+    ));
+    assert_eq!(subs.len(), 2);
+    assert_near(subs[0].points[0], v(10.0, -5.0), 1e-6);
+    assert_near(subs[0].points[1], v(10.0, -7.0), 1e-6);
+    // skewX(45): x += y; the translate(0 1) inside first.
+    assert_near(subs[1].points[0], v(4.0, -5.0), 1e-6);
+    assert_near(subs[1].points[1], v(5.0, -5.0), 1e-6);
+}
+
+#[test]
+fn use_instances_each_give_a_subpath() {
+    let subs = import(&doc(
+        MM,
+        r##"<defs><path id="seg" d="M 0 0 L 10 0" stroke="black"/></defs>
+           <use href="#seg" x="5" y="5"/>
+           <use xlink:href="#seg" transform="translate(0,20)"/>"##,
+    ));
+    assert_eq!(subs.len(), 2, "the definition itself is not drawn");
+    let expect = [
+        [v(5.0, -5.0), v(15.0, -5.0)],
+        [v(0.0, -20.0), v(10.0, -20.0)],
+    ];
+    for (s, e) in subs.iter().zip(expect) {
+        assert_eq!(s.points.len(), 2);
+        assert_near(s.points[0], e[0], 1e-5);
+        assert_near(s.points[1], e[1], 1e-5);
+    }
+    assert!(subs.iter().all(|s| s.source == "seg"));
+}
+
+#[test]
+fn use_of_a_circle_keeps_exact_geometry_and_its_name() {
+    let subs = import(&doc(
+        MM,
+        r##"<defs><circle id="dot" r="5" stroke="black" fill="none"/></defs>
+            <use href="#dot" x="50" y="50"/>
+            <g transform="translate(10 0)"><use href="#dot" x="20" y="20"/></g>"##,
+    ));
+    assert_eq!(subs.len(), 2);
+    for (s, c) in subs.iter().zip([v(50.0, -50.0), v(30.0, -20.0)]) {
+        assert_eq!(s.source, "dot");
+        assert!(s.corner.iter().all(|&k| !k));
+        for p in &s.points {
+            assert!((p.distance(c) - 5.0).abs() < 1e-4, "{p}");
+        }
+    }
+}
+
+#[test]
+fn markers_are_not_printed() {
+    let import = match import_svg_with_notes(
+        doc(
+            MM,
+            r##"<defs><marker id="arrow" markerWidth="4" markerHeight="4" refX="2" refY="2">
+                  <path d="M 0 0 L 4 2 L 0 4 z"/></marker></defs>
+                <path d="M 10 10 L 50 10" stroke="black" marker-end="url(#arrow)"/>"##,
+        )
+        .as_bytes(),
+        "m.svg",
+    ) {
+        Ok(i) => i,
+        Err(e) => panic!("{e}"),
+    };
+    assert_eq!(import.subpaths.len(), 1);
+    assert_eq!(import.subpaths[0].points.len(), 2);
+    assert!(import.notes.iter().any(|n| n.contains("marker")));
+}
+
+#[test]
+fn physical_units_become_mm() {
+    let cases = [
+        (r#"width="1in" height="1in" viewBox="0 0 1 1""#, 1.0, 25.4),
+        (r#"width="2cm" height="2cm" viewBox="0 0 2 2""#, 1.0, 10.0),
+        (
+            r#"width="72pt" height="72pt" viewBox="0 0 72 72""#,
+            72.0,
+            25.4,
+        ),
+        (r#"width="96px" height="96px""#, 96.0, 25.4),
+        (r#"width="96" height="96""#, 48.0, 12.7),
+        (
+            r#"width="80mm" height="40mm" viewBox="0 0 160 80""#,
+            10.0,
+            5.0,
+        ),
+    ];
+    for (size, len, mm) in cases {
+        let subs = import(&doc(
+            size,
+            &format!(r#"<path d="M 0 0 L {len} 0" stroke="black"/>"#),
+        ));
+        assert!(
+            (subs[0].length_mm() - mm).abs() < 1e-6,
+            "{size}: {} mm",
+            subs[0].length_mm()
+        );
+    }
+}
+
+#[test]
+fn unpainted_and_hidden_elements_are_not_printed() {
+    let subs = import(&doc(
+        MM,
+        r#"<path d="M 0 0 L 10 0" stroke="none" fill="none"/>
+           <path d="M 0 0 L 10 0" style="stroke:none;fill:none"/>
+           <path d="M 0 0 L 10 0" stroke="black" display="none"/>
+           <g style="display:none"><path d="M 0 0 L 10 0" stroke="black"/></g>
+           <path d="M 0 0 L 10 0" stroke="black" visibility="hidden"/>
+           <rect id="filled" x="1" y="1" width="2" height="2"/>"#,
+    ));
+    assert_eq!(subs.len(), 1, "{subs:?}");
+    assert_eq!(
+        subs[0].source, "filled",
+        "fill-only (the default black) is kept"
+    );
+    assert_eq!(subs[0].points.len(), 5);
+}
+
+#[test]
+fn nothing_printable_is_an_error_that_names_the_file() {
+    let text = doc(
+        MM,
+        r#"<path d="M 0 0 L 10 0" fill="none"/><text x="1" y="1">hello</text>"#,
+    );
+    match import_svg(text.as_bytes(), "empty.svg") {
+        Err(e @ SvgError::NothingPrintable { .. }) => {
+            let msg = e.to_string();
+            assert!(msg.contains("empty.svg") && msg.contains("text"), "{msg}");
+        }
+        other => panic!("expected NothingPrintable, got {other:?}"),
+    }
+}
+
+#[test]
+fn inkscape_file_with_layers_styles_and_text() {
+    let import = match import_svg_with_notes(include_bytes!("data/svg/inkscape.svg"), "ink.svg") {
+        Ok(i) => i,
+        Err(e) => panic!("{e}"),
+    };
+    let subs = &import.subpaths;
+    let names: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
+    assert_eq!(names, ["loop", "ring", "half", "pad"]);
+    // The layer's translate(-10,-20), then y flipped.
+    let expect = [
+        v(10.0, -10.0),
+        v(40.0, -10.0),
+        v(40.0, -30.0),
+        v(10.0, -30.0),
+    ];
+    assert_eq!(subs[0].points.len(), 5);
+    for (p, e) in subs[0].points.iter().zip(expect) {
+        assert_near(*p, e, 1e-5);
+    }
+    for p in &subs[1].points {
+        assert!((p.distance(v(50.0, -30.0)) - 8.0).abs() < 1e-4);
+    }
+    // Two arcs, one smooth join: corners only at the ends.
+    assert_eq!(corner_points(&subs[2]).len(), 2);
+    assert!(!subs[2].closed);
+    assert!(
+        import.notes.iter().any(|n| n.contains("text")),
+        "{:?}",
+        import.notes
+    );
+}
+
+#[test]
+fn illustrator_file_with_entities_and_css_classes() {
+    let subs = match import_svg(include_bytes!("data/svg/illustrator.svg"), "ai.svg") {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    };
+    // The unstroked, unfillable line is dropped.
+    assert_eq!(subs.len(), 2);
+    let unit = 25.4 / 72.0; // 72pt wide, viewBox 72 units
+    assert_near(subs[0].points[1], v(30.0, -10.0) * unit, 1e-5);
+    assert!(!subs[0].closed && subs[1].closed);
+    assert_eq!(subs[1].points.len(), 4);
+}
+
+#[test]
+fn missing_xmlns_and_duplicate_ids_are_tolerated() {
+    let text = r#"<svg width="10mm" height="10mm" viewBox="0 0 10 10">
+        <path id="a" d="M 0 0 L 1 0" stroke="black"/>
+        <path id="a" d="M 0 5 A 2 2 0 0 1 4 5" stroke="black"/></svg>"#;
+    let subs = import(text);
+    assert_eq!(subs.len(), 2);
+    assert_eq!(subs[0].points.len(), 2);
+    for p in &subs[1].points {
+        assert!((p.distance(v(2.0, -5.0)) - 2.0).abs() < 1e-4);
+    }
+}
+
+// ------------------------------------------------------------- hostile
+
+#[test]
+fn hostile_inputs_are_errors_not_panics() {
+    let deep = format!(
+        "{}{}{}",
+        doc(MM, "").replace("</svg>", ""),
+        "<g>".repeat(5000),
+        "</g>".repeat(5000) + "</svg>"
+    );
+    let nan_circle = doc(MM, r#"<circle r="NaN" cx="1" cy="1" stroke="black"/>"#);
+    let bad_bytes: &[&[u8]] = &[
+        b"",
+        b"not xml at all",
+        b"\xff\xfe\x00<",
+        b"<html><body/></html>",
+        b"<svg xmlns='http://example.com/not-svg'/>",
+        b"<svg xmlns='http://www.w3.org/2000/svg'>",
+        b"\x1f\x8b\x08\x00",
+        deep.as_bytes(),
+        nan_circle.as_bytes(),
+    ];
+    for bytes in bad_bytes {
+        match import_svg(bytes, "bad.svg") {
+            Err(e) => assert!(e.to_string().starts_with("bad.svg: "), "{e}"),
+            Ok(s) => panic!(
+                "expected an error for {:?}, got {s:?}",
+                String::from_utf8_lossy(bytes)
+            ),
+        }
+    }
+}
+
+#[test]
+fn hostile_numbers_give_an_error_or_a_sane_result() {
+    let cases = [
+        r#"<circle r="1e30" stroke="black"/>"#,
+        r#"<circle r="1e38" cx="1e38" stroke="black"/>"#,
+        r#"<path d="M 0 0 L 1e38 1e38 L -1e38 3" stroke="black"/>"#,
+        r#"<path d="M 0 0 C 1e300 0 0 1e300 1 1" stroke="black"/>"#,
+        r#"<path d="M NaN 0 L 1 1" stroke="black"/>"#,
+        r#"<path d="M 0 0 L 1 1 L inf 2" stroke="black"/>"#,
+        r#"<path d="M 0 0 A 1e-300 1e300 45 1 1 1 1" stroke="black"/>"#,
+        r#"<path d="M 0 0 A 0 5 0 0 1 10 0 A 5 5 0 0 1 10 0" stroke="black"/>"#,
+        r#"<g transform="scale(1e-30)"><path d="M 0 0 L 1 1" stroke="black"/></g>"#,
+        r#"<g transform="matrix(NaN 0 0 1 0 0)"><path d="M 0 0 L 1 1" stroke="black"/></g>"#,
+        r#"<rect width="1e30" height="1" rx="1e29" stroke="black"/>"#,
+        r##"<use href="#u"/><g id="u"><use href="#u"/></g>"##,
+        r#"<path d="M 5 5 L 5 5" stroke="black" stroke-linecap="round"/>"#,
+    ];
+    for body in cases {
+        match import_svg(doc(MM, body).as_bytes(), "h.svg") {
+            Err(e) => assert!(e.to_string().starts_with("h.svg: "), "{e}"),
+            Ok(subs) => {
+                for s in subs {
+                    assert!(!s.points.is_empty() && s.points.len() == s.corner.len());
+                    assert!(s.points.iter().all(|p| p.is_finite()), "{body}: {s:?}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn moderately_nested_groups_still_work() {
+    let subs = import(&doc(
+        MM,
+        &format!(
+            "{}<path d='M 0 0 L 1 0' stroke='black'/>{}",
+            "<g transform='translate(1 0)'>".repeat(100),
+            "</g>".repeat(100)
+        ),
+    ));
+    assert_near(subs[0].points[0], v(100.0, 0.0), 1e-4);
+}
+
+// ------------------------------------------------------------ placement
+
+#[test]
+fn placement_rotates_scales_then_offsets() {
+    let p = Placement {
+        offset_mm: v(10.0, 20.0),
+        rotation_deg: 90.0,
+        scale: 2.0,
+    };
+    assert!(p.validate().is_ok());
+    assert_near(p.apply(v(1.0, 0.0)), v(10.0, 22.0), 1e-12);
+    assert_eq!(Placement::IDENTITY.apply(v(3.0, -4.0)), v(3.0, -4.0));
+    for bad in [
+        Placement { scale: 0.0, ..p },
+        Placement { scale: -1.0, ..p },
+        Placement {
+            scale: f64::NAN,
+            ..p
+        },
+        Placement {
+            rotation_deg: f64::INFINITY,
+            ..p
+        },
+        Placement {
+            offset_mm: v(f64::NAN, 0.0),
+            ..p
+        },
+    ] {
+        match bad.validate() {
+            Err(e @ SvgError::Placement { .. }) => assert!(e.to_string().contains("placement")),
+            other => panic!("expected an error for {bad:?}, got {other:?}"),
+        }
+    }
+}
+
+// -------------------------------------------------------------- sampling
+
+fn intervals(points: &[DVec2]) -> Vec<f64> {
+    points.windows(2).map(|w| w[0].distance(w[1])).collect()
+}
+
+#[test]
+fn sampling_keeps_corners_and_spacing() {
+    let subs = import(&doc(
+        MM,
+        r#"<polyline points="0,0 10,0 10,7.3 3,7.3" stroke="black" fill="none"/>"#,
+    ));
+    let s = &subs[0];
+    let max = 0.3015;
+    let out = sample_subpath(s, max);
+    assert!(intervals(&out).iter().all(|&d| d <= max + 1e-12));
+    for c in corner_points(s) {
+        assert!(out.contains(&c), "corner {c} missing");
+    }
+    // Each straight piece is uniform.
+    let marked = match try_sample_subpath_marked(s, max) {
+        Ok(m) => m,
+        Err(e) => panic!("{e}"),
+    };
+    let idx: Vec<usize> = (0..marked.points.len())
+        .filter(|&i| marked.corner[i])
+        .collect();
+    assert_eq!(idx.len(), 4);
+    for w in idx.windows(2) {
+        let d = intervals(&marked.points[w[0]..=w[1]]);
+        let (lo, hi) = d
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+        assert!(hi / lo - 1.0 < 1e-6, "{lo} .. {hi}");
+    }
+    let sampled: f64 = intervals(&out).iter().sum();
+    assert!((sampled - s.length_mm()).abs() < 1e-9);
+    assert_eq!(out.len(), 1 + 34 + 25 + 24); // ceil(10/.3015), ceil(7.3/.3015), ceil(7/.3015)
+}
+
+#[test]
+fn sampling_a_circle_is_uniform_and_closed() {
+    let subs = import(&doc(
+        MM,
+        r#"<circle cx="0" cy="0" r="5" stroke="black" fill="none"/>"#,
+    ));
+    let out = sample_subpath(&subs[0], 0.3);
+    assert_eq!(out.first(), out.last());
+    let d = intervals(&out);
+    let (lo, hi) = d
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+    assert!(hi <= 0.3 && hi / lo - 1.0 < 1e-3);
+    assert_eq!(
+        out.len(),
+        1 + (std::f64::consts::TAU * 5.0 / 0.3).ceil() as usize
+    );
+}
+
+// -------------------------------------------------------------- antennas
+
+#[test]
+fn paper_spiral_is_556_mm_and_1853_points() {
+    let subs = import(&paper_spiral_svg());
+    assert_eq!(subs.len(), 1);
+    let len = subs[0].length_mm();
+    assert!((len - PAPER_SPIRAL_LENGTH_MM).abs() < 2.0, "{len}");
+    let n = sample_subpath(&subs[0], 0.603 / 2.0).len();
+    assert!((n as i64 - 1853).abs() <= 10, "{n} points");
+    assert_eq!(corner_points(&subs[0]).len(), 2, "smooth: only its ends");
+}
+
+#[test]
+fn archimedean_spiral_round_trips() {
+    let svg = match archimedean_spiral_svg(3.0, 2.0, 1.0) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    };
+    let subs = import(&svg);
+    let expected = pcpp::demo::antennas::archimedean_spiral_length_mm(3.0, 2.0, 1.0);
+    let len = subs[0].length_mm();
+    // Shorter than the true spiral by the flattening's chord error only.
+    assert!((len - expected).abs() < 1e-3, "{len} vs {expected}");
+    // Starts at the inner radius on +x of the centre, which sits in the
+    // middle of the page, and ends at inner + 3 pitches.
+    let half = 1.0 + 3.0 * 2.0 + 2.0 * 0.603;
+    let centre = v(half, -half);
+    assert_near(subs[0].points[0], centre + v(1.0, 0.0), 1e-5);
+    let last = subs[0].points.last().copied().unwrap_or(DVec2::NAN);
+    assert!((last.distance(centre) - 7.0).abs() < 1e-5);
+    // Counter-clockwise in the printer frame (y up): it starts going +y.
+    assert!(subs[0].points[1].y > subs[0].points[0].y);
+}
+
+fn segments_cross(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let eps = 1e-9;
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if ((d1 > eps && d2 < -eps) || (d1 < -eps && d2 > eps))
+        && ((d3 > eps && d4 < -eps) || (d3 < -eps && d4 > eps))
+    {
+        return true;
+    }
+    // Touching or overlapping: an end point on the other segment.
+    let on = |p: DVec2, q: DVec2, r: DVec2| {
+        orient(p, q, r).abs() <= eps
+            && r.x >= p.x.min(q.x) - eps
+            && r.x <= p.x.max(q.x) + eps
+            && r.y >= p.y.min(q.y) - eps
+            && r.y <= p.y.max(q.y) + eps
+    };
+    on(c, d, a) || on(c, d, b) || on(a, b, c) || on(a, b, d)
+}
+
+#[test]
+fn hilbert_loops_are_closed_simple_and_inside_their_square() {
+    for order in 1..=5 {
+        let size = 20.0;
+        let svg = match hilbert_loop_svg(order, size) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        };
+        let subs = import(&svg);
+        assert_eq!(subs.len(), 1);
+        let s = &subs[0];
+        assert!(s.closed && s.points.first() == s.points.last());
+        let centre = v(size / 2.0 + 0.603, -(size / 2.0 + 0.603));
+        assert!(s
+            .points
+            .iter()
+            .all(|p| (*p - centre).abs().max_element() <= size / 2.0));
+        let cell = size / f64::from(1u32 << order);
+        let expected = cell * f64::from(1u32 << (2 * order));
+        let len = s.length_mm();
+        assert!(
+            (len - expected).abs() < 1e-5 * expected,
+            "order {order}: {len} vs {expected}"
+        );
+        let p = &s.points;
+        let n = p.len() - 1;
+        for i in 0..n {
+            for j in i + 1..n {
+                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                if !adjacent {
+                    assert!(
+                        !segments_cross(p[i], p[i + 1], p[j], p[j + 1]),
+                        "order {order}: segments {i} and {j} meet"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn triangular_monopole_round_trips() {
+    let svg = match triangular_monopole_svg(30.0, 20.0, 5.0) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    };
+    let subs = import(&svg);
+    assert_eq!(subs.len(), 2);
+    let (feed, tri) = (&subs[0], &subs[1]);
+    // The apex sits a margin of 2 x 0.603 mm inside the page's corner region.
+    let apex = v(10.0 + 1.206, -(30.0 + 1.206));
+    assert_near(feed.points[0], apex, 1e-5);
+    assert_near(feed.points[1], apex + v(0.0, -5.0), 1e-5);
+    assert!(tri.closed);
+    assert_eq!(tri.points.len(), 4);
+    assert_eq!(tri.corner, vec![true; 4]);
+    assert_near(tri.points[0], apex, 1e-5);
+    assert_near(tri.points[1], apex + v(-10.0, 30.0), 1e-5);
+    assert!(hilbert_loop_svg(0, 1.0).is_err());
+    assert!(triangular_monopole_svg(f64::NAN, 1.0, 1.0).is_err());
+}

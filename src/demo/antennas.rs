@@ -1,8 +1,12 @@
 //! The paper's antenna paths as SVG text (spec "The paper's test part and
 //! prints"): a spiral (556 mm), a Hilbert-curve loop and a triangular
 //! monopole. Each is drawn in mm (`width="..mm"` with a viewBox in mm, so one
-//! user unit is one mm), stroked, unfilled, centred on the SVG origin so a
-//! [`crate::svg::Placement`] puts it where it belongs.
+//! user unit is one mm), stroked and unfilled. The viewBox is centred on the
+//! antenna's reference point (the spiral's and loop's centre, the monopole's
+//! apex); as with any SVG, import measures from the page's top-left corner,
+//! so that point lands at (`x`, -`y`) mm with `x`, `y` its distances from
+//! the page's left and top edges, and a [`crate::svg::Placement`] moves it
+//! onto the part.
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
 
@@ -111,10 +115,12 @@ pub fn archimedean_spiral_svg(
 fn spiral_svg(turns: f64, pitch_mm: f64, inner_radius_mm: f64) -> String {
     let b = pitch_mm / TAU;
     let total = turns * TAU;
-    // Sixteen Hermite cubics per turn: the end points and tangents are exact,
-    // so joins are smooth and the path stays within ~1e-6 r of the spiral.
+    // Sixteen cubics per turn, end points and tangent directions exact (so
+    // joins are smooth), handles of length (4/3) tan(step/4) |P'|: the
+    // circle's best cubic, within ~1e-7 r of the spiral at this step.
     let n = (turns * 16.0).ceil().max(1.0) as usize;
     let step = total / n as f64;
+    let handle = 4.0 / 3.0 * (step / 4.0).tan();
     // SVG y points down; drawing (x, -y) makes the imported spiral turn
     // counter-clockwise in the printer frame.
     let point = |t: f64| {
@@ -132,7 +138,7 @@ fn spiral_svg(turns: f64, pitch_mm: f64, inner_radius_mm: f64) -> String {
         let (t0, t1) = (step * k as f64, step * (k + 1) as f64);
         let (p0, p1) = (point(t0), point(t1));
         let (d0, d1) = (deriv(t0), deriv(t1));
-        let h = step / 3.0;
+        let h = handle;
         let _ = write!(
             d,
             " C {} {} {} {} {} {}",
