@@ -1,4 +1,5 @@
 //! All integration tests in one binary, a module per area (as parry does).
+mod cli;
 mod gcode;
 mod importers;
 mod planning;
