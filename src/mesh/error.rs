@@ -77,3 +77,33 @@ impl MeshError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_file_and_line_when_known() {
+        let e = MeshError::NonFiniteVertex {
+            file: "a.obj".into(),
+            vertex: 3,
+            line: Some(7),
+            value: f64::NAN,
+        };
+        assert_eq!(
+            e.to_string(),
+            "a.obj:7: vertex 3 has a non-finite coordinate (NaN)"
+        );
+        let e = MeshError::IndexOutOfRange {
+            file: "a.ply".into(),
+            face: 2,
+            line: None,
+            index: 9,
+            vertex_count: 4,
+        };
+        assert_eq!(
+            e.to_string(),
+            "a.ply: face 2 refers to vertex index 9, but only 4 vertices are defined"
+        );
+    }
+}
