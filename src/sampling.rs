@@ -117,7 +117,7 @@ pub fn try_sample_subpath_marked(
         });
     };
     let n = count(&pieces, max_spacing_mm);
-    if !(n <= MAX_SAMPLES as f64) {
+    if n.is_nan() || n > MAX_SAMPLES as f64 {
         return Err(SamplingError::TooManySamples {
             element: sub.source.clone(),
             count: n,

@@ -1155,7 +1155,7 @@ fn parse_path_data(d: &str) -> Vec<LocalSubpath> {
         if ok.is_none() {
             break;
         }
-        if command.to_ascii_uppercase() != b'M' {
+        if !command.eq_ignore_ascii_case(&b'M') {
             cmd = Some(command);
         }
         last_cubic_ctrl = cubic_ctrl;
@@ -1273,7 +1273,7 @@ fn flatten_subpath(
     if segs.is_empty() {
         // A dot (e.g. "M5 5 L5 5" with round caps): one point.
         *budget = budget.checked_sub(1).ok_or(())?;
-        return Ok(points[0].is_finite().then(|| (points, corner, false)));
+        return Ok(points[0].is_finite().then_some((points, corner, false)));
     }
     for (i, seg) in segs.iter().enumerate() {
         if i > 0 {

@@ -531,6 +531,33 @@ fn hostile_numbers_give_an_error_or_a_sane_result() {
 }
 
 #[test]
+fn use_chains_and_use_bombs_do_not_hang_or_overflow() {
+    // A chain of 400 uses, each instantiating the previous one.
+    let mut chain = String::from(r#"<defs><path id="g0" d="M 0 0 L 1 0" stroke="black"/>"#);
+    for k in 1..400 {
+        chain.push_str(&format!(r##"<g id="g{k}"><use href="#g{}"/></g>"##, k - 1));
+    }
+    chain.push_str(r##"</defs><use href="#g399"/>"##);
+    // Each level doubles: 2^40 paths if nothing stopped it.
+    let mut bomb = String::from(r#"<defs><path id="b0" d="M 0 0 L 1 0" stroke="black"/>"#);
+    for k in 1..40 {
+        bomb.push_str(&format!(
+            r##"<g id="b{k}"><use href="#b{0}"/><use href="#b{0}"/></g>"##,
+            k - 1
+        ));
+    }
+    bomb.push_str(r##"</defs><use href="#b39"/>"##);
+    for body in [chain, bomb] {
+        let start = std::time::Instant::now();
+        let result = import_svg(doc(MM, &body).as_bytes(), "u.svg");
+        assert!(start.elapsed().as_secs() < 20, "took {:?}", start.elapsed());
+        if let Ok(subs) = result {
+            assert!(subs.iter().all(|s| s.points.iter().all(|p| p.is_finite())));
+        }
+    }
+}
+
+#[test]
 fn moderately_nested_groups_still_work() {
     let subs = import(&doc(
         MM,
