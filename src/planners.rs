@@ -203,15 +203,16 @@ mod tests {
     }
 
     fn flat() -> Surface {
-        let mut m = TriMesh::default();
-        m.vertices = vec![
-            DVec3::new(-10.0, -10.0, 0.0),
-            DVec3::new(10.0, -10.0, 0.0),
-            DVec3::new(10.0, 10.0, 0.0),
-            DVec3::new(-10.0, 10.0, 0.0),
-        ];
-        m.triangles = vec![[0, 1, 2], [0, 2, 3]];
-        Surface::new(m).unwrap()
+        Surface::new(TriMesh {
+            vertices: vec![
+                DVec3::new(-10.0, -10.0, 0.0),
+                DVec3::new(10.0, -10.0, 0.0),
+                DVec3::new(10.0, 10.0, 0.0),
+                DVec3::new(-10.0, 10.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        })
+        .unwrap()
     }
 
     #[test]

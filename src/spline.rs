@@ -251,8 +251,8 @@ impl Spline {
         let d = self.ders_basis_funs(span, u);
         let mut out = [DVec3::ZERO; 3];
         for (k, o) in out.iter_mut().enumerate() {
-            for j in 0..=p {
-                *o += self.ctrl[span - p + j] * d[k][j];
+            for (c, w) in self.ctrl[span - p..=span].iter().zip(&d[k]) {
+                *o += *c * *w;
             }
         }
         out
