@@ -2,6 +2,7 @@
 //! test part with its line paths, and antenna path generators.
 pub mod antennas;
 pub mod test_part;
+pub mod workloads;
 
 use crate::mesh::TriMesh;
 

@@ -1,0 +1,132 @@
+//! Benchmark workloads, generated reproducibly (never checked in):
+//! - W1: a wrinkled film scan, 100 x 100 mm, folds and fine noise, about
+//!   2,000,000 triangles (1001 x 1001 vertices) at the default size.
+//! - W2: the paper's spiral antenna (556 mm, 1853 points at d = 0.603 mm)
+//!   placed on W1.
+//! - W3: a dense serpentine raster of about 100,000 points on W1.
+
+use glam::DVec3;
+
+use crate::mesh::TriMesh;
+
+/// A small deterministic generator (xorshift64*), so workloads are the same
+/// on every machine without a dependency.
+struct Rng(u64);
+
+impl Rng {
+    fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Side of the film, mm.
+pub const FILM_MM: f64 = 100.0;
+
+/// The wrinkled film's height: wrinkles in a few directions, two sharp
+/// folds (creases of |sin|) and fine noise from `noise`, 0-6 mm.
+fn film_height(x: f64, y: f64, waves: &[(f64, f64, f64, f64)], noise: f64) -> f64 {
+    let mut z = 3.0;
+    for &(kx, ky, amp, phase) in waves {
+        z += amp * (kx * x + ky * y + phase).sin();
+    }
+    // Folds: sharp ridges along two lines.
+    z += 1.5 * (0.9 - ((x - 0.6 * y - 20.0) / 9.0).sin().abs()).max(0.0);
+    z += 1.0 * (0.8 - ((0.3 * x + y - 70.0) / 7.0).sin().abs()).max(0.0);
+    z + noise
+}
+
+/// W1 with `n` x `n` grid cells (2 n^2 triangles); n = 1000 gives the
+/// ~2 M triangle scan of the benchmarks.
+pub fn wrinkled_film(n: usize) -> TriMesh {
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let waves: Vec<(f64, f64, f64, f64)> = (0..6)
+        .map(|_| {
+            let ang = rng.next_f64() * std::f64::consts::PI;
+            let k = 2.0 * std::f64::consts::PI / (4.0 + 12.0 * rng.next_f64());
+            (
+                k * ang.cos(),
+                k * ang.sin(),
+                0.15 + 0.35 * rng.next_f64(),
+                6.3 * rng.next_f64(),
+            )
+        })
+        .collect();
+    let h = FILM_MM / n as f64;
+    let mut m = TriMesh {
+        vertices: Vec::with_capacity((n + 1) * (n + 1)),
+        triangles: Vec::with_capacity(2 * n * n),
+    };
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 * h, j as f64 * h);
+            let noise = 0.01 * (rng.next_f64() - 0.5);
+            m.vertices
+                .push(DVec3::new(x, y, film_height(x, y, &waves, noise)));
+        }
+    }
+    let w = (n + 1) as u32;
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * w + i;
+            m.triangles.push([a, a + 1, a + w + 1]);
+            m.triangles.push([a, a + w + 1, a + w]);
+        }
+    }
+    m
+}
+
+/// The mesh as OBJ text (for the OBJ import benchmark).
+pub fn to_obj(mesh: &TriMesh) -> String {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(mesh.vertices.len() * 36 + mesh.triangles.len() * 24);
+    for v in &mesh.vertices {
+        let _ = writeln!(s, "v {:.5} {:.5} {:.5}", v.x, v.y, v.z);
+    }
+    for t in &mesh.triangles {
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
+}
+
+/// W3: a serpentine raster over the film's middle, `lines` passes 90 mm long,
+/// as SVG in mm (place it with an offset of (0, 100) mm: SVG y points down).
+pub fn serpentine_svg(lines: usize) -> String {
+    let pitch = 90.0 / lines.max(1) as f64;
+    let mut d = String::from("M 5 5");
+    for k in 0..lines {
+        let y = 5.0 + k as f64 * pitch;
+        let x = if k % 2 == 0 { 95.0 } else { 5.0 };
+        d.push_str(&format!(" L {x} {y:.4}"));
+        if k + 1 < lines {
+            d.push_str(&format!(" L {x} {:.4}", y + pitch));
+        }
+    }
+    format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"100mm\" height=\"100mm\" \
+         viewBox=\"0 0 100 100\"><path d=\"{d}\" fill=\"none\" stroke=\"black\"/></svg>"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn film_is_a_clean_height_field() {
+        let m = wrinkled_film(20);
+        assert_eq!(m.triangles.len(), 800);
+        let (lo, hi) = m.bbox().unwrap();
+        assert!(lo.z > 0.0 && hi.z < 8.0, "{lo:?} {hi:?}");
+        assert_eq!(wrinkled_film(20), m, "reproducible");
+        assert!(to_obj(&m).lines().count() == 441 + 800);
+    }
+
+    #[test]
+    fn serpentine_has_the_requested_passes() {
+        let s = serpentine_svg(10);
+        assert_eq!(s.matches(" L ").count(), 19);
+    }
+}
