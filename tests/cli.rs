@@ -1,1 +1,782 @@
-//! Integration tests: the pcpp command-line tool.
+//! Integration tests: the pcpp command-line tool, run as a process in
+//! throw-away folders, and the golden G-code of the demo.
+//!
+//! Golden files: `tests/golden/demo-<dialect>.gcode`. When the library's
+//! output changes on purpose, regenerate them with
+//! `PCPP_UPDATE_GOLDEN=1 cargo test --test lib cli::golden` and review the diff.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+use pcpp::demo::{self, test_part};
+use pcpp::gcode::MachineProfile;
+use pcpp::job::{self, JobSettings};
+use serde_json::Value;
+
+const BIN: &str = env!("CARGO_BIN_EXE_pcpp");
+const DIALECTS: [&str; 3] = ["marlin", "aerotech", "grbl"];
+
+/// The paper's Table S1: fiducials in the scanner and printer frames.
+const TABLE_S1_SCAN: &str =
+    "-58.4037,86.5977,-39.1942;-88.5714,153.855,-53.3039;-57.0373,153.469,-124.727";
+const TABLE_S1_PRINTER: &str =
+    "88.1799,14.0904,-50.7744;13.4989,11.1944,-50.7974;10.1549,89.0994,-50.7314";
+
+fn golden_path(dialect: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("demo-{dialect}.gcode"))
+}
+
+/// Removes the folders of earlier runs whose process has ended (the demo
+/// folder holds a 6 MB scan). Only where /proc tells which processes live.
+fn sweep_stale_dirs() {
+    static SWEPT: OnceLock<()> = OnceLock::new();
+    SWEPT.get_or_init(|| {
+        if !Path::new("/proc/self").exists() {
+            return;
+        }
+        let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let pid = name
+                .strip_prefix("pcpp-cli-")
+                .and_then(|rest| rest.split('-').next())
+                .and_then(|pid| pid.parse::<u32>().ok());
+            if let Some(pid) = pid {
+                if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+                    let _ = std::fs::remove_dir_all(e.path());
+                }
+            }
+        }
+    });
+}
+
+/// A fresh empty folder for one test.
+fn temp_dir(test: &str) -> PathBuf {
+    sweep_stale_dirs();
+    let dir = std::env::temp_dir().join(format!("pcpp-cli-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn pcpp(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Files in a folder (to check that nothing, not even a temporary, was left).
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `pcpp demo` run once for all the tests that read its files.
+fn demo_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = temp_dir("demo").join("out");
+        let o = pcpp(&["demo", "--out", s(&dir)]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        dir
+    })
+}
+
+fn demo_file(name: &str) -> PathBuf {
+    demo_dir().join(name)
+}
+
+#[test]
+fn golden_gcode_of_the_demo_in_each_dialect() {
+    let scan = demo::demo_scan_bytes();
+    let svg = test_part::test_part_svg();
+    let mut settings = JobSettings::default();
+    settings.plan.placement = test_part::placement();
+    let update = std::env::var("PCPP_UPDATE_GOLDEN").is_ok_and(|v| v == "1");
+    for dialect in DIALECTS {
+        let profile = MachineProfile::builtin(dialect).unwrap();
+        let out = job::run(
+            &scan,
+            demo::DEMO_SCAN_NAME,
+            svg.as_bytes(),
+            demo::DEMO_PATH_NAME,
+            &settings,
+            &profile,
+            false,
+        )
+        .unwrap();
+        // ~1400 points: a few tens of kB, fine to keep in the repository.
+        assert!(out.gcode.len() < 200_000, "{dialect}: {}", out.gcode.len());
+        let path = golden_path(dialect);
+        if update {
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, &out.gcode).unwrap();
+            continue;
+        }
+        let golden = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; generate it with PCPP_UPDATE_GOLDEN=1",
+                path.display()
+            )
+        });
+        if golden != out.gcode {
+            let line = golden
+                .lines()
+                .zip(out.gcode.lines())
+                .position(|(a, b)| a != b)
+                .map_or_else(|| "the end".to_string(), |i| format!("line {}", i + 1));
+            panic!(
+                "{} differs from the library's output at {line}; if the change is intended, \
+                 regenerate with PCPP_UPDATE_GOLDEN=1",
+                path.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn demo_writes_every_file_and_the_golden_gcode() {
+    let dir = demo_dir();
+    let names = listing(dir);
+    for name in [
+        demo::DEMO_SCAN_NAME,
+        demo::DEMO_PATH_NAME,
+        "demo-constant.gcode",
+        "demo-slope.gcode",
+        "demo-pcpp.gcode",
+        "demo-pcpp-guarded.gcode",
+        "demo-comparison.json",
+        "demo-pcpp-guarded-report.json",
+        "demo-registration.json",
+        "antenna-spiral.svg",
+        "antenna-hilbert.svg",
+        "antenna-monopole.svg",
+    ] {
+        assert!(names.iter().any(|n| n == name), "{name} missing: {names:?}");
+        let len = std::fs::metadata(dir.join(name)).unwrap().len();
+        assert!(len > 0, "{name} is empty");
+    }
+    assert!(
+        !names.iter().any(|n| n.contains("pcpp-tmp")),
+        "temporary left: {names:?}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join(demo::DEMO_SCAN_NAME)).unwrap(),
+        demo::demo_scan_bytes()
+    );
+    let gcode = std::fs::read_to_string(dir.join("demo-pcpp-guarded.gcode")).unwrap();
+    if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
+        assert!(
+            gcode == std::fs::read_to_string(golden_path("marlin")).unwrap(),
+            "pcpp demo's guarded G-code differs from tests/golden/demo-marlin.gcode"
+        );
+    }
+    // Registration on the part's own holes: identity, residuals ~0.
+    let reg: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("demo-registration.json")).unwrap())
+            .unwrap();
+    let rms = reg["registration"]["rms_mm"].as_f64().unwrap();
+    assert!(rms < 1e-3, "{rms}");
+    let cmp: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("demo-comparison.json")).unwrap()).unwrap();
+    assert_eq!(cmp["planners"].as_array().unwrap().len(), 4);
+}
+
+#[test]
+fn demo_prints_the_table_and_takes_a_dialect() {
+    let dir = temp_dir("demo-aerotech");
+    let o = pcpp(&["demo", "-o", s(&dir), "--dialect", "aerotech"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = stdout(&o);
+    for k in ["constant", "slope", "pcpp", "pcpp-guarded", "rms"] {
+        assert!(out.contains(k), "{k} missing from:\n{out}");
+    }
+    let gcode = std::fs::read_to_string(dir.join("demo-pcpp-guarded.gcode")).unwrap();
+    if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
+        assert!(gcode == std::fs::read_to_string(golden_path("aerotech")).unwrap());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn plan_on_the_demo_files_writes_the_golden_gcode() {
+    let dir = temp_dir("plan-golden");
+    let out = dir.join("out.gcode");
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "--place",
+        "0,80,0,1",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let summary = stdout(&o);
+    assert!(summary.contains("points"), "{summary}");
+    assert!(summary.contains("mm"), "{summary}");
+    assert!(summary.contains("mean |e|"), "{summary}");
+    if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
+        assert!(
+            std::fs::read_to_string(&out).unwrap()
+                == std::fs::read_to_string(golden_path("marlin")).unwrap(),
+            "pcpp plan on the demo files differs from tests/golden/demo-marlin.gcode"
+        );
+    }
+    assert_eq!(listing(&dir), ["out.gcode"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn plan_report_has_every_field() {
+    let dir = temp_dir("plan-report");
+    let (out, report) = (dir.join("p.gcode"), dir.join("p.json"));
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "--place=0,80",
+        "--output",
+        s(&out),
+        "--report",
+        s(&report),
+        "--planner",
+        "slope",
+        "--accept-risk",
+        "--dialect",
+        "grbl",
+        "--fiducials",
+        "auto",
+        "--printer-points",
+        "4,4,5; 76,4,5; 4,76,5",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("registration"), "{}", stdout(&o));
+    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert!(r["mesh"]["triangles"].as_u64().unwrap() > 1000);
+    assert_eq!(r["mesh"]["bbox_mm"].as_array().unwrap().len(), 2);
+    let m = r["registration"]["matrix"].as_array().unwrap();
+    assert_eq!(m.len(), 4);
+    assert!(m.iter().all(|row| row.as_array().unwrap().len() == 4));
+    assert_eq!(
+        r["registration"]["residuals_mm"].as_array().unwrap().len(),
+        3
+    );
+    assert!(r["registration"]["rms_mm"].as_f64().unwrap() < 1e-3);
+    assert_eq!(r["planner"], "slope");
+    for k in [
+        "mean_abs_error_mm",
+        "mean_negative_error_mm",
+        "mean_positive_error_mm",
+        "contact_pct",
+        "flattening_pct",
+        "floating_pct",
+    ] {
+        assert!(r["quality"][k].is_number(), "quality.{k}");
+    }
+    for k in [
+        "points",
+        "length_mm",
+        "height_change_mm",
+        "max_inclination_deg",
+        "min_radius_mm",
+    ] {
+        assert!(r["stats"][k].is_number(), "stats.{k}");
+    }
+    assert!(r["stats"]["points"].as_u64().unwrap() > 1000);
+    assert!(r["warnings"].is_array());
+    assert!(!r["surface_path"].as_array().unwrap().is_empty());
+    assert!(!r["toolpath"].as_array().unwrap().is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn compare_prints_four_rows_and_writes_json() {
+    let dir = temp_dir("compare");
+    let report = dir.join("cmp.json");
+    let o = pcpp(&[
+        "compare",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "--place",
+        "0,80",
+        "--report",
+        s(&report),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 5, "{out}");
+    for (line, k) in lines[1..]
+        .iter()
+        .zip(["constant", "slope", "pcpp", "pcpp-guarded"])
+    {
+        assert!(line.split_whitespace().next() == Some(k), "{line}");
+        assert_eq!(line.matches('%').count(), 3, "{line}");
+    }
+    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let rows = r["planners"].as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    assert_eq!(rows[3]["planner"], "pcpp-guarded");
+    assert_eq!(rows[3]["quality"]["contact_pct"].as_f64(), Some(0.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn fiducials_lists_the_demo_holes_as_json() {
+    let o = pcpp(&["fiducials", "--scan", s(&demo_file(demo::DEMO_SCAN_NAME))]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let found = v.as_array().unwrap();
+    assert!(found.len() >= 3, "{v}");
+    for f in test_part::FIDUCIALS_MM {
+        let hit = found.iter().any(|c| {
+            let p = c["centroid"].as_array().unwrap();
+            let d: f64 = [f.x, f.y, f.z]
+                .iter()
+                .zip(p)
+                .map(|(a, b)| (a - b.as_f64().unwrap()).powi(2))
+                .sum();
+            d.sqrt() < 0.05
+        });
+        assert!(hit, "no candidate at {f:?}: {v}");
+    }
+    for k in ["diameter_mm", "loop_len", "roundness"] {
+        assert!(found[0][k].is_number(), "{k}");
+    }
+    // Units scale the centroids.
+    let o = pcpp(&[
+        "fiducials",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--scan-units",
+        "cm",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let d = v[0]["diameter_mm"].as_f64().unwrap();
+    assert!((d - 10.0).abs() < 1.0, "{d}");
+}
+
+#[test]
+fn register_on_table_s1_gives_the_papers_residuals() {
+    for method in ["lsq", "paper"] {
+        let o = pcpp(&[
+            "register",
+            "--scan-points",
+            TABLE_S1_SCAN,
+            "--printer-points",
+            TABLE_S1_PRINTER,
+            "--registration",
+            method,
+            "--json",
+        ]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let res: Vec<f64> = v["residuals_mm"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r.as_f64().unwrap())
+            .collect();
+        assert_eq!(res.len(), 3);
+        assert!(res.iter().all(|&r| r < 0.5), "{method}: {res:?}");
+        let rms = v["rms_mm"].as_f64().unwrap();
+        assert!((0.05..=0.35).contains(&rms), "{method}: {rms}");
+        let m = v["matrix"].as_array().unwrap();
+        assert_eq!(m.len(), 4);
+        assert_eq!(m[3], serde_json::json!([0.0, 0.0, 0.0, 1.0]));
+    }
+    let o = pcpp(&[
+        "register",
+        "--scan-points",
+        TABLE_S1_SCAN,
+        "--printer-points",
+        TABLE_S1_PRINTER,
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("fiducial 3:") && out.contains("rms:"), "{out}");
+    assert_eq!(out.lines().filter(|l| l.contains("1.000000")).count(), 1);
+}
+
+#[test]
+fn help_and_version() {
+    for args in [
+        &["--help"][..],
+        &["-h"],
+        &["help"],
+        &["help", "plan"],
+        &["plan", "--help"],
+        &["compare", "-h"],
+        &["fiducials", "--help"],
+        &["register", "--help"],
+        &["demo", "--help"],
+    ] {
+        let o = pcpp(args);
+        assert_eq!(code(&o), 0, "{args:?}: {}", stderr(&o));
+        assert!(stdout(&o).contains("usage: pcpp"), "{args:?}");
+    }
+    assert!(stdout(&pcpp(&["plan", "--help"])).contains("--printer-points"));
+    let o = pcpp(&["--version"]);
+    assert_eq!(code(&o), 0);
+    assert_eq!(
+        stdout(&o).trim(),
+        format!("pcpp {}", env!("CARGO_PKG_VERSION"))
+    );
+}
+
+#[test]
+fn usage_errors_exit_2_and_name_the_flag() {
+    let (scan, svg) = (
+        demo_file(demo::DEMO_SCAN_NAME),
+        demo_file(demo::DEMO_PATH_NAME),
+    );
+    let (scan, svg) = (s(&scan), s(&svg));
+    let cases: &[(&[&str], &str)] = &[
+        (&[], "no command"),
+        (&["frobnicate"], "frobnicate"),
+        (&["help", "frobnicate"], "frobnicate"),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--bogus",
+            ],
+            "--bogus",
+        ),
+        (&["plan", "--scan", scan, "--path", svg], "--output"),
+        (&["plan", "--path", svg, "-o", "x.gcode"], "--scan"),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--tol", "abc",
+            ],
+            "--tol",
+        ),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--speed",
+            ],
+            "--speed",
+        ),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--speed", "-5",
+            ],
+            "--speed",
+        ),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--place", "1,y",
+            ],
+            "--place",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--planner",
+                "best",
+            ],
+            "--planner",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--dialect",
+                "fanuc",
+            ],
+            "--dialect",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--scan-units",
+                "ft",
+            ],
+            "--scan-units",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--fiducials",
+                "auto",
+            ],
+            "--printer-points",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--fiducials",
+                "1,2;3",
+            ],
+            "--fiducials",
+        ),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--tol", "1", "--tol", "2",
+            ],
+            "--tol",
+        ),
+        (
+            &["compare", "--scan", scan, "--path", svg, "-o", "x.gcode"],
+            "-o",
+        ),
+        (
+            &["fiducials", "--scan", scan, "--up-axis", "w"],
+            "--up-axis",
+        ),
+        (
+            &["register", "--scan-points", TABLE_S1_SCAN],
+            "--printer-points",
+        ),
+        (
+            &[
+                "register",
+                "--scan-points",
+                "1,2,x",
+                "--printer-points",
+                TABLE_S1_PRINTER,
+            ],
+            "--scan-points",
+        ),
+        (
+            &[
+                "register",
+                "--scan-points",
+                TABLE_S1_SCAN,
+                "--printer-points",
+                TABLE_S1_PRINTER,
+                "--registration",
+                "icp",
+            ],
+            "--registration",
+        ),
+        (&["demo", "--dialect", "fanuc"], "--dialect"),
+        (&["demo", "extra"], "extra"),
+    ];
+    for (args, needle) in cases {
+        let o = pcpp(args);
+        assert_eq!(code(&o), 2, "{args:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    assert!(!Path::new("x.gcode").exists());
+}
+
+#[test]
+fn bad_input_exits_1_naming_the_file_and_line() {
+    let dir = temp_dir("bad-input");
+    let bad_obj = dir.join("bad-scan.obj");
+    std::fs::write(&bad_obj, "v 0 0 0\nv 1 0 0\nv 0 1 oops\nf 1 2 3\n").unwrap();
+    let bad_svg = dir.join("bad-path.svg");
+    std::fs::write(
+        &bad_svg,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\"><path d=",
+    )
+    .unwrap();
+    let bad_profile = dir.join("my-profile.json");
+    std::fs::write(&bad_profile, "{\"name\": \"x\"}").unwrap();
+    let out = dir.join("out.gcode");
+    let svg = demo_file(demo::DEMO_PATH_NAME);
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&bad_obj),
+        "--path",
+        s(&svg),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("bad-scan.obj") && err.contains("line 3"),
+        "{err}"
+    );
+
+    let o = pcpp(&["fiducials", "--scan", s(&bad_obj)]);
+    assert_eq!(code(&o), 1);
+    assert!(stderr(&o).contains("bad-scan.obj"), "{}", stderr(&o));
+
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&bad_svg),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad-path.svg"), "{}", stderr(&o));
+
+    let missing = dir.join("missing.ply");
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&missing),
+        "--path",
+        s(&svg),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 1);
+    assert!(stderr(&o).contains("missing.ply"), "{}", stderr(&o));
+
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&svg),
+        "-o",
+        s(&out),
+        "--profile",
+        s(&bad_profile),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("my-profile.json"), "{}", stderr(&o));
+
+    // Collinear fiducials: a registration error, bad input rather than usage.
+    let o = pcpp(&[
+        "register",
+        "--scan-points",
+        "0,0,0;1,0,0;2,0,0",
+        "--printer-points",
+        TABLE_S1_PRINTER,
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("collinear"), "{}", stderr(&o));
+
+    assert_eq!(
+        listing(&dir),
+        ["bad-path.svg", "bad-scan.obj", "my-profile.json"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_path_that_misses_the_scan_writes_nothing() {
+    let dir = temp_dir("misses");
+    let (out, report) = (dir.join("out.gcode"), dir.join("out.json"));
+    // Without the placement the SVG lies at y < 0, off the 80 x 80 mm part.
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(demo::DEMO_PATH_NAME) && err.contains("misses the scan"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty());
+    assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
+
+    // An output folder that does not exist: bad input, nothing written.
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "--place",
+        "0,80",
+        "-o",
+        s(&dir.join("no-such-dir").join("out.gcode")),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("no-such-dir"), "{}", stderr(&o));
+    assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn no_progress_chatter_when_stderr_is_not_a_terminal() {
+    let dir = temp_dir("quiet");
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--path",
+        s(&demo_file(demo::DEMO_PATH_NAME)),
+        "--place",
+        "0,80",
+        "-o",
+        s(&dir.join("q.gcode")),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.lines().all(|l| l.starts_with("warning: ")),
+        "only warnings expected on a pipe:\n{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -512,11 +512,18 @@ fn file_name(path: &Path) -> String {
 
 /// Puts the path in front of a library message. The library names files by
 /// the name it was given; where a message starts with that name, the path
-/// replaces it ("dir/scan.obj:12: ...").
+/// replaces it, and the library's `name:12: ...` line form reads
+/// "dir/scan.obj, line 12: ...".
 fn in_file(path: &Path, name: &str, message: &str) -> String {
-    match message.strip_prefix(name) {
-        Some(rest) if rest.starts_with(':') => format!("{}{rest}", path.display()),
-        _ => format!("{}: {message}", path.display()),
+    let Some(rest) = message.strip_prefix(name).and_then(|r| r.strip_prefix(':')) else {
+        return format!("{}: {message}", path.display());
+    };
+    let line = rest
+        .split_once(':')
+        .filter(|(n, _)| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+    match line {
+        Some((n, tail)) => format!("{}, line {n}:{tail}", path.display()),
+        None => format!("{}:{rest}", path.display()),
     }
 }
 
@@ -1169,7 +1176,11 @@ mod tests {
         let p = Path::new("dir/scan.obj");
         assert_eq!(
             in_file(p, "scan.obj", "scan.obj:12: bad vertex"),
-            "dir/scan.obj:12: bad vertex"
+            "dir/scan.obj, line 12: bad vertex"
+        );
+        assert_eq!(
+            in_file(p, "scan.obj", "scan.obj: truncated"),
+            "dir/scan.obj: truncated"
         );
         assert_eq!(
             in_file(p, "scan.obj", "the path misses"),
