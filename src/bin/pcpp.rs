@@ -952,6 +952,8 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
     // One G-code per planner. Only the guarded planner refuses to write a
     // path that would touch the part; the others are written anyway since
     // they are there to be compared.
+    std::fs::create_dir_all(&out)
+        .map_err(|e| Failure::Input(format!("cannot create {}: {e}", out.display())))?;
     let mut staged = Staged::default();
     let mut rows = Vec::new();
     let mut guarded_report = None;
@@ -969,8 +971,6 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         )
         .map_err(|e| fail("plan", &e))?;
         rows.push((k, o.plan.quality));
-        std::fs::create_dir_all(&out)
-            .map_err(|e| Failure::Input(format!("cannot create {}: {e}", out.display())))?;
         staged.add(&out.join(demo_gcode_name(k)), o.gcode.as_bytes())?;
         if k == PlannerKind::PcppGuarded {
             guarded_report = Some(o.report);
@@ -1070,8 +1070,8 @@ exit status: 0 success, 1 bad input (the message names the file and where),
 2 usage error (the message names the flag)
 ";
 
-const JOB_FLAGS_HELP: &str = "\
-  --scan FILE              the scanned surface: OBJ, PLY, STL, glTF or GLB (required)
+const JOB_FLAGS_HELP: &str =
+    "  --scan FILE              the scanned surface: OBJ, PLY, STL, glTF or GLB (required)
   --path FILE.svg          the drawn path (required)
   --nozzle-id MM           nozzle inner diameter d (default 0.603)
   --nozzle-od MM           nozzle outer diameter do (default 0.908)
@@ -1106,6 +1106,7 @@ usage: pcpp plan --scan FILE --path FILE.svg -o OUT.gcode [flags]
   --profile FILE.json      a machine profile instead of a built-in dialect
   --accept-risk            write G-code even where the guarded planner could
                            not keep the nozzle off the surface
+
 The summary goes to stdout, warnings to stderr.
 
 inputs:
