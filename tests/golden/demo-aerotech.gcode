@@ -1,5 +1,5 @@
 ' pcpp 0.1.0
-' scan file: demo-test-part.ply (6216813 bytes, sha256 e4f1e423c6f01e691cfb91327a654b12f587440e0d2acb1e46badef4aa03c884)
+' scan file: demo-test-part.ply (6216475 bytes, sha256 a46203794eb7f81695c8a4e885a29c3b35bb6b1e88e4ac2e2584282907b8a926)
 ' path file: demo-test-part-lines.svg (659 bytes, sha256 59d5ff20ad48e19174edc3fc622ec0b592f1ab01fd86bf289a383636e8344544)
 ' nozzle: d 0.603 mm, do 0.908 mm
 ' process: tol 0.1 mm, speed 5 mm/s, dwell 0 s
@@ -9,7 +9,7 @@
 ' residuals: [] mm, rms 0.0000 mm
 ' path: 6 piece(s), 1362 points, 465.636 mm, height change 4.500 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 93.1 s
 ' predicted quality: mean |e| 0.0671 mm, mean e- -0.0858 mm, mean e+ 0.0489 mm, contact 0.00%, flattening 15.57%, floating 4.11%
-' warnings: 1
+' warnings: 0
 ' profile: aerotech
 ' print feed: F5 mm/s (5 mm/s)
 ' safe travel height: 13.603 mm
