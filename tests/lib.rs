@@ -3,5 +3,6 @@ mod cli;
 mod gcode;
 mod importers;
 mod planning;
+mod realworld;
 mod registration;
 mod svg;

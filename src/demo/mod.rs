@@ -53,9 +53,12 @@ mod tests {
         let m = test_part::test_part();
         let bytes = to_binary_ply(&m);
         let back = import_mesh(&bytes, DEMO_SCAN_NAME, &ImportOptions::DEFAULT).unwrap();
-        assert_eq!(back.mesh.vertices, m.vertices);
-        // Zero-area triangles are dropped by the importer, nothing else.
-        assert!(back.mesh.triangles.len() <= m.triangles.len());
-        assert!(back.mesh.triangles.len() + 100 > m.triangles.len());
+        // The same triangles, corner for corner (the importer may weld a
+        // few coincident vertices the generator kept apart).
+        assert_eq!(back.mesh.triangles.len(), m.triangles.len());
+        for i in 0..m.triangles.len() {
+            assert_eq!(back.mesh.triangle(i), m.triangle(i));
+        }
+        assert!(back.warnings.is_empty(), "{:?}", back.warnings);
     }
 }

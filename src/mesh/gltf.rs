@@ -35,7 +35,17 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     } else {
         (bytes, None)
     };
-    let root = gltf::json::Root::from_slice(json).map_err(|e| not_gltf(&e))?;
+    let root = gltf::json::Root::from_slice(json).map_err(|e| {
+        // A glTF 1.0 file fails the 2.0 schema with an opaque serde message;
+        // name the version instead.
+        match gltf_version(json) {
+            Some(v) if !v.starts_with('2') => MeshError::invalid(
+                file,
+                format!("glTF version {v}, only glTF 2.0 is read (convert it, e.g. with Blender)"),
+            ),
+            _ => not_gltf(&e),
+        }
+    })?;
     check_position_accessors(&root, file)?;
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
     let buffers = load_buffers(&gltf, blob, file)?;
@@ -93,6 +103,12 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         triangles: scene.triangles,
         warnings,
     })
+}
+
+/// `asset.version` of a glTF JSON document, if it has one.
+fn gltf_version(json: &[u8]) -> Option<String> {
+    let v: serde_json::Value = serde_json::from_slice(json).ok()?;
+    v.get("asset")?.get("version")?.as_str().map(str::to_string)
 }
 
 /// The JSON and BIN chunks of a GLB container. Split here with checked

@@ -113,6 +113,12 @@ pub fn import_mesh(
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(MeshError::invalid(file, "the file is empty"));
     }
+    if bytes.starts_with(&[0xFE, 0xFF]) || bytes.starts_with(&[0xFF, 0xFE]) {
+        return Err(MeshError::invalid(
+            file,
+            "the file is UTF-16 text; save it as UTF-8 or ASCII (OBJ, PLY and STL text must be)",
+        ));
+    }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
     let parsed = match format {
@@ -123,7 +129,12 @@ pub fn import_mesh(
     };
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
-    let (mesh, warnings) = finish(parsed, file, units.to_mm(), up_axis)?;
+    // STL and glTF parsers weld as they read; OBJ and PLY files from
+    // exporters often split vertices at UV seams too (a Blender PLY cube has
+    // 24 vertices), which would turn every seam into fake holes for the
+    // fiducial detector, so they are welded here.
+    let weld = matches!(format, MeshFormat::Obj | MeshFormat::Ply);
+    let (mesh, warnings) = finish(parsed, file, units.to_mm(), up_axis, weld)?;
     Ok(ImportedMesh {
         mesh,
         format,
@@ -141,6 +152,7 @@ fn finish(
     file: &str,
     scale: f64,
     up_axis: UpAxis,
+    weld: bool,
 ) -> Result<(TriMesh, Vec<String>), MeshError> {
     let Parsed {
         mut vertices,
@@ -157,6 +169,23 @@ fn finish(
         });
     }
     let n = vertices.len();
+    // remap[i]: the welded index of vertex i (bit-identical positions merge).
+    let remap: Option<Vec<u32>> = if weld {
+        let mut welder = Welder::with_capacity(n);
+        let mut remap = Vec::with_capacity(n);
+        for &v in &vertices {
+            // At most n <= u32::MAX + 1 vertices were indexable, so this holds.
+            remap.push(welder.index(v).unwrap_or(u32::MAX));
+        }
+        if welder.vertices.len() < n {
+            vertices = welder.vertices;
+            Some(remap)
+        } else {
+            None
+        }
+    } else {
+        None
+    };
     let mut kept = Vec::with_capacity(triangles.len());
     let mut degenerate = 0usize;
     for (face, tri) in triangles.into_iter().enumerate() {
@@ -169,6 +198,10 @@ fn finish(
                 vertex_count: n,
             });
         }
+        let tri = match &remap {
+            Some(r) => tri.map(|i| r[i as usize]),
+            None => tri,
+        };
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
         if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c) {
             degenerate += 1;
@@ -310,7 +343,7 @@ mod tests {
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
             warnings: vec![],
         };
-        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z).unwrap();
+        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z, false).unwrap();
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
@@ -323,7 +356,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             warnings: vec![],
         };
-        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
+        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y, false).unwrap();
         assert_eq!(mesh.vertices[2], DVec3::new(0.0, 0.0, 2.0));
     }
 

@@ -82,10 +82,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
                         format!("face has {} vertices, needs at least 3", polygon.len()),
                     ));
                 }
-                // Fan triangulation: scanner polygons are small and convex.
-                for pair in polygon.windows(2).skip(1) {
-                    triangles.push([polygon[0], pair[0], pair[1]]);
-                }
+                triangulate(&polygon, &vertices, &mut triangles);
                 faces += 1;
             }
             _ => {}
@@ -96,6 +93,73 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         triangles,
         warnings: Vec::new(),
     })
+}
+
+/// Polygons above this many corners are fanned without the ear test (its
+/// cost grows with the square of the corner count).
+const MAX_EAR_CLIP: usize = 1024;
+
+/// Triangulates a face: a fan when the polygon is convex (every scanner
+/// quad), ear clipping in the polygon's own plane (Newell normal) when it is
+/// not, so a concave face is covered exactly once with one orientation.
+fn triangulate(polygon: &[u32], vertices: &[DVec3], out: &mut Vec<[u32; 3]>) {
+    let fan = |out: &mut Vec<[u32; 3]>| {
+        for pair in polygon.windows(2).skip(1) {
+            out.push([polygon[0], pair[0], pair[1]]);
+        }
+    };
+    let n = polygon.len();
+    if n == 3 || n > MAX_EAR_CLIP {
+        return fan(out);
+    }
+    let p: Vec<DVec3> = polygon.iter().map(|&i| vertices[i as usize]).collect();
+    let mut normal = DVec3::ZERO;
+    for k in 0..n {
+        let (a, b) = (p[k], p[(k + 1) % n]);
+        normal += DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let Some(normal) = normal.try_normalize() else {
+        return fan(out);
+    };
+    let turn = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - b).dot(normal);
+    if (0..n).all(|k| turn(p[k], p[(k + 1) % n], p[(k + 2) % n]) >= 0.0) {
+        return fan(out);
+    }
+    // Ear clipping over the remaining corners.
+    let mut idx: Vec<usize> = (0..n).collect();
+    let inside = |q: DVec3, a: DVec3, b: DVec3, c: DVec3| {
+        turn(a, b, q) >= 0.0 && turn(b, c, q) >= 0.0 && turn(c, a, q) >= 0.0
+    };
+    let mut guard = 0;
+    while idx.len() > 3 && guard < n * n {
+        guard += 1;
+        let m = idx.len();
+        let ear = (0..m).find(|&k| {
+            let (ia, ib, ic) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
+            let (a, b, c) = (p[ia], p[ib], p[ic]);
+            turn(a, b, c) > 0.0
+                && idx
+                    .iter()
+                    // A corner visited twice (a face that bridges to an
+                    // inner outline) sits on the ear's own corners: skip it.
+                    .all(|&j| {
+                        let q = p[j];
+                        q == a || q == b || q == c || !inside(q, a, b, c)
+                    })
+        });
+        let Some(k) = ear else { break };
+        let (ia, ib, ic) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
+        out.push([polygon[ia], polygon[ib], polygon[ic]]);
+        idx.remove(k);
+    }
+    // What is left (a last triangle, or a degenerate remainder) is fanned.
+    for pair in idx.windows(2).skip(1) {
+        out.push([polygon[idx[0]], polygon[pair[0]], polygon[pair[1]]]);
+    }
 }
 
 enum IndexError {
