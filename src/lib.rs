@@ -42,11 +42,15 @@ pub mod planners;
 pub mod projection;
 pub mod quality;
 pub mod registration;
+#[cfg(target_arch = "wasm32")]
+pub mod render;
 pub mod sampling;
 pub mod spline;
 pub mod stats;
 pub mod surface;
 pub mod svg;
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
 
 pub use error::{Error, Result};
 pub use glam::{DMat4, DVec2, DVec3};

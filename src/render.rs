@@ -1,0 +1,517 @@
+//! The page's 3-D view (wasm32 only): WebGL2 through web-sys.
+//!
+//! Draws the registered scan shaded, the surface path Ta and the tool path
+//! T* as lines (T* coloured by predicted defect) and fiducial markers, with
+//! an orbit camera. It only draws what the page hands it: no planning
+//! happens here (house style: rendering code holds no planning logic).
+
+use glam::{DMat4, DVec3};
+use serde::Deserialize;
+use wasm_bindgen::{JsCast, JsValue};
+use web_sys::{
+    HtmlCanvasElement, WebGl2RenderingContext as Gl, WebGlBuffer, WebGlProgram, WebGlShader,
+    WebGlUniformLocation, WebGlVertexArrayObject,
+};
+
+use crate::quality::Defect;
+
+/// Background, mesh and line colours, linear 0-1. The browser tests find
+/// the mesh and the path by these colours in the read-back pixels.
+pub const BACKGROUND: [f32; 3] = [0.09, 0.10, 0.13];
+pub const MESH: [f32; 3] = [0.62, 0.68, 0.78];
+/// Ta: light, so that it reads on the shaded mesh under T*.
+pub const SURFACE_PATH: [f32; 3] = [0.95, 0.95, 0.95];
+pub const HOLE_MARKER: [f32; 3] = [1.0, 0.85, 0.1];
+pub const PRINTER_MARKER: [f32; 3] = [0.9, 0.2, 0.9];
+
+/// Defect colours (the issue's legend): contact red, flattening orange,
+/// floating blue, good green.
+pub fn defect_rgb8(name: &str) -> [u8; 3] {
+    match name {
+        "contact" => [230, 40, 40],
+        "flattening" => [255, 150, 20],
+        "floating" => [40, 120, 255],
+        _ => [40, 210, 70],
+    }
+}
+
+fn defect_rgb(d: Defect) -> [f32; 3] {
+    let name = match d {
+        Defect::Contact => "contact",
+        Defect::Flattening => "flattening",
+        Defect::Floating => "floating",
+        Defect::Good => "good",
+    };
+    defect_rgb8(name).map(|c| f32::from(c) / 255.0)
+}
+
+/// The parts of a report the view draws (other fields are ignored).
+#[derive(Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct ViewPaths {
+    pub surface_path: Vec<Vec<[f64; 3]>>,
+    pub toolpath: Vec<Vec<[f64; 3]>>,
+    pub defects: Vec<Vec<Defect>>,
+}
+
+/// Fiducial markers, printer frame.
+#[derive(Debug, Default)]
+pub struct Markers {
+    pub holes: Vec<[f64; 3]>,
+    pub printer: Vec<[f64; 3]>,
+}
+
+const MESH_VS: &str = r#"#version 300 es
+uniform mat4 u_mvp;
+layout(location = 0) in vec3 a_pos;
+out vec3 v_pos;
+void main() {
+  v_pos = a_pos;
+  gl_Position = u_mvp * vec4(a_pos, 1.0);
+}
+"#;
+
+// Flat shading from screen-space derivatives: the scan needs no normals
+// uploaded, and its facets (the scanner's resolution) stay visible.
+const MESH_FS: &str = r#"#version 300 es
+precision highp float;
+uniform vec3 u_light;
+uniform vec3 u_color;
+in vec3 v_pos;
+out vec4 o_color;
+void main() {
+  vec3 n = normalize(cross(dFdx(v_pos), dFdy(v_pos)));
+  float l = abs(dot(n, u_light));
+  o_color = vec4(u_color * (0.35 + 0.65 * l), 1.0);
+}
+"#;
+
+const LINE_VS: &str = r#"#version 300 es
+uniform mat4 u_mvp;
+uniform float u_point_size;
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_color;
+out vec3 v_color;
+void main() {
+  v_color = a_color;
+  gl_PointSize = u_point_size;
+  gl_Position = u_mvp * vec4(a_pos, 1.0);
+}
+"#;
+
+const LINE_FS: &str = r#"#version 300 es
+precision mediump float;
+in vec3 v_color;
+out vec4 o_color;
+void main() { o_color = vec4(v_color, 1.0); }
+"#;
+
+fn compile(gl: &Gl, kind: u32, src: &str) -> Result<WebGlShader, String> {
+    let shader = gl
+        .create_shader(kind)
+        .ok_or("WebGL could not create a shader")?;
+    gl.shader_source(&shader, src);
+    gl.compile_shader(&shader);
+    if gl
+        .get_shader_parameter(&shader, Gl::COMPILE_STATUS)
+        .as_bool()
+        .unwrap_or(false)
+    {
+        Ok(shader)
+    } else {
+        let log = gl.get_shader_info_log(&shader).unwrap_or_default();
+        gl.delete_shader(Some(&shader));
+        Err(format!("shader did not compile: {log}"))
+    }
+}
+
+fn link(gl: &Gl, vs: &str, fs: &str) -> Result<WebGlProgram, String> {
+    let v = compile(gl, Gl::VERTEX_SHADER, vs)?;
+    let f = compile(gl, Gl::FRAGMENT_SHADER, fs)?;
+    let p = gl
+        .create_program()
+        .ok_or("WebGL could not create a program")?;
+    gl.attach_shader(&p, &v);
+    gl.attach_shader(&p, &f);
+    gl.link_program(&p);
+    // Shaders are no longer needed once linked (or failed).
+    gl.delete_shader(Some(&v));
+    gl.delete_shader(Some(&f));
+    if gl
+        .get_program_parameter(&p, Gl::LINK_STATUS)
+        .as_bool()
+        .unwrap_or(false)
+    {
+        Ok(p)
+    } else {
+        let log = gl.get_program_info_log(&p).unwrap_or_default();
+        gl.delete_program(Some(&p));
+        Err(format!("shader program did not link: {log}"))
+    }
+}
+
+struct Program {
+    program: WebGlProgram,
+    mvp: Option<WebGlUniformLocation>,
+    light: Option<WebGlUniformLocation>,
+    color: Option<WebGlUniformLocation>,
+    point_size: Option<WebGlUniformLocation>,
+}
+
+impl Program {
+    fn new(gl: &Gl, vs: &str, fs: &str) -> Result<Program, String> {
+        let program = link(gl, vs, fs)?;
+        Ok(Program {
+            mvp: gl.get_uniform_location(&program, "u_mvp"),
+            light: gl.get_uniform_location(&program, "u_light"),
+            color: gl.get_uniform_location(&program, "u_color"),
+            point_size: gl.get_uniform_location(&program, "u_point_size"),
+            program,
+        })
+    }
+}
+
+/// One uploaded vertex array and its buffers (deleted on replacement).
+struct Drawable {
+    vao: WebGlVertexArrayObject,
+    buffers: Vec<WebGlBuffer>,
+    count: i32,
+}
+
+impl Drawable {
+    fn delete(self, gl: &Gl) {
+        gl.delete_vertex_array(Some(&self.vao));
+        for b in &self.buffers {
+            gl.delete_buffer(Some(b));
+        }
+    }
+}
+
+fn upload_f32(gl: &Gl, target: u32, data: &[f32]) -> Result<WebGlBuffer, String> {
+    let b = gl
+        .create_buffer()
+        .ok_or("WebGL could not create a buffer")?;
+    gl.bind_buffer(target, Some(&b));
+    let view = js_sys::Float32Array::from(data);
+    gl.buffer_data_with_array_buffer_view(target, &view, Gl::STATIC_DRAW);
+    Ok(b)
+}
+
+fn attrib(gl: &Gl, location: u32, data: &[f32]) -> Result<WebGlBuffer, String> {
+    let b = upload_f32(gl, Gl::ARRAY_BUFFER, data)?;
+    gl.enable_vertex_attrib_array(location);
+    gl.vertex_attrib_pointer_with_i32(location, 3, Gl::FLOAT, false, 0, 0);
+    Ok(b)
+}
+
+/// Line or point vertices with a colour each.
+fn colored(gl: &Gl, pos: &[f32], col: &[f32]) -> Result<Drawable, String> {
+    let vao = gl
+        .create_vertex_array()
+        .ok_or("WebGL could not create a vertex array")?;
+    gl.bind_vertex_array(Some(&vao));
+    let buffers = vec![attrib(gl, 0, pos)?, attrib(gl, 1, col)?];
+    gl.bind_vertex_array(None);
+    Ok(Drawable {
+        vao,
+        buffers,
+        count: (pos.len() / 3) as i32,
+    })
+}
+
+/// An orbit camera around a target, +Z up (the printer's).
+#[derive(Debug, Clone, Copy)]
+pub struct Camera {
+    pub target: DVec3,
+    pub distance: f64,
+    /// Azimuth about +Z and elevation above the XY plane, radians.
+    pub yaw: f64,
+    pub pitch: f64,
+    /// Radius of the scene's bounding sphere (near/far planes, pan speed).
+    pub radius: f64,
+    pub aspect: f64,
+    pub height_px: f64,
+}
+
+/// Vertical field of view: 40 degrees.
+const FOV: f64 = 0.698;
+/// Elevation stops short of the poles, where look-at has no "up".
+const MAX_PITCH: f64 = 1.5690;
+
+impl Camera {
+    fn framing(lo: DVec3, hi: DVec3, aspect: f64, height_px: f64) -> Camera {
+        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+        let fit = radius / (0.5 * FOV).sin() / aspect.min(1.0);
+        Camera {
+            target: 0.5 * (lo + hi),
+            distance: 1.05 * fit,
+            yaw: -1.9,
+            pitch: 0.6,
+            radius,
+            aspect,
+            height_px,
+        }
+    }
+
+    fn eye(&self) -> DVec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.target + self.distance * DVec3::new(cp * cy, cp * sy, sp)
+    }
+
+    fn view_proj(&self) -> DMat4 {
+        let near = (self.distance - 2.0 * self.radius).max(self.distance * 1e-3);
+        let far = self.distance + 2.0 * self.radius;
+        glam::dcamera::rh::proj::opengl::perspective(FOV, self.aspect, near, far)
+            * glam::dcamera::rh::view::look_at_mat4(self.eye(), self.target, DVec3::Z)
+    }
+
+    pub fn orbit(&mut self, dx: f64, dy: f64) {
+        self.yaw -= dx * 0.008;
+        self.pitch = (self.pitch + dy * 0.008).clamp(-MAX_PITCH, MAX_PITCH);
+    }
+
+    /// Moves the target so the scene follows the pointer.
+    pub fn pan(&mut self, dx: f64, dy: f64) {
+        let per_px = 2.0 * self.distance * (0.5 * FOV).tan() / self.height_px.max(1.0);
+        let f = (self.target - self.eye()).normalize();
+        let right = f.cross(DVec3::Z).normalize_or_zero();
+        let up = right.cross(f);
+        self.target += (-dx * right + dy * up) * per_px;
+    }
+
+    pub fn zoom(&mut self, delta: f64) {
+        let k = (delta * 0.0015).clamp(-1.0, 1.0).exp();
+        self.distance = (self.distance * k).clamp(self.radius * 0.02, self.radius * 50.0);
+    }
+
+    pub fn top(&mut self) {
+        self.yaw = -std::f64::consts::FRAC_PI_2;
+        self.pitch = MAX_PITCH;
+    }
+}
+
+/// The WebGL2 state of one canvas.
+pub struct Renderer {
+    gl: Gl,
+    mesh_prog: Program,
+    line_prog: Program,
+    mesh: Option<(Drawable, WebGlBuffer)>,
+    lines: Option<Drawable>,
+    /// Holes found in the scan, and the printer points P drawn smaller on
+    /// top (after a good registration they coincide).
+    holes: Option<Drawable>,
+    printer: Option<Drawable>,
+    bounds: (DVec3, DVec3),
+    width: u32,
+    height: u32,
+    pub camera: Camera,
+}
+
+impl Renderer {
+    pub fn new(canvas: HtmlCanvasElement) -> Result<Renderer, String> {
+        let opts = js_sys::Object::new();
+        // Tests read the pixels back after the frame is presented.
+        js_sys::Reflect::set(&opts, &"preserveDrawingBuffer".into(), &JsValue::TRUE)
+            .map_err(|_| "could not set WebGL options")?;
+        js_sys::Reflect::set(&opts, &"antialias".into(), &JsValue::TRUE)
+            .map_err(|_| "could not set WebGL options")?;
+        let gl: Gl = canvas
+            .get_context_with_context_options("webgl2", &opts)
+            .map_err(|_| "WebGL2 is not available in this browser")?
+            .ok_or("WebGL2 is not available in this browser")?
+            .dyn_into()
+            .map_err(|_| "the canvas did not give a WebGL2 context")?;
+        let mesh_prog = Program::new(&gl, MESH_VS, MESH_FS)?;
+        let line_prog = Program::new(&gl, LINE_VS, LINE_FS)?;
+        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let bounds = (DVec3::splat(-50.0), DVec3::splat(50.0));
+        let aspect = f64::from(width) / f64::from(height);
+        Ok(Renderer {
+            gl,
+            mesh_prog,
+            line_prog,
+            mesh: None,
+            lines: None,
+            holes: None,
+            printer: None,
+            bounds,
+            width,
+            height,
+            camera: Camera::framing(bounds.0, bounds.1, aspect, f64::from(height)),
+        })
+    }
+
+    pub fn resize(&mut self, width: u32, height: u32) {
+        self.width = width.max(1);
+        self.height = height.max(1);
+        self.camera.aspect = f64::from(self.width) / f64::from(self.height);
+        self.camera.height_px = f64::from(self.height);
+    }
+
+    pub fn pan(&mut self, dx: f64, dy: f64) {
+        self.camera.pan(dx, dy);
+    }
+
+    pub fn reset_view(&mut self) {
+        self.camera = Camera::framing(
+            self.bounds.0,
+            self.bounds.1,
+            self.camera.aspect,
+            self.camera.height_px,
+        );
+    }
+
+    /// Uploads a mesh and frames it.
+    pub fn set_mesh(&mut self, positions: &[f32], indices: &[u32]) -> Result<(), String> {
+        if !positions.len().is_multiple_of(3) || !indices.len().is_multiple_of(3) {
+            return Err("mesh arrays must hold whole points and triangles".into());
+        }
+        let n = (positions.len() / 3) as u32;
+        if indices.iter().any(|&i| i >= n) {
+            return Err("a mesh index is past the last vertex".into());
+        }
+        let gl = &self.gl;
+        if let Some((d, ib)) = self.mesh.take() {
+            d.delete(gl);
+            gl.delete_buffer(Some(&ib));
+        }
+        let vao = gl
+            .create_vertex_array()
+            .ok_or("WebGL could not create a vertex array")?;
+        gl.bind_vertex_array(Some(&vao));
+        let vb = attrib(gl, 0, positions)?;
+        let ib = gl
+            .create_buffer()
+            .ok_or("WebGL could not create a buffer")?;
+        gl.bind_buffer(Gl::ELEMENT_ARRAY_BUFFER, Some(&ib));
+        let view = js_sys::Uint32Array::from(indices);
+        gl.buffer_data_with_array_buffer_view(Gl::ELEMENT_ARRAY_BUFFER, &view, Gl::STATIC_DRAW);
+        gl.bind_vertex_array(None);
+        self.mesh = Some((
+            Drawable {
+                vao,
+                buffers: vec![vb],
+                count: indices.len() as i32,
+            },
+            ib,
+        ));
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for p in positions.chunks_exact(3) {
+            let v = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if lo.is_finite() && hi.is_finite() {
+            self.bounds = (lo, hi);
+        }
+        self.reset_view();
+        Ok(())
+    }
+
+    /// Uploads Ta (one colour) and T* (coloured per point by its defect) as
+    /// line segments.
+    pub fn set_paths(&mut self, paths: &ViewPaths) -> Result<(), String> {
+        let mut pos: Vec<f32> = Vec::new();
+        let mut col: Vec<f32> = Vec::new();
+        let mut push = |p: &[f64; 3], c: [f32; 3]| {
+            pos.extend(p.iter().map(|&v| v as f32));
+            col.extend(c);
+        };
+        for piece in &paths.surface_path {
+            for w in piece.windows(2) {
+                push(&w[0], SURFACE_PATH);
+                push(&w[1], SURFACE_PATH);
+            }
+        }
+        for (k, piece) in paths.toolpath.iter().enumerate() {
+            let defects = paths.defects.get(k);
+            let color = |j: usize| {
+                defects
+                    .and_then(|d| d.get(j))
+                    .map_or(defect_rgb(Defect::Good), |&d| defect_rgb(d))
+            };
+            // Each segment takes the colour of its start point.
+            for (j, w) in piece.windows(2).enumerate() {
+                let c = color(j);
+                push(&w[0], c);
+                push(&w[1], c);
+            }
+        }
+        if let Some(d) = self.lines.take() {
+            d.delete(&self.gl);
+        }
+        if !pos.is_empty() {
+            self.lines = Some(colored(&self.gl, &pos, &col)?);
+        }
+        Ok(())
+    }
+
+    pub fn set_markers(&mut self, m: &Markers) -> Result<(), String> {
+        let points = |list: &[[f64; 3]], c: [f32; 3]| -> Result<Option<Drawable>, String> {
+            if list.is_empty() {
+                return Ok(None);
+            }
+            let pos: Vec<f32> = list.iter().flatten().map(|&v| v as f32).collect();
+            let col: Vec<f32> = list.iter().flat_map(|_| c).collect();
+            colored(&self.gl, &pos, &col).map(Some)
+        };
+        let holes = points(&m.holes, HOLE_MARKER)?;
+        let printer = points(&m.printer, PRINTER_MARKER)?;
+        for d in [self.holes.take(), self.printer.take()]
+            .into_iter()
+            .flatten()
+        {
+            d.delete(&self.gl);
+        }
+        self.holes = holes;
+        self.printer = printer;
+        Ok(())
+    }
+
+    pub fn draw(&self) {
+        let gl = &self.gl;
+        gl.viewport(0, 0, self.width as i32, self.height as i32);
+        let [r, g, b] = BACKGROUND;
+        gl.clear_color(r, g, b, 1.0);
+        gl.clear(Gl::COLOR_BUFFER_BIT | Gl::DEPTH_BUFFER_BIT);
+        gl.enable(Gl::DEPTH_TEST);
+        let mvp = self.camera.view_proj().as_mat4().to_cols_array();
+        if let Some((mesh, _)) = &self.mesh {
+            let p = &self.mesh_prog;
+            gl.use_program(Some(&p.program));
+            gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, &mvp);
+            // A headlight, a little above and left of the eye, so faces
+            // turned to the viewer are lit from any orbit angle.
+            let eye = self.camera.eye() - self.camera.target;
+            let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
+            gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+            let [r, g, b] = MESH;
+            gl.uniform3f(p.color.as_ref(), r, g, b);
+            // Push the surface back in depth so Ta, which lies on it, wins.
+            gl.enable(Gl::POLYGON_OFFSET_FILL);
+            gl.polygon_offset(1.0, 2.0);
+            gl.bind_vertex_array(Some(&mesh.vao));
+            gl.draw_elements_with_i32(Gl::TRIANGLES, mesh.count, Gl::UNSIGNED_INT, 0);
+            gl.disable(Gl::POLYGON_OFFSET_FILL);
+        }
+        let p = &self.line_prog;
+        gl.use_program(Some(&p.program));
+        gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, &mvp);
+        if let Some(lines) = &self.lines {
+            gl.bind_vertex_array(Some(&lines.vao));
+            gl.draw_arrays(Gl::LINES, 0, lines.count);
+        }
+        // Markers sit in holes: draw them over the surface.
+        gl.disable(Gl::DEPTH_TEST);
+        for (m, size) in [(&self.holes, 13.0), (&self.printer, 6.0)] {
+            if let Some(m) = m {
+                gl.uniform1f(p.point_size.as_ref(), size);
+                gl.bind_vertex_array(Some(&m.vao));
+                gl.draw_arrays(Gl::POINTS, 0, m.count);
+            }
+        }
+        gl.bind_vertex_array(None);
+    }
+}

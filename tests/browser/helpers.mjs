@@ -1,0 +1,108 @@
+// Shared set-up for the browser tests: the built page (dist/) served on a
+// free 127.0.0.1 port by scripts/serve.mjs, and Debian's Chromium driven by
+// playwright-core with the flags measured in shared/toolchain.md.
+import { spawn } from 'node:child_process';
+import { createServer } from 'node:net';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
+export const DIST = join(ROOT, 'dist');
+
+const FLAGS = [
+  '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync',
+  '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+];
+
+function freePort() {
+  return new Promise((ok, fail) => {
+    const s = createServer();
+    s.once('error', fail);
+    s.listen(0, '127.0.0.1', () => {
+      const { port } = s.address();
+      s.close(() => ok(port));
+    });
+  });
+}
+
+export async function startServer() {
+  const port = await freePort();
+  const proc = spawn(process.execPath, [join(ROOT, 'scripts/serve.mjs'), DIST], {
+    env: { ...process.env, PORT: String(port) },
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  await new Promise((ok, fail) => {
+    proc.once('exit', (code) => fail(new Error(`server exited with ${code}`)));
+    proc.stdout.on('data', (d) => { if (String(d).includes('127.0.0.1')) ok(); });
+  });
+  return { url: `http://127.0.0.1:${port}/`, stop: () => proc.kill() };
+}
+
+// Playwright gives every launch a fresh temporary profile (it refuses a
+// --user-data-dir flag), and adds --headless itself.
+export async function launch() {
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: FLAGS.filter((f) => f !== '--headless'),
+    headless: true,
+  });
+  return { browser, close: () => browser.close() };
+}
+
+// A fresh page that records console errors and uncaught exceptions.
+export async function openPage(browser, url) {
+  const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1280, height: 1000 } });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
+  await page.goto(url);
+  return { page, context, problems };
+}
+
+// Waits until the current plan finished and offered its G-code.
+export async function waitForPlan(page, timeout = 120_000) {
+  await page.waitForFunction(() => {
+    const s = window.pcpp && window.pcpp.state;
+    return s && !s.busy && s.lastPlan && !document.getElementById('dl-gcode').hidden;
+  }, null, { timeout });
+}
+
+export async function waitIdle(page, timeout = 120_000) {
+  await page.waitForFunction(() => window.pcpp && window.pcpp.state && !window.pcpp.state.busy
+    && !window.pcpp.state.queued, null, { timeout });
+}
+
+// Downloads through the page's link and returns the bytes and file name.
+export async function download(page, linkId) {
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.click(`#${linkId}`)]);
+  const path = await dl.path();
+  const { readFileSync } = await import('node:fs');
+  return { name: dl.suggestedFilename(), bytes: readFileSync(path) };
+}
+
+// Counts view pixels by class: background, mesh (blue-grey), path (the
+// saturated defect colours and the white Ta).
+export async function viewPixels(page) {
+  return page.evaluate(() => {
+    const gl = document.getElementById('view');
+    const c = document.createElement('canvas');
+    c.width = gl.width;
+    c.height = gl.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(gl, 0, 0);
+    const d = ctx.getImageData(0, 0, c.width, c.height).data;
+    const out = { total: c.width * c.height, background: 0, mesh: 0, good: 0, defect: 0, ta: 0 };
+    for (let i = 0; i < d.length; i += 4) {
+      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
+      if (Math.abs(r - 23) < 6 && Math.abs(g - 26) < 6 && Math.abs(b - 33) < 6) out.background++;
+      else if (g > r + 90 && g > b + 60) out.good++;
+      else if ((r > g + 100 && r > b + 100) || (b > r + 120 && b > g + 50) || (r > 200 && g > 100 && g < 190 && b < 60)) out.defect++;
+      else if (r > 225 && g > 225 && b > 225) out.ta++;
+      else if (b > r + 4 && b >= g && b - r < 70 && r > 30) out.mesh++;
+    }
+    return out;
+  });
+}

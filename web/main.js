@@ -1,0 +1,836 @@
+// The page: settings, files, the planning worker, the 3-D view and the
+// report. Planning happens only in Rust (the worker's wasm Session, the
+// same `job` code as the CLI); this file moves bytes and settings around
+// and shows results. Text from files and errors is set with textContent.
+import { loadWasm, startWorker } from './engine.js';
+import { drawPlot } from './plot.js';
+import {
+  Viewer,
+  antennaSvg,
+  demoPathName,
+  demoPathSvg,
+  demoScan,
+  demoScanName,
+  demoSettings,
+  dialects,
+  parsePoints,
+  pathBounds,
+  version,
+} from '../pkg/pcpp.js';
+
+const $ = (id) => document.getElementById(id);
+const STORE_KEY = 'pcpp.settings.v1';
+// Common dispensing-tip gauges: inner / outer diameter, mm.
+const GAUGES = [
+  ['20 G', 0.603, 0.908],
+  ['22 G', 0.413, 0.718],
+  ['25 G', 0.26, 0.515],
+  ['27 G', 0.21, 0.413],
+  ['30 G', 0.159, 0.312],
+];
+const STAGES = ['scan', 'plan', 'compare'];
+const encoder = new TextEncoder();
+
+const state = {
+  scan: null, // the accepted scan {key, name, bytes}
+  pendingScan: null, // a scan loaded but not yet read by the worker
+  svgFile: null, // the accepted SVG file
+  pendingSvg: null,
+  nextKey: 1,
+  module: null,
+  worker: null,
+  busy: null, // the plan request in flight
+  queued: false,
+  planId: 0,
+  lastPlan: null,
+  info: null, // the scan as the worker read it
+  viewer: null,
+  redraw: 0,
+  debounce: 0,
+  urls: [],
+};
+
+let settings = null;
+
+// ---------- settings ----------
+
+const fmtPoints = (pts) => pts.map((p) => p.map((v) => +v.toFixed(4)).join(', ')).join('\n');
+
+function demoUiSettings() {
+  const d = demoSettings();
+  const pl = d.plan.placement;
+  return {
+    scanUnits: '',
+    scanUp: '',
+    fidSource: 'auto',
+    fidMethod: d.registration.method,
+    fidScanText: '',
+    fidPrinterText: fmtPoints(d.registration.printer_points),
+    pathSource: 'demo',
+    spiral: { turns: null, pitch_mm: 1.5, inner_radius_mm: 1 },
+    hilbert: { order: 3, size_mm: 20 },
+    monopole: { height_mm: 20, base_mm: 15, feed_mm: 5 },
+    placement: { x: pl.offset_mm[0], y: pl.offset_mm[1], rot: pl.rotation_deg, scale: pl.scale },
+    nozzle: { id: d.plan.nozzle.inner_diameter_mm, od: d.plan.nozzle.outer_diameter_mm },
+    process: {
+      tol: d.plan.process.tolerance_mm,
+      speed: d.plan.process.speed_mm_s,
+      dwell: d.plan.process.dwell_s,
+    },
+    planner: d.plan.planner,
+    dialect: 'marlin',
+    acceptRisk: false,
+  };
+}
+
+function loadSettings() {
+  const base = demoUiSettings();
+  try {
+    const saved = JSON.parse(localStorage.getItem(STORE_KEY) || 'null');
+    if (saved && typeof saved === 'object') {
+      for (const k of Object.keys(base)) {
+        if (!(k in saved)) continue;
+        const b = base[k];
+        base[k] = b && typeof b === 'object' ? { ...b, ...saved[k] } : saved[k];
+      }
+    }
+  } catch {
+    // Unreadable saved settings: start from the demo's.
+  }
+  // Files are not stored, so a saved "SVG file" source starts as the demo.
+  if (base.pathSource === 'file') base.pathSource = 'demo';
+  return base;
+}
+
+function saveSettings() {
+  try {
+    localStorage.setItem(STORE_KEY, JSON.stringify(settings));
+  } catch {
+    // Private mode or a full quota: settings just do not persist.
+  }
+}
+
+const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
+
+// What the library reads: a `job::JobSettings`.
+function jobSettings() {
+  const s = settings;
+  let fiducials = 'none';
+  let printer = [];
+  if (s.fidSource !== 'none') {
+    printer = parseField('printer points P', s.fidPrinterText);
+    fiducials = s.fidSource === 'auto' ? 'auto' : { points: parseField('scan points Sr', s.fidScanText) };
+  }
+  return {
+    scan: { units: s.scanUnits || null, up_axis: s.scanUp || null },
+    registration: { fiducials, printer_points: printer, method: s.fidMethod },
+    plan: {
+      nozzle: { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) },
+      process: {
+        tolerance_mm: num(s.process.tol),
+        speed_mm_s: num(s.process.speed),
+        dwell_s: num(s.process.dwell),
+      },
+      planner: s.planner,
+      placement: {
+        offset_mm: [num(s.placement.x), num(s.placement.y)],
+        rotation_deg: num(s.placement.rot),
+        scale: num(s.placement.scale),
+      },
+    },
+  };
+}
+
+function parseField(label, text) {
+  try {
+    return parsePoints(text || '');
+  } catch (e) {
+    throw new Error(`${label}: ${e.message}`);
+  }
+}
+
+function antennaParams(kind) {
+  const p = { ...settings[kind] };
+  if (kind === 'spiral' && (p.turns === null || p.turns === '' || Number.isNaN(p.turns))) delete p.turns;
+  for (const k of Object.keys(p)) p[k] = num(p[k]);
+  if (kind === 'hilbert') p.order = Math.round(p.order);
+  return p;
+}
+
+// The path to plan: {key, name, bytes}.
+function currentSvg() {
+  switch (settings.pathSource) {
+    case 'file': {
+      const f = state.pendingSvg || state.svgFile;
+      if (!f) throw new Error('no SVG file loaded: open one, or choose another path source');
+      return f;
+    }
+    case 'spiral':
+    case 'hilbert':
+    case 'monopole': {
+      const text = antennaSvg(settings.pathSource, antennaParams(settings.pathSource));
+      return { key: `antenna-${settings.pathSource}`, name: `antenna-${settings.pathSource}.svg`, bytes: encoder.encode(text) };
+    }
+    default:
+      return { key: 'demo', name: demoPathName(), bytes: encoder.encode(demoPathSvg()) };
+  }
+}
+
+// ---------- form binding ----------
+
+// [element id, getter, setter, re-plan on every keystroke]
+const FIELDS = [
+  ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; }],
+  ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
+  ['fid-source', () => settings.fidSource, (v) => { settings.fidSource = v; }],
+  ['fid-method', () => settings.fidMethod, (v) => { settings.fidMethod = v; }],
+  ['fid-scan', () => settings.fidScanText, (v) => { settings.fidScanText = v; }],
+  ['fid-printer', () => settings.fidPrinterText, (v) => { settings.fidPrinterText = v; }],
+  ['path-source', () => settings.pathSource, (v) => { settings.pathSource = v; }],
+  ['sp-turns', () => settings.spiral.turns, (v) => { settings.spiral.turns = v === '' ? null : Number(v); }],
+  ['sp-pitch', () => settings.spiral.pitch_mm, (v) => { settings.spiral.pitch_mm = Number(v); }],
+  ['sp-inner', () => settings.spiral.inner_radius_mm, (v) => { settings.spiral.inner_radius_mm = Number(v); }],
+  ['hb-order', () => settings.hilbert.order, (v) => { settings.hilbert.order = Number(v); }],
+  ['hb-size', () => settings.hilbert.size_mm, (v) => { settings.hilbert.size_mm = Number(v); }],
+  ['mp-height', () => settings.monopole.height_mm, (v) => { settings.monopole.height_mm = Number(v); }],
+  ['mp-base', () => settings.monopole.base_mm, (v) => { settings.monopole.base_mm = Number(v); }],
+  ['mp-feed', () => settings.monopole.feed_mm, (v) => { settings.monopole.feed_mm = Number(v); }],
+  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, true],
+  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, true],
+  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, true],
+  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, true],
+  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }],
+  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }],
+  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }],
+  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = Number(v); }],
+  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = Number(v); }],
+  ['planner', () => settings.planner, (v) => { settings.planner = v; }],
+  ['dialect', () => settings.dialect, (v) => { settings.dialect = v; }],
+  ['accept-risk', () => settings.acceptRisk, (v) => { settings.acceptRisk = v; }],
+];
+
+function writeForm() {
+  for (const [id, get] of FIELDS) {
+    const el = $(id);
+    const v = get();
+    if (el.type === 'checkbox') el.checked = !!v;
+    else el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+  }
+  syncGauge();
+  syncVisibility();
+}
+
+function syncGauge() {
+  const id = Number(settings.nozzle.id);
+  const od = Number(settings.nozzle.od);
+  const i = GAUGES.findIndex(([, a, b]) => a === id && b === od);
+  $('gauge').value = i >= 0 ? String(i) : 'custom';
+}
+
+function syncVisibility() {
+  for (const k of ['spiral', 'hilbert', 'monopole']) $(`antenna-${k}`).hidden = settings.pathSource !== k;
+  $('fid-scan-wrap').hidden = settings.fidSource !== 'points';
+  const svg = settings.pathSource === 'file' ? state.pendingSvg || state.svgFile : null;
+  $('svg-name').textContent = settings.pathSource === 'file'
+    ? (svg ? svg.name : 'no SVG file loaded')
+    : $('path-source').selectedOptions[0].textContent;
+}
+
+function bindForm() {
+  for (const [id, , set, live] of FIELDS) {
+    const el = $(id);
+    const handler = () => {
+      set(el.type === 'checkbox' ? el.checked : el.value);
+      saveSettings();
+      syncGauge();
+      syncVisibility();
+      if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
+        centreOnScan(false);
+      }
+      schedulePlan(live ? 200 : 350);
+    };
+    el.addEventListener(live || el.tagName === 'TEXTAREA' ? 'input' : 'change', handler);
+  }
+  const gauge = $('gauge');
+  GAUGES.forEach(([name, id, od], i) => gauge.add(new Option(`${name}  (${id} / ${od} mm)`, String(i))));
+  gauge.add(new Option('custom', 'custom'));
+  gauge.addEventListener('change', () => {
+    const g = GAUGES[Number(gauge.value)];
+    if (!g) return;
+    settings.nozzle.id = g[1];
+    settings.nozzle.od = g[2];
+    saveSettings();
+    writeForm();
+    schedulePlan(0);
+  });
+  const dialect = $('dialect');
+  for (const d of dialects()) dialect.add(new Option(d, d));
+}
+
+// ---------- errors and status ----------
+
+function showError(title, message) {
+  $('error-title').textContent = title;
+  $('error-message').textContent = message;
+  $('error-panel').hidden = false;
+}
+
+function clearError() {
+  $('error-panel').hidden = true;
+}
+
+function setStatus(text, stale) {
+  const el = $('plan-status');
+  el.textContent = text;
+  el.classList.toggle('stale', !!stale);
+}
+
+function hideDownloads() {
+  $('dl-gcode').hidden = true;
+  $('dl-report').hidden = true;
+  for (const u of state.urls) URL.revokeObjectURL(u);
+  state.urls = [];
+  $('dl-gcode').removeAttribute('href');
+  $('dl-report').removeAttribute('href');
+}
+
+function offerDownloads(plan) {
+  hideDownloads();
+  const stem = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
+  const link = (el, text, type, name) => {
+    const url = URL.createObjectURL(new Blob([text], { type }));
+    state.urls.push(url);
+    el.href = url;
+    el.download = name;
+    el.hidden = false;
+  };
+  link($('dl-gcode'), plan.gcode, 'text/plain', `${stem}-${plan.planner}.gcode`);
+  link($('dl-report'), plan.reportJson, 'application/json', `${stem}-${plan.planner}.json`);
+}
+
+function showProgress(stage, label) {
+  $('progress').hidden = false;
+  const at = STAGES.indexOf(stage);
+  for (const li of $('stages').children) {
+    const i = STAGES.indexOf(li.dataset.stage);
+    li.classList.toggle('active', i === at);
+    li.classList.toggle('done', i < at);
+  }
+  $('progress-label').textContent = label || '';
+}
+
+function endProgress() {
+  $('progress').hidden = true;
+  $('cancel-btn').hidden = true;
+}
+
+// ---------- planning ----------
+
+function schedulePlan(delay) {
+  hideDownloads();
+  if (state.lastPlan) setStatus('settings changed: re-planning…', true);
+  clearTimeout(state.debounce);
+  state.debounce = setTimeout(requestPlan, delay);
+}
+
+function requestPlan() {
+  clearTimeout(state.debounce);
+  if (state.busy) {
+    state.queued = true;
+    return;
+  }
+  runPlan();
+}
+
+function runPlan() {
+  hideDownloads();
+  let job;
+  let svg;
+  try {
+    job = jobSettings();
+    svg = currentSvg();
+  } catch (e) {
+    showError('Cannot plan', e.message);
+    setStatus(state.lastPlan ? 'plan failed: showing the previous plan' : 'plan failed', true);
+    return;
+  }
+  const scan = state.pendingScan || state.scan;
+  const id = ++state.planId;
+  state.busy = { id, scan, svg, job, planner: job.plan.planner };
+  state.queued = false;
+  $('cancel-btn').hidden = false;
+  showProgress('scan', 'starting');
+  setStatus('planning…');
+  state.worker.postMessage({
+    type: 'plan',
+    id,
+    scan: { key: scan.key, name: scan.name, bytes: scan.bytes },
+    svg: { name: svg.name, bytes: svg.bytes },
+    settings: job,
+    dialect: settings.dialect,
+    acceptRisk: !!settings.acceptRisk,
+    compare: true,
+  });
+}
+
+function finish() {
+  state.busy = null;
+  endProgress();
+  if (state.queued) runPlan();
+}
+
+function onWorkerMessage(e) {
+  const m = e.data;
+  const busy = state.busy;
+  if (m.type === 'ready') return;
+  if (!busy || m.id !== busy.id) {
+    if (m.type === 'error' && m.stage === 'init') showError('Could not start the planner', m.message);
+    return;
+  }
+  switch (m.type) {
+    case 'progress':
+      showProgress(m.stage, m.label);
+      break;
+    case 'scan':
+      if (state.pendingScan && state.pendingScan.key === m.key) {
+        state.scan = state.pendingScan;
+        state.pendingScan = null;
+      }
+      showScan(m.info, m.positions, m.indices);
+      break;
+    case 'result': {
+      if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {
+        state.svgFile = state.pendingSvg;
+        state.pendingSvg = null;
+      }
+      const report = JSON.parse(m.reportJson);
+      state.lastPlan = {
+        gcode: m.gcode,
+        reportJson: m.reportJson,
+        report,
+        svgName: busy.svg.name,
+        planner: busy.planner,
+      };
+      clearError();
+      showPlan(report);
+      if (state.queued) {
+        setStatus('settings changed: re-planning…', true);
+      } else {
+        offerDownloads(state.lastPlan);
+        setStatus(`planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}`);
+      }
+      $('compare-table').tBodies[0].replaceChildren();
+      break;
+    }
+    case 'comparison':
+      showComparison(m.rows, busy.planner);
+      break;
+    case 'done':
+      finish();
+      break;
+    case 'error':
+      onPlanError(m, busy);
+      finish();
+      break;
+    default:
+      break;
+  }
+}
+
+function onPlanError(m, busy) {
+  let title = 'Planning failed';
+  let message = m.message;
+  if (m.stage === 'scan' && m.kind === 'mesh' && state.pendingScan && busy.scan === state.pendingScan) {
+    // The file could not be read: keep working with the previous scan.
+    title = `Could not read the scan ${state.pendingScan.name}`;
+    state.pendingScan = null;
+    message += `\nStill using the previous scan, ${state.scan.name}.`;
+  } else if (m.stage === 'scan') {
+    title = m.kind === 'mesh' ? 'Could not read the scan' : 'Registration failed';
+    if (state.pendingScan && busy.scan === state.pendingScan) {
+      // Readable but not registered: it stays loaded until the fiducials fit.
+      state.scan = state.pendingScan;
+      state.pendingScan = null;
+      $('scan-name').textContent = state.scan.name;
+    }
+  } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
+    title = `Could not read the SVG ${state.pendingSvg.name}`;
+    state.pendingSvg = null;
+    if (!state.svgFile) settings.pathSource = 'demo';
+    writeForm();
+    message += state.svgFile
+      ? `\nStill using the previous SVG, ${state.svgFile.name}.`
+      : '\nBack to the demo paths.';
+  } else if (m.stage === 'compare') {
+    // The plan itself succeeded and stays downloadable.
+    title = 'Comparing the planners failed';
+    showError(title, message);
+    return;
+  }
+  showError(title, message);
+  hideDownloads();
+  setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+}
+
+function cancelPlan() {
+  if (!state.busy) return;
+  // The only way to stop wasm mid-computation: end the worker.
+  state.worker.terminate();
+  state.worker = makeWorker();
+  state.busy = null;
+  state.queued = false;
+  endProgress();
+  hideDownloads();
+  setStatus('cancelled', true);
+}
+
+function makeWorker() {
+  const w = startWorker(state.module);
+  w.onmessage = onWorkerMessage;
+  w.onerror = (e) => {
+    showError('The planner stopped', e.message || 'the worker failed to load');
+    state.busy = null;
+    endProgress();
+  };
+  return w;
+}
+
+// ---------- showing results ----------
+
+const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '∞' : v.toFixed(d));
+
+function showScan(info, positions, indices) {
+  state.info = info;
+  $('scan-name').textContent = info.name;
+  const [lo, hi] = info.bbox_mm;
+  $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString()} triangles, `
+    + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units})`;
+  if (state.viewer) {
+    try {
+      state.viewer.setMesh(positions, indices);
+    } catch (e) {
+      showError('Could not draw the scan', e.message);
+    }
+  }
+  showFiducials();
+  requestDraw();
+}
+
+function showFiducials() {
+  const info = state.info;
+  const holes = $('fid-holes');
+  const res = $('fid-residuals');
+  holes.replaceChildren();
+  res.replaceChildren();
+  if (!info) return;
+  const list = info.holes.slice(0, 8);
+  if (list.length) {
+    const p = document.createElement('p');
+    p.textContent = `${info.holes.length} hole(s) found (scan frame):`;
+    holes.append(p);
+    const ol = document.createElement('ol');
+    for (const h of list) {
+      const li = document.createElement('li');
+      li.textContent = `(${h.scan.map((v) => fmt(v)).join(', ')}) Ø ${fmt(h.diameter_mm)} mm`;
+      ol.append(li);
+    }
+    holes.append(ol);
+    const use = document.createElement('button');
+    use.type = 'button';
+    use.className = 'small-btn';
+    use.textContent = 'Use the first three as scan points';
+    use.addEventListener('click', () => {
+      settings.fidScanText = fmtPoints(info.holes.slice(0, 3).map((h) => h.scan));
+      settings.fidSource = 'points';
+      saveSettings();
+      writeForm();
+      schedulePlan(0);
+    });
+    holes.append(use);
+  } else {
+    holes.textContent = 'No holes found in the scan.';
+  }
+  const r = info.registration;
+  if (r.residuals_mm.length === 0) {
+    res.textContent = 'No registration: the scan is used as it is (printer frame).';
+  } else {
+    const d = Number(settings.nozzle.id);
+    const p = document.createElement('p');
+    p.textContent = `Residuals: ${r.residuals_mm.map((v) => fmt(v, 4)).join(', ')} mm; RMS `;
+    const rms = document.createElement('span');
+    rms.className = 'rms';
+    rms.id = 'rms';
+    rms.textContent = `${fmt(r.rms_mm, 4)} mm`;
+    // Above d/2 the path lands off by more than half a filament width.
+    if (r.rms_mm > d / 2) {
+      rms.classList.add('bad');
+      rms.title = `above d/2 = ${fmt(d / 2)} mm`;
+    }
+    p.append(rms);
+    res.append(p);
+    for (const n of r.notes) {
+      const q = document.createElement('p');
+      q.textContent = n;
+      res.append(q);
+    }
+  }
+  if (state.viewer) {
+    const printer = settings.fidSource === 'none' ? [] : safePoints(settings.fidPrinterText);
+    try {
+      state.viewer.setMarkers(info.holes.map((h) => h.printer), printer);
+    } catch (e) {
+      showError('Could not draw the fiducials', e.message);
+    }
+    requestDraw();
+  }
+}
+
+function safePoints(text) {
+  try {
+    return parsePoints(text || '');
+  } catch {
+    return [];
+  }
+}
+
+function showPlan(report) {
+  if (state.viewer) {
+    try {
+      state.viewer.setPaths(report);
+    } catch (e) {
+      showError('Could not draw the paths', e.message);
+    }
+    requestDraw();
+  }
+  const st = report.stats;
+  const rows = [
+    ['pieces', st.subpaths],
+    ['points', st.points],
+    ['tool-path length', `${fmt(st.length_mm, 2)} mm`],
+    ['height change', `${fmt(st.height_change_mm)} mm`],
+    ['max inclination', `${fmt(st.max_inclination_deg, 1)}°`],
+    ['min radius of curvature', `${fmt(st.min_radius_mm)} mm`],
+    ['print time', `${fmt(st.print_time_s, 1)} s`],
+    ['registration RMS', `${fmt(report.registration.rms_mm, 4)} mm`],
+  ];
+  const body = $('stats-table').tBodies[0];
+  body.replaceChildren(...rows.map(([k, v]) => {
+    const tr = document.createElement('tr');
+    const a = document.createElement('td');
+    const b = document.createElement('td');
+    a.textContent = k;
+    b.textContent = String(v);
+    tr.append(a, b);
+    return tr;
+  }));
+  $('warnings').replaceChildren(...report.warnings.map((w) => {
+    const li = document.createElement('li');
+    li.textContent = w;
+    return li;
+  }));
+  drawPlot($('plot'), report, report.settings.nozzle.inner_diameter_mm);
+}
+
+function showComparison(rows, selected) {
+  const body = $('compare-table').tBodies[0];
+  body.replaceChildren(...rows.map((r) => {
+    const q = r.quality;
+    const tr = document.createElement('tr');
+    if (r.planner === selected) tr.className = 'selected';
+    for (const v of [r.planner, fmt(q.mean_abs_error_mm, 4), fmt(q.mean_negative_error_mm, 4),
+      fmt(q.mean_positive_error_mm, 4), `${fmt(q.contact_pct, 1)}%`, `${fmt(q.flattening_pct, 1)}%`,
+      `${fmt(q.floating_pct, 1)}%`]) {
+      const td = document.createElement('td');
+      td.textContent = v;
+      tr.append(td);
+    }
+    return tr;
+  }));
+}
+
+// ---------- files ----------
+
+async function openFile(file) {
+  let bytes;
+  try {
+    // Bytes go to wasm as a Uint8Array, never through a JS string.
+    bytes = new Uint8Array(await file.arrayBuffer());
+  } catch (e) {
+    showError(`Could not read ${file.name}`, e.message);
+    return;
+  }
+  const entry = { key: `file-${state.nextKey++}`, name: file.name, bytes };
+  if (/\.svg$/i.test(file.name)) {
+    state.pendingSvg = entry;
+    settings.pathSource = 'file';
+  } else {
+    state.pendingScan = entry;
+    // The demo's fiducials belong to the demo part: a new scan starts
+    // unregistered until the user sets its fiducials.
+    const demo = demoUiSettings();
+    if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
+      settings.fidSource = 'none';
+    }
+    $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
+  }
+  saveSettings();
+  writeForm();
+  schedulePlan(0);
+}
+
+function bindFiles() {
+  for (const id of ['scan-input', 'svg-input']) {
+    const input = $(id);
+    input.addEventListener('change', () => {
+      const f = input.files && input.files[0];
+      if (f) openFile(f);
+      input.value = '';
+    });
+  }
+  const overlay = $('drop-overlay');
+  let depth = 0;
+  window.addEventListener('dragenter', (e) => {
+    e.preventDefault();
+    depth++;
+    overlay.hidden = false;
+  });
+  window.addEventListener('dragleave', () => {
+    depth = Math.max(0, depth - 1);
+    if (depth === 0) overlay.hidden = true;
+  });
+  window.addEventListener('dragover', (e) => e.preventDefault());
+  window.addEventListener('drop', (e) => {
+    e.preventDefault();
+    depth = 0;
+    overlay.hidden = true;
+    for (const f of e.dataTransfer.files) openFile(f);
+  });
+}
+
+function loadDemo() {
+  const demo = demoUiSettings();
+  settings.fidSource = demo.fidSource;
+  settings.fidMethod = demo.fidMethod;
+  settings.fidPrinterText = demo.fidPrinterText;
+  settings.pathSource = 'demo';
+  settings.placement = demo.placement;
+  settings.scanUnits = '';
+  settings.scanUp = '';
+  state.pendingScan = null;
+  state.scan = { key: 'demo', name: demoScanName(), bytes: demoScan() };
+  saveSettings();
+  writeForm();
+  schedulePlan(0);
+}
+
+// Places the centre of the path's box over the scan's centre, keeping rotation and scale.
+function centreOnScan(showErrors = true) {
+  if (!state.info) return;
+  try {
+    const svg = currentSvg();
+    const b = pathBounds(svg.bytes, svg.name);
+    // The drawing's box centre, as imported (before placement).
+    const c = [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
+    const [lo, hi] = state.info.bbox_mm;
+    const s = num(settings.placement.scale);
+    const a = (num(settings.placement.rot) * Math.PI) / 180;
+    const rx = Math.cos(a) * c[0] - Math.sin(a) * c[1];
+    const ry = Math.sin(a) * c[0] + Math.cos(a) * c[1];
+    settings.placement.x = +(((lo[0] + hi[0]) / 2) - s * rx).toFixed(3);
+    settings.placement.y = +(((lo[1] + hi[1]) / 2) - s * ry).toFixed(3);
+    saveSettings();
+    writeForm();
+  } catch (e) {
+    if (showErrors) showError('Cannot centre the path', e.message);
+  }
+}
+
+// ---------- 3-D view ----------
+
+function requestDraw() {
+  if (!state.viewer || state.redraw) return;
+  state.redraw = requestAnimationFrame(() => {
+    state.redraw = 0;
+    state.viewer.draw();
+  });
+}
+
+function bindView() {
+  const canvas = $('view');
+  try {
+    state.viewer = new Viewer(canvas);
+  } catch (e) {
+    showError('No 3-D view', e.message);
+    return;
+  }
+  const resize = () => {
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+    const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+    if (canvas.width !== w || canvas.height !== h) {
+      canvas.width = w;
+      canvas.height = h;
+    }
+    state.viewer.resize(w, h);
+    requestDraw();
+  };
+  new ResizeObserver(resize).observe(canvas);
+  resize();
+  let drag = null;
+  canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+  canvas.addEventListener('pointerdown', (e) => {
+    drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.button === 1 || e.shiftKey };
+    canvas.setPointerCapture(e.pointerId);
+  });
+  canvas.addEventListener('pointermove', (e) => {
+    if (!drag) return;
+    const dpr = window.devicePixelRatio || 1;
+    const dx = (e.clientX - drag.x) * dpr;
+    const dy = (e.clientY - drag.y) * dpr;
+    drag.x = e.clientX;
+    drag.y = e.clientY;
+    if (drag.pan) state.viewer.pan(dx, dy);
+    else state.viewer.orbit(dx, dy);
+    requestDraw();
+  });
+  const end = () => { drag = null; };
+  canvas.addEventListener('pointerup', end);
+  canvas.addEventListener('pointercancel', end);
+  canvas.addEventListener('wheel', (e) => {
+    e.preventDefault();
+    state.viewer.zoom(e.deltaMode === 1 ? e.deltaY * 20 : e.deltaY);
+    requestDraw();
+  }, { passive: false });
+  $('reset-view').addEventListener('click', () => { state.viewer.resetView(); requestDraw(); });
+  $('top-view').addEventListener('click', () => { state.viewer.topView(); requestDraw(); });
+}
+
+// ---------- start ----------
+
+async function start() {
+  try {
+    state.module = await loadWasm();
+  } catch (e) {
+    showError('Could not load the planner (WebAssembly)', e.message);
+    return;
+  }
+  $('version').textContent = `v${version()}`;
+  settings = loadSettings();
+  bindForm();
+  writeForm();
+  bindFiles();
+  bindView();
+  $('plan-btn').addEventListener('click', requestPlan);
+  $('cancel-btn').addEventListener('click', cancelPlan);
+  $('demo-btn').addEventListener('click', loadDemo);
+  $('center-btn').addEventListener('click', () => { centreOnScan(true); schedulePlan(0); });
+  $('error-close').addEventListener('click', clearError);
+  state.worker = makeWorker();
+  state.scan = { key: 'demo', name: demoScanName(), bytes: demoScan() };
+  $('scan-name').textContent = state.scan.name;
+  // For tests and the curious: read-only access to the page's state.
+  window.pcpp = { state, get settings() { return settings; } };
+  requestPlan();
+}
+
+start();

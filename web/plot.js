@@ -1,0 +1,92 @@
+// The error plot (the paper's Figure 3d): predicted filament error against
+// surface slope and against curvature, one dot per point, coloured by the
+// predicted defect. Drawn on a 2-D canvas from the report's series.
+
+const COLORS = {
+  good: '#28d246',
+  contact: '#e62828',
+  flattening: '#ff9614',
+  floating: '#2878ff',
+};
+
+// Loops, not Math.min(...xs): a long path would overflow the argument list.
+function extent(values, lo = Infinity, hi = -Infinity) {
+  for (const v of values) {
+    if (Number.isFinite(v)) {
+      if (v < lo) lo = v;
+      if (v > hi) hi = v;
+    }
+  }
+  return [lo, hi];
+}
+
+function niceRange(lo, hi) {
+  if (!Number.isFinite(lo) || !Number.isFinite(hi)) { lo = 0; hi = 0; }
+  if (!(hi > lo)) { lo -= 1; hi += 1; }
+  const pad = 0.05 * (hi - lo);
+  return [lo - pad, hi + pad];
+}
+
+function panel(ctx, box, points, xLabel, xOf, d) {
+  const { x, y, w, h } = box;
+  const [x0, x1] = niceRange(...extent(points.map(xOf)));
+  // Contacts carry no error estimate: they are drawn on the top edge.
+  const [y0, y1] = niceRange(...extent(points.map((p) => p.e), -d, d));
+  const px = (v) => x + ((v - x0) / (x1 - x0)) * w;
+  const py = (v) => y + h - ((v - y0) / (y1 - y0)) * h;
+  ctx.strokeStyle = '#c8ccd4';
+  ctx.strokeRect(x, y, w, h);
+  ctx.fillStyle = '#667085';
+  ctx.font = '11px system-ui, sans-serif';
+  ctx.textAlign = 'center';
+  ctx.fillText(xLabel, x + w / 2, y + h + 26);
+  for (const t of [x0, (x0 + x1) / 2, x1]) ctx.fillText(t.toFixed(2), px(t), y + h + 13);
+  ctx.textAlign = 'right';
+  for (const t of [y0, 0, y1]) ctx.fillText(t.toFixed(3), x - 4, py(t) + 4);
+  ctx.save();
+  ctx.translate(x - 40, y + h / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.textAlign = 'center';
+  ctx.fillText('error e (mm)', 0, 0);
+  ctx.restore();
+  ctx.strokeStyle = '#9aa3b2';
+  ctx.setLineDash([3, 3]);
+  ctx.beginPath();
+  ctx.moveTo(x, py(0));
+  ctx.lineTo(x + w, py(0));
+  ctx.stroke();
+  ctx.setLineDash([]);
+  for (const p of points) {
+    ctx.fillStyle = COLORS[p.defect] || COLORS.good;
+    const vy = p.e === null ? y + 3 : py(p.e);
+    ctx.fillRect(px(xOf(p)) - 1.5, vy - 1.5, 3, 3);
+  }
+}
+
+// Draws both panels; `report` is the parsed JSON report (null clears).
+export function drawPlot(canvas, report, nozzleD) {
+  const dpr = window.devicePixelRatio || 1;
+  const cw = canvas.clientWidth || 900;
+  const ch = canvas.clientHeight || 260;
+  canvas.width = Math.round(cw * dpr);
+  canvas.height = Math.round(ch * dpr);
+  const ctx = canvas.getContext('2d');
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, cw, ch);
+  if (!report) return;
+  const points = [];
+  report.series.forEach((piece, k) => {
+    piece.forEach((s, j) => {
+      points.push({
+        slope: s.slope_deg,
+        kappa: s.kappa_per_mm,
+        e: s.error_mm,
+        defect: (report.defects[k] || [])[j] || 'good',
+      });
+    });
+  });
+  if (points.length === 0) return;
+  const w = (cw - 130) / 2;
+  panel(ctx, { x: 55, y: 10, w, h: ch - 50 }, points, 'slope (deg)', (p) => p.slope, nozzleD);
+  panel(ctx, { x: 55 + w + 65, y: 10, w, h: ch - 50 }, points, 'curvature κ (1/mm)', (p) => p.kappa, nozzleD);
+}
