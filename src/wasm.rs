@@ -357,7 +357,9 @@ impl Session {
         let profile = profile(dialect)?;
         let out = job::run_on(&self.scan, svg, svg_name, &settings, &profile, accept_risk)
             .map_err(core_err)?;
-        let report_json = serde_json::to_string_pretty(&out.report).map_err(js_err)?;
+        // Pretty JSON and a final newline: what the CLI's `--report` writes.
+        let mut report_json = serde_json::to_string_pretty(&out.report).map_err(js_err)?;
+        report_json.push('\n');
         Ok(to_js(&PlanResult {
             gcode: out.gcode,
             report_json,

@@ -1,0 +1,340 @@
+//! The core's tests that matter, compiled to wasm32 and run in Node
+//! (`wasm-pack test --node -- --test wasm_core`): importers, registration,
+//! projection, planners, quality and G-code must give in the browser what
+//! they give natively. The demo's G-code is compared with the native golden
+//! file byte for byte, both through `pcpp::job` and through the page's
+//! `pcpp::wasm::Session` adapter.
+#![cfg(target_arch = "wasm32")]
+
+use pcpp::demo::{self, antennas, test_part};
+use pcpp::gcode::MachineProfile;
+use pcpp::job::{self, FiducialSource, JobSettings, RegistrationSettings};
+use pcpp::mesh::{import_mesh, ImportOptions, MeshFormat, ScanUnits};
+use pcpp::planners::PlannerKind;
+use pcpp::quality::Defect;
+use pcpp::registration::{parse_points, register, RegistrationMethod};
+use pcpp::DVec3;
+use wasm_bindgen::JsValue;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+const GOLDEN_MARLIN: &str = include_str!("golden/demo-marlin.gcode");
+const GOLDEN_GRBL: &str = include_str!("golden/demo-grbl.gcode");
+
+/// A 4 x 4 grid of quads in cm with a bump, as OBJ text.
+fn small_obj() -> String {
+    let mut s = String::from("# a small bumpy sheet\n");
+    for j in 0..5 {
+        for i in 0..5 {
+            let z = if (i, j) == (2, 2) { 0.1 } else { 0.0 };
+            s.push_str(&format!("v {} {} {z}\n", i as f64 * 0.5, j as f64 * 0.5));
+        }
+    }
+    for j in 0..4 {
+        for i in 0..4 {
+            let a = j * 5 + i + 1;
+            s.push_str(&format!("f {} {} {} {}\n", a, a + 1, a + 6, a + 5));
+        }
+    }
+    s
+}
+
+#[wasm_bindgen_test]
+fn obj_imports_with_units() {
+    let cm = ImportOptions {
+        units: Some(ScanUnits::Cm),
+        up_axis: None,
+    };
+    let m = import_mesh(small_obj().as_bytes(), "sheet.obj", &cm).unwrap();
+    assert_eq!(m.format, MeshFormat::Obj);
+    assert_eq!(m.mesh.triangle_count(), 32);
+    let (lo, hi) = m.mesh.bbox().unwrap();
+    assert_eq!(lo, DVec3::ZERO);
+    assert_eq!(hi, DVec3::new(20.0, 20.0, 1.0));
+}
+
+#[wasm_bindgen_test]
+fn demo_ply_round_trips_through_the_importer() {
+    let bytes = demo::demo_scan_bytes();
+    let m = import_mesh(&bytes, demo::DEMO_SCAN_NAME, &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.format, MeshFormat::Ply);
+    let part = test_part::test_part();
+    // Zero-area triangles may be dropped by the importer, nothing else.
+    let (n, k) = (m.mesh.triangle_count(), part.triangle_count());
+    assert!(n <= k && n + 100 > k, "{n} of {k} triangles");
+    assert!(m.mesh.bbox() == part.bbox());
+}
+
+#[wasm_bindgen_test]
+fn hostile_scans_are_errors_not_panics() {
+    let inputs: [&[u8]; 6] = [
+        b"",
+        b"ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\nend_header\n",
+        b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2\n",
+        b"v 1 2 3\nf 1 2 99\n",
+        b"glTF\x02\x00\x00\x00\xff\xff\xff\xff",
+        &[0xff; 300],
+    ];
+    let names = ["a.obj", "b.ply", "c.stl", "d.obj", "e.glb", "f.stl"];
+    for (bytes, name) in inputs.iter().zip(names) {
+        let e = import_mesh(bytes, name, &ImportOptions::DEFAULT);
+        assert!(e.is_err(), "{name} imported");
+    }
+}
+
+#[wasm_bindgen_test]
+fn paper_table_s1_registers() {
+    // Table S1's points, typed as the page and the CLI take them.
+    let sr = parse_points(
+        "-58.4037,86.5977,-39.1942; -88.5714,153.855,-53.3039; -57.0373,153.469,-124.727",
+    )
+    .unwrap();
+    let p = parse_points(
+        "88.1799,14.0904,-50.7744\n13.4989,11.1944,-50.7974\n10.1549,89.0994,-50.7314",
+    )
+    .unwrap();
+    let lsq = register(&sr, &p, RegistrationMethod::Lsq).unwrap();
+    let paper = register(&sr, &p, RegistrationMethod::Paper).unwrap();
+    assert!((0.05..=0.35).contains(&lsq.rms_mm), "{}", lsq.rms_mm);
+    assert!(lsq.rms_mm <= paper.rms_mm);
+    assert!(paper.residuals_mm[1] < 1e-12);
+    assert!(parse_points("1, 2").is_err());
+}
+
+/// The G-code without its scan-file header line. The demo scan is
+/// generated with `cos`/`sqrt`, whose last bit differs between wasm32's
+/// libm and the native one, so its sha256 (and only that: every coordinate
+/// written agrees) differs from the native golden file's. Uploaded files
+/// are the same bytes on both sides, so the page's G-code for them equals
+/// the CLI's in full (tests/browser/upload.test.mjs checks that).
+fn without_scan_line(gcode: &str) -> String {
+    gcode
+        .lines()
+        .filter(|l| !l.contains("scan file: "))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn golden_settings() -> JobSettings {
+    let mut s = JobSettings::default();
+    s.plan.placement = test_part::placement();
+    s
+}
+
+#[wasm_bindgen_test]
+fn demo_gcode_equals_the_native_golden_files() {
+    let scan = demo::demo_scan_bytes();
+    let svg = test_part::test_part_svg();
+    let settings = golden_settings();
+    let prepared = job::prepare_scan(
+        &scan,
+        demo::DEMO_SCAN_NAME,
+        &settings.scan,
+        &settings.registration,
+    )
+    .unwrap();
+    for (dialect, golden) in [("marlin", GOLDEN_MARLIN), ("grbl", GOLDEN_GRBL)] {
+        let profile = MachineProfile::builtin(dialect).unwrap();
+        let out = job::run_on(
+            &prepared,
+            svg.as_bytes(),
+            demo::DEMO_PATH_NAME,
+            &settings.plan,
+            &profile,
+            false,
+        )
+        .unwrap();
+        let (golden, gcode) = (without_scan_line(golden), without_scan_line(&out.gcode));
+        if gcode != golden {
+            let diffs: Vec<String> = golden
+                .lines()
+                .zip(gcode.lines())
+                .enumerate()
+                .filter(|(_, (a, b))| a != b)
+                .map(|(i, (a, b))| format!("line {}: golden {a:?} wasm {b:?}", i + 1))
+                .collect();
+            panic!(
+                "{dialect}: wasm G-code differs from tests/golden in {} line(s):\n{}",
+                diffs.len(),
+                diffs
+                    .iter()
+                    .take(12)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            );
+        }
+    }
+}
+
+#[wasm_bindgen_test]
+fn planners_compare_and_the_guarded_one_never_touches() {
+    let scan = demo::demo_scan_bytes();
+    let svg = test_part::test_part_svg();
+    let settings = golden_settings();
+    let prepared = job::prepare_scan(
+        &scan,
+        demo::DEMO_SCAN_NAME,
+        &settings.scan,
+        &settings.registration,
+    )
+    .unwrap();
+    let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan).unwrap();
+    let kinds: Vec<PlannerKind> = rows.iter().map(|r| r.0).collect();
+    assert_eq!(kinds, PlannerKind::ALL.to_vec());
+    let guarded = rows[3].1;
+    assert_eq!(guarded.contact_pct, 0.0);
+    // The constant stand-off runs into the part's steps (the paper's point).
+    assert!(rows[0].1.contact_pct > guarded.contact_pct);
+
+    // Projection: every Ta point of the first line lies on the part.
+    let out = job::run_on(
+        &prepared,
+        svg.as_bytes(),
+        "lines.svg",
+        &settings.plan,
+        &MachineProfile::builtin("marlin").unwrap(),
+        false,
+    )
+    .unwrap();
+    // Walls are vertical, so points right at a wall may take either side's
+    // height: require nearly all, not all, to sit on the analytic surface.
+    let ta: Vec<&[f64; 3]> = out.report.surface_path.iter().flatten().collect();
+    let on = ta
+        .iter()
+        .filter(|p| (p[2] - test_part::height(p[0], p[1])).abs() < 1e-3)
+        .count();
+    assert!(on * 100 >= ta.len() * 95, "{on} of {}", ta.len());
+    assert!(out
+        .report
+        .defects
+        .iter()
+        .flatten()
+        .all(|d| *d != Defect::Contact));
+}
+
+#[wasm_bindgen_test]
+fn auto_fiducials_register_the_demo() {
+    let scan = demo::demo_scan_bytes();
+    let reg = RegistrationSettings {
+        fiducials: FiducialSource::Auto,
+        printer_points: test_part::FIDUCIALS_MM.to_vec(),
+        method: RegistrationMethod::Lsq,
+    };
+    let prepared =
+        job::prepare_scan(&scan, demo::DEMO_SCAN_NAME, &ImportOptions::DEFAULT, &reg).unwrap();
+    assert!(prepared.registration.rms_mm < 0.05);
+}
+
+#[wasm_bindgen_test]
+fn antennas_plan_on_the_demo_part() {
+    let svg = antennas::hilbert_loop_svg(3, 20.0).unwrap();
+    let drawn = pcpp::pipeline::load_path(svg.as_bytes(), "hilbert.svg").unwrap();
+    assert!(!drawn.subpaths.is_empty());
+    assert!(antennas::hilbert_loop_svg(0, 20.0).is_err());
+    assert!(antennas::archimedean_spiral_svg(f64::NAN, 1.0, 1.0).is_err());
+}
+
+// ---- the page's adapter (src/wasm.rs), as the worker calls it ----
+
+fn js<T: serde::Serialize>(v: &T) -> JsValue {
+    serde_wasm_bindgen::to_value(v).unwrap()
+}
+
+#[wasm_bindgen_test]
+fn session_plans_the_golden_gcode_and_the_cli_report() {
+    let settings = golden_settings();
+    let session = pcpp::wasm::Session::new(
+        &demo::demo_scan_bytes(),
+        demo::DEMO_SCAN_NAME,
+        js(&settings.scan),
+        js(&settings.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = test_part::test_part_svg();
+    let out = session
+        .plan(
+            svg.as_bytes(),
+            demo::DEMO_PATH_NAME,
+            js(&settings.plan),
+            "marlin",
+            false,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let gcode = js_sys::Reflect::get(&out, &"gcode".into()).unwrap();
+    assert!(without_scan_line(&gcode.as_string().unwrap()) == without_scan_line(GOLDEN_MARLIN));
+    let report = js_sys::Reflect::get(&out, &"report_json".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(report.ends_with("}\n"));
+    let parsed: serde_json::Value = serde_json::from_str(&report).unwrap();
+    assert_eq!(parsed["planner"], "pcpp-guarded");
+
+    // A placement change re-plans on the same session (no re-import).
+    let mut moved = settings.plan;
+    moved.placement.offset_mm.x += 1.0;
+    let again = session
+        .plan(
+            svg.as_bytes(),
+            demo::DEMO_PATH_NAME,
+            js(&moved),
+            "marlin",
+            false,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let g2 = js_sys::Reflect::get(&again, &"gcode".into()).unwrap();
+    assert!(without_scan_line(&g2.as_string().unwrap()) != without_scan_line(GOLDEN_MARLIN));
+}
+
+#[wasm_bindgen_test]
+fn session_errors_name_the_cause_and_the_stage() {
+    let none = JobSettings::default();
+    let err = pcpp::wasm::Session::new(
+        b"v 1 2 3\nf 1 2 99\n",
+        "broken.obj",
+        js(&none.scan),
+        js(&none.registration),
+    )
+    .err()
+    .expect("a broken OBJ must not import");
+    let message = js_sys::Reflect::get(&err, &"message".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(message.contains("broken.obj"), "{message}");
+    let kind = js_sys::Reflect::get(&err, &"kind".into()).unwrap();
+    assert_eq!(kind.as_string().as_deref(), Some("mesh"));
+
+    // A readable scan with too few printer points: a registration error.
+    let reg = RegistrationSettings {
+        fiducials: FiducialSource::Auto,
+        printer_points: vec![DVec3::ZERO],
+        method: RegistrationMethod::Lsq,
+    };
+    let err = pcpp::wasm::Session::new(
+        small_obj().as_bytes(),
+        "sheet.obj",
+        js(&none.scan),
+        js(&reg),
+    )
+    .err()
+    .expect("one printer point cannot register");
+    let kind = js_sys::Reflect::get(&err, &"kind".into()).unwrap();
+    assert_eq!(kind.as_string().as_deref(), Some("registration"));
+
+    // Unknown dialect and bad settings objects are errors, not panics.
+    let ok = pcpp::wasm::Session::new(
+        small_obj().as_bytes(),
+        "sheet.obj",
+        js(&none.scan),
+        js(&none.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M1 5 L9 5"/></svg>"#;
+    assert!(ok
+        .plan(svg, "l.svg", js(&none.plan), "no-such-dialect", false)
+        .is_err());
+    assert!(ok
+        .plan(svg, "l.svg", JsValue::from_str("nonsense"), "marlin", false)
+        .is_err());
+}
