@@ -8,7 +8,7 @@
 //   handled below; anything else fails the build loudly.
 // - The worker's modules joined the same way into a non-executed
 //   <script type="text/plain" id="pcpp-worker">; web/engine.js starts it
-//   from a Blob URL.
+//   from a Blob URL, as a classic worker.
 // - The wasm as base64 in <script type="application/octet-stream"
 //   id="pcpp-wasm">; engine.js compiles it and posts the module to the
 //   worker, so it is inlined once.
@@ -91,7 +91,12 @@ function scriptSafe(text, what) {
 let html = readFileSync(input, 'utf8');
 const css = readFileSync(resolve(base, 'web/style.css'), 'utf8');
 const mainJs = scriptSafe(bundle(resolve(base, 'web/main.js')), 'the page bundle');
-const workerJs = scriptSafe(bundle(resolve(base, 'web/worker.js')), 'the worker bundle');
+// The worker runs as a classic script: Chromium will not start a module
+// worker from a Blob URL made by a file:// page (its origin is opaque). The
+// bundle has no import/export left; only the glue's default wasm URL, never
+// used here (the module is posted to the worker), names import.meta.
+const workerJs = scriptSafe(bundle(resolve(base, 'web/worker.js')), 'the worker bundle')
+  .replaceAll('import.meta.url', 'self.location.href');
 const wasm = readFileSync(resolve(base, 'pkg/pcpp_bg.wasm')).toString('base64');
 const hash = createHash('sha256').update(mainJs, 'utf8').digest('base64');
 const csp = [

@@ -38,8 +38,10 @@ export function startWorker(module) {
   const src = inlined('pcpp-worker');
   let worker;
   if (src !== null) {
+    // Classic, not module: Chromium refuses module workers from the Blob
+    // URLs of a file:// page (scripts/single-file.mjs bundles it that way).
     const url = URL.createObjectURL(new Blob([src], { type: 'text/javascript' }));
-    worker = new Worker(url, { type: 'module' });
+    worker = new Worker(url);
   } else {
     worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
   }

@@ -112,12 +112,12 @@ function saveSettings() {
 
 const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
 
-// What the library reads: a `job::JobSettings`.
-function jobSettings() {
+// What the library reads: a `job::JobSettings` for planning on `scan`.
+function jobSettings(scan) {
   const s = settings;
   let fiducials = 'none';
   let printer = [];
-  if (s.fidSource !== 'none') {
+  if (s.fidSource !== 'none' && !(scan && scan.unregistered)) {
     printer = parseField('printer points P', s.fidPrinterText);
     fiducials = s.fidSource === 'auto' ? 'auto' : { points: parseField('scan points Sr', s.fidScanText) };
   }
@@ -239,8 +239,19 @@ function syncVisibility() {
 function bindForm() {
   for (const [id, , set, live] of FIELDS) {
     const el = $(id);
+    // Antenna SVGs measure from their page's corner, so a new size moves
+    // the antenna; keep its centre where the user placed it.
+    const antennaField = /^(sp|hb|mp)-/.test(id);
     const handler = () => {
+      const before = antennaField ? pathCentre() : null;
       set(el.type === 'checkbox' ? el.checked : el.value);
+      const after = before ? pathCentre() : null;
+      if (before && after) {
+        const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);
+        settings.placement.x = +(num(settings.placement.x) + dx).toFixed(3);
+        settings.placement.y = +(num(settings.placement.y) + dy).toFixed(3);
+        writeForm();
+      }
       saveSettings();
       syncGauge();
       syncVisibility();
@@ -344,17 +355,17 @@ function requestPlan() {
 
 function runPlan() {
   hideDownloads();
+  const scan = state.pendingScan || state.scan;
   let job;
   let svg;
   try {
-    job = jobSettings();
+    job = jobSettings(scan);
     svg = currentSvg();
   } catch (e) {
     showError('Cannot plan', e.message);
     setStatus(state.lastPlan ? 'plan failed: showing the previous plan' : 'plan failed', true);
     return;
   }
-  const scan = state.pendingScan || state.scan;
   const id = ++state.planId;
   state.busy = { id, scan, svg, job, planner: job.plan.planner };
   state.queued = false;
@@ -393,8 +404,7 @@ function onWorkerMessage(e) {
       break;
     case 'scan':
       if (state.pendingScan && state.pendingScan.key === m.key) {
-        state.scan = state.pendingScan;
-        state.pendingScan = null;
+        acceptScan();
       }
       showScan(m.info, m.positions, m.indices);
       break;
@@ -444,13 +454,13 @@ function onPlanError(m, busy) {
     // The file could not be read: keep working with the previous scan.
     title = `Could not read the scan ${state.pendingScan.name}`;
     state.pendingScan = null;
+    $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
   } else if (m.stage === 'scan') {
     title = m.kind === 'mesh' ? 'Could not read the scan' : 'Registration failed';
     if (state.pendingScan && busy.scan === state.pendingScan) {
       // Readable but not registered: it stays loaded until the fiducials fit.
-      state.scan = state.pendingScan;
-      state.pendingScan = null;
+      acceptScan();
       $('scan-name').textContent = state.scan.name;
     }
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
@@ -470,6 +480,20 @@ function onPlanError(m, busy) {
   showError(title, message);
   hideDownloads();
   setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+}
+
+// The pending scan was read: it becomes the scan, and the demo's fiducial
+// settings it was read without are dropped for good.
+function acceptScan() {
+  const scan = state.pendingScan;
+  state.scan = scan;
+  state.pendingScan = null;
+  if (scan.unregistered) {
+    delete scan.unregistered;
+    settings.fidSource = 'none';
+    saveSettings();
+    writeForm();
+  }
 }
 
 function cancelPlan() {
@@ -665,11 +689,12 @@ async function openFile(file) {
     settings.pathSource = 'file';
   } else {
     state.pendingScan = entry;
-    // The demo's fiducials belong to the demo part: a new scan starts
-    // unregistered until the user sets its fiducials.
+    // The demo's fiducials belong to the demo part: a new scan is read
+    // unregistered until the user sets its fiducials (the settings change
+    // only once the scan is read, so a bad file changes nothing).
     const demo = demoUiSettings();
     if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
-      settings.fidSource = 'none';
+      entry.unregistered = true;
     }
     $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
   }
@@ -723,26 +748,43 @@ function loadDemo() {
   schedulePlan(0);
 }
 
-// Places the centre of the path's box over the scan's centre, keeping rotation and scale.
-function centreOnScan(showErrors = true) {
-  if (!state.info) return;
+// The centre of the path's box as imported (before placement), or null.
+function pathCentre() {
   try {
     const svg = currentSvg();
     const b = pathBounds(svg.bytes, svg.name);
-    // The drawing's box centre, as imported (before placement).
-    const c = [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
-    const [lo, hi] = state.info.bbox_mm;
-    const s = num(settings.placement.scale);
-    const a = (num(settings.placement.rot) * Math.PI) / 180;
-    const rx = Math.cos(a) * c[0] - Math.sin(a) * c[1];
-    const ry = Math.sin(a) * c[0] + Math.cos(a) * c[1];
-    settings.placement.x = +(((lo[0] + hi[0]) / 2) - s * rx).toFixed(3);
-    settings.placement.y = +(((lo[1] + hi[1]) / 2) - s * ry).toFixed(3);
-    saveSettings();
-    writeForm();
+    return [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
+  } catch {
+    return null;
+  }
+}
+
+// A drawing-frame vector after the placement's rotation and scale.
+function placed([x, y]) {
+  const s = num(settings.placement.scale);
+  const a = (num(settings.placement.rot) * Math.PI) / 180;
+  return [s * (Math.cos(a) * x - Math.sin(a) * y), s * (Math.sin(a) * x + Math.cos(a) * y)];
+}
+
+// Places the centre of the path's box over the scan's centre, keeping
+// rotation and scale.
+function centreOnScan(showErrors = true) {
+  if (!state.info) return;
+  let c;
+  try {
+    const svg = currentSvg();
+    const b = pathBounds(svg.bytes, svg.name);
+    c = [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
   } catch (e) {
     if (showErrors) showError('Cannot centre the path', e.message);
+    return;
   }
+  const [lo, hi] = state.info.bbox_mm;
+  const [rx, ry] = placed(c);
+  settings.placement.x = +((lo[0] + hi[0]) / 2 - rx).toFixed(3);
+  settings.placement.y = +((lo[1] + hi[1]) / 2 - ry).toFixed(3);
+  saveSettings();
+  writeForm();
 }
 
 // ---------- 3-D view ----------
