@@ -80,3 +80,26 @@ test('fiducial residuals are shown and an RMS above d/2 is highlighted', async (
   assert.ok(rms > 0.3015, `${rms}`);
   await context.close();
 });
+
+test('cancel ends the worker; a dropped SVG then plans on a fresh one', async () => {
+  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  await waitForPlan(page);
+  await page.click('#plan-btn');
+  await page.click('#cancel-btn');
+  assert.equal(await page.textContent('#plan-status'), 'cancelled');
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  // Drag and drop, as a user would drop a file on the page.
+  await page.evaluate(() => {
+    const svg = '<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80">'
+      + '<path d="M 10 40 L 70 40" stroke="black"/></svg>';
+    const dt = new DataTransfer();
+    dt.items.add(new File([svg], 'dropped.svg', { type: 'image/svg+xml' }));
+    window.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, cancelable: true }));
+  });
+  await page.waitForFunction(() => document.getElementById('svg-name').textContent === 'dropped.svg');
+  await waitIdle(page);
+  await waitForPlan(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.svgName), 'dropped.svg');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
