@@ -123,7 +123,7 @@ impl Registration {
     pub fn rotation_deg(&self) -> f64 {
         let r = DMat3::from_mat4(self.matrix);
         let c = ((r.x_axis.x + r.y_axis.y + r.z_axis.z - 1.0) * 0.5).clamp(-1.0, 1.0);
-        c.acos().to_degrees()
+        libm::acos(c).to_degrees()
     }
 }
 
@@ -435,19 +435,19 @@ fn fit_paper(s: [DVec3; 3], p: [DVec3; 3]) -> DMat4 {
         // poor but any axis perpendicular to a1 works.
         let v1 = cross / sin1;
         let v1 = (v1 - v1.dot(a1) * a1).normalize();
-        DMat3::from_axis_angle(v1, sin1.atan2(cos1))
+        axis_angle(v1, libm::atan2(sin1, cos1))
     } else if cos1 > 0.0 {
         DMat3::IDENTITY
     } else {
-        DMat3::from_axis_angle(a1.any_orthonormal_vector(), std::f64::consts::PI)
+        axis_angle(a1.any_orthonormal_vector(), std::f64::consts::PI)
     };
 
     let v2 = (r1 * a1).normalize();
     let ra2 = r1 * a2;
     let u = ra2 - ra2.dot(v2) * v2;
     let w = b2 - b2.dot(v2) * v2;
-    let th2 = v2.dot(u.cross(w)).atan2(u.dot(w));
-    let r2 = DMat3::from_axis_angle(v2, th2);
+    let th2 = libm::atan2(v2.dot(u.cross(w)), u.dot(w));
+    let r2 = axis_angle(v2, th2);
     rigid(r2 * r1, s[1], p[1])
 }
 
@@ -537,6 +537,19 @@ fn symmetric_eigen4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
         }
     }
     ([a[0][0], a[1][1], a[2][2], a[3][3]], v)
+}
+
+/// R(u, th): the axis-angle (Rodrigues) rotation of spec section 1, through
+/// libm so it has the same bits natively and in wasm.
+fn axis_angle(axis: DVec3, angle: f64) -> DMat3 {
+    let (s, c) = (libm::sin(angle), libm::cos(angle));
+    let (x, y, z) = (axis.x, axis.y, axis.z);
+    let t = 1.0 - c;
+    DMat3::from_cols(
+        DVec3::new(t * x * x + c, t * x * y + s * z, t * x * z - s * y),
+        DVec3::new(t * x * y - s * z, t * y * y + c, t * y * z + s * x),
+        DVec3::new(t * x * z + s * y, t * y * z - s * x, t * z * z + c),
+    )
 }
 
 #[cfg(test)]

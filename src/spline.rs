@@ -305,7 +305,7 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
             v,
             n: DVec3::ZERO,
             kappa: 0.0,
-            slope_rad: tangent.z.atan2(tangent.truncate().length()),
+            slope_rad: libm::atan2(tangent.z, tangent.truncate().length()),
             curvature_3d: if len > 0.0 {
                 d1.cross(d2).length() / (len * len * len)
             } else {
@@ -333,7 +333,8 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
         // the path is vertical.
         let (s1, z1) = (d1.dot(g.v), d1.z);
         let (s2, z2) = (d2.dot(g.v), d2.z);
-        let den = (s1 * s1 + z1 * z1).powf(1.5);
+        let q = s1 * s1 + z1 * z1;
+        let den = q * q.sqrt();
         g.kappa = if den > 0.0 {
             (s1 * z2 - z1 * s2) / den
         } else {

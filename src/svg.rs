@@ -94,7 +94,8 @@ impl Placement {
     /// counter-clockwise rotation and uniform scale about the SVG origin,
     /// then the offset (spec section 4, Decision on placement).
     pub fn apply(&self, p: DVec2) -> DVec2 {
-        let (s, c) = self.rotation_deg.to_radians().sin_cos();
+        let r = self.rotation_deg.to_radians();
+        let (s, c) = (libm::sin(r), libm::cos(r));
         DVec2::new(c * p.x - s * p.y, s * p.x + c * p.y) * self.scale + self.offset_mm
     }
 
@@ -234,7 +235,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut unpainted = 0usize;
     let mut images = 0usize;
     let mut non_finite = 0usize;
-    let cos_corner = CORNER_ANGLE_DEG.to_radians().cos();
+    let cos_corner = libm::cos(CORNER_ANGLE_DEG.to_radians());
 
     // The hidden copies: their usvg geometry names the shape of each
     // id-less path usvg makes for a `use` instance.
@@ -662,16 +663,22 @@ struct EllipseArc {
     dtheta: f64,
 }
 
+/// A rotation by `angle` radians through libm, so arcs flatten to the same
+/// bits natively and in wasm (glam's `from_angle` uses the platform's).
+fn rotation(angle: f64) -> DMat2 {
+    let (s, c) = (libm::sin(angle), libm::cos(angle));
+    DMat2::from_cols(DVec2::new(c, s), DVec2::new(-s, c))
+}
+
 impl EllipseArc {
     fn point(&self, theta: f64) -> DVec2 {
-        let (s, c) = theta.sin_cos();
-        self.center
-            + DMat2::from_angle(self.rotation) * DVec2::new(self.radii.x * c, self.radii.y * s)
+        let (s, c) = (libm::sin(theta), libm::cos(theta));
+        self.center + rotation(self.rotation) * DVec2::new(self.radii.x * c, self.radii.y * s)
     }
 
     fn tangent(&self, theta: f64) -> DVec2 {
-        let (s, c) = theta.sin_cos();
-        DMat2::from_angle(self.rotation)
+        let (s, c) = (libm::sin(theta), libm::cos(theta));
+        rotation(self.rotation)
             * DVec2::new(-self.radii.x * s, self.radii.y * c)
             * self.dtheta.signum()
     }
@@ -1183,7 +1190,7 @@ fn arc_segment(
         return Some(Seg::Line(from, to));
     }
     let phi = rotation_deg.to_radians();
-    let rot = DMat2::from_angle(phi);
+    let rot = rotation(phi);
     let h = rot.transpose() * ((from - to) * 0.5);
     let lambda = (h.x / rx).powi(2) + (h.y / ry).powi(2);
     if lambda > 1.0 {
@@ -1202,8 +1209,8 @@ fn arc_segment(
     let center = rot * cp + (from + to) * 0.5;
     let u = DVec2::new((h.x - cp.x) / rx, (h.y - cp.y) / ry);
     let v = DVec2::new((-h.x - cp.x) / rx, (-h.y - cp.y) / ry);
-    let theta0 = u.y.atan2(u.x);
-    let mut dtheta = u.perp_dot(v).atan2(u.dot(v));
+    let theta0 = libm::atan2(u.y, u.x);
+    let mut dtheta = libm::atan2(u.perp_dot(v), u.dot(v));
     if !sweep && dtheta > 0.0 {
         dtheta -= TAU;
     } else if sweep && dtheta < 0.0 {

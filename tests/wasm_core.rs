@@ -100,20 +100,6 @@ fn paper_table_s1_registers() {
     assert!(parse_points("1, 2").is_err());
 }
 
-/// The G-code without its scan-file header line. The demo scan is
-/// generated with `cos`/`sqrt`, whose last bit differs between wasm32's
-/// libm and the native one, so its sha256 (and only that: every coordinate
-/// written agrees) differs from the native golden file's. Uploaded files
-/// are the same bytes on both sides, so the page's G-code for them equals
-/// the CLI's in full (tests/browser/upload.test.mjs checks that).
-fn without_scan_line(gcode: &str) -> String {
-    gcode
-        .lines()
-        .filter(|l| !l.contains("scan file: "))
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 fn golden_settings() -> JobSettings {
     let mut s = JobSettings::default();
     s.plan.placement = test_part::placement();
@@ -143,7 +129,7 @@ fn demo_gcode_equals_the_native_golden_files() {
             false,
         )
         .unwrap();
-        let (golden, gcode) = (without_scan_line(golden), without_scan_line(&out.gcode));
+        let (golden, gcode) = (golden, out.gcode.as_str());
         if gcode != golden {
             let diffs: Vec<String> = golden
                 .lines()
@@ -261,7 +247,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let gcode = js_sys::Reflect::get(&out, &"gcode".into()).unwrap();
-    assert!(without_scan_line(&gcode.as_string().unwrap()) == without_scan_line(GOLDEN_MARLIN));
+    assert_eq!(gcode.as_string().unwrap(), GOLDEN_MARLIN);
     let report = js_sys::Reflect::get(&out, &"report_json".into())
         .unwrap()
         .as_string()
@@ -283,7 +269,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let g2 = js_sys::Reflect::get(&again, &"gcode".into()).unwrap();
-    assert!(without_scan_line(&g2.as_string().unwrap()) != without_scan_line(GOLDEN_MARLIN));
+    assert_ne!(g2.as_string().unwrap(), GOLDEN_MARLIN);
 }
 
 #[wasm_bindgen_test]

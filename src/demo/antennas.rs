@@ -60,7 +60,7 @@ pub fn archimedean_spiral_length_mm(turns: f64, pitch_mm: f64, inner_radius_mm: 
     let b = pitch_mm / TAU;
     let f = |r: f64| {
         let h = (r * r + b * b).sqrt();
-        0.5 * r * h + 0.5 * b * b * (r + h).ln()
+        0.5 * r * h + 0.5 * b * b * libm::log(r + h)
     };
     let outer = inner_radius_mm + pitch_mm * turns;
     (f(outer) - f(inner_radius_mm)) / b
@@ -120,16 +120,19 @@ fn spiral_svg(turns: f64, pitch_mm: f64, inner_radius_mm: f64) -> String {
     // circle's best cubic, within ~1e-7 r of the spiral at this step.
     let n = (turns * 16.0).ceil().max(1.0) as usize;
     let step = total / n as f64;
-    let handle = 4.0 / 3.0 * (step / 4.0).tan();
+    let handle = 4.0 / 3.0 * libm::tan(step / 4.0);
     // SVG y points down; drawing (x, -y) makes the imported spiral turn
     // counter-clockwise in the printer frame.
     let point = |t: f64| {
         let r = inner_radius_mm + b * t;
-        (r * t.cos(), -(r * t.sin()))
+        (r * libm::cos(t), -(r * libm::sin(t)))
     };
     let deriv = |t: f64| {
         let r = inner_radius_mm + b * t;
-        (b * t.cos() - r * t.sin(), -(b * t.sin() + r * t.cos()))
+        (
+            b * libm::cos(t) - r * libm::sin(t),
+            -(b * libm::sin(t) + r * libm::cos(t)),
+        )
     };
     let mut d = String::new();
     let (x0, y0) = point(0.0);
@@ -309,7 +312,7 @@ mod tests {
         for k in 1..=n {
             let t = turns * TAU * k as f64 / n as f64;
             let r = a + b * t;
-            let p = (r * t.cos(), r * t.sin());
+            let p = (r * libm::cos(t), r * libm::sin(t));
             len += ((p.0 - prev.0).powi(2) + (p.1 - prev.1).powi(2)).sqrt();
             prev = p;
         }

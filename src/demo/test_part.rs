@@ -50,7 +50,7 @@ fn tri(x: f64, c: f64, half: f64, h: f64) -> f64 {
 fn cos_bump(x: f64, c: f64, r: f64, a: f64) -> f64 {
     let w = PI * (r * a / 2.0).sqrt();
     if (x - c).abs() < w {
-        a * (1.0 + (PI * (x - c) / w).cos()) / 2.0
+        a * (1.0 + libm::cos(PI * (x - c) / w)) / 2.0
     } else {
         0.0
     }
@@ -91,7 +91,7 @@ fn region2(x: f64) -> f64 {
 fn region3(x: f64) -> f64 {
     let mut start = 12.0;
     for deg in [15.0f64, 30.0, 45.0, 60.0, 75.0] {
-        let run = 2.0 / deg.to_radians().tan();
+        let run = 2.0 / libm::tan(deg.to_radians());
         let (top0, top1, end) = (start + run, start + run + 2.0, start + 2.0 * run + 2.0);
         if x >= start && x < end {
             return if x < top0 {
