@@ -47,7 +47,7 @@ for t in "${targets[@]}"; do
     </dev/null >"$log" 2>&1
   status=$?
   set -e
-  grep -E '^(INFO: seed|#[0-9]+ +(INITED|DONE))|panicked|ERROR|SUMMARY|Test unit written|stat::(number_of_executed_units|peak_rss)' "$log" || true
+  grep -E '^(INFO: seed|#[0-9]+[[:space:]]+(INITED|DONE))|panicked|ERROR|SUMMARY|Test unit written|stat::(number_of_executed_units|peak_rss)' "$log" || true
   if [ "$status" -ne 0 ]; then
     tail -n 60 "$log"
   fi
