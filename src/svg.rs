@@ -421,6 +421,77 @@ const SHAPES: [&str; 7] = [
     "path", "rect", "circle", "ellipse", "line", "polyline", "polygon",
 ];
 
+/// Largest coordinate, radius or length accepted in geometry attributes
+/// (user units): ten kilometres at 1 unit = 1 mm.
+pub const MAX_COORDINATE: f64 = 1e7;
+
+const NUMERIC_ATTRIBUTES: [&str; 18] = [
+    "d",
+    "points",
+    "x",
+    "y",
+    "x1",
+    "y1",
+    "x2",
+    "y2",
+    "cx",
+    "cy",
+    "r",
+    "rx",
+    "ry",
+    "width",
+    "height",
+    "viewBox",
+    "transform",
+    "pathLength",
+];
+
+/// The numbers of an SVG attribute (path data, point lists, transforms), as
+/// the SVG grammar reads them: "1-2" is 1 and -2, "1e40" one number.
+fn svg_numbers(text: &str) -> impl Iterator<Item = f64> + '_ {
+    let b = text.as_bytes();
+    let mut i = 0;
+    std::iter::from_fn(move || {
+        while i < b.len() {
+            let start = i;
+            let c = b[i];
+            if c.is_ascii_digit() || c == b'.' || ((c == b'-' || c == b'+') && i + 1 < b.len()) {
+                i += 1;
+                let mut seen_dot = c == b'.';
+                while i < b.len() {
+                    match b[i] {
+                        b'0'..=b'9' => i += 1,
+                        b'.' if !seen_dot => {
+                            seen_dot = true;
+                            i += 1
+                        }
+                        b'e' | b'E'
+                            if i + 1 < b.len()
+                                && (b[i + 1].is_ascii_digit()
+                                    || ((b[i + 1] == b'-' || b[i + 1] == b'+')
+                                        && i + 2 < b.len()
+                                        && b[i + 2].is_ascii_digit())) =>
+                        {
+                            i += 2;
+                            while i < b.len() && b[i].is_ascii_digit() {
+                                i += 1;
+                            }
+                            break;
+                        }
+                        _ => break,
+                    }
+                }
+                if let Some(v) = text.get(start..i).and_then(|t| t.parse::<f64>().ok()) {
+                    return Some(v);
+                }
+            } else {
+                i += 1;
+            }
+        }
+        None
+    })
+}
+
 fn prepare(text: &str) -> Result<Prepared, String> {
     let opt = roxmltree::ParsingOptions {
         allow_dtd: true,
@@ -469,6 +540,26 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             "elements are nested more than {MAX_NESTING_DEPTH} levels deep, which is not supported \
              (ungroup the drawing)"
         ));
+    }
+
+    // Geometry far past any printer (usvg turns an arc of radius 1e40 into
+    // cubics without limit, hanging or exhausting memory before our own
+    // point budget applies) is refused up front, naming the element.
+    for node in root.descendants().filter(|n| n.is_element()) {
+        for attr in node.attributes() {
+            if !NUMERIC_ATTRIBUTES.contains(&attr.name()) {
+                continue;
+            }
+            if let Some(v) = svg_numbers(attr.value()).find(|v| v.abs() > MAX_COORDINATE) {
+                let pos = doc.text_pos_at(node.range().start);
+                return Err(format!(
+                    "line {}: <{}> attribute {} holds the number {v:e}, beyond the {MAX_COORDINATE:e}                      user units this program accepts (check the drawing's units)",
+                    pos.row,
+                    node.tag_name().name(),
+                    attr.name()
+                ));
+            }
+        }
     }
 
     let existing: HashSet<&str> = root
@@ -1332,6 +1423,16 @@ fn flatten_subpath(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn numbers_are_read_as_svg_reads_them() {
+        let v: Vec<f64> = svg_numbers("M1-2e3.5.5 A1 1 0 0 1 1e40,0 scale(-.5e-2)").collect();
+        assert_eq!(
+            v,
+            vec![1.0, -2000.0, 0.5, 0.5, 1.0, 1.0, 0.0, 0.0, 1.0, 1e40, 0.0, -0.005]
+        );
+    }
+
     use super::*;
 
     fn svg(body: &str) -> String {

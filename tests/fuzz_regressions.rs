@@ -56,10 +56,7 @@ const TIME_LIMIT: Duration = Duration::from_secs(10);
 
 /// Saved cases of bugs not fixed yet: skipped by the replay below, each
 /// pinned by an ignored named test instead (drop it from here when fixed).
-const KNOWN_BUGS: [&str; 2] = [
-    "load_svg-arc-endpoint-1e40-hangs.svg",
-    "load_svg-arc-endpoint-2e32-timeout-tmin.svg",
-];
+const KNOWN_BUGS: [&str; 0] = [];
 
 /// Replays on a thread and fails if it panics or takes longer than the
 /// fuzzers allow (a hung thread is left behind; the test has failed).
@@ -142,15 +139,21 @@ fn pipeline_seeds_reach_the_gcode_writer() {
     }
 }
 
-/// An elliptical arc to an endpoint at 1e40 makes usvg (svgtypes ->
-/// kurbo `Arc::to_cubic_beziers`, called from `usvg::Tree::from_str` in
-/// `pcpp::svg::import_svg_with_notes`) emit cubic segments without bound
-/// before pcpp's own 4,000,000-point limit is reached: > 20 s, and with
-/// 1e70 more than 7 GB of memory, from an 81-byte SVG.
+/// An elliptical arc to an endpoint at 1e40 made usvg (svgtypes -> kurbo
+/// `Arc::to_cubic_beziers`) emit cubic segments without bound before
+/// pcpp's own point limit applied: > 20 s, and with 1e70 more than 7 GB,
+/// from an 81-byte SVG. Such numbers are now refused before usvg sees them.
 #[test]
-#[ignore = "bug: huge arc endpoints hang usvg's arc flattening before pcpp's point limit (load_svg timeout)"]
 fn svg_arc_to_a_huge_endpoint_returns_in_time() {
-    for name in KNOWN_BUGS {
+    for name in [
+        "load_svg-arc-endpoint-1e40-hangs.svg",
+        "load_svg-arc-endpoint-2e32-timeout-tmin.svg",
+    ] {
         replay_file(&saved(name));
+        let bytes = std::fs::read(saved(name)).unwrap();
+        let e = pcpp::pipeline::load_path(&bytes, name)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("beyond") && e.contains("line"), "{e}");
     }
 }

@@ -1,8 +1,10 @@
 //! All integration tests in one binary, a module per area (as parry does).
 mod cli;
+mod fuzz_regressions;
 mod gcode;
 mod importers;
 mod planning;
+mod properties;
 mod realworld;
 mod registration;
 mod svg;
