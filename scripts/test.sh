@@ -39,3 +39,7 @@ step "browser tests (node --test tests/browser/, headless Chromium)"
 # The browser tests compare the page's G-code with the CLI's.
 cargo build --bin pcpp
 node --test tests/browser/
+
+step "fuzzing, bounded (scripts/fuzz.sh, 10 s per target)"
+# The long runs and their figures are in fuzz/README.md.
+bash scripts/fuzz.sh "${PCPP_FUZZ_SECONDS:-10}"
