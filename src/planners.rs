@@ -117,10 +117,7 @@ fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, 
 /// (radius do/2 + tol) higher than tol below the tip. This covers the tip
 /// disk and the nozzle body above it (a vertical cylinder of diameter do).
 fn clears(surface: &Surface, t: DVec3, r_clear: f64, tol: f64) -> Option<f64> {
-    match surface.max_height_in_disk(t.truncate(), r_clear) {
-        Some(h) if h > t.z - tol + 1e-9 => Some(h),
-        _ => None,
-    }
+    surface.max_height_in_disk_above(t.truncate(), r_clear, t.z - tol + 1e-9)
 }
 
 /// Plans one subpath. `ta` and `geometry` have the same length.

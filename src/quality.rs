@@ -125,9 +125,12 @@ pub fn predict(
         let lo = j.saturating_sub(SEARCH);
         let hi = (j + SEARCH).min(back.len() - 1);
         let mut best: Option<(usize, f64)> = None;
+        // The curve passes through F_k at u_k, so the window is scanned on
+        // the F_k themselves; only the crossing span is bisected.
+        let fk = |k: usize| (back[k] - a).dot(g.tangent);
         for k in lo..hi {
             let (u0, u1) = (params[k], params[k + 1]);
-            let (f0, f1) = (f(u0), f(u1));
+            let (f0, f1) = (fk(k), fk(k + 1));
             if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
                 let dist = k.abs_diff(j).min((k + 1).abs_diff(j));
                 if best.is_none_or(|(bd, _)| dist < bd) {
@@ -179,7 +182,8 @@ fn bisect(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64) -> f64 {
     if fa == 0.0 {
         return a;
     }
-    for _ in 0..60 {
+    // 2^-48 of a span is far below a nanometre.
+    for _ in 0..48 {
         let m = 0.5 * (a + b);
         let fm = f(m);
         if fm == 0.0 {

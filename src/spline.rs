@@ -240,7 +240,15 @@ impl Spline {
 
     /// The point at parameter `u` (clamped to [0, 1]).
     pub fn eval(&self, u: f64) -> DVec3 {
-        self.derivs(u)[0]
+        let u = u.clamp(0.0, 1.0);
+        let p = self.degree;
+        let span = self.find_span(u);
+        let mut basis = [0.0; 4];
+        self.basis_funs(span, u, &mut basis);
+        self.ctrl[span - p..=span]
+            .iter()
+            .zip(&basis)
+            .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w)
     }
 
     /// C(u), C'(u), C''(u).

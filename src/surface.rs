@@ -18,6 +18,9 @@ use crate::mesh::TriMesh;
 pub struct Surface {
     mesh: TriMesh,
     bvh: Bvh,
+    /// Triangle indices in leaf order: leaf k holds
+    /// `order[k * LEAF_SIZE..][..LEAF_SIZE]`.
+    order: Vec<u32>,
     bbox: (DVec3, DVec3),
 }
 
@@ -37,6 +40,22 @@ impl std::fmt::Debug for Surface {
             .field("bbox", &self.bbox)
             .finish()
     }
+}
+
+/// Triangles per BVH leaf.
+const LEAF_SIZE: usize = 4;
+
+/// Interleaves the low 21 bits of x, y and z (a Morton / Z-order code).
+fn morton3(x: u64, y: u64, z: u64) -> u64 {
+    fn spread(v: u64) -> u64 {
+        let mut v = v & 0x1f_ffff;
+        v = (v | v << 32) & 0x1f_0000_0000_ffff;
+        v = (v | v << 16) & 0x1f_0000_ff00_00ff;
+        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
+        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
+        (v | v << 2) & 0x1249_2492_4924_9249
+    }
+    spread(x) | spread(y) << 1 | spread(z) << 2
 }
 
 /// f64 -> f32 rounded towards -inf / +inf, so an f32 box always contains
@@ -92,23 +111,52 @@ impl Surface {
             ));
         }
         let n = mesh.vertices.len();
-        let mut leaves = Vec::with_capacity(mesh.triangles.len());
-        for (i, t) in mesh.triangles.iter().enumerate() {
-            if t.iter().any(|&k| k as usize >= n) {
-                return Err(Error::Plan(format!(
-                    "triangle {i} refers to a vertex past the {n} the scan has"
-                )));
-            }
-            let [a, b, c] = mesh.triangle(i);
-            let lo = a.min(b).min(c);
-            let hi = a.max(b).max(c);
-            leaves.push(Aabb::new(
-                Vec3::new(f32_down(lo.x), f32_down(lo.y), f32_down(lo.z)),
-                Vec3::new(f32_up(hi.x), f32_up(hi.y), f32_up(hi.z)),
-            ));
+        if let Some(i) = mesh
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|&k| k as usize >= n))
+        {
+            return Err(Error::Plan(format!(
+                "triangle {i} refers to a vertex past the {n} the scan has"
+            )));
         }
+        // Triangles in Morton order of their centroids, LEAF_SIZE to a BVH
+        // leaf: a quarter of the leaves to build over (parry's binned build
+        // dominates loading a 2 M triangle scan), each leaf still compact
+        // whatever order the file listed its triangles in.
+        let extent = (bbox.1 - bbox.0).max(DVec3::splat(1e-12));
+        let mut keyed: Vec<(u64, u32)> = (0..mesh.triangles.len())
+            .map(|i| {
+                let [a, b, c] = mesh.triangle(i);
+                let q = ((a + b + c) / 3.0 - bbox.0) / extent * 2_097_151.0;
+                (morton3(q.x as u64, q.y as u64, q.z as u64), i as u32)
+            })
+            .collect();
+        keyed.sort_unstable_by_key(|&(k, _)| k);
+        let order: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
+        let leaves: Vec<Aabb> = order
+            .chunks(LEAF_SIZE)
+            .map(|chunk| {
+                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for &i in chunk {
+                    for v in mesh.triangle(i as usize) {
+                        lo = lo.min(v);
+                        hi = hi.max(v);
+                    }
+                }
+                Aabb::new(
+                    Vec3::new(f32_down(lo.x), f32_down(lo.y), f32_down(lo.z)),
+                    Vec3::new(f32_up(hi.x), f32_up(hi.y), f32_up(hi.z)),
+                )
+            })
+            .collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
-        Ok(Surface { mesh, bvh, bbox })
+        Ok(Surface {
+            mesh,
+            bvh,
+            order,
+            bbox,
+        })
     }
 
     pub fn mesh(&self) -> &TriMesh {
@@ -126,7 +174,11 @@ impl Surface {
     }
 
     fn candidates(&self, q: QueryBox) -> impl Iterator<Item = usize> + '_ {
-        self.bvh.leaves(move |n| q.hits(n)).map(|i| i as usize)
+        self.bvh.leaves(move |n| q.hits(n)).flat_map(move |leaf| {
+            let start = (leaf as usize * LEAF_SIZE).min(self.order.len());
+            let end = (start + LEAF_SIZE).min(self.order.len());
+            self.order[start..end].iter().map(|&i| i as usize)
+        })
     }
 
     /// z of the highest intersection of the vertical line through `xy` with
@@ -204,8 +256,15 @@ impl Surface {
     /// `xy` (the footprint of a vertical nozzle there), `None` if the scan has
     /// nothing under it. The guarded planner's clearance rests on this.
     pub fn max_height_in_disk(&self, xy: DVec2, radius: f64) -> Option<f64> {
+        self.max_height_in_disk_above(xy, radius, f64::NEG_INFINITY)
+    }
+
+    /// [`Self::max_height_in_disk`] when it exceeds `floor`, else `None`.
+    /// Only triangles reaching above `floor` are visited, so asking "does
+    /// anything under the nozzle come within tol of its tip" is cheap.
+    pub fn max_height_in_disk_above(&self, xy: DVec2, radius: f64, floor: f64) -> Option<f64> {
         let q = QueryBox {
-            lo: DVec3::new(xy.x - radius, xy.y - radius, f64::NEG_INFINITY),
+            lo: DVec3::new(xy.x - radius, xy.y - radius, floor),
             hi: DVec3::new(xy.x + radius, xy.y + radius, f64::INFINITY),
         };
         let mut best: Option<f64> = None;
@@ -214,7 +273,7 @@ impl Surface {
                 best = Some(best.map_or(z, |b: f64| b.max(z)));
             }
         }
-        best
+        best.filter(|&h| h > floor)
     }
 }
 

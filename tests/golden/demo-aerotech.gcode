@@ -8,7 +8,7 @@
 ' registration: lsq [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
 ' residuals: [] mm, rms 0.0000 mm
 ' path: 6 piece(s), 1362 points, 465.636 mm, height change 4.500 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 93.1 s
-' predicted quality: mean |e| 0.0671 mm, mean e- -0.0858 mm, mean e+ 0.0489 mm, contact 0.00%, flattening 15.57%, floating 4.11%
+' predicted quality: mean |e| 0.0671 mm, mean e- -0.0853 mm, mean e+ 0.0491 mm, contact 0.00%, flattening 15.57%, floating 4.11%
 ' warnings: 0
 ' profile: aerotech
 ' print feed: F5 mm/s (5 mm/s)
@@ -1342,7 +1342,7 @@ G1 X53.2389 Y66.0000 Z5.6030
 G1 X53.5398 Y66.0000 Z5.6030
 G1 X53.7734 Y66.0000 Z5.7030
 G1 X53.7876 Y66.0000 Z5.7561
-G1 X54.0501 Y66.0000 Z6.7355
+G1 X54.0501 Y66.0000 Z6.7356
 G1 X54.7434 Y66.0000 Z7.5994
 G1 X55.0442 Y66.0000 Z7.6030
 G1 X55.3451 Y66.0000 Z7.6030
