@@ -23,6 +23,8 @@ pub const MESH: [f32; 3] = [0.62, 0.68, 0.78];
 pub const SURFACE_PATH: [f32; 3] = [0.95, 0.95, 0.95];
 pub const HOLE_MARKER: [f32; 3] = [1.0, 0.85, 0.1];
 pub const PRINTER_MARKER: [f32; 3] = [0.9, 0.2, 0.9];
+/// Points picked on the mesh (scan points Sr chosen by clicking): cyan.
+pub const PICK_MARKER: [f32; 3] = [0.1, 0.9, 0.95];
 
 /// Defect colours (the issue's legend): contact red, flattening orange,
 /// floating blue, good green.
@@ -59,6 +61,8 @@ pub struct ViewPaths {
 pub struct Markers {
     pub holes: Vec<[f64; 3]>,
     pub printer: Vec<[f64; 3]>,
+    /// Scan points picked on the mesh, drawn in the mesh's (printer) frame.
+    pub picked: Vec<[f64; 3]>,
 }
 
 const MESH_VS: &str = r#"#version 300 es
@@ -285,6 +289,20 @@ impl Camera {
         self.distance = (self.distance * k).clamp(self.radius * 0.02, self.radius * 50.0);
     }
 
+    /// The ray through the pixel (x, y) of a `width` x `height` drawing
+    /// buffer (device pixels from the top-left corner): its origin on the
+    /// near plane and its unit direction, in the frame the mesh is drawn in.
+    /// `None` when the camera matrix cannot be inverted.
+    pub fn ray(&self, x_px: f64, y_px: f64, width: f64, height: f64) -> Option<(DVec3, DVec3)> {
+        let ndc_x = 2.0 * x_px / width.max(1.0) - 1.0;
+        let ndc_y = 1.0 - 2.0 * y_px / height.max(1.0);
+        let inv = self.view_proj().inverse();
+        let near = inv.project_point3(DVec3::new(ndc_x, ndc_y, -1.0));
+        let far = inv.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));
+        let dir = (far - near).normalize_or_zero();
+        (near.is_finite() && dir != DVec3::ZERO).then_some((near, dir))
+    }
+
     pub fn top(&mut self) {
         self.yaw = -std::f64::consts::FRAC_PI_2;
         self.pitch = MAX_PITCH;
@@ -302,6 +320,7 @@ pub struct Renderer {
     /// top (after a good registration they coincide).
     holes: Option<Drawable>,
     printer: Option<Drawable>,
+    picked: Option<Drawable>,
     bounds: (DVec3, DVec3),
     width: u32,
     height: u32,
@@ -335,6 +354,7 @@ impl Renderer {
             lines: None,
             holes: None,
             printer: None,
+            picked: None,
             bounds,
             width,
             height,
@@ -351,6 +371,13 @@ impl Renderer {
 
     pub fn pan(&mut self, dx: f64, dy: f64) {
         self.camera.pan(dx, dy);
+    }
+
+    /// The camera ray through a pixel of the drawing buffer (see
+    /// [`Camera::ray`]).
+    pub fn pick_ray(&self, x_px: f64, y_px: f64) -> Option<(DVec3, DVec3)> {
+        self.camera
+            .ray(x_px, y_px, f64::from(self.width), f64::from(self.height))
     }
 
     pub fn reset_view(&mut self) {
@@ -459,7 +486,8 @@ impl Renderer {
         };
         let holes = points(&m.holes, HOLE_MARKER)?;
         let printer = points(&m.printer, PRINTER_MARKER)?;
-        for d in [self.holes.take(), self.printer.take()]
+        let picked = points(&m.picked, PICK_MARKER)?;
+        for d in [self.holes.take(), self.printer.take(), self.picked.take()]
             .into_iter()
             .flatten()
         {
@@ -467,6 +495,7 @@ impl Renderer {
         }
         self.holes = holes;
         self.printer = printer;
+        self.picked = picked;
         Ok(())
     }
 
@@ -505,7 +534,11 @@ impl Renderer {
         }
         // Markers sit in holes: draw them over the surface.
         gl.disable(Gl::DEPTH_TEST);
-        for (m, size) in [(&self.holes, 13.0), (&self.printer, 6.0)] {
+        for (m, size) in [
+            (&self.holes, 13.0),
+            (&self.printer, 6.0),
+            (&self.picked, 9.0),
+        ] {
             if let Some(m) = m {
                 gl.uniform1f(p.point_size.as_ref(), size);
                 gl.bind_vertex_array(Some(&m.vao));

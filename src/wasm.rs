@@ -200,13 +200,49 @@ pub fn antenna_svg(kind: &str, params: JsValue) -> Result<String, JsError> {
     }
 }
 
-fn profile(dialect: &str) -> Result<MachineProfile, JsError> {
-    MachineProfile::builtin(dialect).ok_or_else(|| {
-        JsError::new(&format!(
-            "unknown G-code dialect '{dialect}' (expected one of {})",
-            MachineProfile::builtin_names().join(", ")
-        ))
-    })
+/// The machine profile to write with: a built-in name (`marlin`, ...) or a
+/// user's profile as JSON text, validated by the core; `file_name` labels
+/// the JSON's errors (which then name the file and the field).
+fn profile(dialect: &str, file_name: Option<&str>) -> Result<MachineProfile, JsValue> {
+    if let Some(p) = MachineProfile::builtin(dialect) {
+        return Ok(p);
+    }
+    if dialect.trim_start().starts_with('{') {
+        let name = file_name.unwrap_or("machine profile");
+        return MachineProfile::from_json(dialect, name).map_err(|e| core_err(e.into()));
+    }
+    Err(JsError::new(&format!(
+        "unknown G-code dialect '{dialect}' (expected one of {}, or a machine profile as JSON)",
+        MachineProfile::builtin_names().join(", ")
+    ))
+    .into())
+}
+
+/// A user's machine profile checked before the page offers it: returns
+/// its `name`, or an `Error` whose message names `file_name` and the field.
+#[wasm_bindgen(js_name = checkProfile)]
+pub fn check_profile(text: &str, file_name: &str) -> Result<String, JsValue> {
+    let p = MachineProfile::from_json(text, file_name).map_err(|e| core_err(e.into()))?;
+    Ok(p.name)
+}
+
+/// Three finite numbers from the page, or an error naming `what`.
+fn vec3(what: &str, v: &[f64]) -> Result<DVec3, JsError> {
+    match v {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err(JsError::new(&format!(
+            "{what} must be three finite numbers, got {v:?}"
+        ))),
+    }
+}
+
+/// A point picked on the scan, in both frames.
+#[derive(Serialize)]
+struct PickView {
+    /// Printer frame: where the view draws it.
+    printer: [f64; 3],
+    /// Scanner frame: what the registration reads as a scan point Sr.
+    scan: [f64; 3],
 }
 
 /// A fiducial hole as the page lists and draws it.
@@ -343,8 +379,40 @@ impl Session {
         })
     }
 
-    /// Plans `svg` on this scan ([`job::run_on`]) and writes G-code in
-    /// `dialect`; returns `{gcode, report_json, warnings}`.
+    /// The surface point the view shows first along the ray from `origin`
+    /// in `direction` (printer frame, as [`Viewer::pick_ray`] gives it), as
+    /// `{printer, scan}`, or `null` when the ray misses the scan. The view
+    /// draws the registered mesh, so the hit is found on the registered
+    /// surface and taken back to the scanner frame by the inverse of G.
+    pub fn pick(&self, origin: &[f64], direction: &[f64]) -> Result<JsValue, JsError> {
+        let a = vec3("the ray origin", origin)?;
+        let dir = vec3("the ray direction", direction)?.normalize_or_zero();
+        if dir == DVec3::ZERO {
+            return Err(JsError::new("the ray direction must not be zero"));
+        }
+        let (lo, hi) = self.scan.surface.bbox();
+        // Long enough to pass the whole scan from wherever the ray starts.
+        let reach = (a - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
+        let Some(hit) = self.scan.surface.segment_first_hit(a, a + reach * dir) else {
+            return Ok(JsValue::NULL);
+        };
+        // G is rigid (rotation and translation), so its inverse is exact.
+        let scan = self
+            .scan
+            .registration
+            .matrix
+            .inverse()
+            .transform_point3(hit);
+        to_js(&PickView {
+            printer: arr(hit),
+            scan: arr(scan),
+        })
+    }
+
+    /// Plans `svg` on this scan ([`job::run_on`]) and writes G-code with the
+    /// machine profile `dialect`: a built-in name or a profile's JSON text
+    /// (`profile_file` then names the file in errors); returns
+    /// `{gcode, report_json, warnings}`.
     pub fn plan(
         &self,
         svg: &[u8],
@@ -352,9 +420,10 @@ impl Session {
         settings: JsValue,
         dialect: &str,
         accept_risk: bool,
+        profile_file: Option<String>,
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
-        let profile = profile(dialect)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
         let out = job::run_on(&self.scan, svg, svg_name, &settings, &profile, accept_risk)
             .map_err(core_err)?;
         // Pretty JSON and a final newline: what the CLI's `--report` writes.
@@ -420,15 +489,45 @@ impl Viewer {
         self.r.set_paths(&paths).map_err(|e| JsError::new(&e))
     }
 
-    /// Fiducial markers: holes found in the scan and the printer points P,
-    /// each `[[x, y, z], ...]` in the printer frame.
+    /// Fiducial markers: holes found in the scan, the printer points P and
+    /// (optional) the points picked on the mesh, each `[[x, y, z], ...]` in
+    /// the printer frame.
     #[wasm_bindgen(js_name = setMarkers)]
-    pub fn set_markers(&mut self, holes: JsValue, printer: JsValue) -> Result<(), JsError> {
+    pub fn set_markers(
+        &mut self,
+        holes: JsValue,
+        printer: JsValue,
+        picked: JsValue,
+    ) -> Result<(), JsError> {
         let holes: Vec<[f64; 3]> = from_js("hole markers", holes)?;
         let printer: Vec<[f64; 3]> = from_js("printer points", printer)?;
+        let picked: Vec<[f64; 3]> = if picked.is_undefined() || picked.is_null() {
+            Vec::new()
+        } else {
+            from_js("picked points", picked)?
+        };
         self.r
-            .set_markers(&Markers { holes, printer })
+            .set_markers(&Markers {
+                holes,
+                printer,
+                picked,
+            })
             .map_err(|e| JsError::new(&e))
+    }
+
+    /// The camera ray through the drawing-buffer pixel (x, y) (device
+    /// pixels from the top-left): `[ox, oy, oz, dx, dy, dz]`, origin on the
+    /// near plane and unit direction, printer frame (the mesh's).
+    #[wasm_bindgen(js_name = pickRay)]
+    pub fn pick_ray(&self, x: f64, y: f64) -> Result<Vec<f64>, JsError> {
+        if !x.is_finite() || !y.is_finite() {
+            return Err(JsError::new("the pixel position must be finite"));
+        }
+        let (o, d) = self
+            .r
+            .pick_ray(x, y)
+            .ok_or_else(|| JsError::new("the camera has no ray through that pixel"))?;
+        Ok(vec![o.x, o.y, o.z, d.x, d.y, d.z])
     }
 
     /// Sets the drawing-buffer size in device pixels.

@@ -244,6 +244,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
             js(&settings.plan),
             "marlin",
             false,
+            None,
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let gcode = js_sys::Reflect::get(&out, &"gcode".into()).unwrap();
@@ -266,6 +267,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
             js(&moved),
             "marlin",
             false,
+            None,
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let g2 = js_sys::Reflect::get(&again, &"gcode".into()).unwrap();
@@ -318,9 +320,103 @@ fn session_errors_name_the_cause_and_the_stage() {
     .unwrap_or_else(|e| panic!("{e:?}"));
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M1 5 L9 5"/></svg>"#;
     assert!(ok
-        .plan(svg, "l.svg", js(&none.plan), "no-such-dialect", false)
+        .plan(svg, "l.svg", js(&none.plan), "no-such-dialect", false, None)
         .is_err());
     assert!(ok
-        .plan(svg, "l.svg", JsValue::from_str("nonsense"), "marlin", false)
+        .plan(
+            svg,
+            "l.svg",
+            JsValue::from_str("nonsense"),
+            "marlin",
+            false,
+            None
+        )
         .is_err());
+}
+
+#[wasm_bindgen_test]
+fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
+    let settings = golden_settings();
+    let session = pcpp::wasm::Session::new(
+        &demo::demo_scan_bytes(),
+        demo::DEMO_SCAN_NAME,
+        js(&settings.scan),
+        js(&settings.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = test_part::test_part_svg();
+    let svg = svg.as_bytes();
+    let mut profile: serde_json::Value =
+        serde_json::from_str(include_str!("../src/gcode/profiles/marlin.json")).unwrap();
+    profile["name"] = "my-printer".into();
+    profile["start"] = serde_json::json!(["G21", "G90", "M117 custom start"]);
+    let text = profile.to_string();
+    assert_eq!(
+        pcpp::wasm::check_profile(&text, "my-printer.json").ok(),
+        Some("my-printer".to_string())
+    );
+    let out = session
+        .plan(
+            svg,
+            demo::DEMO_PATH_NAME,
+            js(&settings.plan),
+            &text,
+            false,
+            Some("my-printer.json".into()),
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let gcode = js_sys::Reflect::get(&out, &"gcode".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(gcode.contains("M117 custom start"), "{gcode}");
+
+    profile["decimals"] = "three".into();
+    let bad = profile.to_string();
+    let err = session
+        .plan(
+            svg,
+            demo::DEMO_PATH_NAME,
+            js(&settings.plan),
+            &bad,
+            false,
+            Some("bad.json".into()),
+        )
+        .expect_err("a profile with a bad field must not plan");
+    let message = js_sys::Reflect::get(&err, &"message".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(
+        message.contains("bad.json") && message.contains("decimals"),
+        "{message}"
+    );
+}
+
+#[wasm_bindgen_test]
+fn session_pick_finds_the_surface_under_a_vertical_ray() {
+    let none = JobSettings::default();
+    let session = pcpp::wasm::Session::new(
+        &demo::demo_scan_bytes(),
+        demo::DEMO_SCAN_NAME,
+        js(&none.scan),
+        js(&none.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    // The demo part's flat margin is at 5 mm.
+    let hit = session
+        .pick(&[2.0, 40.0, 100.0], &[0.0, 0.0, -1.0])
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let scan: [f64; 3] =
+        serde_wasm_bindgen::from_value(js_sys::Reflect::get(&hit, &"scan".into()).unwrap())
+            .unwrap();
+    assert!((scan[2] - 5.0).abs() < 1e-9, "{scan:?}");
+    assert!((scan[0] - 2.0).abs() < 1e-9 && (scan[1] - 40.0).abs() < 1e-9);
+    // A ray that misses is null; a bad direction is an error.
+    let miss = session
+        .pick(&[-50.0, -50.0, 100.0], &[0.0, 0.0, -1.0])
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    assert!(miss.is_null());
+    assert!(session.pick(&[0.0, 0.0, 1.0], &[0.0, 0.0, 0.0]).is_err());
+    assert!(session.pick(&[0.0, 0.0], &[0.0, 0.0, -1.0]).is_err());
 }
