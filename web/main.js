@@ -7,6 +7,7 @@ import { drawPlot } from './plot.js';
 import {
   Viewer,
   antennaSvg,
+  checkProfile,
   demoPathName,
   demoPathSvg,
   demoScan,
@@ -48,6 +49,8 @@ const state = {
   redraw: 0,
   debounce: 0,
   urls: [],
+  picking: false, // "pick on mesh" mode: a click on the view adds a scan point
+  pickId: 0,
 };
 
 let settings = null;
@@ -79,6 +82,8 @@ function demoUiSettings() {
     },
     planner: d.plan.planner,
     dialect: 'marlin',
+    // A user's machine profile {name, file, text}; dialect 'custom' uses it.
+    customProfile: null,
     acceptRisk: false,
   };
 }
@@ -99,6 +104,9 @@ function loadSettings() {
   }
   // Files are not stored, so a saved "SVG file" source starts as the demo.
   if (base.pathSource === 'file') base.pathSource = 'demo';
+  const cp = base.customProfile;
+  if (!cp || typeof cp.text !== 'string' || typeof cp.name !== 'string') base.customProfile = null;
+  if (base.dialect === 'custom' && !base.customProfile) base.dialect = 'marlin';
   return base;
 }
 
@@ -229,7 +237,7 @@ function syncGauge() {
 
 function syncVisibility() {
   for (const k of ['spiral', 'hilbert', 'monopole']) $(`antenna-${k}`).hidden = settings.pathSource !== k;
-  $('fid-scan-wrap').hidden = settings.fidSource !== 'points';
+  $('fid-scan-wrap').hidden = settings.fidSource !== 'points' && !state.picking;
   const svg = settings.pathSource === 'file' ? state.pendingSvg || state.svgFile : null;
   $('svg-name').textContent = settings.pathSource === 'file'
     ? (svg ? svg.name : 'no SVG file loaded')
@@ -276,6 +284,23 @@ function bindForm() {
   });
   const dialect = $('dialect');
   for (const d of dialects()) dialect.add(new Option(d, d));
+  syncProfileOption();
+}
+
+// The dialect list's entry for the user's own profile, if one is loaded.
+function syncProfileOption() {
+  const dialect = $('dialect');
+  let opt = dialect.querySelector('option[value="custom"]');
+  const cp = settings.customProfile;
+  if (!cp) {
+    if (opt) opt.remove();
+    return;
+  }
+  if (!opt) {
+    opt = new Option('', 'custom');
+    dialect.add(opt);
+  }
+  opt.textContent = `custom: ${cp.name} (${cp.file})`;
 }
 
 // ---------- errors and status ----------
@@ -378,7 +403,11 @@ function runPlan() {
     scan: { key: scan.key, name: scan.name, bytes: scan.bytes },
     svg: { name: svg.name, bytes: svg.bytes },
     settings: job,
-    dialect: settings.dialect,
+    // A built-in name, or the user's profile as JSON text (named by its file).
+    dialect: settings.dialect === 'custom' && settings.customProfile
+      ? settings.customProfile.text : settings.dialect,
+    profileFile: settings.dialect === 'custom' && settings.customProfile
+      ? settings.customProfile.file : undefined,
     acceptRisk: !!settings.acceptRisk,
     compare: true,
   });
@@ -394,6 +423,10 @@ function onWorkerMessage(e) {
   const m = e.data;
   const busy = state.busy;
   if (m.type === 'ready') return;
+  if (m.type === 'pick') {
+    onPick(m);
+    return;
+  }
   if (!busy || m.id !== busy.id) {
     if (m.type === 'error' && m.stage === 'init') showError('Could not start the planner', m.message);
     return;
@@ -559,18 +592,6 @@ function showFiducials() {
       ol.append(li);
     }
     holes.append(ol);
-    const use = document.createElement('button');
-    use.type = 'button';
-    use.className = 'small-btn';
-    use.textContent = 'Use the first three as scan points';
-    use.addEventListener('click', () => {
-      settings.fidScanText = fmtPoints(info.holes.slice(0, 3).map((h) => h.scan));
-      settings.fidSource = 'points';
-      saveSettings();
-      writeForm();
-      schedulePlan(0);
-    });
-    holes.append(use);
   } else {
     holes.textContent = 'No holes found in the scan.';
   }
@@ -592,16 +613,102 @@ function showFiducials() {
     }
     p.append(rms);
     res.append(p);
+
     for (const n of r.notes) {
       const q = document.createElement('p');
       q.textContent = n;
       res.append(q);
     }
   }
-  if (state.viewer) {
+  showPairs(list);
+  updateMarkers();
+}
+
+// Which hole is matched with which printer point P: one select per P row
+// (the holes in the list above), the residual of each pair beside it.
+// Choosing holes here types their centres as the scan points Sr.
+function showPairs(list) {
+  const box = $('fid-pairs');
+  box.replaceChildren();
+  const info = state.info;
+  const printer = safePoints(settings.fidPrinterText);
+  if (!info || !list.length || !printer.length || settings.fidSource === 'none') return;
+  const scanPts = settings.fidSource === 'points' ? safePoints(settings.fidScanText) : [];
+  const r = info.registration;
+  const near = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  const closest = (p, key, tol) => {
+    let best = -1;
+    let bd = tol;
+    list.forEach((h, i) => {
+      const dd = near(h[key], p);
+      if (dd < bd) { bd = dd; best = i; }
+    });
+    return best;
+  };
+  const head = document.createElement('p');
+  head.textContent = 'Pairs (hole → printer point P), residual:';
+  const table = document.createElement('table');
+  table.className = 'num pairs';
+  const selects = [];
+  printer.forEach((pp, i) => {
+    // Preselected: the hole typed for this row, or (auto) the hole that
+    // lands nearest to P after the registration.
+    let chosen = -1;
+    if (settings.fidSource === 'points') {
+      if (scanPts[i]) chosen = closest(scanPts[i], 'scan', 1e-3);
+    } else if (r.residuals_mm.length) {
+      chosen = closest(pp, 'printer', Infinity);
+    }
+    const tr = document.createElement('tr');
+    const sel = document.createElement('select');
+    sel.id = `fid-pair-${i}`;
+    sel.className = 'pair-select';
+    sel.setAttribute('aria-label', `hole for printer point ${i + 1}`);
+    sel.add(new Option('—', ''));
+    list.forEach((h, k) => sel.add(new Option(`hole ${k + 1}`, String(k))));
+    sel.value = chosen >= 0 ? String(chosen) : '';
+    sel.addEventListener('change', () => choosePairs(list, selects));
+    selects.push(sel);
+    const cells = [sel, `P${i + 1} (${pp.map((v) => fmt(v, 2)).join(', ')})`,
+      r.residuals_mm.length === printer.length ? `${fmt(r.residuals_mm[i], 4)} mm` : ''];
+    for (const c of cells) {
+      const td = document.createElement('td');
+      if (typeof c === 'string') td.textContent = c;
+      else td.append(c);
+      tr.append(td);
+    }
+    table.append(tr);
+  });
+  box.append(head, table);
+}
+
+function choosePairs(list, selects) {
+  const chosen = selects.map((s) => (s.value === '' ? null : list[Number(s.value)]));
+  // Registration needs a hole for every P; wait until each row has one.
+  if (chosen.some((h) => !h)) return;
+  settings.fidScanText = fmtPoints(chosen.map((h) => h.scan));
+  settings.fidSource = 'points';
+  saveSettings();
+  writeForm();
+  schedulePlan(0);
+}
+
+// G (the registration, row-major 4 x 4) applied to a scanner-frame point.
+function applyG(m, p) {
+  return [0, 1, 2].map((r) => m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
+}
+
+// Holes, printer points P and the typed or picked scan points Sr, drawn in
+// the view's (printer) frame.
+function updateMarkers() {
+  const info = state.info;
+  if (state.viewer && info) {
     const printer = settings.fidSource === 'none' ? [] : safePoints(settings.fidPrinterText);
+    const showScan = settings.fidSource === 'points' || state.picking;
+    const picked = showScan
+      ? safePoints(settings.fidScanText).map((p) => applyG(info.registration.matrix, p)) : [];
     try {
-      state.viewer.setMarkers(info.holes.map((h) => h.printer), printer);
+      state.viewer.setMarkers(info.holes.map((h) => h.printer), printer, picked);
     } catch (e) {
       showError('Could not draw the fiducials', e.message);
     }
@@ -703,7 +810,40 @@ async function openFile(file) {
   schedulePlan(0);
 }
 
+// A user's machine profile: checked by the core (the error names the file
+// and the field); a bad file changes nothing, the previous dialect stays.
+async function openProfile(file) {
+  let text;
+  try {
+    text = await file.text();
+  } catch (e) {
+    showError(`Could not read ${file.name}`, e.message);
+    return;
+  }
+  let name;
+  try {
+    name = checkProfile(text, file.name);
+  } catch (e) {
+    showError(`Could not use the machine profile ${file.name}`,
+      `${e.message}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`);
+    return;
+  }
+  clearError();
+  settings.customProfile = { name, file: file.name, text };
+  settings.dialect = 'custom';
+  syncProfileOption();
+  saveSettings();
+  writeForm();
+  schedulePlan(0);
+}
+
 function bindFiles() {
+  const profileInput = $('profile-input');
+  profileInput.addEventListener('change', () => {
+    const f = profileInput.files && profileInput.files[0];
+    if (f) openProfile(f);
+    profileInput.value = '';
+  });
   for (const id of ['scan-input', 'svg-input']) {
     const input = $(id);
     input.addEventListener('change', () => {
@@ -787,6 +927,62 @@ function centreOnScan(showErrors = true) {
   writeForm();
 }
 
+// ---------- picking scan points on the mesh ----------
+
+function setPicking(on) {
+  state.picking = on;
+  const b = $('pick-btn');
+  b.setAttribute('aria-pressed', on ? 'true' : 'false');
+  b.textContent = on ? 'Picking: click the scan (Esc stops)' : 'Pick on mesh';
+  $('view').classList.toggle('picking', on);
+  $('pick-status').textContent = on ? 'Click the 3-D view where a scan point Sr is; drag still turns the view.' : '';
+  syncVisibility();
+  updateMarkers();
+}
+
+// Asks the worker (which holds the scan) where the camera ray through the
+// clicked pixel first meets the mesh.
+function pickAt(x, y) {
+  let ray;
+  try {
+    ray = state.viewer.pickRay(x, y);
+  } catch (e) {
+    $('pick-status').textContent = e.message;
+    return;
+  }
+  if (!state.info) {
+    $('pick-status').textContent = 'No scan read yet.';
+    return;
+  }
+  state.worker.postMessage({ type: 'pick', id: ++state.pickId, origin: ray.slice(0, 3), direction: ray.slice(3, 6) });
+}
+
+function onPick(m) {
+  if (m.id !== state.pickId) return;
+  if (m.error) {
+    $('pick-status').textContent = m.error;
+    return;
+  }
+  if (!m.hit) {
+    $('pick-status').textContent = 'That click missed the scan.';
+    return;
+  }
+  const pts = safePoints(settings.fidScanText);
+  pts.push(m.hit.scan);
+  settings.fidScanText = fmtPoints(pts);
+  const nPrinter = safePoints(settings.fidPrinterText).length;
+  $('pick-status').textContent = `Picked Sr${pts.length} (${m.hit.scan.map((v) => fmt(v)).join(', ')}); `
+    + `${pts.length} of ${nPrinter} printer point(s) P.`;
+  // Register as soon as every P has its scan point (not before: fewer
+  // points cannot register).
+  const ready = pts.length === nPrinter && pts.length >= 3;
+  if (ready) settings.fidSource = 'points';
+  saveSettings();
+  writeForm();
+  updateMarkers();
+  if (ready) schedulePlan(0);
+}
+
 // ---------- 3-D view ----------
 
 function requestDraw() {
@@ -821,7 +1017,10 @@ function bindView() {
   let drag = null;
   canvas.addEventListener('contextmenu', (e) => e.preventDefault());
   canvas.addEventListener('pointerdown', (e) => {
-    drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.button === 1 || e.shiftKey };
+    drag = {
+      x: e.clientX, y: e.clientY, x0: e.clientX, y0: e.clientY,
+      pan: e.button === 2 || e.button === 1 || e.shiftKey,
+    };
     canvas.setPointerCapture(e.pointerId);
   });
   canvas.addEventListener('pointermove', (e) => {
@@ -836,7 +1035,15 @@ function bindView() {
     requestDraw();
   });
   const end = () => { drag = null; };
-  canvas.addEventListener('pointerup', end);
+  canvas.addEventListener('pointerup', (e) => {
+    // In pick mode a click (no drag) picks; a drag still turns the view.
+    if (drag && state.picking && !drag.pan && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) {
+      const rect = canvas.getBoundingClientRect();
+      pickAt((e.clientX - rect.left) * (canvas.width / rect.width),
+        (e.clientY - rect.top) * (canvas.height / rect.height));
+    }
+    end();
+  });
   canvas.addEventListener('pointercancel', end);
   canvas.addEventListener('wheel', (e) => {
     e.preventDefault();
@@ -867,6 +1074,16 @@ async function start() {
   $('demo-btn').addEventListener('click', loadDemo);
   $('center-btn').addEventListener('click', () => { centreOnScan(true); schedulePlan(0); });
   $('error-close').addEventListener('click', clearError);
+  $('pick-btn').addEventListener('click', () => setPicking(!state.picking));
+  $('clear-scan-btn').addEventListener('click', () => {
+    settings.fidScanText = '';
+    $('pick-status').textContent = '';
+    saveSettings();
+    writeForm();
+    updateMarkers();
+    if (settings.fidSource === 'points') schedulePlan(0);
+  });
+  window.addEventListener('keydown', (e) => { if (e.key === 'Escape' && state.picking) setPicking(false); });
   state.worker = makeWorker();
   state.scan = { key: 'demo', name: demoScanName(), bytes: demoScan() };
   $('scan-name').textContent = state.scan.name;

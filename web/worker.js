@@ -35,7 +35,8 @@ function plan(m) {
     }
     stage = 'plan';
     post({ type: 'progress', id, stage, label: 'projecting and planning the tool path' });
-    const r = session.plan(m.svg.bytes, m.svg.name, m.settings.plan, m.dialect, m.acceptRisk);
+    const r = session.plan(m.svg.bytes, m.svg.name, m.settings.plan, m.dialect, m.acceptRisk,
+      m.profileFile);
     post({ type: 'result', id, gcode: r.gcode, reportJson: r.report_json });
     if (m.compare) {
       stage = 'compare';
@@ -60,5 +61,16 @@ self.onmessage = (e) => {
     }
   } else if (m.type === 'plan') {
     plan(m);
+  } else if (m.type === 'pick') {
+    // The first surface point along the view's ray, on the session's scan.
+    if (!session) {
+      post({ type: 'pick', id: m.id, error: 'No scan read yet.' });
+      return;
+    }
+    try {
+      post({ type: 'pick', id: m.id, hit: session.pick(m.origin, m.direction) });
+    } catch (err) {
+      post({ type: 'pick', id: m.id, error: errorOf(err).message });
+    }
   }
 };

@@ -1,0 +1,72 @@
+// A user's machine profile loaded from a file joins the dialect list and
+// writes the G-code; a bad one shows an error naming the file and the
+// field and keeps the previous dialect.
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { after, before, test } from 'node:test';
+import { ROOT, download, launch, openPage, startServer, waitForPlan, waitIdle } from './helpers.mjs';
+
+let server;
+let chrome;
+before(async () => {
+  server = await startServer();
+  chrome = await launch();
+});
+after(async () => {
+  await chrome?.close();
+  server?.stop();
+});
+
+const marlin = () => JSON.parse(readFileSync(join(ROOT, 'src/gcode/profiles/marlin.json'), 'utf8'));
+const file = (name, text) => ({ name, mimeType: 'application/json', buffer: Buffer.from(text) });
+
+test('a custom machine profile changes the G-code; a bad one names its field', async () => {
+  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  await waitForPlan(page);
+  const before = (await download(page, 'dl-gcode')).bytes.toString('utf8');
+  assert.doesNotMatch(before, /M117 lab printer ready/);
+
+  // Invalid: a field of the wrong type. The error names file and field; the
+  // dialect stays marlin.
+  const bad = marlin();
+  bad.decimals = 'three';
+  await page.setInputFiles('#profile-input', file('broken-profile.json', JSON.stringify(bad)));
+  await page.waitForSelector('#error-panel:not([hidden])');
+  const message = await page.textContent('#error-message');
+  assert.match(message, /broken-profile\.json/);
+  assert.match(message, /decimals/);
+  assert.equal(await page.inputValue('#dialect'), 'marlin');
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#dl-gcode'), false); // the plan still stands
+
+  // Valid: its start block appears in the G-code.
+  const good = marlin();
+  good.name = 'lab-printer';
+  good.start = ['G21', 'G90', 'M117 lab printer ready'];
+  await page.setInputFiles('#profile-input', file('lab-printer.json', JSON.stringify(good)));
+  await page.waitForFunction(() => document.getElementById('dialect').value === 'custom');
+  assert.equal(await page.isHidden('#error-panel'), true);
+  assert.match(await page.$eval('#dialect', (s) => s.selectedOptions[0].textContent), /lab-printer/);
+  await page.waitForFunction((g) => {
+    const s = window.pcpp.state;
+    return !s.busy && !s.queued && s.lastPlan && s.lastPlan.gcode !== g
+      && !document.getElementById('dl-gcode').hidden;
+  }, before, { timeout: 120_000 });
+  const after = (await download(page, 'dl-gcode')).bytes.toString('utf8');
+  assert.match(after, /^M117 lab printer ready$/m);
+
+  // The profile survives a reload and stays selected.
+  await page.reload();
+  await waitForPlan(page);
+  assert.equal(await page.inputValue('#dialect'), 'custom');
+  assert.match((await download(page, 'dl-gcode')).bytes.toString('utf8'), /M117 lab printer ready/);
+
+  // Back to a built-in dialect.
+  await page.selectOption('#dialect', 'grbl');
+  await waitIdle(page);
+  await waitForPlan(page);
+  assert.doesNotMatch((await download(page, 'dl-gcode')).bytes.toString('utf8'), /M117 lab printer ready/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
