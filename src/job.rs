@@ -311,18 +311,6 @@ pub fn report(
     }
 }
 
-fn fmt_summary(q: &QualitySummary) -> String {
-    format!(
-        "mean |e| {:.4} mm, mean e- {:.4} mm, mean e+ {:.4} mm, contact {:.2}%, flattening {:.2}%, floating {:.2}%",
-        q.mean_abs_error_mm,
-        q.mean_negative_error_mm,
-        q.mean_positive_error_mm,
-        q.contact_pct,
-        q.flattening_pct,
-        q.floating_pct
-    )
-}
-
 /// The provenance header of the G-code (spec section 9).
 pub fn provenance(report: &Report) -> Vec<(String, String)> {
     let s = &report.settings;
@@ -403,7 +391,7 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             st.print_time_s
         ),
     ));
-    h.push(("predicted quality".into(), fmt_summary(&report.quality)));
+    h.push(("predicted quality".into(), report.quality.to_string()));
     h.push(("warnings".into(), report.warnings.len().to_string()));
     h
 }

@@ -131,23 +131,8 @@ mod tests {
     use crate::mesh::TriMesh;
 
     fn sine_grid(n: usize, size: f64) -> TriMesh {
-        let mut m = TriMesh::default();
-        let h = size / n as f64;
-        for j in 0..=n {
-            for i in 0..=n {
-                let (x, y) = (i as f64 * h, j as f64 * h);
-                m.vertices.push(DVec3::new(x, y, (x / 2.0).sin()));
-            }
-        }
-        let w = (n + 1) as u32;
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * w + i;
-                m.triangles.push([a, a + 1, a + w + 1]);
-                m.triangles.push([a, a + w + 1, a + w]);
-            }
-        }
-        m
+        let axis: Vec<f64> = (0..=n).map(|i| i as f64 * size / n as f64).collect();
+        TriMesh::height_field(&axis, &axis, |x, _| (x / 2.0).sin())
     }
 
     #[test]

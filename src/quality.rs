@@ -50,6 +50,23 @@ pub struct QualitySummary {
     pub floating_pct: f64,
 }
 
+/// One line, as the G-code header and the CLI print it.
+impl std::fmt::Display for QualitySummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "mean |e| {:.4} mm, mean e- {:.4} mm, mean e+ {:.4} mm, contact {:.2}%, \
+             flattening {:.2}%, floating {:.2}%",
+            self.mean_abs_error_mm,
+            self.mean_negative_error_mm,
+            self.mean_positive_error_mm,
+            self.contact_pct,
+            self.flattening_pct,
+            self.floating_pct
+        )
+    }
+}
+
 impl QualitySummary {
     /// Defective points (contact, flattening or floating), in percent.
     pub fn defect_pct(&self) -> f64 {

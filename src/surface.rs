@@ -445,25 +445,10 @@ fn triangle_max_z_in_disk(t: [DVec3; 3], c: DVec2, r: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
-    /// A height field z = f(x, y) on a regular grid, for tests.
+    /// A height field z = f(x, y) on a regular n x n grid, for tests.
     pub(crate) fn grid(n: usize, size: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh {
-        let mut m = TriMesh::default();
-        let h = size / n as f64;
-        for j in 0..=n {
-            for i in 0..=n {
-                let (x, y) = (i as f64 * h, j as f64 * h);
-                m.vertices.push(DVec3::new(x, y, f(x, y)));
-            }
-        }
-        let w = (n + 1) as u32;
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * w + i;
-                m.triangles.push([a, a + 1, a + w + 1]);
-                m.triangles.push([a, a + w + 1, a + w]);
-            }
-        }
-        m
+        let axis: Vec<f64> = (0..=n).map(|i| i as f64 * size / n as f64).collect();
+        TriMesh::height_field(&axis, &axis, f)
     }
 
     #[test]

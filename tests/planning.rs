@@ -10,23 +10,8 @@ use pcpp::quality::Defect;
 use pcpp::surface::Surface;
 use pcpp::{DVec2, DVec3, Nozzle, Process};
 
-/// A height field z = f(x, y) over a rectangular grid.
 fn height_field(xs: &[f64], ys: &[f64], f: impl Fn(f64, f64) -> f64) -> TriMesh {
-    let mut m = TriMesh::default();
-    for &y in ys {
-        for &x in xs {
-            m.vertices.push(DVec3::new(x, y, f(x, y)));
-        }
-    }
-    let w = xs.len() as u32;
-    for j in 0..ys.len() as u32 - 1 {
-        for i in 0..w - 1 {
-            let a = j * w + i;
-            m.triangles.push([a, a + 1, a + w + 1]);
-            m.triangles.push([a, a + w + 1, a + w]);
-        }
-    }
-    m
+    TriMesh::height_field(xs, ys, f)
 }
 
 fn range(from: f64, to: f64, n: usize) -> Vec<f64> {

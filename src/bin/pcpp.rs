@@ -627,19 +627,6 @@ fn thousands(n: usize) -> String {
     out
 }
 
-fn quality_line(q: &QualitySummary) -> String {
-    format!(
-        "mean |e| {:.4} mm, mean e- {:.4} mm, mean e+ {:.4} mm, contact {:.2}%, \
-         flattening {:.2}%, floating {:.2}%",
-        q.mean_abs_error_mm,
-        q.mean_negative_error_mm,
-        q.mean_positive_error_mm,
-        q.contact_pct,
-        q.flattening_pct,
-        q.floating_pct
-    )
-}
-
 fn registration_line(r: &Registration, method: RegistrationMethod) -> String {
     let res: Vec<String> = r.residuals_mm.iter().map(|v| format!("{v:.4}")).collect();
     format!(
@@ -769,11 +756,7 @@ fn cmd_plan(a: &Args) -> CliResult<()> {
             registration_line(&inputs.prepared.registration, inputs.prepared.method)
         );
     }
-    let _ = writeln!(
-        s,
-        "predicted quality: {}",
-        quality_line(&output.report.quality)
-    );
+    let _ = writeln!(s, "predicted quality: {}", output.report.quality);
     if let Some(r) = &report_path {
         let _ = writeln!(s, "report: {}", r.display());
     }

@@ -5,8 +5,6 @@
 //!   placed on W1.
 //! - W3: a dense serpentine raster of about 100,000 points on W1.
 
-use glam::DVec3;
-
 use crate::mesh::TriMesh;
 
 /// A small deterministic generator (xorshift64*), so workloads are the same
@@ -54,28 +52,11 @@ pub fn wrinkled_film(n: usize) -> TriMesh {
             )
         })
         .collect();
-    let h = FILM_MM / n as f64;
-    let mut m = TriMesh {
-        vertices: Vec::with_capacity((n + 1) * (n + 1)),
-        triangles: Vec::with_capacity(2 * n * n),
-    };
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64 * h, j as f64 * h);
-            let noise = 0.01 * (rng.next_f64() - 0.5);
-            m.vertices
-                .push(DVec3::new(x, y, film_height(x, y, &waves, noise)));
-        }
-    }
-    let w = (n + 1) as u32;
-    for j in 0..n as u32 {
-        for i in 0..n as u32 {
-            let a = j * w + i;
-            m.triangles.push([a, a + 1, a + w + 1]);
-            m.triangles.push([a, a + w + 1, a + w]);
-        }
-    }
-    m
+    let axis: Vec<f64> = (0..=n).map(|i| i as f64 * FILM_MM / n as f64).collect();
+    TriMesh::height_field(&axis, &axis, |x, y| {
+        let noise = 0.01 * (rng.next_f64() - 0.5);
+        film_height(x, y, &waves, noise)
+    })
 }
 
 /// The mesh as OBJ text (for the OBJ import benchmark).

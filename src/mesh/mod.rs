@@ -58,6 +58,32 @@ impl TriMesh {
         Some((lo, hi))
     }
 
+    /// A height field z = f(x, y) over the grid `xs` x `ys` (row by row, y
+    /// outer), two counter-clockwise triangles a cell: test surfaces and the
+    /// generated workloads.
+    pub fn height_field(xs: &[f64], ys: &[f64], mut f: impl FnMut(f64, f64) -> f64) -> TriMesh {
+        let mut m = TriMesh {
+            vertices: Vec::with_capacity(xs.len() * ys.len()),
+            triangles: Vec::with_capacity(
+                2 * xs.len().saturating_sub(1) * ys.len().saturating_sub(1),
+            ),
+        };
+        for &y in ys {
+            for &x in xs {
+                m.vertices.push(DVec3::new(x, y, f(x, y)));
+            }
+        }
+        let w = xs.len() as u32;
+        for j in 0..(ys.len() as u32).saturating_sub(1) {
+            for i in 0..w.saturating_sub(1) {
+                let a = j * w + i;
+                m.triangles.push([a, a + 1, a + w + 1]);
+                m.triangles.push([a, a + w + 1, a + w]);
+            }
+        }
+        m
+    }
+
     /// Applies an affine transform to every vertex.
     pub fn transform(&mut self, m: &DMat4) {
         for v in &mut self.vertices {
