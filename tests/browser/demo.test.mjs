@@ -2,23 +2,14 @@
 // G-code; the screenshot of the planned demo is kept in target/.
 import assert from 'node:assert/strict';
 import { mkdirSync } from 'node:fs';
-import { after, before, test } from 'node:test';
+import { test } from 'node:test';
 import { join } from 'node:path';
-import { ROOT, download, launch, openPage, startServer, viewPixels, waitForPlan } from './helpers.mjs';
+import { ROOT, download, openPage, viewPixels, waitForPlan, withPageServer } from './helpers.mjs';
 
-let server;
-let chrome;
-before(async () => {
-  server = await startServer();
-  chrome = await launch();
-});
-after(async () => {
-  await chrome?.close();
-  server?.stop();
-});
+const env = withPageServer();
 
 test('the demo plans on load, is drawn, and its G-code downloads', async () => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   // The comparison of the four planners arrives after the plan.
   await page.waitForFunction(() => document.querySelectorAll('#compare-table tbody tr').length === 4);
@@ -53,7 +44,7 @@ test('the demo plans on load, is drawn, and its G-code downloads', async () => {
 });
 
 test('settings persist across reloads and a placement change re-plans', async () => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
   await page.fill('#pl-x', '1.5');

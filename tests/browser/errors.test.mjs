@@ -1,24 +1,15 @@
 // Bad input shows the error panel naming the cause, keeps what was loaded
 // and the previous plan on screen, and offers no stale download.
 import assert from 'node:assert/strict';
-import { after, before, test } from 'node:test';
-import { download, launch, openPage, startServer, viewPixels, waitForPlan, waitIdle } from './helpers.mjs';
+import { test } from 'node:test';
+import { download, openPage, viewPixels, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
 
-let server;
-let chrome;
-before(async () => {
-  server = await startServer();
-  chrome = await launch();
-});
-after(async () => {
-  await chrome?.close();
-  server?.stop();
-});
+const env = withPageServer();
 
 const file = (name, text) => ({ name, mimeType: 'application/octet-stream', buffer: Buffer.from(text) });
 
 test('a corrupt scan shows the error, keeps the previous plan, offers no download', async () => {
-  const { page, context } = await openPage(chrome.browser, server.url);
+  const { page, context } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
 
@@ -47,7 +38,7 @@ test('a corrupt scan shows the error, keeps the previous plan, offers no downloa
 });
 
 test('a corrupt SVG names the file and falls back; bad settings name the parameter', async () => {
-  const { page, context } = await openPage(chrome.browser, server.url);
+  const { page, context } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   await page.setInputFiles('#svg-input', file('nonsense.svg', '<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 L'));
   await page.waitForSelector('#error-panel:not([hidden])');
@@ -66,7 +57,7 @@ test('a corrupt SVG names the file and falls back; bad settings name the paramet
 });
 
 test('fiducial residuals are shown and an RMS above d/2 is highlighted', async () => {
-  const { page, context } = await openPage(chrome.browser, server.url);
+  const { page, context } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   assert.equal(await page.$eval('#rms', (e) => e.classList.contains('bad')), false);
   // Move one printer point by 2 mm: the best rigid fit leaves ~0.9 mm RMS.
@@ -82,7 +73,7 @@ test('fiducial residuals are shown and an RMS above d/2 is highlighted', async (
 });
 
 test('cancel ends the worker; a dropped SVG then plans on a fresh one', async () => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   // Plan and cancel in one task: a re-plan on the kept session now ends in
   // well under 100 ms, faster than two separate clicks from the test.

@@ -3,25 +3,16 @@
 // in an order the user chooses (a wrong order shows a large RMS, the right
 // one ~0 on the demo).
 import assert from 'node:assert/strict';
-import { after, before, test } from 'node:test';
-import { launch, openPage, startServer, waitForPlan, waitIdle } from './helpers.mjs';
+import { test } from 'node:test';
+import { openPage, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
 
-let server;
-let chrome;
-before(async () => {
-  server = await startServer();
-  chrome = await launch();
-});
-after(async () => {
-  await chrome?.close();
-  server?.stop();
-});
+const env = withPageServer();
 
 const scanPoints = (page) => page.evaluate(() => window.pcpp.settings.fidScanText
   .split('\n').filter((l) => l.trim()).map((l) => l.split(',').map(Number)));
 
 test('a click in pick mode adds the surface point under the pointer as a scan point', async (t) => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   await page.click('#top-view');
   await page.click('#pick-btn');
@@ -67,7 +58,7 @@ test('a click in pick mode adds the surface point under the pointer as a scan po
 });
 
 test('the order of the holes paired with the printer points sets the registration', async () => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   await page.waitForSelector('#fid-pair-2');
   // The demo part is in the printer frame: each printer point's hole is the

@@ -1,6 +1,7 @@
 // Shared set-up for the browser tests: the built page (dist/) served on a
 // free 127.0.0.1 port by scripts/serve.mjs, and Debian's Chromium driven by
 // playwright-core with the flags measured in shared/toolchain.md.
+import { after, before } from 'node:test';
 import { spawn } from 'node:child_process';
 import { createServer } from 'node:net';
 import { dirname, join, resolve } from 'node:path';
@@ -105,4 +106,19 @@ export async function viewPixels(page) {
     }
     return out;
   });
+}
+
+// One static server and one browser for a test file, started before its
+// tests and stopped after them.
+export function withPageServer() {
+  const env = {};
+  before(async () => {
+    env.server = await startServer();
+    env.chrome = await launch();
+  });
+  after(async () => {
+    await env.chrome?.close();
+    env.server?.stop();
+  });
+  return env;
 }

@@ -4,25 +4,16 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { after, before, test } from 'node:test';
-import { ROOT, download, launch, openPage, startServer, waitForPlan, waitIdle } from './helpers.mjs';
+import { test } from 'node:test';
+import { ROOT, download, openPage, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
 
-let server;
-let chrome;
-before(async () => {
-  server = await startServer();
-  chrome = await launch();
-});
-after(async () => {
-  await chrome?.close();
-  server?.stop();
-});
+const env = withPageServer();
 
 const marlin = () => JSON.parse(readFileSync(join(ROOT, 'src/gcode/profiles/marlin.json'), 'utf8'));
 const file = (name, text) => ({ name, mimeType: 'application/json', buffer: Buffer.from(text) });
 
 test('a custom machine profile changes the G-code; a bad one names its field', async () => {
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   const before = (await download(page, 'dl-gcode')).bytes.toString('utf8');
   assert.doesNotMatch(before, /M117 lab printer ready/);
