@@ -110,6 +110,7 @@ pub fn import_mesh(
     file: &str,
     options: &ImportOptions,
 ) -> Result<ImportedMesh, MeshError> {
+    check_scan_size(bytes.len(), file)?;
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(MeshError::invalid(file, "the file is empty"));
     }
@@ -142,6 +143,36 @@ pub fn import_mesh(
         up_axis,
         warnings,
     })
+}
+
+/// Refuses files past [`super::MAX_SCAN_BYTES`] before reading them.
+fn check_scan_size(len: usize, file: &str) -> Result<(), MeshError> {
+    if len > super::MAX_SCAN_BYTES {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "the file is {:.1} MB, more than the {:.0} MB this program reads; decimate the \
+                 scan (e.g. MeshLab's quadric edge collapse) or crop it to the printed area",
+                len as f64 / 1e6,
+                super::MAX_SCAN_BYTES as f64 / 1e6
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses meshes past [`super::MAX_TRIANGLES`].
+fn check_triangle_count(n: usize, file: &str) -> Result<(), MeshError> {
+    if n > super::MAX_TRIANGLES {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "{n} triangles, more than the {} this program plans on; decimate the scan",
+                super::MAX_TRIANGLES
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The shared steps after parsing. Parsers already report bad values with
@@ -217,6 +248,7 @@ fn finish(
     if kept.is_empty() {
         return Err(MeshError::Empty { file: file.into() });
     }
+    check_triangle_count(kept.len(), file)?;
     for v in &mut vertices {
         let p = *v * scale;
         *v = match up_axis {
@@ -302,6 +334,25 @@ impl Welder {
 
 #[cfg(test)]
 mod tests {
+    use crate::mesh::{MAX_SCAN_BYTES, MAX_TRIANGLES};
+
+    #[test]
+    fn limits_are_errors_that_say_what_to_do() {
+        let e = check_scan_size(MAX_SCAN_BYTES + 1, "huge.stl")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("huge.stl: ") && e.contains("MB") && e.contains("decimate"),
+            "{e}"
+        );
+        assert!(check_scan_size(MAX_SCAN_BYTES, "ok.stl").is_ok());
+        let e = check_triangle_count(MAX_TRIANGLES + 1, "big.ply")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("20000001 triangles"), "{e}");
+        assert!(check_triangle_count(MAX_TRIANGLES, "ok.ply").is_ok());
+    }
+
     use super::*;
 
     #[test]
