@@ -2,14 +2,15 @@
 //! entry the CLI and the page both call, so that for the same inputs and
 //! settings they write identical bytes.
 
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
+use crate::fiducials::Fiducial;
 use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
-use crate::mesh::{ImportOptions, ImportedMesh};
+use crate::mesh::{ImportOptions, MeshFormat, ScanUnits, TriMesh};
 use crate::pipeline::{self, Plan, PlanSettings};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
@@ -51,10 +52,7 @@ pub struct JobSettings {
 }
 
 /// Finds the registration the settings ask for.
-pub fn registration_for(
-    mesh: &ImportedMesh,
-    settings: &RegistrationSettings,
-) -> Result<Registration> {
+pub fn registration_for(mesh: &TriMesh, settings: &RegistrationSettings) -> Result<Registration> {
     let p = &settings.printer_points;
     let scan_points: Vec<DVec3> = match &settings.fiducials {
         FiducialSource::None if p.is_empty() => return Ok(Registration::identity()),
@@ -75,7 +73,7 @@ const AUTO_CANDIDATES: usize = 6;
 /// Tries every ordered choice of the best hole candidates against P and
 /// keeps the one with the lowest RMS: the user need not order the holes.
 fn best_auto_match(
-    mesh: &ImportedMesh,
+    mesh: &TriMesh,
     printer: &[DVec3],
     method: RegistrationMethod,
 ) -> Result<Registration> {
@@ -83,7 +81,7 @@ fn best_auto_match(
     if k < 3 {
         return Err(Error::Registration(RegistrationError::TooFew(k)));
     }
-    let found = find_fiducials(&mesh.mesh);
+    let found = find_fiducials(mesh);
     let cands: Vec<DVec3> = found
         .iter()
         .take(AUTO_CANDIDATES.max(k))
@@ -203,23 +201,38 @@ pub struct Report {
     pub defects: Vec<Vec<crate::quality::Defect>>,
 }
 
-fn row_major(m: &DMat4) -> [[f64; 4]; 4] {
-    let c = m.to_cols_array_2d();
-    std::array::from_fn(|r| std::array::from_fn(|k| c[k][r]))
-}
-
 fn arr(p: &DVec3) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
 /// A scan loaded and registered: reused while only the path or the
-/// settings change.
+/// settings change. It holds the mesh once, in the printer frame, inside
+/// its [`Surface`]; scanner-frame facts are mapped back through G^-1.
 pub struct PreparedScan {
     pub file: InputFile,
-    pub imported: ImportedMesh,
+    pub format: MeshFormat,
+    pub units: ScanUnits,
+    /// What the importer noticed (degenerate triangles skipped, ...).
+    pub warnings: Vec<String>,
     pub registration: Registration,
     pub method: RegistrationMethod,
     pub surface: Surface,
+}
+
+impl PreparedScan {
+    pub fn triangle_count(&self) -> usize {
+        self.surface.mesh().triangle_count()
+    }
+
+    /// The fiducial holes, centroids in the scanner frame (a rigid G moves
+    /// loops but keeps their sizes and shapes).
+    pub fn scan_fiducials(&self) -> Vec<Fiducial> {
+        let mut found = find_fiducials(self.surface.mesh());
+        for f in &mut found {
+            f.centroid = self.registration.apply_inverse(f.centroid);
+        }
+        found
+    }
 }
 
 /// Import, register and index a scan.
@@ -230,11 +243,13 @@ pub fn prepare_scan(
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
     let imported = pipeline::load_scan(bytes, name, scan)?;
-    let reg = registration_for(&imported, registration)?;
-    let surface = pipeline::registered_surface(&imported.mesh, &reg)?;
+    let reg = registration_for(&imported.mesh, registration)?;
+    let surface = pipeline::registered_surface(imported.mesh, &reg)?;
     Ok(PreparedScan {
         file: InputFile::new(name, bytes),
-        imported,
+        format: imported.format,
+        units: imported.units,
+        warnings: imported.warnings,
         registration: reg,
         method: registration.method,
         surface,
@@ -256,7 +271,7 @@ pub fn report(
     settings: &PlanSettings,
 ) -> Report {
     let (lo, hi) = scan.surface.bbox();
-    let mut warnings = scan.imported.warnings.clone();
+    let mut warnings = scan.warnings.clone();
     warnings.extend(scan.registration.notes.iter().cloned());
     warnings.extend(plan.warnings.iter().cloned());
     Report {
@@ -264,12 +279,12 @@ pub fn report(
         version: env!("CARGO_PKG_VERSION").into(),
         inputs: vec![scan.file.clone(), path_file.clone()],
         mesh: MeshReport {
-            triangles: scan.imported.mesh.triangle_count(),
+            triangles: scan.triangle_count(),
             bbox_mm: [arr(&lo), arr(&hi)],
         },
         registration: RegistrationReport {
             method: scan.method,
-            matrix: row_major(&scan.registration.matrix),
+            matrix: scan.registration.matrix_row_major(),
             residuals_mm: scan.registration.residuals_mm.clone(),
             rms_mm: scan.registration.rms_mm,
         },
@@ -508,11 +523,15 @@ pub fn comparison_table(rows: &[(PlannerKind, QualitySummary)]) -> String {
 mod tests {
     use super::*;
     use crate::demo::test_part;
+    use glam::DMat4;
 
     #[test]
     fn matrix_is_row_major() {
-        let m = DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0));
-        let r = row_major(&m);
+        let reg = Registration {
+            matrix: DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0)),
+            ..Registration::identity()
+        };
+        let r = reg.matrix_row_major();
         assert_eq!(r[0][3], 1.0);
         assert_eq!(r[2][3], 3.0);
         assert_eq!(r[3], [0.0, 0.0, 0.0, 1.0]);
@@ -524,13 +543,6 @@ mod tests {
         // Put the scan in a "scanner frame": turned and moved.
         let g = DMat4::from_translation(DVec3::new(-30.0, 12.0, 4.0)) * DMat4::from_rotation_z(0.7);
         mesh.transform(&g);
-        let imported = ImportedMesh {
-            mesh,
-            format: crate::mesh::MeshFormat::Obj,
-            units: crate::mesh::ScanUnits::Mm,
-            up_axis: crate::mesh::UpAxis::Z,
-            warnings: vec![],
-        };
         let mut p = test_part::FIDUCIALS_MM.to_vec();
         p.swap(0, 2);
         let settings = RegistrationSettings {
@@ -538,10 +550,33 @@ mod tests {
             printer_points: p.clone(),
             method: RegistrationMethod::Lsq,
         };
-        let r = registration_for(&imported, &settings).unwrap();
+        let r = registration_for(&mesh, &settings).unwrap();
         assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
         // The recovered G is the inverse of the turn applied.
         let back = r.matrix * g;
         assert!(back.abs_diff_eq(DMat4::IDENTITY, 1e-2), "{back:?}");
+    }
+
+    #[test]
+    fn scan_fiducials_are_given_in_the_scanner_frame() {
+        let g = DMat4::from_translation(DVec3::new(5.0, -7.0, 2.0)) * DMat4::from_rotation_z(-0.4);
+        let mut mesh = test_part::test_part();
+        mesh.transform(&g);
+        let bytes = crate::demo::to_binary_ply(&mesh);
+        let settings = RegistrationSettings {
+            fiducials: FiducialSource::Auto,
+            printer_points: test_part::FIDUCIALS_MM.to_vec(),
+            method: RegistrationMethod::Lsq,
+        };
+        let scan = prepare_scan(&bytes, "turned.ply", &ImportOptions::DEFAULT, &settings).unwrap();
+        let found = scan.scan_fiducials();
+        for f in test_part::FIDUCIALS_MM {
+            let want = g.transform_point3(f);
+            assert!(
+                found.iter().any(|h| h.centroid.distance(want) < 0.05),
+                "{want:?}"
+            );
+        }
+        assert_eq!(scan.triangle_count(), mesh.triangle_count());
     }
 }

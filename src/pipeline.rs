@@ -50,12 +50,11 @@ pub fn load_scan(bytes: &[u8], file: &str, options: &ImportOptions) -> Result<Im
 }
 
 /// Stage 2: Sa = G S, and the acceleration structure over it.
-pub fn registered_surface(mesh: &TriMesh, registration: &Registration) -> Result<Surface> {
-    let mut m = mesh.clone();
+pub fn registered_surface(mut mesh: TriMesh, registration: &Registration) -> Result<Surface> {
     if registration.matrix != glam::DMat4::IDENTITY {
-        m.transform(&registration.matrix);
+        mesh.transform(&registration.matrix);
     }
-    Surface::new(m)
+    Surface::new(mesh)
 }
 
 /// A drawn path read from an SVG, with notes on what was skipped.

@@ -108,6 +108,18 @@ impl Registration {
         }
     }
 
+    /// G as 4 x 4 rows (reports, the CLI, the page).
+    pub fn matrix_row_major(&self) -> [[f64; 4]; 4] {
+        let c = self.matrix.to_cols_array_2d();
+        std::array::from_fn(|r| std::array::from_fn(|k| c[k][r]))
+    }
+
+    /// G^-1 p: maps a printer-frame point back into the scanner frame.
+    pub fn apply_inverse(&self, p: DVec3) -> DVec3 {
+        // G is rigid (rotation and translation), so its inverse is exact.
+        self.matrix.inverse().transform_point3(p)
+    }
+
     /// G p: maps a scanner-frame point into the printer frame.
     #[inline]
     pub fn apply(&self, p: DVec3) -> DVec3 {

@@ -11,7 +11,6 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, test_part};
-use crate::fiducials::find_fiducials;
 use crate::gcode::MachineProfile;
 use crate::job::{self, JobSettings, PreparedScan, RegistrationSettings};
 use crate::mesh::ImportOptions;
@@ -350,7 +349,8 @@ impl Session {
     pub fn info(&self) -> Result<JsValue, JsError> {
         let s = &self.scan;
         let (lo, hi) = s.surface.bbox();
-        let holes = find_fiducials(&s.imported.mesh)
+        let holes = s
+            .scan_fiducials()
             .into_iter()
             .map(|f| HoleView {
                 scan: arr(f.centroid),
@@ -359,18 +359,17 @@ impl Session {
                 roundness: f.roundness,
             })
             .collect();
-        let m = s.registration.matrix.to_cols_array_2d();
         to_js(&ScanView {
             name: &s.file.name,
             bytes: s.file.bytes,
-            format: s.imported.format,
-            units: s.imported.units,
-            triangles: s.imported.mesh.triangle_count(),
+            format: s.format,
+            units: s.units,
+            triangles: s.triangle_count(),
             bbox_mm: [arr(lo), arr(hi)],
-            warnings: &s.imported.warnings,
+            warnings: &s.warnings,
             registration: RegistrationView {
                 method: s.method,
-                matrix: std::array::from_fn(|r| std::array::from_fn(|k| m[k][r])),
+                matrix: s.registration.matrix_row_major(),
                 residuals_mm: &s.registration.residuals_mm,
                 rms_mm: s.registration.rms_mm,
                 notes: &s.registration.notes,
@@ -396,13 +395,7 @@ impl Session {
         let Some(hit) = self.scan.surface.segment_first_hit(a, a + reach * dir) else {
             return Ok(JsValue::NULL);
         };
-        // G is rigid (rotation and translation), so its inverse is exact.
-        let scan = self
-            .scan
-            .registration
-            .matrix
-            .inverse()
-            .transform_point3(hit);
+        let scan = self.scan.registration.apply_inverse(hit);
         to_js(&PickView {
             printer: arr(hit),
             scan: arr(scan),

@@ -672,7 +672,7 @@ fn load_inputs(a: &Args, settings: &JobSettings, progress: &Progress) -> CliResu
         })?;
     progress.say(&format!(
         "scan: {} triangles",
-        thousands(prepared.imported.mesh.triangle_count())
+        thousands(prepared.triangle_count())
     ));
     if settings.registration.fiducials != FiducialSource::None {
         progress.say(&registration_line(&prepared.registration, prepared.method));
@@ -807,7 +807,7 @@ fn cmd_compare(a: &Args) -> CliResult<()> {
         )?;
         staged.commit()?;
     }
-    warn_all(&inputs.prepared.imported.warnings);
+    warn_all(&inputs.prepared.warnings);
     warn_all(&inputs.prepared.registration.notes);
     print!("{}", job::comparison_table(&rows));
     Ok(())
@@ -856,8 +856,7 @@ fn cmd_register(a: &Args) -> CliResult<()> {
         .unwrap_or_default();
     let r = register(&scan, &printer, method)
         .map_err(|e| Failure::Input(format!("registration: {e}")))?;
-    let c = r.matrix.to_cols_array_2d();
-    let rows: [[f64; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|k| c[k][i]));
+    let rows = r.matrix_row_major();
     if a.has("json") {
         let v = serde_json::json!({
             "method": method,
@@ -917,7 +916,7 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
     .map_err(|e| fail("scan", &e))?;
     progress.say(&format!(
         "scan: {} triangles",
-        thousands(prepared.imported.mesh.triangle_count())
+        thousands(prepared.triangle_count())
     ));
 
     // Registration as a user would run it: the holes found in the scan
@@ -929,7 +928,7 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         printer_points: test_part::FIDUCIALS_MM.to_vec(),
         method: RegistrationMethod::Lsq,
     };
-    let registration = job::registration_for(&prepared.imported, &reg_settings)
+    let registration = job::registration_for(prepared.surface.mesh(), &reg_settings)
         .map_err(|e| fail("registration", &e))?;
 
     // One G-code per planner. Only the guarded planner refuses to write a
