@@ -181,7 +181,6 @@ pub fn plan_points(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::TriMesh;
 
     #[test]
     fn names_round_trip() {
@@ -199,18 +198,7 @@ mod tests {
         assert!(forward_shift(d, -1.0) < 0.3015);
     }
 
-    fn flat() -> Surface {
-        Surface::new(TriMesh {
-            vertices: vec![
-                DVec3::new(-10.0, -10.0, 0.0),
-                DVec3::new(10.0, -10.0, 0.0),
-                DVec3::new(10.0, 10.0, 0.0),
-                DVec3::new(-10.0, 10.0, 0.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        })
-        .unwrap()
-    }
+    use crate::surface::tests::flat;
 
     #[test]
     fn all_planners_agree_on_a_flat_surface() {

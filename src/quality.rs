@@ -264,21 +264,9 @@ pub fn summarize<'a>(points: impl IntoIterator<Item = &'a PointQuality>) -> Qual
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::TriMesh;
     use crate::planners::{plan_points, PlannerKind};
 
-    fn flat() -> Surface {
-        Surface::new(TriMesh {
-            vertices: vec![
-                DVec3::new(-10.0, -10.0, 0.0),
-                DVec3::new(10.0, -10.0, 0.0),
-                DVec3::new(10.0, 10.0, 0.0),
-                DVec3::new(-10.0, 10.0, 0.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        })
-        .unwrap()
-    }
+    use crate::surface::tests::flat;
 
     fn line() -> Vec<DVec3> {
         (0..20)

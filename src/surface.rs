@@ -442,8 +442,22 @@ fn triangle_max_z_in_disk(t: [DVec3; 3], c: DVec2, r: f64) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The plane z = 0 over [-10, 10]^2, for the planners' and quality tests.
+    pub(crate) fn flat() -> Surface {
+        Surface::new(TriMesh {
+            vertices: vec![
+                DVec3::new(-10.0, -10.0, 0.0),
+                DVec3::new(10.0, -10.0, 0.0),
+                DVec3::new(10.0, 10.0, 0.0),
+                DVec3::new(-10.0, 10.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        })
+        .unwrap()
+    }
 
     /// A height field z = f(x, y) on a regular n x n grid, for tests.
     pub(crate) fn grid(n: usize, size: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh {

@@ -122,29 +122,9 @@ fn registration_applies_to_points() {
     assert!(reg.max_residual_mm() < 1e-12);
 }
 
-/// Table S1 prints 3x3 matrices whose columns are the points.
-fn table_s1() -> (Vec<DVec3>, Vec<DVec3>) {
-    let sr = [
-        [-58.4037, -88.5714, -57.0373],
-        [86.5977, 153.855, 153.469],
-        [-39.1942, -53.3039, -124.727],
-    ];
-    let p = [
-        [88.1799, 13.4989, 10.1549],
-        [14.0904, 11.1944, 89.0994],
-        [-50.7744, -50.7974, -50.7314],
-    ];
-    let cols = |m: [[f64; 3]; 3]| -> Vec<DVec3> {
-        (0..3)
-            .map(|j| DVec3::new(m[0][j], m[1][j], m[2][j]))
-            .collect()
-    };
-    (cols(sr), cols(p))
-}
-
 #[test]
 fn paper_table_s1_residuals_match_the_data() {
-    let (sr, p) = table_s1();
+    let (sr, p) = pcpp::registration::paper_table_s1();
     // Read as columns the printer points lie on the stage (equal z) and the
     // triangles agree to ~0.3 mm, which bounds what any rigid fit can do.
     assert!(p.iter().all(|q| (q.z - p[0].z).abs() < 0.1));
