@@ -474,6 +474,7 @@ pub fn run(
     profile: &MachineProfile,
     accept_risk: bool,
 ) -> Result<JobOutput> {
+    // Bad settings fail before the (possibly long) import.
     settings.plan.validate()?;
     let prepared = prepare_scan(scan, scan_name, &settings.scan, &settings.registration)?;
     run_on(

@@ -57,18 +57,19 @@ impl Shape {
     }
 }
 
-fn import(bytes: &[u8], file: &str, options: &ImportOptions) -> ImportedMesh {
+pub(crate) fn import(bytes: &[u8], file: &str, options: &ImportOptions) -> ImportedMesh {
     import_mesh(bytes, file, options).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 
-fn error(bytes: &[u8], file: &str) -> String {
+pub(crate) fn error(bytes: &[u8], file: &str) -> String {
     match import_mesh(bytes, file, &ImportOptions::DEFAULT) {
         Ok(m) => panic!("{file}: imported {} triangles", m.mesh.triangle_count()),
         Err(e) => e.to_string(),
     }
 }
 
-fn assert_error(bytes: &[u8], file: &str, needles: &[&str]) {
+/// The error names the file and says each of `needles`.
+pub(crate) fn assert_error(bytes: &[u8], file: &str, needles: &[&str]) {
     let e = error(bytes, file);
     assert!(e.starts_with(file), "message does not name the file: {e}");
     for needle in needles {

@@ -12,7 +12,7 @@ use std::collections::BTreeSet;
 use pcpp::fiducials::{boundary_loops, find_fiducials};
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{prepare_scan, run_on, FiducialSource, RegistrationSettings};
-use pcpp::mesh::{import_mesh, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, TriMesh};
+use pcpp::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits, TriMesh};
 use pcpp::pipeline::{load_path, DrawnPath, PlanSettings};
 use pcpp::svg::Placement;
 use pcpp::{DVec2, DVec3};
@@ -25,24 +25,10 @@ macro_rules! data {
     };
 }
 
+use crate::importers::{assert_error as assert_import_error, error as import_error};
+
 fn import(bytes: &[u8], file: &str) -> ImportedMesh {
-    import_mesh(bytes, file, &ImportOptions::DEFAULT).unwrap_or_else(|e| panic!("{file}: {e}"))
-}
-
-fn import_error(bytes: &[u8], file: &str) -> String {
-    match import_mesh(bytes, file, &ImportOptions::DEFAULT) {
-        Ok(m) => panic!("{file}: imported {} triangles", m.mesh.triangle_count()),
-        Err(e) => e.to_string(),
-    }
-}
-
-/// The error names the file and says each of `needles`.
-fn assert_import_error(bytes: &[u8], file: &str, needles: &[&str]) {
-    let e = import_error(bytes, file);
-    assert!(e.starts_with(file), "message does not name the file: {e}");
-    for needle in needles {
-        assert!(e.contains(needle), "'{needle}' not in: {e}");
-    }
+    crate::importers::import(bytes, file, &ImportOptions::DEFAULT)
 }
 
 fn assert_close(a: DVec3, b: DVec3, tol: f64, what: &str) {
