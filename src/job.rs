@@ -487,16 +487,32 @@ pub fn run(
     )
 }
 
+/// The four planners side by side, with what the user should know.
+pub struct Comparison {
+    pub rows: Vec<(PlannerKind, QualitySummary)>,
+    /// Notes on the drawing, projection gaps and planner warnings, each once.
+    pub warnings: Vec<String>,
+}
+
 /// The four planners' summaries side by side (the paper's Figure 3e-f).
 pub fn compare_on(
     scan: &PreparedScan,
     svg: &[u8],
     svg_name: &str,
     settings: &PlanSettings,
-) -> Result<Vec<(PlannerKind, QualitySummary)>> {
+) -> Result<Comparison> {
     let drawn = pipeline::load_path(svg, svg_name)?;
     let plans = pipeline::compare(&scan.surface, &drawn.subpaths, settings)?;
-    Ok(plans.into_iter().map(|p| (p.planner, p.quality)).collect())
+    let mut warnings = drawn.notes;
+    for w in plans.iter().flat_map(|p| &p.warnings) {
+        if !warnings.contains(w) {
+            warnings.push(w.clone());
+        }
+    }
+    Ok(Comparison {
+        rows: plans.into_iter().map(|p| (p.planner, p.quality)).collect(),
+        warnings,
+    })
 }
 
 /// The comparison as a plain-text table.
@@ -579,5 +595,37 @@ mod tests {
             );
         }
         assert_eq!(scan.triangle_count(), mesh.triangle_count());
+    }
+
+    #[test]
+    fn comparison_keeps_the_path_warnings() {
+        let bytes = crate::demo::demo_scan_bytes();
+        let scan = prepare_scan(
+            &bytes,
+            "part.ply",
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        // A line that runs off the part's right edge.
+        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="80mm" viewBox="0 0 100 80"><path d="M 60 40 H 90" stroke="black"/></svg>"#;
+        let settings = PlanSettings {
+            placement: test_part::placement(),
+            ..Default::default()
+        };
+        let c = compare_on(&scan, svg, "off.svg", &settings).unwrap();
+        assert_eq!(c.rows.len(), 4);
+        assert!(
+            c.warnings.iter().any(|w| w.contains("off the scan")),
+            "{:?}",
+            c.warnings
+        );
+        assert_eq!(
+            c.warnings
+                .iter()
+                .filter(|w| w.contains("off the scan"))
+                .count(),
+            1
+        );
     }
 }

@@ -437,8 +437,9 @@ impl Session {
         settings: JsValue,
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
-        let rows = job::compare_on(&self.scan, svg, svg_name, &settings).map_err(core_err)?;
-        let rows: Vec<CompareRow> = rows
+        let comparison = job::compare_on(&self.scan, svg, svg_name, &settings).map_err(core_err)?;
+        let rows: Vec<CompareRow> = comparison
+            .rows
             .into_iter()
             .map(|(planner, quality)| CompareRow { planner, quality })
             .collect();

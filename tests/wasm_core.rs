@@ -164,7 +164,9 @@ fn planners_compare_and_the_guarded_one_never_touches() {
         &settings.registration,
     )
     .unwrap();
-    let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan).unwrap();
+    let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan)
+        .unwrap()
+        .rows;
     let kinds: Vec<PlannerKind> = rows.iter().map(|r| r.0).collect();
     assert_eq!(kinds, PlannerKind::ALL.to_vec());
     let guarded = rows[3].1;

@@ -788,13 +788,14 @@ fn cmd_compare(a: &Args) -> CliResult<()> {
     let progress = Progress::new();
     let inputs = load_inputs(a, &settings, &progress)?;
     progress.say("planning with all four planners...");
-    let rows = job::compare_on(
+    let comparison = job::compare_on(
         &inputs.prepared,
         &inputs.svg,
         &inputs.svg_name,
         &settings.plan,
     )
     .map_err(|e| plan_failure(&inputs, e))?;
+    let rows = comparison.rows;
     if let Some(r) = &report_path {
         let files = [
             inputs.prepared.file.clone(),
@@ -809,6 +810,7 @@ fn cmd_compare(a: &Args) -> CliResult<()> {
     }
     warn_all(&inputs.prepared.warnings);
     warn_all(&inputs.prepared.registration.notes);
+    warn_all(&comparison.warnings);
     print!("{}", job::comparison_table(&rows));
     Ok(())
 }
