@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
-use crate::mesh::{ImportOptions, MeshFormat, ScanUnits, TriMesh};
+use crate::mesh::{ImportOptions, MeshFormat, ScanUnits};
 use crate::pipeline::{self, Plan, PlanSettings};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
@@ -51,8 +51,12 @@ pub struct JobSettings {
     pub plan: PlanSettings,
 }
 
-/// Finds the registration the settings ask for.
-pub fn registration_for(mesh: &TriMesh, settings: &RegistrationSettings) -> Result<Registration> {
+/// Finds the registration the settings ask for; `holes` are the scan's
+/// fiducial candidates ([`find_fiducials`]), used by `FiducialSource::Auto`.
+pub fn registration_for(
+    holes: &[Fiducial],
+    settings: &RegistrationSettings,
+) -> Result<Registration> {
     let p = &settings.printer_points;
     let scan_points: Vec<DVec3> = match &settings.fiducials {
         FiducialSource::None if p.is_empty() => return Ok(Registration::identity()),
@@ -61,7 +65,7 @@ pub fn registration_for(mesh: &TriMesh, settings: &RegistrationSettings) -> Resu
         }
         FiducialSource::Points(s) => s.clone(),
         FiducialSource::Auto => {
-            return best_auto_match(mesh, p, settings.method);
+            return best_auto_match(holes, p, settings.method);
         }
     };
     Ok(register(&scan_points, p, settings.method)?)
@@ -73,7 +77,7 @@ const AUTO_CANDIDATES: usize = 6;
 /// Tries every ordered choice of the best hole candidates against P and
 /// keeps the one with the lowest RMS: the user need not order the holes.
 fn best_auto_match(
-    mesh: &TriMesh,
+    found: &[Fiducial],
     printer: &[DVec3],
     method: RegistrationMethod,
 ) -> Result<Registration> {
@@ -81,7 +85,6 @@ fn best_auto_match(
     if k < 3 {
         return Err(Error::Registration(RegistrationError::TooFew(k)));
     }
-    let found = find_fiducials(mesh);
     let cands: Vec<DVec3> = found
         .iter()
         .take(AUTO_CANDIDATES.max(k))
@@ -207,13 +210,16 @@ fn arr(p: &DVec3) -> [f64; 3] {
 
 /// A scan loaded and registered: reused while only the path or the
 /// settings change. It holds the mesh once, in the printer frame, inside
-/// its [`Surface`]; scanner-frame facts are mapped back through G^-1.
+/// its [`Surface`]; the fiducial holes are found before that, in the
+/// scanner frame, so their order does not depend on the registration.
 pub struct PreparedScan {
     pub file: InputFile,
     pub format: MeshFormat,
     pub units: ScanUnits,
     /// What the importer noticed (degenerate triangles skipped, ...).
     pub warnings: Vec<String>,
+    /// Fiducial candidates, scanner frame, smallest/roundest first.
+    pub fiducials: Vec<Fiducial>,
     pub registration: Registration,
     pub method: RegistrationMethod,
     pub surface: Surface,
@@ -222,16 +228,6 @@ pub struct PreparedScan {
 impl PreparedScan {
     pub fn triangle_count(&self) -> usize {
         self.surface.mesh().triangle_count()
-    }
-
-    /// The fiducial holes, centroids in the scanner frame (a rigid G moves
-    /// loops but keeps their sizes and shapes).
-    pub fn scan_fiducials(&self) -> Vec<Fiducial> {
-        let mut found = find_fiducials(self.surface.mesh());
-        for f in &mut found {
-            f.centroid = self.registration.apply_inverse(f.centroid);
-        }
-        found
     }
 }
 
@@ -243,13 +239,15 @@ pub fn prepare_scan(
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
     let imported = pipeline::load_scan(bytes, name, scan)?;
-    let reg = registration_for(&imported.mesh, registration)?;
+    let fiducials = find_fiducials(&imported.mesh);
+    let reg = registration_for(&fiducials, registration)?;
     let surface = pipeline::registered_surface(imported.mesh, &reg)?;
     Ok(PreparedScan {
         file: InputFile::new(name, bytes),
         format: imported.format,
         units: imported.units,
         warnings: imported.warnings,
+        fiducials,
         registration: reg,
         method: registration.method,
         surface,
@@ -567,7 +565,7 @@ mod tests {
             printer_points: p.clone(),
             method: RegistrationMethod::Lsq,
         };
-        let r = registration_for(&mesh, &settings).unwrap();
+        let r = registration_for(&find_fiducials(&mesh), &settings).unwrap();
         assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
         // The recovered G is the inverse of the turn applied.
         let back = r.matrix * g;
@@ -586,7 +584,7 @@ mod tests {
             method: RegistrationMethod::Lsq,
         };
         let scan = prepare_scan(&bytes, "turned.ply", &ImportOptions::DEFAULT, &settings).unwrap();
-        let found = scan.scan_fiducials();
+        let found = &scan.fiducials;
         for f in test_part::FIDUCIALS_MM {
             let want = g.transform_point3(f);
             assert!(

@@ -350,8 +350,8 @@ impl Session {
         let s = &self.scan;
         let (lo, hi) = s.surface.bbox();
         let holes = s
-            .scan_fiducials()
-            .into_iter()
+            .fiducials
+            .iter()
             .map(|f| HoleView {
                 scan: arr(f.centroid),
                 printer: arr(s.registration.apply(f.centroid)),

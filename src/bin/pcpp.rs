@@ -930,7 +930,7 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         printer_points: test_part::FIDUCIALS_MM.to_vec(),
         method: RegistrationMethod::Lsq,
     };
-    let registration = job::registration_for(prepared.surface.mesh(), &reg_settings)
+    let registration = job::registration_for(&prepared.fiducials, &reg_settings)
         .map_err(|e| fail("registration", &e))?;
 
     // One G-code per planner. Only the guarded planner refuses to write a
