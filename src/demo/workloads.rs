@@ -5,7 +5,11 @@
 //!   placed on W1.
 //! - W3: a dense serpentine raster of about 100,000 points on W1.
 
+use glam::DVec2;
+
+use crate::job::JobSettings;
 use crate::mesh::TriMesh;
+use crate::svg::Placement;
 
 /// A small deterministic generator (xorshift64*), so workloads are the same
 /// on every machine without a dependency.
@@ -22,6 +26,51 @@ impl Rng {
 
 /// Side of the film, mm.
 pub const FILM_MM: f64 = 100.0;
+
+/// Grid cells per side of W1 at full size (2,000,000 triangles).
+pub const FILM_CELLS: usize = 1000;
+
+/// Passes of the W3 raster: 335 passes of 90 mm sampled at d/2 = 0.3015 mm
+/// give about 100,000 points.
+pub const W3_LINES: usize = 335;
+
+/// File names of the workloads, as `examples/workloads.rs` writes them and
+/// the benchmark scripts read them.
+pub const W1_PLY: &str = "W1.ply";
+pub const W1_OBJ: &str = "W1.obj";
+pub const W2_SVG: &str = "W2.svg";
+pub const W3_SVG: &str = "W3.svg";
+
+/// W2's drawing: the paper's 556 mm spiral antenna.
+pub fn w2_svg() -> String {
+    super::antennas::paper_spiral_svg()
+}
+
+/// W3's drawing: the serpentine raster of [`W3_LINES`] passes.
+pub fn w3_svg() -> String {
+    serpentine_svg(W3_LINES)
+}
+
+/// W2's job settings (the paper's defaults, pcpp-guarded): the spiral's
+/// drawing is centred on its own page, the offset puts it mid-film.
+pub fn w2_settings() -> JobSettings {
+    with_offset(DVec2::new(20.0, 80.0))
+}
+
+/// W3's job settings: the raster's SVG is the film's 100 mm square with y
+/// down, so the offset (0, 100) lays it onto the film.
+pub fn w3_settings() -> JobSettings {
+    with_offset(DVec2::new(0.0, FILM_MM))
+}
+
+fn with_offset(offset_mm: DVec2) -> JobSettings {
+    let mut s = JobSettings::default();
+    s.plan.placement = Placement {
+        offset_mm,
+        ..Placement::IDENTITY
+    };
+    s
+}
 
 /// The wrinkled film's height: wrinkles in a few directions, two sharp
 /// folds (creases of |sin|) and fine noise from `noise`, 0-6 mm.
@@ -103,6 +152,32 @@ mod tests {
         assert!(lo.z > 0.0 && hi.z < 8.0, "{lo:?} {hi:?}");
         assert_eq!(wrinkled_film(20), m, "reproducible");
         assert!(to_obj(&m).lines().count() == 441 + 800);
+    }
+
+    /// W2 and W3 have the sizes issue 5 names (W2 about 1,853 points at
+    /// d = 0.603, W3 about 100,000), wherever they land on the film.
+    #[test]
+    fn paths_have_the_issue_sizes_on_the_film() {
+        let surface = crate::surface::Surface::new(wrinkled_film(20)).unwrap();
+        for (svg, settings, expected) in [
+            (w2_svg(), w2_settings(), 1853.0),
+            (w3_svg(), w3_settings(), 100_000.0),
+        ] {
+            let drawn = crate::pipeline::load_path(svg.as_bytes(), "w.svg").unwrap();
+            let sp = crate::pipeline::surface_path(
+                &surface,
+                &drawn.subpaths,
+                &settings.plan.nozzle,
+                &settings.plan.placement,
+            )
+            .unwrap();
+            assert_eq!(sp.pieces.len(), 1, "the path stays on the film");
+            let n = sp.pieces[0].ta.len() as f64;
+            assert!(
+                (n / expected - 1.0).abs() < 0.01,
+                "{n} points, expected ~{expected}"
+            );
+        }
     }
 
     #[test]
