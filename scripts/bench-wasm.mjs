@@ -1,0 +1,158 @@
+#!/usr/bin/env node
+// Times the issue-5 stages in the wasm build, in Node, single-threaded, on
+// the workloads written by `cargo run --release --example workloads`:
+//   - Session from W1.ply's bytes (import, fiducial holes, registration, BVH);
+//   - Session from W1.obj's bytes (MB/s of the file; the API imports only
+//     through a Session, so this includes the BVH: a lower bound on the OBJ
+//     importer's own speed);
+//   - Session.plan of W2 and W3 on W1 (plan, report and G-code, converted to
+//     JS: what the page's Plan button runs);
+//   - wasm memory (memory.buffer.byteLength) holding W1 ready to plan. Wasm
+//     memory never shrinks, so this is also the peak while it was prepared.
+// Medians over a few runs. It builds nothing: scripts/bench.sh runs
+//   wasm-pack build --release --target nodejs --out-dir target/pkg-node --no-pack
+// first. Progress goes to stderr, the results as JSON to stdout (or --json).
+//
+//   node scripts/bench-wasm.mjs [--pkg target/pkg-node] [--workloads target/workloads]
+//                               [--json FILE] [--quick]
+import { createRequire } from 'node:module';
+import { readFileSync, writeFileSync, existsSync } from 'node:fs';
+import { resolve, join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { performance } from 'node:perf_hooks';
+
+const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
+const args = process.argv.slice(2);
+function opt(name, dflt) {
+  const i = args.indexOf(name);
+  if (i < 0) return dflt;
+  if (i + 1 >= args.length) die(`${name} needs a value`);
+  return args[i + 1];
+}
+function die(msg) {
+  console.error(`bench-wasm: ${msg}`);
+  process.exit(1);
+}
+const pkgDir = resolve(root, opt('--pkg', 'target/pkg-node'));
+const dir = resolve(root, opt('--workloads', 'target/workloads'));
+const jsonOut = opt('--json', null);
+const quick = args.includes('--quick');
+// Runs per step (the first run of the planning steps is a warm-up, not counted).
+const runs = quick
+  ? { ply: 1, obj: 1, w2: 3, w3: 1 }
+  : { ply: 5, obj: 3, w2: 20, w3: 5 };
+
+const glue = join(pkgDir, 'pcpp.js');
+if (!existsSync(glue)) {
+  die(`${glue} is missing: build it with wasm-pack build --release --target nodejs --out-dir target/pkg-node --no-pack`);
+}
+for (const f of ['W1.ply', 'W1.obj', 'W2.svg', 'W3.svg', 'W2.settings.json', 'W3.settings.json']) {
+  if (!existsSync(join(dir, f))) {
+    die(`${join(dir, f)} is missing: cargo run --release --example workloads -- ${dir}`);
+  }
+}
+
+// wasm-bindgen's nodejs glue keeps its instance to itself (no `__wasm`
+// export in 0.2.130): catch it as the glue instantiates, to read its memory.
+const instances = [];
+const RealInstance = WebAssembly.Instance;
+WebAssembly.Instance = new Proxy(RealInstance, {
+  construct(target, argv, newTarget) {
+    const inst = Reflect.construct(target, argv, newTarget);
+    instances.push(inst);
+    return inst;
+  },
+});
+const pcpp = createRequire(import.meta.url)(glue);
+WebAssembly.Instance = RealInstance;
+const memory = instances.map((i) => i.exports.memory).find((m) => m instanceof WebAssembly.Memory);
+if (!memory) die('could not find the wasm memory of the pcpp module');
+pcpp.initPanicHook();
+
+const read = (f) => new Uint8Array(readFileSync(join(dir, f)));
+const settings = (f) => JSON.parse(readFileSync(join(dir, f), 'utf8'));
+const ply = read('W1.ply');
+const obj = read('W1.obj');
+const w2 = { svg: read('W2.svg'), s: settings('W2.settings.json') };
+const w3 = { svg: read('W3.svg'), s: settings('W3.settings.json') };
+
+function median(xs) {
+  const s = [...xs].sort((a, b) => a - b);
+  const m = s.length >> 1;
+  return s.length % 2 ? s[m] : 0.5 * (s[m - 1] + s[m]);
+}
+function time(f) {
+  const t0 = performance.now();
+  const r = f();
+  return [performance.now() - t0, r];
+}
+const log = (msg) => console.error(`[bench-wasm] ${msg}`);
+const mb = (b) => (b / 1e6).toFixed(1);
+
+const session = (bytes, name) => new pcpp.Session(bytes, name, w2.s.scan, w2.s.registration);
+
+// 1. W1 PLY -> Session; wasm memory measured once, holding the first one,
+// before anything else has grown it.
+const plyMs = [];
+let memoryBytes = 0;
+let triangles = 0;
+for (let k = 0; k < runs.ply; k++) {
+  const [ms, s] = time(() => session(ply, 'W1.ply'));
+  plyMs.push(ms);
+  if (k === 0) {
+    memoryBytes = memory.buffer.byteLength;
+    triangles = s.info().triangles;
+    log(`W1.ply holds ${triangles} triangles; wasm memory ${mb(memoryBytes)} MB`);
+  }
+  s.free();
+  log(`Session(W1.ply, ${mb(ply.length)} MB): ${ms.toFixed(0)} ms`);
+}
+
+// 2. W1 OBJ -> Session.
+const objMs = [];
+for (let k = 0; k < runs.obj; k++) {
+  const [ms, s] = time(() => session(obj, 'W1.obj'));
+  objMs.push(ms);
+  s.free();
+  log(`Session(W1.obj, ${mb(obj.length)} MB): ${ms.toFixed(0)} ms, ${(obj.length / 1e3 / ms).toFixed(1)} MB/s`);
+}
+
+// 3. Plans on one W1 Session (accept risk: the timing must not depend on
+// whether some raster point could not be cleared).
+const scan = session(ply, 'W1.ply');
+function planRuns(w, name, n) {
+  const plan = () => scan.plan(w.svg, name, w.s.plan, 'marlin', true, undefined);
+  const [, first] = time(plan); // warm-up
+  const report = JSON.parse(first.report_json);
+  const ms = [];
+  for (let k = 0; k < n; k++) ms.push(time(plan)[0]);
+  log(`plan ${name}: ${report.stats.points} points, median ${median(ms).toFixed(1)} ms over ${n}`);
+  return { ms, points: report.stats.points };
+}
+const p2 = planRuns(w2, 'W2.svg', runs.w2);
+const p3 = planRuns(w3, 'W3.svg', runs.w3);
+scan.free();
+
+const result = {
+  node: process.version,
+  pcpp: pcpp.version(),
+  triangles,
+  ply_bytes: ply.length,
+  obj_bytes: obj.length,
+  ply_session_s: median(plyMs) / 1e3,
+  // The first import in a fresh Node runs V8's baseline code (the parser's
+  // long loop is tiered up only on a later call): what a page's first load sees.
+  ply_session_first_s: plyMs[0] / 1e3,
+  obj_session_s: median(objMs) / 1e3,
+  obj_session_mb_s: obj.length / 1e6 / (median(objMs) / 1e3),
+  w2_plan_ms: median(p2.ms),
+  w2_points: p2.points,
+  w3_plan_ms: median(p3.ms),
+  w3_points: p3.points,
+  memory_w1_ready_bytes: memoryBytes,
+  memory_end_bytes: memory.buffer.byteLength,
+  runs: { ply_ms: plyMs, obj_ms: objMs, w2_ms: p2.ms, w3_ms: p3.ms },
+};
+const text = JSON.stringify(result, null, 2) + '\n';
+if (jsonOut) writeFileSync(jsonOut, text);
+else process.stdout.write(text);

@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# Issue 5's speed benchmarks, one command (`npm run bench`): writes the
+# workloads W1-W3 into target/workloads (when missing or stale), runs the
+# criterion benches of the native stages (benches/pipeline.rs), builds the
+# Node-target wasm package and times the same stages in it
+# (scripts/bench-wasm.mjs), measures native peak memory holding W1 ready
+# (examples/peak_memory.rs), and prints one markdown table, also saved to
+# target/bench/table.md. Progress goes to stderr, the table to stdout.
+#
+# Everything runs single-threaded. Needs no stdin, works as root; installs
+# nothing itself (scripts/setup.sh does, idempotently).
+#   PCPP_BENCH_QUICK=1  a fast smoke run (criterion --quick, fewer wasm runs)
+#   PCPP_BENCH_N=300    a smaller film (grid cells per side, default 1000);
+#                       the targets are for the full size
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$HOME/.cargo/bin:$PATH"
+
+log() { printf '[bench] %s\n' "$*" >&2; }
+CELLS="${PCPP_BENCH_N:-1000}"
+QUICK="${PCPP_BENCH_QUICK:-0}"
+WL=target/workloads
+OUT=target/bench
+mkdir -p "$OUT"
+
+PCPP_SKIP_BROWSER=1 bash scripts/setup.sh </dev/null
+
+log "building the release examples"
+cargo build --release --example workloads --example peak_memory </dev/null >&2
+
+# Regenerate when missing, of another size, or older than the generator.
+if [ ! -f "$WL/workloads.json" ] \
+  || ! grep -q "\"cells\": $CELLS\b" "$WL/workloads.json" \
+  || [ target/release/examples/workloads -nt "$WL/workloads.json" ]; then
+  log "writing the workloads into $WL ($CELLS cells per side)"
+  rm -f "$WL/workloads.json"
+  PCPP_BENCH_N="$CELLS" target/release/examples/workloads "$WL" </dev/null >&2
+else
+  log "workloads in $WL are up to date"
+fi
+
+log "native peak memory holding W1 ready (examples/peak_memory.rs)"
+target/release/examples/peak_memory "$WL/W1.ply" </dev/null >"$OUT/native-memory.txt"
+cat "$OUT/native-memory.txt" >&2
+
+log "criterion benches (cargo bench --bench pipeline)"
+if [ "$QUICK" = 1 ]; then
+  CRITERION_ARGS=(--quick)
+else
+  CRITERION_ARGS=(--warm-up-time 1 --measurement-time 3)
+fi
+# Estimates older than this marker are from an earlier run: refused below.
+touch "$OUT/.started"
+PCPP_BENCH_N="$CELLS" cargo bench --bench pipeline -- "${CRITERION_ARGS[@]}" </dev/null >&2
+
+log "wasm package for Node (wasm-pack, release)"
+wasm-pack build --release --target nodejs --out-dir target/pkg-node --no-pack </dev/null >&2
+
+log "wasm timings in Node (scripts/bench-wasm.mjs)"
+WASM_ARGS=(--pkg target/pkg-node --workloads "$WL" --json "$OUT/wasm.json")
+[ "$QUICK" = 1 ] && WASM_ARGS+=(--quick)
+node scripts/bench-wasm.mjs "${WASM_ARGS[@]}" </dev/null
+
+MACHINE="$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)"
+MACHINE="${MACHINE:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo)"
+COMMIT="$(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+git diff --quiet HEAD -- src benches 2>/dev/null || COMMIT="$COMMIT + local changes"
+
+CELLS="$CELLS" QUICK="$QUICK" MACHINE="$MACHINE" COMMIT="$COMMIT" \
+  RUSTC="$(rustc --version)" node --input-type=module - <<'EOF' | tee "$OUT/table.md"
+import { readFileSync, readdirSync, existsSync, statSync } from 'node:fs';
+import { join } from 'node:path';
+
+const die = (m) => { console.error(`[bench] ${m}`); process.exit(1); };
+const started = statSync('target/bench/.started').mtimeMs;
+
+// Criterion's own files: benchmark.json names each bench, estimates.json
+// has its statistics in ns. Keyed by full id ("group/function").
+const crit = {};
+for (const group of readdirSync('target/criterion')) {
+  const gdir = join('target/criterion', group);
+  if (!statSync(gdir).isDirectory()) continue;
+  for (const b of readdirSync(gdir)) {
+    const meta = join(gdir, b, 'new', 'benchmark.json');
+    const est = join(gdir, b, 'new', 'estimates.json');
+    if (!existsSync(meta) || !existsSync(est)) continue;
+    const m = JSON.parse(readFileSync(meta, 'utf8'));
+    crit[m.full_id] = {
+      fresh: statSync(est).mtimeMs >= started,
+      median_s: JSON.parse(readFileSync(est, 'utf8')).median.point_estimate / 1e9,
+      bytes: m.throughput?.Bytes,
+    };
+  }
+}
+const bench = (id) => {
+  const b = crit[id];
+  if (!b) die(`criterion has no results for '${id}' (target/criterion)`);
+  if (!b.fresh) die(`criterion's results for '${id}' are from an earlier run`);
+  return b;
+};
+const wasm = JSON.parse(readFileSync('target/bench/wasm.json', 'utf8'));
+const mem = readFileSync('target/bench/native-memory.txt', 'utf8');
+const peakRss = Number(/peak_rss_bytes=(\d+)/.exec(mem)?.[1] ?? die('no peak_rss_bytes'));
+
+const plyS = bench('import/W1 binary PLY + BVH').median_s;
+const obj = bench('import/W1 OBJ text');
+const objMbS = obj.bytes / 1e6 / obj.median_s;
+const objSessionS = bench('import/W1 OBJ + BVH').median_s;
+const w2S = bench('plan/W2 spiral on W1 (pcpp-guarded + quality)').median_s;
+const w3S = bench('plan/W3 raster on W1 (pcpp-guarded + quality)').median_s;
+const w2JobS = bench('job/W2 plan + report + G-code').median_s;
+const w3JobS = bench('job/W3 plan + report + G-code').median_s;
+
+const f = (x, d) => x.toFixed(d);
+const ms = (s) => (s < 0.1 ? f(s * 1e3, 1) : f(s * 1e3, 0)) + ' ms';
+const yes = (ok) => (ok ? 'yes' : 'no');
+const rows = [
+  // step, target native, measured native, ok, target wasm, measured wasm, ok
+  ['W1 binary PLY import + BVH', '<= 0.8 s', f(plyS, 2) + ' s', plyS <= 0.8,
+    '<= 1.2 s', f(wasm.ply_session_s, 2) + ' s', wasm.ply_session_s <= 1.2],
+  ['W1 OBJ import', '>= 200 MB/s', f(objMbS, 0) + ' MB/s', objMbS >= 200,
+    '>= 120 MB/s', f(wasm.obj_session_mb_s, 0) + ' MB/s (a)', wasm.obj_session_mb_s >= 120],
+  ['plan W2 on W1 (project, spline, pcpp-guarded, quality)', '<= 5 ms', ms(w2S), w2S <= 0.005,
+    '<= 10 ms', ms(wasm.w2_plan_ms / 1e3) + ' (b)', wasm.w2_plan_ms <= 10],
+  ['plan W3 on W1', '<= 150 ms', ms(w3S), w3S <= 0.15,
+    '<= 250 ms', ms(wasm.w3_plan_ms / 1e3) + ' (b)', wasm.w3_plan_ms <= 250],
+  ['peak memory holding W1 ready to plan', '<= 250 MB', f(peakRss / 1e6, 0) + ' MB (c)', peakRss <= 250e6,
+    '<= 250 MB', f(wasm.memory_w1_ready_bytes / 1e6, 0) + ' MB (d)', wasm.memory_w1_ready_bytes <= 250e6],
+];
+const e = process.env;
+const out = [];
+out.push(`Measured ${new Date().toISOString().slice(0, 10)} on ${e.MACHINE}, single-threaded; ` +
+  `commit ${e.COMMIT}; ${e.RUSTC}; Node ${wasm.node}.`);
+out.push(`W1 ${wasm.triangles.toLocaleString('en-US')} triangles (${f(wasm.ply_bytes / 1e6, 1)} MB PLY, ` +
+  `${f(wasm.obj_bytes / 1e6, 1)} MB OBJ), W2 ${wasm.w2_points} points, W3 ${wasm.w3_points} points` +
+  (e.CELLS !== '1000' ? ` (PCPP_BENCH_N=${e.CELLS}: not the issue's size)` : '') +
+  (e.QUICK === '1' ? '; quick run (PCPP_BENCH_QUICK=1)' : '') + '.');
+out.push('');
+out.push('| step | target native | measured native | target wasm | measured wasm | met? (native / wasm) |');
+out.push('|---|---|---|---|---|---|');
+for (const [step, tn, mn, okn, tw, mw, okw] of rows) {
+  out.push(`| ${step} | ${tn} | ${mn} | ${tw} | ${mw} | ${yes(okn)} / ${yes(okw)} |`);
+}
+out.push('');
+out.push(`(a) Session from the OBJ's bytes, which also finds the holes and builds the BVH ` +
+  `(the wasm API imports only through a Session): a lower bound; the same natively ` +
+  `${f(obj.bytes / 1e6 / objSessionS, 0)} MB/s.`);
+out.push(`(b) Session.plan: the plan, its report and G-code, converted to JS (what the page runs); ` +
+  `the same job natively: W2 ${ms(w2JobS)}, W3 ${ms(w3JobS)}.`);
+out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs: the file's bytes, the mesh and ` +
+  `its BVH; ${f(Number(/ rss_bytes=(\d+)/.exec(mem)?.[1] ?? 0) / 1e6, 0)} MB resident once ` +
+  `the bytes are dropped.`);
+out.push(`(d) memory.buffer.byteLength holding a Session on W1.ply (wasm memory never shrinks: ` +
+  `also the peak while preparing it).`);
+out.push(`Medians (wasm: W1 imports ${wasm.runs.ply_ms.length}x, plans ${wasm.runs.w2_ms.length}x and ` +
+  `${wasm.runs.w3_ms.length}x after a warm-up); the first W1.ply Session in a fresh Node took ` +
+  `${f(wasm.ply_session_first_s, 2)} s (V8's baseline code). MB = 10^6 bytes.`);
+console.log(out.join('\n'));
+EOF
