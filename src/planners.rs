@@ -145,8 +145,10 @@ pub fn plan_points(
                 let start = pcpp_point(surface, p, g, nozzle, tol);
                 let r_clear = r + tol;
                 let mut t = start;
+                // The highest surface too close under the nozzle at t, if any.
+                let mut blocked = clears(surface, t, r_clear, tol);
                 for _ in 0..GUARD_MAX_PUSHES {
-                    if clears(surface, t, r_clear, tol).is_none() {
+                    if blocked.is_none() {
                         break;
                     }
                     // Re-apply eq. 6-10 with the clearance radius.
@@ -157,17 +159,22 @@ pub fn plan_points(
                     let dist = away.length();
                     let q = if dist > 1e-9 { away / dist } else { g.n };
                     t += (r_clear - dist + 1e-6) * q;
+                    blocked = clears(surface, t, r_clear, tol);
                 }
                 // Pushing sideways must not carry the tip off the path.
                 if (t - p).truncate().length() > nozzle.outer_diameter_mm {
                     t = start;
+                    blocked = clears(surface, t, r_clear, tol);
                 }
-                if let Some(h) = clears(surface, t, r_clear, tol) {
+                if let Some(h) = blocked {
                     let lift = h + tol - t.z;
                     t.z = h + tol;
                     out.lifted.push((j, lift));
+                    // Lifting to h + tol clears by construction; checked
+                    // again, so rounding can never pass an uncleared point.
+                    blocked = clears(surface, t, r_clear, tol);
                 }
-                if !t.is_finite() || clears(surface, t, r_clear, tol).is_some() {
+                if !t.is_finite() || blocked.is_some() {
                     out.uncleared.push(j);
                 }
                 t

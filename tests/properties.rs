@@ -8,7 +8,7 @@ use pcpp::mesh::TriMesh;
 use pcpp::pipeline::{self, Plan, PlanSettings};
 use pcpp::planners::PlannerKind;
 use pcpp::registration::{register, RegistrationMethod};
-use pcpp::surface::Surface;
+use pcpp::surface::{SpatialIndex, Surface};
 use pcpp::svg::{Placement, Subpath2};
 use pcpp::{DMat4, DVec2, DVec3, Nozzle, Process};
 use proptest::prelude::*;
@@ -406,6 +406,11 @@ fn assert_pcpp_above(plan: &Plan) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// Either spatial index: every query property must hold for both.
+fn index_kind() -> impl Strategy<Value = SpatialIndex> {
+    prop_oneof![Just(SpatialIndex::Grid), Just(SpatialIndex::Bvh)]
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(CASES))]
 
@@ -415,8 +420,9 @@ proptest! {
     fn highest_hit_is_the_barycentric_height(
         f in field(3.0),
         xy in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 20),
+        index in index_kind(),
     ) {
-        let s = Surface::new(f.mesh()).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let s = Surface::with_index(f.mesh(), index).map_err(|e| TestCaseError::fail(e.to_string()))?;
         for (u, v) in xy {
             let (x, y) = (u * f.size(), v * f.size());
             let z = s.highest_hit(DVec2::new(x, y));
@@ -428,12 +434,17 @@ proptest! {
 
     /// Every projected point Ta of a drawn path lies on the mesh.
     #[test]
-    fn projected_points_lie_on_the_mesh(f in field(3.0), line in polyline()) {
+    fn projected_points_lie_on_the_mesh(
+        f in field(3.0),
+        line in polyline(),
+        index in index_kind(),
+    ) {
         let size = f.size();
         let Some(sub) = drawing(&line, 0.02 * size, 0.98 * size) else {
             return Ok(());
         };
-        let s = Surface::new(f.mesh()).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let s = Surface::with_index(f.mesh(), index)
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
         let sp = pipeline::surface_path(&s, &[sub], &Nozzle::DEFAULT, &Placement::IDENTITY)
             .map_err(|e| TestCaseError::fail(e.to_string()))?;
         prop_assert!(!sp.pieces.is_empty());
@@ -451,13 +462,15 @@ proptest! {
         f in field(1.5),
         line in polyline(),
         (nozzle, process) in nozzle_and_process(),
+        index in index_kind(),
     ) {
         let size = f.size();
         let Some(sub) = drawing(&line, 0.05 * size, 0.95 * size) else {
             return Ok(());
         };
         let mesh = f.mesh();
-        let s = Surface::new(mesh.clone()).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let s = Surface::with_index(mesh.clone(), index)
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
         let mut settings = PlanSettings { nozzle, process, ..Default::default() };
         settings.planner = PlannerKind::PcppGuarded;
         assert_guarded_clears(&mesh, &plan(&s, &sub, &settings)?, &nozzle, process.tolerance_mm)?;
@@ -471,12 +484,14 @@ proptest! {
         st in steps(),
         line in polyline(),
         (nozzle, process) in nozzle_and_process(),
+        index in index_kind(),
     ) {
         let Some(sub) = drawing(&line, 0.05 * st.size, 0.95 * st.size) else {
             return Ok(());
         };
         let mesh = st.mesh();
-        let s = Surface::new(mesh.clone()).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let s = Surface::with_index(mesh.clone(), index)
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
         let mut settings = PlanSettings { nozzle, process, ..Default::default() };
         settings.planner = PlannerKind::PcppGuarded;
         assert_guarded_clears(&mesh, &plan(&s, &sub, &settings)?, &nozzle, process.tolerance_mm)?;

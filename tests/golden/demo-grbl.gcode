@@ -8,7 +8,7 @@
 ( registration: lsq [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000] )
 ( residuals: [] mm  rms 0.0000 mm )
 ( path: 6 piece[s]  1362 points  465.636 mm  height change 4.500 mm  max inclination 86.9 deg  min radius 0.145 mm  print time 93.1 s )
-( predicted quality: mean |e| 0.0671 mm  mean e- -0.0853 mm  mean e+ 0.0491 mm  contact 0.00%  flattening 15.57%  floating 4.11% )
+( predicted quality: mean |e| 0.0671 mm  mean e- -0.0858 mm  mean e+ 0.0489 mm  contact 0.00%  flattening 15.57%  floating 4.11% )
 ( warnings: 0 )
 ( profile: grbl )
 ( print feed: F300 mm/min [5 mm/s] )

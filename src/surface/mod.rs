@@ -7,20 +7,19 @@
 //! exact test runs in f64 on the mesh's own vertices (projection must land
 //! within 1e-6 mm of the surface).
 
-use glam::{DVec2, DVec3, Vec3};
-use parry3d::bounding_volume::Aabb;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode};
+mod index;
+
+use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
+pub use index::SpatialIndex;
+use index::{Index, QueryBox};
 
 /// A scan in the printer frame, ready for queries.
 pub struct Surface {
     mesh: TriMesh,
-    bvh: Bvh,
-    /// Triangle indices in leaf order: leaf k holds
-    /// `order[k * LEAF_SIZE..][..LEAF_SIZE]`.
-    order: Vec<u32>,
+    index: Index,
     bbox: (DVec3, DVec3),
 }
 
@@ -38,63 +37,8 @@ impl std::fmt::Debug for Surface {
         f.debug_struct("Surface")
             .field("triangles", &self.mesh.triangles.len())
             .field("bbox", &self.bbox)
+            .field("index", &self.index.kind())
             .finish()
-    }
-}
-
-/// Triangles per BVH leaf.
-const LEAF_SIZE: usize = 4;
-
-/// Interleaves the low 21 bits of x, y and z (a Morton / Z-order code).
-fn morton3(x: u64, y: u64, z: u64) -> u64 {
-    fn spread(v: u64) -> u64 {
-        let mut v = v & 0x1f_ffff;
-        v = (v | v << 32) & 0x1f_0000_0000_ffff;
-        v = (v | v << 16) & 0x1f_0000_ff00_00ff;
-        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
-        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
-        (v | v << 2) & 0x1249_2492_4924_9249
-    }
-    spread(x) | spread(y) << 1 | spread(z) << 2
-}
-
-/// f64 -> f32 rounded towards -inf / +inf, so an f32 box always contains
-/// the f64 triangle.
-fn f32_down(v: f64) -> f32 {
-    let f = v as f32;
-    if f as f64 > v {
-        f.next_down()
-    } else {
-        f
-    }
-}
-
-fn f32_up(v: f64) -> f32 {
-    let f = v as f32;
-    if (f as f64) < v {
-        f.next_up()
-    } else {
-        f
-    }
-}
-
-/// A query box in f64; `hits` tests it against a BVH node's f32 box.
-#[derive(Clone, Copy)]
-struct QueryBox {
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl QueryBox {
-    #[inline]
-    fn hits(&self, node: &BvhNode) -> bool {
-        let (mins, maxs) = (node.mins(), node.maxs());
-        (mins.x as f64) <= self.hi.x
-            && (maxs.x as f64) >= self.lo.x
-            && (mins.y as f64) <= self.hi.y
-            && (maxs.y as f64) >= self.lo.y
-            && (mins.z as f64) <= self.hi.z
-            && (maxs.z as f64) >= self.lo.z
     }
 }
 
@@ -102,6 +46,12 @@ impl Surface {
     /// Builds the BVH. The mesh must be non-empty with finite vertices (the
     /// importers guarantee both; this re-checks for meshes built in code).
     pub fn new(mesh: TriMesh) -> Result<Surface> {
+        Surface::with_index(mesh, SpatialIndex::Auto)
+    }
+
+    /// [`Self::new`] with a chosen spatial index (tests and benchmarks
+    /// compare them; results agree to the last bit but for summation order).
+    pub fn with_index(mesh: TriMesh, kind: SpatialIndex) -> Result<Surface> {
         let Some(bbox) = mesh.bbox() else {
             return Err(Error::Plan("the scan has no triangles".into()));
         };
@@ -120,43 +70,13 @@ impl Surface {
                 "triangle {i} refers to a vertex past the {n} the scan has"
             )));
         }
-        // Triangles in Morton order of their centroids, LEAF_SIZE to a BVH
-        // leaf: a quarter of the leaves to build over (parry's binned build
-        // dominates loading a 2 M triangle scan), each leaf still compact
-        // whatever order the file listed its triangles in.
-        let extent = (bbox.1 - bbox.0).max(DVec3::splat(1e-12));
-        let mut keyed: Vec<(u64, u32)> = (0..mesh.triangles.len())
-            .map(|i| {
-                let [a, b, c] = mesh.triangle(i);
-                let q = ((a + b + c) / 3.0 - bbox.0) / extent * 2_097_151.0;
-                (morton3(q.x as u64, q.y as u64, q.z as u64), i as u32)
-            })
-            .collect();
-        keyed.sort_unstable_by_key(|&(k, _)| k);
-        let order: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
-        let leaves: Vec<Aabb> = order
-            .chunks(LEAF_SIZE)
-            .map(|chunk| {
-                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-                for &i in chunk {
-                    for v in mesh.triangle(i as usize) {
-                        lo = lo.min(v);
-                        hi = hi.max(v);
-                    }
-                }
-                Aabb::new(
-                    Vec3::new(f32_down(lo.x), f32_down(lo.y), f32_down(lo.z)),
-                    Vec3::new(f32_up(hi.x), f32_up(hi.y), f32_up(hi.z)),
-                )
-            })
-            .collect();
-        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
-        Ok(Surface {
-            mesh,
-            bvh,
-            order,
-            bbox,
-        })
+        let index = Index::build(&mesh, bbox, kind);
+        Ok(Surface { mesh, index, bbox })
+    }
+
+    /// Which spatial index the scan got.
+    pub fn spatial_index(&self) -> SpatialIndex {
+        self.index.kind()
     }
 
     pub fn mesh(&self) -> &TriMesh {
@@ -173,14 +93,6 @@ impl Surface {
         self.bbox.1.z
     }
 
-    fn candidates(&self, q: QueryBox) -> impl Iterator<Item = usize> + '_ {
-        self.bvh.leaves(move |n| q.hits(n)).flat_map(move |leaf| {
-            let start = (leaf as usize * LEAF_SIZE).min(self.order.len());
-            let end = (start + LEAF_SIZE).min(self.order.len());
-            self.order[start..end].iter().map(|&i| i as usize)
-        })
-    }
-
     /// z of the highest intersection of the vertical line through `xy` with
     /// the scan (spec section 4), `None` if the line misses it.
     pub fn highest_hit(&self, xy: DVec2) -> Option<f64> {
@@ -189,11 +101,15 @@ impl Surface {
             hi: DVec3::new(xy.x, xy.y, f64::INFINITY),
         };
         let mut best: Option<f64> = None;
-        for i in self.candidates(q) {
-            if let Some(z) = vertical_hit(self.mesh.triangle(i), xy) {
+        self.index.visit(&q, |i| {
+            let t = self.mesh.triangle(i);
+            if !meets(&t, &q) {
+                return;
+            }
+            if let Some(z) = vertical_hit(t, xy) {
                 best = Some(best.map_or(z, |b: f64| b.max(z)));
             }
-        }
+        });
         best
     }
 
@@ -208,8 +124,12 @@ impl Surface {
         let mut length = 0.0;
         let mut touches = DVec3::ZERO;
         let mut touch_count = 0usize;
-        for i in self.candidates(q) {
-            for (p, s, w) in plane_cut(self.mesh.triangle(i), center.z) {
+        self.index.visit(&q, |i| {
+            let t = self.mesh.triangle(i);
+            if !meets(&t, &q) {
+                return;
+            }
+            for (p, s, w) in plane_cut(t, center.z) {
                 if let Some((a, b)) = clip_to_circle(p, s, center, radius) {
                     let l = a.distance(b) * w;
                     weighted += (a + b) * 0.5 * l;
@@ -218,7 +138,7 @@ impl Surface {
                     touch_count += 1;
                 }
             }
-        }
+        });
         if touch_count == 0 {
             return None;
         }
@@ -242,13 +162,17 @@ impl Surface {
         };
         let dir = b - a;
         let mut best: Option<f64> = None;
-        for i in self.candidates(q) {
-            if let Some(t) = segment_triangle(a, dir, self.mesh.triangle(i)) {
+        self.index.visit(&q, |i| {
+            let tri = self.mesh.triangle(i);
+            if !meets(&tri, &q) {
+                return;
+            }
+            if let Some(t) = segment_triangle(a, dir, tri) {
                 if best.is_none_or(|b| t < b) {
                     best = Some(t);
                 }
             }
-        }
+        });
         best.map(|t| a + dir * t)
     }
 
@@ -268,13 +192,34 @@ impl Surface {
             hi: DVec3::new(xy.x + radius, xy.y + radius, f64::INFINITY),
         };
         let mut best: Option<f64> = None;
-        for i in self.candidates(q) {
-            if let Some(z) = triangle_max_z_in_disk(self.mesh.triangle(i), xy, radius) {
+        self.index.visit(&q, |i| {
+            // A triangle whose box misses the query box (in particular one
+            // wholly at or below the floor) cannot raise the answer above
+            // the floor: its height over the disk is a mix of its vertices'.
+            let t = self.mesh.triangle(i);
+            if !meets(&t, &q) {
+                return;
+            }
+            if let Some(z) = triangle_max_z_in_disk(t, xy, radius) {
                 best = Some(best.map_or(z, |b: f64| b.max(z)));
             }
-        }
+        });
         best.filter(|&h| h > floor)
     }
+}
+
+/// Whether the triangle's box meets the query box (exact, in f64): the index
+/// prunes by cells or leaves, this by the triangle itself.
+#[inline]
+fn meets(t: &[DVec3; 3], q: &QueryBox) -> bool {
+    let lo = t[0].min(t[1]).min(t[2]);
+    let hi = t[0].max(t[1]).max(t[2]);
+    lo.x <= q.hi.x
+        && hi.x >= q.lo.x
+        && lo.y <= q.hi.y
+        && hi.y >= q.lo.y
+        && lo.z <= q.hi.z
+        && hi.z >= q.lo.z
 }
 
 /// Relative tolerance of the inclusive point-in-triangle tests, so a line
