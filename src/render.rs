@@ -56,6 +56,26 @@ pub struct ViewPaths {
     pub defects: Vec<Vec<Defect>>,
 }
 
+/// A plan's paths as flat arrays (the page's live re-planning hands these
+/// over without a JSON report): points per piece, Ta and T* as xyz, and a
+/// defect code per point (0 good, 1 contact, 2 flattening, 3 floating).
+#[derive(Debug, Clone, Copy)]
+pub struct PathArrays<'a> {
+    pub pieces: &'a [u32],
+    pub ta: &'a [f32],
+    pub tool: &'a [f32],
+    pub defects: &'a [u8],
+}
+
+fn defect_of_code(code: u8) -> Defect {
+    match code {
+        1 => Defect::Contact,
+        2 => Defect::Flattening,
+        3 => Defect::Floating,
+        _ => Defect::Good,
+    }
+}
+
 /// Fiducial markers, printer frame.
 #[derive(Debug, Default)]
 pub struct Markers {
@@ -90,16 +110,19 @@ void main() {
 }
 "#;
 
+// u_offset moves the paths while the user drags them, until the re-plan
+// at the new placement arrives (zero for markers).
 const LINE_VS: &str = r#"#version 300 es
 uniform mat4 u_mvp;
 uniform float u_point_size;
+uniform vec3 u_offset;
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_color;
 out vec3 v_color;
 void main() {
   v_color = a_color;
   gl_PointSize = u_point_size;
-  gl_Position = u_mvp * vec4(a_pos, 1.0);
+  gl_Position = u_mvp * vec4(a_pos + u_offset, 1.0);
 }
 "#;
 
@@ -160,6 +183,7 @@ struct Program {
     light: Option<WebGlUniformLocation>,
     color: Option<WebGlUniformLocation>,
     point_size: Option<WebGlUniformLocation>,
+    offset: Option<WebGlUniformLocation>,
 }
 
 impl Program {
@@ -170,6 +194,7 @@ impl Program {
             light: gl.get_uniform_location(&program, "u_light"),
             color: gl.get_uniform_location(&program, "u_color"),
             point_size: gl.get_uniform_location(&program, "u_point_size"),
+            offset: gl.get_uniform_location(&program, "u_offset"),
             program,
         })
     }
@@ -322,6 +347,8 @@ pub struct Renderer {
     printer: Option<Drawable>,
     picked: Option<Drawable>,
     bounds: (DVec3, DVec3),
+    /// Where the paths are drawn relative to where they were planned.
+    pub path_offset: DVec3,
     width: u32,
     height: u32,
     pub camera: Camera,
@@ -356,6 +383,7 @@ impl Renderer {
             printer: None,
             picked: None,
             bounds,
+            path_offset: DVec3::ZERO,
             width,
             height,
             camera: Camera::framing(bounds.0, bounds.1, aspect, f64::from(height)),
@@ -466,11 +494,51 @@ impl Renderer {
                 push(&w[1], c);
             }
         }
+        self.set_lines(&pos, &col)
+    }
+
+    /// [`Renderer::set_paths`] from flat arrays; the lengths must agree.
+    pub fn set_path_arrays(&mut self, a: &PathArrays) -> Result<(), String> {
+        let n: usize = a.pieces.iter().map(|&k| k as usize).sum();
+        if a.ta.len() != 3 * n || a.tool.len() != 3 * n || a.defects.len() != n {
+            return Err(format!(
+                "path arrays disagree: {n} points in the pieces, {} Ta and {} T* coordinates, \
+                 {} defects",
+                a.ta.len(),
+                a.tool.len(),
+                a.defects.len()
+            ));
+        }
+        let segments = n.saturating_sub(a.pieces.len());
+        let mut pos: Vec<f32> = Vec::with_capacity(12 * segments);
+        let mut col: Vec<f32> = Vec::with_capacity(12 * segments);
+        let mut start = 0;
+        for &k in a.pieces {
+            let (lo, hi) = (start, start + k as usize);
+            for j in lo..hi.saturating_sub(1) {
+                pos.extend_from_slice(&a.ta[3 * j..3 * j + 6]);
+                col.extend(SURFACE_PATH);
+                col.extend(SURFACE_PATH);
+            }
+            // Each segment takes the colour of its start point.
+            for j in lo..hi.saturating_sub(1) {
+                let c = defect_rgb(defect_of_code(a.defects[j]));
+                pos.extend_from_slice(&a.tool[3 * j..3 * j + 6]);
+                col.extend(c);
+                col.extend(c);
+            }
+            start = hi;
+        }
+        self.set_lines(&pos, &col)
+    }
+
+    fn set_lines(&mut self, pos: &[f32], col: &[f32]) -> Result<(), String> {
         if let Some(d) = self.lines.take() {
             d.delete(&self.gl);
         }
+        self.path_offset = DVec3::ZERO;
         if !pos.is_empty() {
-            self.lines = Some(colored(&self.gl, &pos, &col)?);
+            self.lines = Some(colored(&self.gl, pos, col)?);
         }
         Ok(())
     }
@@ -529,9 +597,12 @@ impl Renderer {
         gl.use_program(Some(&p.program));
         gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, &mvp);
         if let Some(lines) = &self.lines {
+            let o = self.path_offset.as_vec3();
+            gl.uniform3f(p.offset.as_ref(), o.x, o.y, o.z);
             gl.bind_vertex_array(Some(&lines.vao));
             gl.draw_arrays(Gl::LINES, 0, lines.count);
         }
+        gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
         // Markers sit in holes: draw them over the surface.
         gl.disable(Gl::DEPTH_TEST);
         for (m, size) in [

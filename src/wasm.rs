@@ -11,11 +11,35 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, test_part};
-use crate::gcode::MachineProfile;
-use crate::job::{self, JobSettings, PreparedScan, RegistrationSettings};
-use crate::mesh::ImportOptions;
-use crate::pipeline::PlanSettings;
-use crate::render::{Markers, Renderer, ViewPaths};
+use crate::fiducials::{find_fiducials, Fiducial};
+use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
+use crate::job::{self, InputFile, JobSettings, PreparedScan, RegistrationSettings};
+use crate::mesh::{ImportOptions, ImportedMesh, MAX_SCAN_BYTES};
+use crate::params::Nozzle;
+use crate::pipeline::{self, DrawnPath, Plan, PlanSettings, SurfacePath};
+use crate::planners::PlannerKind;
+use crate::quality::Defect;
+use crate::registration::{Registration, RegistrationMethod};
+use crate::render::{Markers, PathArrays, Renderer, ViewPaths};
+use crate::sampling::{try_sample_subpath, MAX_SAMPLES};
+use crate::svg::Placement;
+
+/// Largest scan file the page reads: 512 MiB. The core reads up to
+/// [`MAX_SCAN_BYTES`] (1 GiB), but a wasm32 tab has at most 4 GiB of
+/// memory, which must hold the file's bytes while they are parsed, the mesh
+/// in f64, its BVH and the copy drawn by WebGL; wasm memory never shrinks,
+/// so the peak of one import stays. The page checks this before it reads a
+/// byte (`checkScanSize`), so a file past it leaves the loaded scan alone.
+pub const PAGE_MAX_SCAN_BYTES: usize = 512 << 20;
+// The page's limit is the tighter one, so its message is the one users see.
+const _: () = assert!(PAGE_MAX_SCAN_BYTES < MAX_SCAN_BYTES);
+
+/// Most samples the page plans for one drawing, all subpaths together: one
+/// million (300 m of path at the 20-gauge tip's d/2). The core allows
+/// [`MAX_SAMPLES`] per subpath, but every sample costs the page about 1 KB
+/// of wasm memory across the surface path, plan, report and G-code, and the
+/// JSON report alone about 300 bytes, so ten million would not fit a tab.
+pub const PAGE_MAX_SAMPLES: usize = 1_000_000;
 
 /// A core error as the JS `Error` the page shows: its message names the
 /// file, line or point at fault.
@@ -39,11 +63,84 @@ fn core_err(e: crate::Error) -> JsValue {
     } else {
         "other"
     };
-    let err = js_sys::Error::new(&e.to_string());
+    kind_err(kind, &e.to_string())
+}
+
+/// A JS `Error` with `message` and a `kind` the page branches on (`limit`
+/// for the page's own size limits, or a core stage as in [`core_err`]).
+fn kind_err(kind: &str, message: &str) -> JsValue {
+    let err = js_sys::Error::new(message);
     // Setting a property on a fresh Error cannot fail; if it did, the
     // message alone still reaches the page.
     let _ = js_sys::Reflect::set(&err, &"kind".into(), &kind.into());
     err.into()
+}
+
+/// Sets `key` on a JS object (a fresh one: cannot fail).
+fn set(obj: &js_sys::Object, key: &str, value: &JsValue) {
+    let _ = js_sys::Reflect::set(obj, &key.into(), value);
+}
+
+const MIB: f64 = (1u64 << 20) as f64;
+
+/// The page's limits, for its messages and the README: `{scan_bytes,
+/// svg_bytes, samples, core_scan_bytes, core_samples_per_subpath}`.
+#[wasm_bindgen(js_name = pageLimits)]
+pub fn page_limits() -> JsValue {
+    let o = js_sys::Object::new();
+    set(&o, "scan_bytes", &(PAGE_MAX_SCAN_BYTES as f64).into());
+    set(&o, "svg_bytes", &(PAGE_MAX_SVG_BYTES as f64).into());
+    set(&o, "samples", &(PAGE_MAX_SAMPLES as f64).into());
+    set(&o, "core_scan_bytes", &(MAX_SCAN_BYTES as f64).into());
+    set(&o, "core_samples_per_subpath", &(MAX_SAMPLES as f64).into());
+    o.into()
+}
+
+/// Largest SVG file the page reads: 64 MiB. The page reads a drawing on its
+/// main thread (to centre it) and usvg holds its whole tree; a drawing
+/// this size is far past the core's own limit of flattened points
+/// ([`crate::svg::MAX_POINTS`]) for any real antenna.
+pub const PAGE_MAX_SVG_BYTES: usize = 64 << 20;
+
+/// Refuses an SVG file of `size` bytes past [`PAGE_MAX_SVG_BYTES`] (kind
+/// `limit`), before the page reads it.
+#[wasm_bindgen(js_name = checkSvgSize)]
+pub fn check_svg_size(name: &str, size: f64) -> Result<(), JsValue> {
+    if size.is_finite() && (0.0..=PAGE_MAX_SVG_BYTES as f64).contains(&size) {
+        return Ok(());
+    }
+    Err(kind_err(
+        "limit",
+        &format!(
+            "{name}: the file is {:.1} MiB, more than the {} MiB this page reads for a \
+             drawing; is it the right file? Simplify the drawing (fewer nodes, no embedded \
+             images), or plan it with the command line",
+            size / MIB,
+            PAGE_MAX_SVG_BYTES >> 20
+        ),
+    ))
+}
+
+/// Refuses a scan file of `size` bytes past [`PAGE_MAX_SCAN_BYTES`] with an
+/// `Error` (kind `limit`) naming the file, its size and the limit. The page
+/// calls this with `File.size`, before reading anything.
+#[wasm_bindgen(js_name = checkScanSize)]
+pub fn check_scan_size(name: &str, size: f64) -> Result<(), JsValue> {
+    if size.is_finite() && (0.0..=PAGE_MAX_SCAN_BYTES as f64).contains(&size) {
+        return Ok(());
+    }
+    Err(kind_err(
+        "limit",
+        &format!(
+            "{name}: the file is {:.1} MiB, more than the {} MiB this page reads (a browser \
+             tab's memory must also hold the mesh and its search structure); decimate the scan \
+             (e.g. MeshLab's quadric edge collapse) or crop it to the printed area, or plan it \
+             with the command line (pcpp plan reads up to {} MiB)",
+            size / MIB,
+            PAGE_MAX_SCAN_BYTES >> 20,
+            MAX_SCAN_BYTES >> 20
+        ),
+    ))
 }
 
 fn from_js<T: for<'de> Deserialize<'de>>(what: &str, v: JsValue) -> Result<T, JsError> {
@@ -281,11 +378,176 @@ fn arr(p: DVec3) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
+/// A scan file's bytes, written into wasm memory chunk by chunk as the
+/// worker reads the file (`Blob.slice().arrayBuffer()`), so a large scan is
+/// never held whole by JS nor passed through a string. The first of the
+/// staged steps that [`job::prepare_scan`] runs in one call; the page shows
+/// progress between them: [`ScanBuffer::import_scan`], [`ScanImport::register`],
+/// [`ScanImport::index`].
+#[wasm_bindgen]
+pub struct ScanBuffer {
+    name: String,
+    size: usize,
+    bytes: Vec<u8>,
+}
+
+#[wasm_bindgen]
+impl ScanBuffer {
+    /// Room for a file of `size` bytes; refuses sizes past the page's limit
+    /// ([`check_scan_size`]) and, without aborting, sizes the tab's memory
+    /// cannot hold.
+    #[wasm_bindgen(constructor)]
+    pub fn new(name: &str, size: f64) -> Result<ScanBuffer, JsValue> {
+        check_scan_size(name, size)?;
+        let size = size as usize;
+        let mut bytes = Vec::new();
+        bytes.try_reserve_exact(size).map_err(|_| {
+            kind_err(
+                "limit",
+                &format!(
+                    "{name}: this tab has no room for the file's {:.1} MiB; close other tabs \
+                     or reload the page (its memory only grows), decimate the scan, or plan it \
+                     with the command line",
+                    size as f64 / MIB
+                ),
+            )
+        })?;
+        Ok(ScanBuffer {
+            name: name.to_string(),
+            size,
+            bytes,
+        })
+    }
+
+    /// The demo scan (the paper's test part as binary PLY), already full.
+    pub fn demo() -> ScanBuffer {
+        let bytes = demo::demo_scan_bytes();
+        ScanBuffer {
+            name: demo::DEMO_SCAN_NAME.to_string(),
+            size: bytes.len(),
+            bytes,
+        }
+    }
+
+    /// Appends the next chunk of the file.
+    pub fn write(&mut self, chunk: &[u8]) -> Result<(), JsError> {
+        if self.bytes.len() + chunk.len() > self.size {
+            return Err(JsError::new(&format!(
+                "{}: the file grew while it was read (more than its {} bytes); open it again",
+                self.name, self.size
+            )));
+        }
+        self.bytes.extend_from_slice(chunk);
+        Ok(())
+    }
+
+    /// Bytes written so far.
+    pub fn received(&self) -> usize {
+        self.bytes.len()
+    }
+
+    /// Imports the bytes ([`pipeline::load_scan`]) with `scan`
+    /// (ImportOptions); the bytes are freed once read, before the next step
+    /// allocates the search structure.
+    #[wasm_bindgen(js_name = importScan)]
+    pub fn import_scan(self, scan: JsValue) -> Result<ScanImport, JsValue> {
+        if self.bytes.len() != self.size {
+            return Err(JsError::new(&format!(
+                "{}: only {} of {} bytes were read; open the file again",
+                self.name,
+                self.bytes.len(),
+                self.size
+            ))
+            .into());
+        }
+        let options: ImportOptions = from_js("scan settings", scan)?;
+        let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
+        let file = InputFile::new(&self.name, &self.bytes);
+        Ok(ScanImport {
+            file,
+            imported,
+            fiducials: None,
+            registration: None,
+        })
+    }
+}
+
+/// A scan imported (scanner frame), not yet registered or indexed.
+#[wasm_bindgen]
+pub struct ScanImport {
+    file: InputFile,
+    imported: ImportedMesh,
+    fiducials: Option<Vec<Fiducial>>,
+    registration: Option<(Registration, RegistrationMethod)>,
+}
+
+#[wasm_bindgen]
+impl ScanImport {
+    pub fn triangles(&self) -> usize {
+        self.imported.mesh.triangle_count()
+    }
+
+    /// Finds the fiducial holes (once, in the scanner frame) and registers
+    /// with `registration` (RegistrationSettings), as [`job::prepare_scan`]
+    /// does. A failure (kind `registration`) leaves the import usable.
+    pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
+        let settings: RegistrationSettings = from_js("registration settings", registration)?;
+        let holes = self
+            .fiducials
+            .get_or_insert_with(|| find_fiducials(&self.imported.mesh));
+        let reg = job::registration_for(holes, &settings).map_err(core_err)?;
+        self.registration = Some((reg, settings.method));
+        Ok(())
+    }
+
+    /// Builds the registered surface and its BVH: the [`Session`] that
+    /// plans. Call [`ScanImport::register`] first.
+    pub fn index(self) -> Result<Session, JsValue> {
+        let Some((registration, method)) = self.registration else {
+            return Err(JsError::new("the scan must be registered before it is indexed").into());
+        };
+        let fiducials = self
+            .fiducials
+            .unwrap_or_else(|| find_fiducials(&self.imported.mesh));
+        let surface =
+            pipeline::registered_surface(self.imported.mesh, &registration).map_err(core_err)?;
+        Ok(Session::from_prepared(PreparedScan {
+            file: self.file,
+            format: self.imported.format,
+            units: self.imported.units,
+            warnings: self.imported.warnings,
+            fiducials,
+            registration,
+            method,
+            surface,
+        }))
+    }
+}
+
+/// The drawing the session plans, read once per file.
+struct LoadedPath {
+    /// Kept for [`job::run_on`], whose refusal message the page shows.
+    bytes: Vec<u8>,
+    file: InputFile,
+    drawn: DrawnPath,
+}
+
+/// The planner-independent surface path of the last placement and nozzle:
+/// a change of planner, tolerance, speed or dwell, or the comparison after
+/// a drag, re-plans without projecting again.
+struct PathCache {
+    nozzle: Nozzle,
+    placement: Placement,
+    surface_path: SurfacePath,
+}
+
 /// A scan loaded, registered and indexed, kept while only the path or the
 /// plan settings change (re-planning then skips import and BVH build).
 #[wasm_bindgen]
 pub struct Session {
     scan: PreparedScan,
+    path: Option<LoadedPath>,
+    cache: Option<PathCache>,
 }
 
 #[derive(Serialize)]
@@ -302,6 +564,159 @@ struct CompareRow {
     quality: crate::quality::QualitySummary,
 }
 
+/// What the page shows of a plan besides the per-point arrays.
+#[derive(Serialize)]
+struct PlanSummary<'a> {
+    planner: PlannerKind,
+    settings: &'a PlanSettings,
+    quality: crate::quality::QualitySummary,
+    stats: crate::stats::PathStats,
+    warnings: &'a [String],
+    registration_rms_mm: f64,
+}
+
+/// The page's code for a defect (the view's and the plot's colour index).
+fn defect_code(d: Defect) -> u8 {
+    match d {
+        Defect::Good => 0,
+        Defect::Contact => 1,
+        Defect::Flattening => 2,
+        Defect::Floating => 3,
+    }
+}
+
+/// Samples a drawing would need at `spacing` after `placement`, estimated
+/// from its drawn length (each corner adds at most one).
+fn estimated_samples(sub: &crate::svg::Subpath2, placement: &Placement, spacing: f64) -> f64 {
+    (sub.length_mm() * placement.scale.abs() / spacing).ceil() + sub.points.len() as f64
+}
+
+/// The page's sample limit ([`PAGE_MAX_SAMPLES`]) over the whole drawing,
+/// after the core's own per-subpath limit, whose message (from
+/// [`try_sample_subpath`], which counts before it allocates) the page shows
+/// as the CLI would.
+fn check_samples(path: &LoadedPath, settings: &PlanSettings) -> Result<(), JsValue> {
+    let spacing = 0.5 * settings.nozzle.inner_diameter_mm;
+    let placement = &settings.placement;
+    let mut total = 0.0;
+    for sub in &path.drawn.subpaths {
+        let n = estimated_samples(sub, placement, spacing);
+        if n > MAX_SAMPLES as f64 {
+            try_sample_subpath(&placement.apply_subpath(sub), spacing)
+                .map_err(|e| core_err(e.into()))?;
+        }
+        total += n;
+    }
+    if total > PAGE_MAX_SAMPLES as f64 {
+        return Err(kind_err(
+            "limit",
+            &format!(
+                "{}: about {:.2} million samples at {} mm spacing (d/2) after scaling by {}, \
+                 more than the {} million this page plans in one drawing; shorten the path or \
+                 scale it down, use a wider nozzle, or plan it with the command line (pcpp plan \
+                 allows {} million per subpath)",
+                path.file.name,
+                total / 1e6,
+                spacing,
+                placement.scale,
+                PAGE_MAX_SAMPLES / 1_000_000,
+                MAX_SAMPLES / 1_000_000
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl Session {
+    fn from_prepared(scan: PreparedScan) -> Session {
+        Session {
+            scan,
+            path: None,
+            cache: None,
+        }
+    }
+
+    /// Projects the drawing for the nozzle and placement of `settings`
+    /// unless the cache already holds that surface path.
+    fn ensure_surface_path(&mut self, settings: &PlanSettings) -> Result<(), JsValue> {
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
+        let hit = self
+            .cache
+            .as_ref()
+            .is_some_and(|c| c.nozzle == settings.nozzle && c.placement == settings.placement);
+        if !hit {
+            // The old surface path goes first: memory for one, not two.
+            self.cache = None;
+            check_samples(path, settings)?;
+            let surface_path = pipeline::surface_path(
+                &self.scan.surface,
+                &path.drawn.subpaths,
+                &settings.nozzle,
+                &settings.placement,
+            )
+            .map_err(core_err)?;
+            self.cache = Some(PathCache {
+                nozzle: settings.nozzle,
+                placement: settings.placement,
+                surface_path,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The per-point arrays of a plan as typed arrays: `pieces` (points per
+/// piece), `ta` and `tool` (xyz f32, printer frame), `defects` (codes of
+/// [`defect_code`]), `slope` (deg), `kappa` (1/mm) and `error` (mm, NaN at a
+/// contact), for the view and the plot without parsing the JSON report.
+fn plan_arrays(plan: &Plan) -> js_sys::Object {
+    let n: usize = plan.pieces.iter().map(|p| p.toolpath.len()).sum();
+    let mut pieces = Vec::with_capacity(plan.pieces.len());
+    let mut ta = Vec::with_capacity(3 * n);
+    let mut tool = Vec::with_capacity(3 * n);
+    let mut defects = Vec::with_capacity(n);
+    let (mut slope, mut kappa, mut error) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for p in &plan.pieces {
+        pieces.push(p.toolpath.len() as u32);
+        ta.extend(
+            p.surface_path
+                .iter()
+                .flat_map(|v| [v.x as f32, v.y as f32, v.z as f32]),
+        );
+        tool.extend(
+            p.toolpath
+                .iter()
+                .flat_map(|v| [v.x as f32, v.y as f32, v.z as f32]),
+        );
+        for (g, q) in p.geometry.iter().zip(&p.quality) {
+            defects.push(defect_code(q.defect));
+            slope.push(g.slope_rad.to_degrees() as f32);
+            kappa.push(g.kappa as f32);
+            error.push(q.error_mm.map_or(f32::NAN, |e| e as f32));
+        }
+    }
+    let o = js_sys::Object::new();
+    set(&o, "pieces", &js_sys::Uint32Array::from(&pieces[..]).into());
+    set(&o, "ta", &js_sys::Float32Array::from(&ta[..]).into());
+    set(&o, "tool", &js_sys::Float32Array::from(&tool[..]).into());
+    set(
+        &o,
+        "defects",
+        &js_sys::Uint8Array::from(&defects[..]).into(),
+    );
+    set(&o, "slope", &js_sys::Float32Array::from(&slope[..]).into());
+    set(&o, "kappa", &js_sys::Float32Array::from(&kappa[..]).into());
+    set(&o, "error", &js_sys::Float32Array::from(&error[..]).into());
+    o
+}
+
 #[wasm_bindgen]
 impl Session {
     /// Imports the scan (`bytes` from the file, never through a JS string),
@@ -316,7 +731,7 @@ impl Session {
         let scan: ImportOptions = from_js("scan settings", scan)?;
         let registration: RegistrationSettings = from_js("registration settings", registration)?;
         let scan = job::prepare_scan(bytes, name, &scan, &registration).map_err(core_err)?;
-        Ok(Session { scan })
+        Ok(Session::from_prepared(scan))
     }
 
     /// Vertices of the registered mesh, printer frame, xyz f32 (for drawing).
@@ -429,6 +844,134 @@ impl Session {
         })?)
     }
 
+    /// Reads the drawing the next plans use (an error, kind `svg`, names
+    /// the file and keeps the previous drawing).
+    #[wasm_bindgen(js_name = setPath)]
+    pub fn set_path(&mut self, svg: &[u8], svg_name: &str) -> Result<(), JsValue> {
+        let drawn = pipeline::load_path(svg, svg_name).map_err(core_err)?;
+        self.cache = None;
+        self.path = Some(LoadedPath {
+            bytes: svg.to_vec(),
+            file: InputFile::new(svg_name, svg),
+            drawn,
+        });
+        Ok(())
+    }
+
+    /// One call for a live re-plan: plans the drawing of [`Session::set_path`]
+    /// with `settings` and writes G-code with `dialect` (as
+    /// [`Session::plan`]: the same G-code and report bytes as
+    /// [`job::run_on`] and the CLI), projecting the drawing once (reused
+    /// while the nozzle and placement stay) and, when `compare`, also
+    /// plans the other three planners on that one surface path. Returns
+    /// `{gcode, report}` (UTF-8 bytes, Uint8Array), `summary` (planner,
+    /// settings, quality, stats, warnings, registration RMS), `view` (see
+    /// [`plan_arrays`]) and `comparison` (`[{planner, quality}]` or null).
+    #[wasm_bindgen(js_name = planLive)]
+    pub fn plan_live(
+        &mut self,
+        settings: JsValue,
+        dialect: &str,
+        accept_risk: bool,
+        profile_file: Option<String>,
+        compare: bool,
+    ) -> Result<JsValue, JsValue> {
+        let settings: PlanSettings = from_js("plan settings", settings)?;
+        // As job::run_on: bad settings and profiles fail before any work.
+        settings.validate().map_err(core_err)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
+        self.ensure_surface_path(&settings)?;
+        let Some(cache) = &self.cache else {
+            return Err(JsError::new("the surface path was not kept").into());
+        };
+        let sp = &cache.surface_path;
+        let surface = &self.scan.surface;
+        let plan_with = |k: PlannerKind| {
+            pipeline::plan_surface_path(surface, sp, k, &settings.nozzle, &settings.process)
+        };
+        let plan = plan_with(settings.planner);
+        let comparison = if compare {
+            let rows: Vec<CompareRow> = PlannerKind::ALL
+                .iter()
+                .map(|&k| CompareRow {
+                    planner: k,
+                    quality: if k == settings.planner {
+                        plan.quality
+                    } else {
+                        plan_with(k).quality
+                    },
+                })
+                .collect();
+            to_js(&rows)?
+        } else {
+            JsValue::NULL
+        };
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
+        if !plan.uncleared.is_empty() && !accept_risk {
+            // The core's own refusal (and message): it plans once more, but
+            // only on this path, where no G-code is written anyway.
+            return Err(
+                match job::run_on(
+                    &self.scan,
+                    &path.bytes,
+                    &path.file.name,
+                    &settings,
+                    &profile,
+                    accept_risk,
+                ) {
+                    Err(e) => core_err(e),
+                    Ok(_) => {
+                        JsError::new("the nozzle would touch the surface; no G-code written").into()
+                    }
+                },
+            );
+        }
+        // From here as job::run_on, so the bytes are the CLI's.
+        let mut report = job::report(&self.scan, &path.file, &plan, &settings);
+        report.warnings.extend(path.drawn.notes.iter().cloned());
+        let header = job::provenance(&report);
+        let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.toolpath.clone()).collect();
+        let gcode = write_gcode(
+            &GcodeJob {
+                toolpaths: &toolpaths,
+                speed_mm_s: settings.process.speed_mm_s,
+                dwell_s: settings.process.dwell_s,
+                header: &header,
+                scan_top_z_mm: surface.top_z(),
+            },
+            &profile,
+        )
+        .map_err(|e| core_err(e.into()))?;
+        let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
+        report_json.push(b'\n');
+        let out = js_sys::Object::new();
+        set(
+            &out,
+            "gcode",
+            &js_sys::Uint8Array::from(gcode.as_bytes()).into(),
+        );
+        set(
+            &out,
+            "report",
+            &js_sys::Uint8Array::from(&report_json[..]).into(),
+        );
+        let summary = PlanSummary {
+            planner: plan.planner,
+            settings: &settings,
+            quality: plan.quality,
+            stats: plan.stats,
+            warnings: &report.warnings,
+            registration_rms_mm: report.registration.rms_mm,
+        };
+        set(&out, "summary", &to_js(&summary)?);
+        set(&out, "view", &plan_arrays(&plan).into());
+        set(&out, "comparison", &comparison);
+        Ok(out.into())
+    }
+
     /// The four planners' quality summaries side by side ([`job::compare_on`]).
     pub fn compare(
         &self,
@@ -481,6 +1024,35 @@ impl Viewer {
             from_js("report", report)?
         };
         self.r.set_paths(&paths).map_err(|e| JsError::new(&e))
+    }
+
+    /// The paths from the flat arrays of a live plan (`view` of
+    /// [`Session::plan_live`]); resets the drag offset.
+    #[wasm_bindgen(js_name = setPathArrays)]
+    pub fn set_path_arrays(
+        &mut self,
+        pieces: &[u32],
+        ta: &[f32],
+        tool: &[f32],
+        defects: &[u8],
+    ) -> Result<(), JsError> {
+        self.r
+            .set_path_arrays(&PathArrays {
+                pieces,
+                ta,
+                tool,
+                defects,
+            })
+            .map_err(|e| JsError::new(&e))
+    }
+
+    /// Draws the paths moved by (dx, dy, dz) mm, printer frame: while the
+    /// user drags the drawing, the last plan follows the pointer until the
+    /// plan at the new placement replaces it.
+    #[wasm_bindgen(js_name = setPathOffset)]
+    pub fn set_path_offset(&mut self, dx: f64, dy: f64, dz: f64) {
+        let o = DVec3::new(dx, dy, dz);
+        self.r.path_offset = if o.is_finite() { o } else { DVec3::ZERO };
     }
 
     /// Fiducial markers: holes found in the scan, the printer points P and

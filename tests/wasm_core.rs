@@ -422,3 +422,272 @@ fn session_pick_finds_the_surface_under_a_vertical_ray() {
     assert!(session.pick(&[0.0, 0.0, 1.0], &[0.0, 0.0, 0.0]).is_err());
     assert!(session.pick(&[0.0, 0.0], &[0.0, 0.0, -1.0]).is_err());
 }
+
+// ---- live re-planning and the page's limits (src/wasm.rs) ----
+
+fn get(v: &JsValue, key: &str) -> JsValue {
+    js_sys::Reflect::get(v, &key.into()).unwrap()
+}
+
+fn message_and_kind(err: &JsValue) -> (String, String) {
+    (
+        get(err, "message").as_string().unwrap_or_default(),
+        get(err, "kind").as_string().unwrap_or_default(),
+    )
+}
+
+fn bytes_text(v: &JsValue) -> String {
+    String::from_utf8(js_sys::Uint8Array::new(v).to_vec()).unwrap()
+}
+
+/// A session built the way the worker builds it: the file written into a
+/// ScanBuffer in chunks, then imported, registered and indexed.
+fn staged_session(bytes: &[u8], name: &str, settings: &JobSettings) -> pcpp::wasm::Session {
+    let mut buf =
+        pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64).unwrap_or_else(|e| panic!("{e:?}"));
+    for chunk in bytes.chunks(100_000) {
+        buf.write(chunk).unwrap_or_else(|e| panic!("{e:?}"));
+    }
+    assert_eq!(buf.received(), bytes.len());
+    let mut imp = buf
+        .import_scan(js(&settings.scan))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    imp.register(js(&settings.registration))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    imp.index().unwrap_or_else(|e| panic!("{e:?}"))
+}
+
+fn demo_page_settings() -> JobSettings {
+    let mut s = golden_settings();
+    s.registration = RegistrationSettings {
+        fiducials: FiducialSource::Auto,
+        printer_points: test_part::FIDUCIALS_MM.to_vec(),
+        method: RegistrationMethod::Lsq,
+    };
+    s
+}
+
+#[wasm_bindgen_test]
+fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
+    let scan = demo::demo_scan_bytes();
+    let svg = test_part::test_part_svg();
+    // The golden settings (no fiducials) and the page's demo (auto
+    // fiducials): the staged session must prepare the scan as
+    // job::prepare_scan does.
+    for settings in [golden_settings(), demo_page_settings()] {
+        let prepared = job::prepare_scan(
+            &scan,
+            demo::DEMO_SCAN_NAME,
+            &settings.scan,
+            &settings.registration,
+        )
+        .unwrap();
+        let mut session = staged_session(&scan, demo::DEMO_SCAN_NAME, &settings);
+        session
+            .set_path(svg.as_bytes(), demo::DEMO_PATH_NAME)
+            .unwrap_or_else(|e| panic!("{e:?}"));
+        let mut plan = settings.plan;
+        // A drag: the placement moves, then a planner and a nozzle change
+        // (the surface path is reused, then projected again).
+        for step in 0..4 {
+            if step == 1 {
+                plan.placement.offset_mm.x += 1.25;
+            } else if step == 2 {
+                plan.planner = PlannerKind::Slope;
+            } else if step == 3 {
+                plan.nozzle.inner_diameter_mm = 0.413;
+                plan.nozzle.outer_diameter_mm = 0.718;
+            }
+            let want = job::run_on(
+                &prepared,
+                svg.as_bytes(),
+                demo::DEMO_PATH_NAME,
+                &plan,
+                &MachineProfile::builtin("grbl").unwrap(),
+                false,
+            )
+            .unwrap();
+            let out = session
+                .plan_live(js(&plan), "grbl", false, None, step == 0)
+                .unwrap_or_else(|e| panic!("{e:?}"));
+            // Compared without printing: a G-code file fills the screen.
+            assert!(
+                bytes_text(&get(&out, "gcode")) == want.gcode,
+                "step {step}: the live plan's G-code differs from job::run_on's"
+            );
+            let mut report = serde_json::to_string_pretty(&want.report).unwrap();
+            report.push('\n');
+            assert!(
+                bytes_text(&get(&out, "report")) == report,
+                "step {step}: the live plan's report differs from job::run_on's"
+            );
+            // The per-point arrays are the report's, as f32 and codes.
+            let view = get(&out, "view");
+            let pieces = js_sys::Uint32Array::new(&get(&view, "pieces")).to_vec();
+            let tool = js_sys::Float32Array::new(&get(&view, "tool")).to_vec();
+            let defects = js_sys::Uint8Array::new(&get(&view, "defects")).to_vec();
+            let toolpath: Vec<&[f64; 3]> = want.report.toolpath.iter().flatten().collect();
+            assert_eq!(
+                pieces,
+                want.report
+                    .toolpath
+                    .iter()
+                    .map(|p| p.len() as u32)
+                    .collect::<Vec<_>>()
+            );
+            assert_eq!(tool.len(), 3 * toolpath.len());
+            assert_eq!(tool[3], toolpath[1][0] as f32);
+            let want_codes: Vec<u8> = want
+                .report
+                .defects
+                .iter()
+                .flatten()
+                .map(|d| match d {
+                    Defect::Good => 0,
+                    Defect::Contact => 1,
+                    Defect::Flattening => 2,
+                    Defect::Floating => 3,
+                })
+                .collect();
+            assert_eq!(defects, want_codes);
+            let summary = get(&out, "summary");
+            assert_eq!(
+                get(&summary, "planner").as_string().unwrap(),
+                plan.planner.name()
+            );
+            // The comparison comes in the same call, on the same surface path.
+            let comparison = get(&out, "comparison");
+            if step == 0 {
+                let rows: Vec<serde_json::Value> =
+                    serde_wasm_bindgen::from_value(comparison).unwrap();
+                let want_rows =
+                    job::compare_on(&prepared, svg.as_bytes(), demo::DEMO_PATH_NAME, &plan)
+                        .unwrap()
+                        .rows;
+                assert_eq!(rows.len(), 4);
+                for (row, (k, q)) in rows.iter().zip(&want_rows) {
+                    assert_eq!(row["planner"], k.name());
+                    assert_eq!(row["quality"]["mean_abs_error_mm"], q.mean_abs_error_mm);
+                }
+            } else {
+                assert!(comparison.is_null());
+            }
+        }
+    }
+}
+
+#[wasm_bindgen_test]
+fn a_failed_registration_keeps_the_import_and_bad_paths_keep_the_drawing() {
+    let scan = demo::demo_scan_bytes();
+    let settings = demo_page_settings();
+    let mut buf = pcpp::wasm::ScanBuffer::demo();
+    assert_eq!(buf.received(), scan.len());
+    assert!(
+        buf.write(b"x").is_err(),
+        "a full buffer takes no more bytes"
+    );
+    let mut imp = buf.import_scan(js(&settings.scan)).unwrap();
+    let bad = RegistrationSettings {
+        printer_points: vec![DVec3::ZERO],
+        ..settings.registration.clone()
+    };
+    let err = imp
+        .register(js(&bad))
+        .expect_err("one point cannot register");
+    assert_eq!(message_and_kind(&err).1, "registration");
+    imp.register(js(&settings.registration)).unwrap();
+    let mut session = imp.index().unwrap_or_else(|e| panic!("{e:?}"));
+
+    // No drawing yet: an error, not a panic.
+    assert!(session
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .is_err());
+    let svg = test_part::test_part_svg();
+    session
+        .set_path(svg.as_bytes(), demo::DEMO_PATH_NAME)
+        .unwrap();
+    let first = session
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .unwrap();
+    // A broken SVG names the file (kind svg) and the previous drawing stays.
+    let err = session
+        .set_path(b"<svg><path d='M 0 0 L", "broken.svg")
+        .expect_err("a broken SVG must not load");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "svg");
+    assert!(message.contains("broken.svg"), "{message}");
+    let again = session
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .unwrap();
+    assert_eq!(
+        bytes_text(&get(&again, "gcode")),
+        bytes_text(&get(&first, "gcode"))
+    );
+}
+
+#[wasm_bindgen_test]
+fn the_page_refuses_scans_past_its_size_limit_before_reading() {
+    let limit = pcpp::wasm::PAGE_MAX_SCAN_BYTES as f64;
+    assert!(pcpp::wasm::check_scan_size("ok.stl", limit).is_ok());
+    let err = pcpp::wasm::check_scan_size("huge-scan.stl", limit + 1.0).unwrap_err();
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "limit");
+    assert!(
+        message.contains("huge-scan.stl") && message.contains("512 MiB"),
+        "{message}"
+    );
+    let err = pcpp::wasm::ScanBuffer::new("huge-scan.stl", limit + 1.0)
+        .err()
+        .expect("no buffer past the limit");
+    assert_eq!(message_and_kind(&err).1, "limit");
+    for bad in [f64::NAN, -1.0, f64::INFINITY] {
+        assert!(pcpp::wasm::check_scan_size("x.stl", bad).is_err());
+    }
+    let err = pcpp::wasm::check_svg_size("huge.svg", 65.0 * 1048576.0).unwrap_err();
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "limit");
+    assert!(message.contains("huge.svg") && message.contains("64 MiB"));
+
+    // A buffer that was not filled does not import.
+    let mut buf = pcpp::wasm::ScanBuffer::new("short.ply", 10.0).unwrap();
+    buf.write(b"ply\n").unwrap();
+    assert!(buf.write(&[0; 7]).is_err(), "more than the declared size");
+    let err = buf
+        .import_scan(js(&ImportOptions::DEFAULT))
+        .err()
+        .expect("a short read must not import");
+    assert!(message_and_kind(&err).0.contains("short.ply"));
+}
+
+#[wasm_bindgen_test]
+fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
+    let settings = golden_settings();
+    let mut session = staged_session(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
+    session
+        .set_path(test_part::test_part_svg().as_bytes(), demo::DEMO_PATH_NAME)
+        .unwrap();
+    // The demo's 466 mm of lines scaled 1000 times: ~1.5 million samples,
+    // past the page's limit but within the core's per subpath.
+    let mut plan = settings.plan;
+    plan.placement.scale = 1000.0;
+    let err = session
+        .plan_live(js(&plan), "marlin", false, None, false)
+        .expect_err("past the page's sample limit");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "limit", "{message}");
+    assert!(
+        message.contains(demo::DEMO_PATH_NAME) && message.contains("1 million"),
+        "{message}"
+    );
+    // Scaled 50 000 times one line needs more samples than the core allows
+    // per subpath: the core's own message (sampling.rs), as the CLI prints it.
+    plan.placement.scale = 50_000.0;
+    let err = session
+        .plan_live(js(&plan), "marlin", false, None, false)
+        .expect_err("past the core's sample limit");
+    let (message, _) = message_and_kind(&err);
+    assert!(
+        message.contains("samples needed") && message.contains("10000000"),
+        "{message}"
+    );
+}
