@@ -12,10 +12,14 @@
 //!   report, G-code), what the wasm `Session.plan` runs.
 //!
 //! `PCPP_BENCH_N` shrinks the film (grid cells per side, default 1000).
-//! `scripts/bench.sh` runs these with the wasm timings and prints the table.
+//! `PCPP_BENCH_CLOCK=cpu` times the bench thread's CPU time instead of wall
+//! time (see [`Clock`]). `scripts/bench.sh` runs these with the wasm timings
+//! and prints the table.
 
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use pcpp::demo::{to_binary_ply, workloads};
 use pcpp::gcode::MachineProfile;
@@ -29,7 +33,70 @@ fn n() -> usize {
         .unwrap_or(workloads::FILM_CELLS)
 }
 
-fn benches(c: &mut Criterion) {
+/// Wall time (the default), or with `PCPP_BENCH_CLOCK=cpu` the CPU time of
+/// the benchmark's own thread (Linux `/proc/thread-self/schedstat`, ns): on
+/// a shared machine the time other processes take from this single-threaded
+/// code is then left out. Criterion runs the routine on the thread that
+/// starts and ends each sample.
+struct Clock {
+    cpu: bool,
+    epoch: Instant,
+    formatter: WallTime,
+}
+
+impl Clock {
+    fn from_env() -> Clock {
+        let want_cpu = std::env::var("PCPP_BENCH_CLOCK").is_ok_and(|v| v == "cpu");
+        let cpu = want_cpu && thread_cpu_ns().is_some();
+        if want_cpu && !cpu {
+            eprintln!(
+                "PCPP_BENCH_CLOCK=cpu: no /proc/thread-self/schedstat here, timing wall time"
+            );
+        }
+        Clock {
+            cpu,
+            epoch: Instant::now(),
+            formatter: WallTime,
+        }
+    }
+}
+
+/// Nanoseconds this thread has run on a CPU (the first field of schedstat).
+fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+impl Measurement for Clock {
+    type Intermediate = u64;
+    type Value = Duration;
+
+    fn start(&self) -> u64 {
+        if self.cpu {
+            thread_cpu_ns().unwrap_or(0)
+        } else {
+            self.epoch.elapsed().as_nanos() as u64
+        }
+    }
+    fn end(&self, start: u64) -> Duration {
+        Duration::from_nanos(self.start().saturating_sub(start))
+    }
+    fn add(&self, a: &Duration, b: &Duration) -> Duration {
+        *a + *b
+    }
+    fn zero(&self) -> Duration {
+        Duration::ZERO
+    }
+    fn to_f64(&self, v: &Duration) -> f64 {
+        v.as_nanos() as f64
+    }
+    fn formatter(&self) -> &dyn ValueFormatter {
+        // Nanoseconds either way: criterion's own time formatter.
+        self.formatter.formatter()
+    }
+}
+
+fn benches(c: &mut Criterion<Clock>) {
     let film = workloads::wrinkled_film(n());
     let ply = to_binary_ply(&film);
     let obj = workloads::to_obj(&film);
@@ -91,5 +158,9 @@ fn benches(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(pipeline_benches, benches);
+criterion_group! {
+    name = pipeline_benches;
+    config = Criterion::default().with_measurement(Clock::from_env());
+    targets = benches
+}
 criterion_main!(pipeline_benches);

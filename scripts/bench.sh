@@ -12,6 +12,10 @@
 #   PCPP_BENCH_QUICK=1  a fast smoke run (criterion --quick, fewer wasm runs)
 #   PCPP_BENCH_N=300    a smaller film (grid cells per side, default 1000);
 #                       the targets are for the full size
+#   PCPP_BENCH_CLOCK    cpu (default): CPU time of the thread running the
+#                       stage (/proc/thread-self/schedstat), so that other
+#                       processes on a shared machine do not inflate it;
+#                       wall: elapsed time (use it on a quiet machine)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -19,6 +23,8 @@ export PATH="$HOME/.cargo/bin:$PATH"
 log() { printf '[bench] %s\n' "$*" >&2; }
 CELLS="${PCPP_BENCH_N:-1000}"
 QUICK="${PCPP_BENCH_QUICK:-0}"
+export PCPP_BENCH_CLOCK="${PCPP_BENCH_CLOCK:-cpu}"
+LOAD_START="$(cut -d' ' -f1 /proc/loadavg)"
 WL=target/workloads
 OUT=target/bench
 mkdir -p "$OUT"
@@ -66,7 +72,8 @@ MACHINE="${MACHINE:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ {printf "%.0
 COMMIT="$(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
 git diff --quiet HEAD -- src benches 2>/dev/null || COMMIT="$COMMIT + local changes"
 
-CELLS="$CELLS" QUICK="$QUICK" MACHINE="$MACHINE" COMMIT="$COMMIT" \
+LOAD="$LOAD_START at the start, $(cut -d' ' -f1 /proc/loadavg) at the end"
+CELLS="$CELLS" QUICK="$QUICK" MACHINE="$MACHINE" COMMIT="$COMMIT" LOAD="$LOAD" \
   RUSTC="$(rustc --version)" node --input-type=module - <<'EOF' | tee "$OUT/table.md"
 import { readFileSync, readdirSync, existsSync, statSync } from 'node:fs';
 import { join } from 'node:path';
@@ -129,8 +136,11 @@ const rows = [
 ];
 const e = process.env;
 const out = [];
-out.push(`Measured ${new Date().toISOString().slice(0, 10)} on ${e.MACHINE}, single-threaded; ` +
-  `commit ${e.COMMIT}; ${e.RUSTC}; Node ${wasm.node}.`);
+const clock = e.PCPP_BENCH_CLOCK === 'cpu' && wasm.clock === 'cpu'
+  ? "CPU time of the thread running each stage (other processes' share left out)"
+  : 'wall time';
+out.push(`Measured ${new Date().toISOString().slice(0, 10)} on ${e.MACHINE}, single-threaded, ` +
+  `${clock}; load average ${e.LOAD}; commit ${e.COMMIT}; ${e.RUSTC}; Node ${wasm.node}.`);
 out.push(`W1 ${wasm.triangles.toLocaleString('en-US')} triangles (${f(wasm.ply_bytes / 1e6, 1)} MB PLY, ` +
   `${f(wasm.obj_bytes / 1e6, 1)} MB OBJ), W2 ${wasm.w2_points} points, W3 ${wasm.w3_points} points` +
   (e.CELLS !== '1000' ? ` (PCPP_BENCH_N=${e.CELLS}: not the issue's size)` : '') +
