@@ -133,6 +133,136 @@ out vec4 o_color;
 void main() { o_color = vec4(v_color, 1.0); }
 "#;
 
+// Copies the cached mesh image (colour and depth) to the canvas: one
+// triangle covering the viewport, texel for pixel, writing the mesh's depth
+// so the paths drawn next are hidden behind the surface as before.
+const BLIT_VS: &str = r#"#version 300 es
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+"#;
+
+const BLIT_FS: &str = r#"#version 300 es
+precision highp float;
+uniform sampler2D u_color_tex;
+uniform highp sampler2D u_depth_tex;
+out vec4 o_color;
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  o_color = texelFetch(u_color_tex, px, 0);
+  gl_FragDepth = texelFetch(u_depth_tex, px, 0).r;
+}
+"#;
+
+/// Calls a WebGL method through the JS object: texture and framebuffer
+/// calls, whose web-sys bindings sit behind the `WebGlTexture` and
+/// `WebGlFramebuffer` features, which the crate does not enable.
+fn gl_call(gl: &Gl, method: &str, args: &[JsValue]) -> Result<JsValue, String> {
+    let f: js_sys::Function = js_sys::Reflect::get(gl, &method.into())
+        .ok()
+        .and_then(|f| f.dyn_into().ok())
+        .ok_or_else(|| format!("WebGL has no {method}"))?;
+    let list: js_sys::Array = args.iter().collect();
+    f.apply(gl, &list)
+        .map_err(|e| format!("WebGL {method} failed: {e:?}"))
+}
+
+/// The mesh drawn once into textures (colour and depth) and reused while
+/// the camera and the canvas size stay: moving the path, or a new plan,
+/// then redraws only the lines. A scan of a few million triangles costs
+/// a software renderer (or a weak GPU) hundreds of milliseconds a frame.
+struct MeshCache {
+    framebuffer: JsValue,
+    color: JsValue,
+    depth: JsValue,
+    width: u32,
+    height: u32,
+    /// The camera matrix the textures hold the mesh for; None: stale.
+    mvp: Option<[f32; 16]>,
+}
+
+impl MeshCache {
+    fn new(gl: &Gl, width: u32, height: u32) -> Result<MeshCache, String> {
+        let texture = |internal: u32, format: u32, kind: u32| -> Result<JsValue, String> {
+            let t = gl_call(gl, "createTexture", &[])?;
+            gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), t.clone()])?;
+            gl_call(
+                gl,
+                "texImage2D",
+                &[
+                    Gl::TEXTURE_2D.into(),
+                    0.into(),
+                    internal.into(),
+                    width.into(),
+                    height.into(),
+                    0.into(),
+                    format.into(),
+                    kind.into(),
+                    JsValue::NULL,
+                ],
+            )?;
+            for p in [Gl::TEXTURE_MIN_FILTER, Gl::TEXTURE_MAG_FILTER] {
+                gl.tex_parameteri(Gl::TEXTURE_2D, p, Gl::NEAREST as i32);
+            }
+            Ok(t)
+        };
+        let color = texture(Gl::RGBA8, Gl::RGBA, Gl::UNSIGNED_BYTE)?;
+        let depth = texture(Gl::DEPTH_COMPONENT24, Gl::DEPTH_COMPONENT, Gl::UNSIGNED_INT)?;
+        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
+        let framebuffer = gl_call(gl, "createFramebuffer", &[])?;
+        gl_call(
+            gl,
+            "bindFramebuffer",
+            &[Gl::FRAMEBUFFER.into(), framebuffer.clone()],
+        )?;
+        for (attachment, t) in [
+            (Gl::COLOR_ATTACHMENT0, &color),
+            (Gl::DEPTH_ATTACHMENT, &depth),
+        ] {
+            gl_call(
+                gl,
+                "framebufferTexture2D",
+                &[
+                    Gl::FRAMEBUFFER.into(),
+                    attachment.into(),
+                    Gl::TEXTURE_2D.into(),
+                    t.clone(),
+                    0.into(),
+                ],
+            )?;
+        }
+        let complete = gl.check_framebuffer_status(Gl::FRAMEBUFFER) == Gl::FRAMEBUFFER_COMPLETE;
+        gl_call(
+            gl,
+            "bindFramebuffer",
+            &[Gl::FRAMEBUFFER.into(), JsValue::NULL],
+        )?;
+        let cache = MeshCache {
+            framebuffer,
+            color,
+            depth,
+            width,
+            height,
+            mvp: None,
+        };
+        if complete {
+            Ok(cache)
+        } else {
+            cache.delete(gl);
+            Err("the mesh cache framebuffer is incomplete".into())
+        }
+    }
+
+    fn delete(self, gl: &Gl) {
+        // Deleting cannot fail in a way that matters: the context drops
+        // them with the canvas anyway.
+        let _ = gl_call(gl, "deleteFramebuffer", &[self.framebuffer]);
+        let _ = gl_call(gl, "deleteTexture", &[self.color]);
+        let _ = gl_call(gl, "deleteTexture", &[self.depth]);
+    }
+}
+
 fn compile(gl: &Gl, kind: u32, src: &str) -> Result<WebGlShader, String> {
     let shader = gl
         .create_shader(kind)
@@ -184,6 +314,8 @@ struct Program {
     color: Option<WebGlUniformLocation>,
     point_size: Option<WebGlUniformLocation>,
     offset: Option<WebGlUniformLocation>,
+    color_tex: Option<WebGlUniformLocation>,
+    depth_tex: Option<WebGlUniformLocation>,
 }
 
 impl Program {
@@ -195,6 +327,8 @@ impl Program {
             color: gl.get_uniform_location(&program, "u_color"),
             point_size: gl.get_uniform_location(&program, "u_point_size"),
             offset: gl.get_uniform_location(&program, "u_offset"),
+            color_tex: gl.get_uniform_location(&program, "u_color_tex"),
+            depth_tex: gl.get_uniform_location(&program, "u_depth_tex"),
             program,
         })
     }
@@ -339,6 +473,13 @@ pub struct Renderer {
     gl: Gl,
     mesh_prog: Program,
     line_prog: Program,
+    blit_prog: Program,
+    /// No attributes: the blit makes its triangle from gl_VertexID.
+    blit_vao: WebGlVertexArrayObject,
+    /// The mesh image; None until first drawn, or when the browser cannot
+    /// render to a depth texture (then the mesh is drawn every frame).
+    cache: Option<MeshCache>,
+    cache_failed: bool,
     mesh: Option<(Drawable, WebGlBuffer)>,
     lines: Option<Drawable>,
     /// Holes found in the scan, and the printer points P drawn smaller on
@@ -370,6 +511,10 @@ impl Renderer {
             .map_err(|_| "the canvas did not give a WebGL2 context")?;
         let mesh_prog = Program::new(&gl, MESH_VS, MESH_FS)?;
         let line_prog = Program::new(&gl, LINE_VS, LINE_FS)?;
+        let blit_prog = Program::new(&gl, BLIT_VS, BLIT_FS)?;
+        let blit_vao = gl
+            .create_vertex_array()
+            .ok_or("WebGL could not create a vertex array")?;
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
         let bounds = (DVec3::splat(-50.0), DVec3::splat(50.0));
         let aspect = f64::from(width) / f64::from(height);
@@ -377,6 +522,10 @@ impl Renderer {
             gl,
             mesh_prog,
             line_prog,
+            blit_prog,
+            blit_vao,
+            cache: None,
+            cache_failed: false,
             mesh: None,
             lines: None,
             holes: None,
@@ -430,6 +579,9 @@ impl Renderer {
         if let Some((d, ib)) = self.mesh.take() {
             d.delete(gl);
             gl.delete_buffer(Some(&ib));
+        }
+        if let Some(c) = &mut self.cache {
+            c.mvp = None;
         }
         let vao = gl
             .create_vertex_array()
@@ -567,32 +719,136 @@ impl Renderer {
         Ok(())
     }
 
-    pub fn draw(&self) {
+    /// Draws the mesh with the camera's `mvp` into the bound framebuffer.
+    fn draw_mesh(&self, mesh: &Drawable, mvp: &[f32; 16]) {
         let gl = &self.gl;
+        let p = &self.mesh_prog;
+        gl.use_program(Some(&p.program));
+        gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
+        // A headlight, a little above and left of the eye, so faces
+        // turned to the viewer are lit from any orbit angle.
+        let eye = self.camera.eye() - self.camera.target;
+        let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
+        gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+        let [r, g, b] = MESH;
+        gl.uniform3f(p.color.as_ref(), r, g, b);
+        // Push the surface back in depth so Ta, which lies on it, wins.
+        gl.enable(Gl::POLYGON_OFFSET_FILL);
+        gl.polygon_offset(1.0, 2.0);
+        gl.bind_vertex_array(Some(&mesh.vao));
+        gl.draw_elements_with_i32(Gl::TRIANGLES, mesh.count, Gl::UNSIGNED_INT, 0);
+        gl.disable(Gl::POLYGON_OFFSET_FILL);
+    }
+
+    /// The mesh image for `mvp`, drawn into the cache if it holds another
+    /// view; false when there is no cache (draw the mesh directly).
+    fn cached_mesh(&mut self, mesh: &Drawable, mvp: &[f32; 16]) -> bool {
+        if self.cache_failed {
+            return false;
+        }
+        let (w, h) = (self.width, self.height);
+        if self
+            .cache
+            .as_ref()
+            .is_some_and(|c| c.width != w || c.height != h)
+        {
+            if let Some(c) = self.cache.take() {
+                c.delete(&self.gl);
+            }
+        }
+        if self.cache.is_none() {
+            match MeshCache::new(&self.gl, w, h) {
+                Ok(c) => self.cache = Some(c),
+                Err(_) => {
+                    self.cache_failed = true;
+                    return false;
+                }
+            }
+        }
+        let Some(cache) = &self.cache else {
+            return false;
+        };
+        if cache.mvp.as_ref() == Some(mvp) {
+            return true;
+        }
+        let fb = cache.framebuffer.clone();
+        let bound = gl_call(&self.gl, "bindFramebuffer", &[Gl::FRAMEBUFFER.into(), fb]).is_ok();
+        if bound {
+            let gl = &self.gl;
+            let [r, g, b] = BACKGROUND;
+            gl.clear_color(r, g, b, 1.0);
+            gl.clear(Gl::COLOR_BUFFER_BIT | Gl::DEPTH_BUFFER_BIT);
+            self.draw_mesh(mesh, mvp);
+        }
+        let unbound = gl_call(
+            &self.gl,
+            "bindFramebuffer",
+            &[Gl::FRAMEBUFFER.into(), JsValue::NULL],
+        )
+        .is_ok();
+        if !(bound && unbound) {
+            self.cache_failed = true;
+            return false;
+        }
+        if let Some(c) = &mut self.cache {
+            c.mvp = Some(*mvp);
+        }
+        true
+    }
+
+    /// Copies the cached mesh image, colour and depth, to the canvas.
+    fn blit_mesh(&self) -> Result<(), String> {
+        let (gl, p) = (&self.gl, &self.blit_prog);
+        let Some(cache) = &self.cache else {
+            return Err("no mesh image".into());
+        };
+        gl.use_program(Some(&p.program));
+        gl.active_texture(Gl::TEXTURE0);
+        gl_call(
+            gl,
+            "bindTexture",
+            &[Gl::TEXTURE_2D.into(), cache.color.clone()],
+        )?;
+        gl.active_texture(Gl::TEXTURE1);
+        gl_call(
+            gl,
+            "bindTexture",
+            &[Gl::TEXTURE_2D.into(), cache.depth.clone()],
+        )?;
+        gl.uniform1i(p.color_tex.as_ref(), 0);
+        gl.uniform1i(p.depth_tex.as_ref(), 1);
+        gl.depth_func(Gl::ALWAYS);
+        gl.bind_vertex_array(Some(&self.blit_vao));
+        gl.draw_arrays(Gl::TRIANGLES, 0, 3);
+        gl.depth_func(Gl::LESS);
+        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
+        gl.active_texture(Gl::TEXTURE0);
+        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
+        Ok(())
+    }
+
+    pub fn draw(&mut self) {
+        let gl = self.gl.clone();
+        gl.viewport(0, 0, self.width as i32, self.height as i32);
+        gl.enable(Gl::DEPTH_TEST);
+        gl.depth_func(Gl::LESS);
+        let mvp = self.camera.view_proj().as_mat4().to_cols_array();
+        let mesh = self.mesh.take();
+        let cached = match &mesh {
+            Some((m, _)) => self.cached_mesh(m, &mvp),
+            None => false,
+        };
         gl.viewport(0, 0, self.width as i32, self.height as i32);
         let [r, g, b] = BACKGROUND;
         gl.clear_color(r, g, b, 1.0);
         gl.clear(Gl::COLOR_BUFFER_BIT | Gl::DEPTH_BUFFER_BIT);
-        gl.enable(Gl::DEPTH_TEST);
-        let mvp = self.camera.view_proj().as_mat4().to_cols_array();
-        if let Some((mesh, _)) = &self.mesh {
-            let p = &self.mesh_prog;
-            gl.use_program(Some(&p.program));
-            gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, &mvp);
-            // A headlight, a little above and left of the eye, so faces
-            // turned to the viewer are lit from any orbit angle.
-            let eye = self.camera.eye() - self.camera.target;
-            let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
-            gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
-            let [r, g, b] = MESH;
-            gl.uniform3f(p.color.as_ref(), r, g, b);
-            // Push the surface back in depth so Ta, which lies on it, wins.
-            gl.enable(Gl::POLYGON_OFFSET_FILL);
-            gl.polygon_offset(1.0, 2.0);
-            gl.bind_vertex_array(Some(&mesh.vao));
-            gl.draw_elements_with_i32(Gl::TRIANGLES, mesh.count, Gl::UNSIGNED_INT, 0);
-            gl.disable(Gl::POLYGON_OFFSET_FILL);
+        if let Some((m, _)) = &mesh {
+            if !(cached && self.blit_mesh().is_ok()) {
+                self.draw_mesh(m, &mvp);
+            }
         }
+        self.mesh = mesh;
+        let gl = &self.gl;
         let p = &self.line_prog;
         gl.use_program(Some(&p.program));
         gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, &mvp);

@@ -1128,7 +1128,7 @@ impl Viewer {
         self.r.camera.top();
     }
 
-    pub fn draw(&self) {
+    pub fn draw(&mut self) {
         self.r.draw();
     }
 
