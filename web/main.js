@@ -8,12 +8,14 @@ import {
   Viewer,
   antennaSvg,
   checkProfile,
+  checkScanSize,
+  checkSvgSize,
   demoPathName,
   demoPathSvg,
-  demoScan,
   demoScanName,
   demoSettings,
   dialects,
+  pageLimits,
   parsePoints,
   pathBounds,
   version,
@@ -29,28 +31,44 @@ const GAUGES = [
   ['27 G', 0.21, 0.413],
   ['30 G', 0.159, 0.312],
 ];
-const STAGES = ['scan', 'plan', 'compare'];
+const STAGES = ['read', 'import', 'register', 'index', 'plan'];
 const encoder = new TextEncoder();
+const decoder = new TextDecoder();
 
 const state = {
-  scan: null, // the accepted scan {key, name, bytes}
+  // The accepted scan {key, name, size, blob}: blob is the user's File
+  // (handed to the worker, which reads it) or null for the demo.
+  scan: null,
   pendingScan: null, // a scan loaded but not yet read by the worker
-  svgFile: null, // the accepted SVG file
+  svgFile: null, // the accepted SVG file {key, name, bytes}
   pendingSvg: null,
+  svgMade: null, // the last generated path {key, name, bytes} (antennas, demo)
   nextKey: 1,
   module: null,
   worker: null,
+  sentSvgKey: null, // the drawing whose bytes the current worker holds
   busy: null, // the plan request in flight
-  queued: false,
+  queued: false, // a newer request waits for it: only the newest is planned
+  // Every change of an input or setting counts up; a plan is offered for
+  // download only if nothing changed since it was requested.
+  gen: 0,
   planId: 0,
   lastPlan: null,
+  interacting: false, // a drag or slider in progress: skip the comparison
   info: null, // the scan as the worker read it
   viewer: null,
   redraw: 0,
+  frames: 0, // frames the view has drawn (tests read the rate)
   debounce: 0,
   urls: [],
   picking: false, // "pick on mesh" mode: a click on the view adds a scan point
+  moving: false, // "move path" mode: a drag in the view moves the placement
   pickId: 0,
+  // Re-planning figures: plans finished, the last planner time and the
+  // last time from request to plan on screen (ms), requests sent while
+  // another was in flight (always 0: never a backlog).
+  stats: { plans: 0, planMs: [], latencyMs: [], overlapped: 0 },
+  progressLog: [], // progress labels of the last scan read (tests read it)
 };
 
 let settings = null;
@@ -165,8 +183,15 @@ function antennaParams(kind) {
   return p;
 }
 
-// The path to plan: {key, name, bytes}.
+// The path to plan: {key, name, bytes}. Generated paths are keyed by their
+// parameters and made once per key (a drag re-plans many times a second).
 function currentSvg() {
+  const made = (key, name, text) => {
+    if (!state.svgMade || state.svgMade.key !== key) {
+      state.svgMade = { key, name, bytes: encoder.encode(text()) };
+    }
+    return state.svgMade;
+  };
   switch (settings.pathSource) {
     case 'file': {
       const f = state.pendingSvg || state.svgFile;
@@ -176,17 +201,22 @@ function currentSvg() {
     case 'spiral':
     case 'hilbert':
     case 'monopole': {
-      const text = antennaSvg(settings.pathSource, antennaParams(settings.pathSource));
-      return { key: `antenna-${settings.pathSource}`, name: `antenna-${settings.pathSource}.svg`, bytes: encoder.encode(text) };
+      const kind = settings.pathSource;
+      const params = antennaParams(kind);
+      return made(`antenna-${kind}-${JSON.stringify(params)}`, `antenna-${kind}.svg`,
+        () => antennaSvg(kind, params));
     }
     default:
-      return { key: 'demo', name: demoPathName(), bytes: encoder.encode(demoPathSvg()) };
+      return made('demo', demoPathName(), demoPathSvg);
   }
 }
 
 // ---------- form binding ----------
 
-// [element id, getter, setter, re-plan on every keystroke]
+// [element id, getter, setter, when to re-plan]: 'live' on every input
+// event at once (sliders; the comparison of the four planners waits for the
+// release), 'typed' on every keystroke after a short pause, otherwise on
+// change. Re-plans are coalesced: only the newest settings are planned.
 const FIELDS = [
   ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; }],
   ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
@@ -203,15 +233,17 @@ const FIELDS = [
   ['mp-height', () => settings.monopole.height_mm, (v) => { settings.monopole.height_mm = Number(v); }],
   ['mp-base', () => settings.monopole.base_mm, (v) => { settings.monopole.base_mm = Number(v); }],
   ['mp-feed', () => settings.monopole.feed_mm, (v) => { settings.monopole.feed_mm = Number(v); }],
-  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, true],
-  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, true],
-  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, true],
-  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, true],
-  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }],
-  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }],
-  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }],
-  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = Number(v); }],
-  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = Number(v); }],
+  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, 'typed'],
+  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, 'typed'],
+  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'typed'],
+  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'typed'],
+  ['pl-rot-range', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'live'],
+  ['pl-scale-range', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'live'],
+  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }, 'typed'],
+  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }, 'typed'],
+  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }, 'typed'],
+  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = Number(v); }, 'typed'],
+  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = Number(v); }, 'typed'],
   ['planner', () => settings.planner, (v) => { settings.planner = v; }],
   ['dialect', () => settings.dialect, (v) => { settings.dialect = v; }],
   ['accept-risk', () => settings.acceptRisk, (v) => { settings.acceptRisk = v; }],
@@ -244,8 +276,21 @@ function syncVisibility() {
     : $('path-source').selectedOptions[0].textContent;
 }
 
+// Number fields and their sliders show the same setting.
+const PAIRS = { 'pl-rot': 'pl-rot-range', 'pl-rot-range': 'pl-rot', 'pl-scale': 'pl-scale-range', 'pl-scale-range': 'pl-scale' };
+
+// Writes one field from the settings (not the one being typed in: that
+// would rewrite "1." as "1" under the user's cursor).
+function writeField(id) {
+  const f = FIELDS.find((x) => x[0] === id);
+  if (!f) return;
+  const el = $(id);
+  const v = f[1]();
+  el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+}
+
 function bindForm() {
-  for (const [id, , set, live] of FIELDS) {
+  for (const [id, , set, mode] of FIELDS) {
     const el = $(id);
     // Antenna SVGs measure from their page's corner, so a new size moves
     // the antenna; keep its centre where the user placed it.
@@ -260,15 +305,25 @@ function bindForm() {
         settings.placement.y = +(num(settings.placement.y) + dy).toFixed(3);
         writeForm();
       }
+      if (PAIRS[id]) writeField(PAIRS[id]);
       saveSettings();
       syncGauge();
       syncVisibility();
       if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
         centreOnScan(false);
       }
-      schedulePlan(live ? 200 : 350);
+      if (mode === 'live') {
+        state.interacting = true;
+        planNow();
+      } else {
+        schedulePlan(mode === 'typed' ? 120 : 350);
+      }
     };
-    el.addEventListener(live || el.tagName === 'TEXTAREA' ? 'input' : 'change', handler);
+    el.addEventListener(mode || el.tagName === 'TEXTAREA' ? 'input' : 'change', handler);
+    if (mode === 'live') {
+      // The slider is let go: plan once more with the comparison.
+      el.addEventListener('change', () => endInteraction());
+    }
   }
   const gauge = $('gauge');
   GAUGES.forEach(([name, id, od], i) => gauge.add(new Option(`${name}  (${id} / ${od} mm)`, String(i))));
@@ -330,29 +385,33 @@ function hideDownloads() {
   $('dl-report').removeAttribute('href');
 }
 
+// The G-code and report as the planner wrote them (bytes, no string copy).
 function offerDownloads(plan) {
   hideDownloads();
   const stem = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
-  const link = (el, text, type, name) => {
-    const url = URL.createObjectURL(new Blob([text], { type }));
+  const link = (el, bytes, type, name) => {
+    const url = URL.createObjectURL(new Blob([bytes], { type }));
     state.urls.push(url);
     el.href = url;
     el.download = name;
     el.hidden = false;
   };
-  link($('dl-gcode'), plan.gcode, 'text/plain', `${stem}-${plan.planner}.gcode`);
-  link($('dl-report'), plan.reportJson, 'application/json', `${stem}-${plan.planner}.json`);
+  link($('dl-gcode'), plan.gcodeBytes, 'text/plain', `${stem}-${plan.planner}.gcode`);
+  link($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
 }
 
-function showProgress(stage, label) {
+function showProgress(stage, label, fraction) {
   $('progress').hidden = false;
   const at = STAGES.indexOf(stage);
   for (const li of $('stages').children) {
     const i = STAGES.indexOf(li.dataset.stage);
     li.classList.toggle('active', i === at);
-    li.classList.toggle('done', i < at);
+    li.classList.toggle('done', at >= 0 && i < at);
   }
   $('progress-label').textContent = label || '';
+  const bar = $('progress-bar');
+  bar.hidden = stage !== 'read' || !(fraction >= 0);
+  if (!bar.hidden) bar.value = fraction;
 }
 
 function endProgress() {
@@ -362,11 +421,34 @@ function endProgress() {
 
 // ---------- planning ----------
 
-function schedulePlan(delay) {
+// Something the plan depends on changed: the G-code on offer is stale from
+// this moment, not from when the new plan starts.
+function markChanged() {
+  state.gen++;
   hideDownloads();
   if (state.lastPlan) setStatus('settings changed: re-planning…', true);
+}
+
+function schedulePlan(delay) {
+  markChanged();
   clearTimeout(state.debounce);
   state.debounce = setTimeout(requestPlan, delay);
+}
+
+// A live change (drag, slider): planned at once if the worker is free,
+// else right after the plan in flight (the newest settings only).
+function planNow() {
+  markChanged();
+  requestPlan();
+}
+
+function endInteraction() {
+  if (!state.interacting) return;
+  state.interacting = false;
+  saveSettings();
+  // Once more with the comparison of the four planners (the surface path is
+  // kept by the worker, so this only plans).
+  requestPlan();
 }
 
 function requestPlan() {
@@ -379,7 +461,6 @@ function requestPlan() {
 }
 
 function runPlan() {
-  hideDownloads();
   const scan = state.pendingScan || state.scan;
   let job;
   let svg;
@@ -391,32 +472,66 @@ function runPlan() {
     setStatus(state.lastPlan ? 'plan failed: showing the previous plan' : 'plan failed', true);
     return;
   }
+  if (state.busy) state.stats.overlapped++;
   const id = ++state.planId;
-  state.busy = { id, scan, svg, job, planner: job.plan.planner };
+  const compare = !state.interacting;
+  state.busy = { id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, t0: performance.now() };
   state.queued = false;
   $('cancel-btn').hidden = false;
-  showProgress('scan', 'starting');
+  showProgress('plan', 'starting');
   setStatus('planning…');
+  // The worker keeps the last drawing it was sent: its bytes go only when
+  // the drawing changes, as a copy whose buffer is transferred.
+  const msgSvg = { key: svg.key, name: svg.name };
+  const transfer = [];
+  if (state.sentSvgKey !== svg.key) {
+    msgSvg.bytes = svg.bytes.slice();
+    transfer.push(msgSvg.bytes.buffer);
+    state.sentSvgKey = svg.key;
+  }
   state.worker.postMessage({
     type: 'plan',
     id,
-    scan: { key: scan.key, name: scan.name, bytes: scan.bytes },
-    svg: { name: svg.name, bytes: svg.bytes },
-    settings: job,
+    // A File is a handle: posting it copies no bytes (the worker reads it).
+    scan: { key: scan.key, name: scan.name, blob: scan.blob },
+    scanSettings: job.scan,
+    registration: job.registration,
+    svg: msgSvg,
+    plan: job.plan,
     // A built-in name, or the user's profile as JSON text (named by its file).
     dialect: settings.dialect === 'custom' && settings.customProfile
       ? settings.customProfile.text : settings.dialect,
     profileFile: settings.dialect === 'custom' && settings.customProfile
       ? settings.customProfile.file : undefined,
     acceptRisk: !!settings.acceptRisk,
-    compare: true,
-  });
+    compare,
+  }, transfer);
 }
 
 function finish() {
   state.busy = null;
   endProgress();
   if (state.queued) runPlan();
+}
+
+// What the page keeps of a plan: the bytes to download (decoded to text
+// only when asked), what the tables show and the per-point arrays.
+function keptPlan(m, busy) {
+  let gcode = null;
+  let reportJson = null;
+  return {
+    gcodeBytes: m.gcode,
+    reportBytes: m.report,
+    get gcode() { gcode ??= decoder.decode(m.gcode); return gcode; },
+    get reportJson() { reportJson ??= decoder.decode(m.report); return reportJson; },
+    summary: m.summary,
+    view: m.view,
+    svgName: busy.svg.name,
+    planner: busy.planner,
+    placement: busy.job.plan.placement,
+    gen: busy.gen,
+    compared: !!m.comparison,
+  };
 }
 
 function onWorkerMessage(e) {
@@ -433,41 +548,46 @@ function onWorkerMessage(e) {
   }
   switch (m.type) {
     case 'progress':
-      showProgress(m.stage, m.label);
+      if (m.stage === 'scan') {
+        if (m.first) state.progressLog = [];
+        state.progressLog.push(m.label);
+        showProgress(m.step === 'done' ? 'plan' : m.step, m.label, m.fraction);
+      } else {
+        showProgress('plan', m.label);
+      }
       break;
     case 'scan':
       if (state.pendingScan && state.pendingScan.key === m.key) {
         acceptScan();
       }
-      showScan(m.info, m.positions, m.indices);
+      showScan(m.info, m.positions, m.indices, m.seconds);
       break;
     case 'result': {
       if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {
         state.svgFile = state.pendingSvg;
         state.pendingSvg = null;
       }
-      const report = JSON.parse(m.reportJson);
-      state.lastPlan = {
-        gcode: m.gcode,
-        reportJson: m.reportJson,
-        report,
-        svgName: busy.svg.name,
-        planner: busy.planner,
-      };
+      state.lastPlan = keptPlan(m, busy);
+      const latency = performance.now() - busy.t0;
+      const st = state.stats;
+      st.plans++;
+      st.planMs.push(m.planMs);
+      st.latencyMs.push(latency);
+      if (st.planMs.length > 1000) { st.planMs.shift(); st.latencyMs.shift(); }
+      $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
-      showPlan(report);
-      if (state.queued) {
-        setStatus('settings changed: re-planning…', true);
-      } else {
+      showPlan(state.lastPlan);
+      if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
         setStatus(`planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}`);
+      } else {
+        // Shown while the user goes on changing things; not offered.
+        setStatus('settings changed: re-planning…', true);
       }
-      $('compare-table').tBodies[0].replaceChildren();
+      if (m.comparison) showComparison(m.comparison, busy.planner);
+      else $('compare-table').classList.add('stale');
       break;
     }
-    case 'comparison':
-      showComparison(m.rows, busy.planner);
-      break;
     case 'done':
       finish();
       break;
@@ -483,7 +603,19 @@ function onWorkerMessage(e) {
 function onPlanError(m, busy) {
   let title = 'Planning failed';
   let message = m.message;
-  if (m.stage === 'scan' && m.kind === 'mesh' && state.pendingScan && busy.scan === state.pendingScan) {
+  if (m.kind === 'crash') {
+    // The wasm instance trapped (most likely out of memory): a new worker.
+    restartWorker();
+    title = m.stage === 'scan' ? `The planner ran out of memory or failed reading ${busy.scan.name}` : 'The planner stopped';
+    message += '\nThe planner was restarted';
+    if (state.pendingScan && busy.scan === state.pendingScan) {
+      state.pendingScan = null;
+      message += `; still using the previous scan, ${state.scan.name}`;
+    }
+    message += '.';
+    $('scan-name').textContent = state.scan.name;
+  } else if (m.stage === 'scan' && (m.kind === 'mesh' || m.kind === 'limit' || m.kind === 'other')
+    && state.pendingScan && busy.scan === state.pendingScan) {
     // The file could not be read: keep working with the previous scan.
     title = `Could not read the scan ${state.pendingScan.name}`;
     state.pendingScan = null;
@@ -504,14 +636,17 @@ function onPlanError(m, busy) {
     message += state.svgFile
       ? `\nStill using the previous SVG, ${state.svgFile.name}.`
       : '\nBack to the demo paths.';
-  } else if (m.stage === 'compare') {
-    // The plan itself succeeded and stays downloadable.
-    title = 'Comparing the planners failed';
-    showError(title, message);
-    return;
+  } else if (m.kind === 'limit') {
+    title = 'The path is too long for the page';
   }
   showError(title, message);
+  // Nothing stale on offer; the previous plan stays on screen, where it was
+  // planned.
   hideDownloads();
+  if (state.viewer) {
+    state.viewer.setPathOffset(0, 0, 0);
+    requestDraw();
+  }
   setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 
@@ -532,8 +667,7 @@ function acceptScan() {
 function cancelPlan() {
   if (!state.busy) return;
   // The only way to stop wasm mid-computation: end the worker.
-  state.worker.terminate();
-  state.worker = makeWorker();
+  restartWorker();
   state.busy = null;
   state.queued = false;
   endProgress();
@@ -541,8 +675,15 @@ function cancelPlan() {
   setStatus('cancelled', true);
 }
 
+function restartWorker() {
+  state.worker.terminate();
+  state.worker = makeWorker();
+}
+
 function makeWorker() {
   const w = startWorker(state.module);
+  // A new worker holds no scan and no drawing.
+  state.sentSvgKey = null;
   w.onmessage = onWorkerMessage;
   w.onerror = (e) => {
     showError('The planner stopped', e.message || 'the worker failed to load');
@@ -556,12 +697,13 @@ function makeWorker() {
 
 const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '∞' : v.toFixed(d));
 
-function showScan(info, positions, indices) {
+function showScan(info, positions, indices, seconds) {
   state.info = info;
   $('scan-name').textContent = info.name;
   const [lo, hi] = info.bbox_mm;
-  $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString()} triangles, `
-    + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units})`;
+  $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
+    + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
+    + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s`;
   if (state.viewer) {
     try {
       state.viewer.setMesh(positions, indices);
@@ -724,17 +866,21 @@ function safePoints(text) {
   }
 }
 
-function showPlan(report) {
+function showPlan(plan) {
+  const { summary, view } = plan;
   if (state.viewer) {
     try {
-      state.viewer.setPaths(report);
+      state.viewer.setPathArrays(view.pieces, view.ta, view.tool, view.defects);
     } catch (e) {
       showError('Could not draw the paths', e.message);
     }
+    updateDragOffset();
     requestDraw();
   }
-  const st = report.stats;
+  const st = summary.stats;
+  const pl = summary.settings.placement;
   const rows = [
+    ['placement', `(${pl.offset_mm[0]}, ${pl.offset_mm[1]}) mm, ${pl.rotation_deg}°, × ${pl.scale}`, 'shown-placement'],
     ['pieces', st.subpaths],
     ['points', st.points],
     ['tool-path length', `${fmt(st.length_mm, 2)} mm`],
@@ -742,27 +888,32 @@ function showPlan(report) {
     ['max inclination', `${fmt(st.max_inclination_deg, 1)}°`],
     ['min radius of curvature', `${fmt(st.min_radius_mm)} mm`],
     ['print time', `${fmt(st.print_time_s, 1)} s`],
-    ['registration RMS', `${fmt(report.registration.rms_mm, 4)} mm`],
+    ['registration RMS', `${fmt(summary.registration_rms_mm, 4)} mm`],
   ];
   const body = $('stats-table').tBodies[0];
-  body.replaceChildren(...rows.map(([k, v]) => {
+  body.replaceChildren(...rows.map(([k, v, id]) => {
     const tr = document.createElement('tr');
     const a = document.createElement('td');
     const b = document.createElement('td');
     a.textContent = k;
     b.textContent = String(v);
+    if (id) b.id = id;
     tr.append(a, b);
     return tr;
   }));
-  $('warnings').replaceChildren(...report.warnings.map((w) => {
+  $('warnings').replaceChildren(...summary.warnings.map((w) => {
     const li = document.createElement('li');
     li.textContent = w;
     return li;
   }));
-  drawPlot($('plot'), report, report.settings.nozzle.inner_diameter_mm);
+  // A long path's plot waits for the end of a drag.
+  if (!state.interacting || view.defects.length < 20000) {
+    drawPlot($('plot'), view, summary.settings.nozzle.inner_diameter_mm);
+  }
 }
 
 function showComparison(rows, selected) {
+  $('compare-table').classList.remove('stale');
   const body = $('compare-table').tBodies[0];
   body.replaceChildren(...rows.map((r) => {
     const q = r.quality;
@@ -782,6 +933,43 @@ function showComparison(rows, selected) {
 // ---------- files ----------
 
 async function openFile(file) {
+  if (/\.svg$/i.test(file.name)) {
+    await openSvg(file);
+    return;
+  }
+  // Past the page's limit the file is refused before a byte is read, and
+  // the loaded scan stays.
+  try {
+    checkScanSize(file.name, file.size);
+  } catch (e) {
+    showError(`Could not open the scan ${file.name}`,
+      `${e.message}\nStill using ${state.scan ? state.scan.name : 'no scan'}.`);
+    return;
+  }
+  // The File itself goes to the worker, which reads it into wasm memory:
+  // the scan's bytes never pass through this thread or a JS string.
+  const entry = { key: `file-${state.nextKey++}`, name: file.name, size: file.size, blob: file };
+  state.pendingScan = entry;
+  // The demo's fiducials belong to the demo part: a new scan is read
+  // unregistered until the user sets its fiducials (the settings change
+  // only once the scan is read, so a bad file changes nothing).
+  const demo = demoUiSettings();
+  if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
+    entry.unregistered = true;
+  }
+  $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
+  saveSettings();
+  writeForm();
+  schedulePlan(0);
+}
+
+async function openSvg(file) {
+  try {
+    checkSvgSize(file.name, file.size);
+  } catch (e) {
+    showError(`Could not open the SVG ${file.name}`, e.message);
+    return;
+  }
   let bytes;
   try {
     // Bytes go to wasm as a Uint8Array, never through a JS string.
@@ -790,21 +978,8 @@ async function openFile(file) {
     showError(`Could not read ${file.name}`, e.message);
     return;
   }
-  const entry = { key: `file-${state.nextKey++}`, name: file.name, bytes };
-  if (/\.svg$/i.test(file.name)) {
-    state.pendingSvg = entry;
-    settings.pathSource = 'file';
-  } else {
-    state.pendingScan = entry;
-    // The demo's fiducials belong to the demo part: a new scan is read
-    // unregistered until the user sets its fiducials (the settings change
-    // only once the scan is read, so a bad file changes nothing).
-    const demo = demoUiSettings();
-    if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
-      entry.unregistered = true;
-    }
-    $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
-  }
+  state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes };
+  settings.pathSource = 'file';
   saveSettings();
   writeForm();
   schedulePlan(0);
@@ -872,6 +1047,11 @@ function bindFiles() {
   });
 }
 
+// The demo scan: the worker makes its bytes itself.
+function demoScanEntry() {
+  return { key: 'demo', name: demoScanName(), size: 0, blob: null };
+}
+
 function loadDemo() {
   const demo = demoUiSettings();
   settings.fidSource = demo.fidSource;
@@ -882,7 +1062,7 @@ function loadDemo() {
   settings.scanUnits = '';
   settings.scanUp = '';
   state.pendingScan = null;
-  state.scan = { key: 'demo', name: demoScanName(), bytes: demoScan() };
+  state.scan = demoScanEntry();
   saveSettings();
   writeForm();
   schedulePlan(0);
@@ -931,6 +1111,7 @@ function centreOnScan(showErrors = true) {
 
 function setPicking(on) {
   state.picking = on;
+  if (on && state.moving) setMoving(false);
   const b = $('pick-btn');
   b.setAttribute('aria-pressed', on ? 'true' : 'false');
   b.textContent = on ? 'Picking: click the scan (Esc stops)' : 'Pick on mesh';
@@ -983,12 +1164,97 @@ function onPick(m) {
   if (ready) schedulePlan(0);
 }
 
+// ---------- moving the path on the scan ----------
+
+function setMoving(on) {
+  state.moving = on;
+  $('move-btn').setAttribute('aria-pressed', on ? 'true' : 'false');
+  $('view').classList.toggle('moving', on);
+  if (on && state.picking) setPicking(false);
+}
+
+// The device pixel of a pointer event on the canvas.
+function canvasPixel(canvas, e) {
+  const rect = canvas.getBoundingClientRect();
+  return [(e.clientX - rect.left) * (canvas.width / rect.width),
+    (e.clientY - rect.top) * (canvas.height / rect.height)];
+}
+
+// Where the camera ray through a pixel meets the plane z = zPlane (printer
+// frame): the point of the scan the pointer holds during a drag. Null when
+// the ray runs parallel to the plane or away from it.
+function groundPoint([px, py], zPlane) {
+  let r;
+  try {
+    r = state.viewer.pickRay(px, py);
+  } catch {
+    return null;
+  }
+  const [ox, oy, oz, dx, dy, dz] = r;
+  if (Math.abs(dz) < 1e-9) return null;
+  const t = (zPlane - oz) / dz;
+  if (!(t > 0)) return null;
+  return [ox + t * dx, oy + t * dy];
+}
+
+// The height a drag moves the path at: the mean of the surface path on
+// screen, else the scan's middle (in the top view any height gives the
+// same XY).
+function dragPlaneZ() {
+  const v = state.lastPlan && state.lastPlan.view;
+  if (v && v.ta.length >= 3) {
+    let z = 0;
+    for (let i = 2; i < v.ta.length; i += 3) z += v.ta[i];
+    return z / (v.ta.length / 3);
+  }
+  const [lo, hi] = state.info.bbox_mm;
+  return (lo[2] + hi[2]) / 2;
+}
+
+// Offsets are kept to 0.01 mm: what the fields show is what is planned.
+const round2 = (v) => Math.round(v * 100) / 100;
+
+function movePlacementTo(x, y) {
+  const nx = round2(x);
+  const ny = round2(y);
+  if (nx === num(settings.placement.x) && ny === num(settings.placement.y)) return;
+  settings.placement.x = nx;
+  settings.placement.y = ny;
+  writeField('pl-x');
+  writeField('pl-y');
+  state.interacting = true;
+  updateDragOffset();
+  planNow();
+}
+
+// While the placement differs from that of the plan on screen by a shift
+// only, the view draws that plan shifted, so the path follows the pointer
+// at the frame rate while the plan at the new placement is computed.
+function updateDragOffset() {
+  if (!state.viewer) return;
+  const p = state.lastPlan && state.lastPlan.placement;
+  const s = settings.placement;
+  let dx = 0;
+  let dy = 0;
+  if (p && p.rotation_deg === num(s.rot) && p.scale === num(s.scale)) {
+    dx = num(s.x) - p.offset_mm[0];
+    dy = num(s.y) - p.offset_mm[1];
+    if (!Number.isFinite(dx) || !Number.isFinite(dy)) {
+      dx = 0;
+      dy = 0;
+    }
+  }
+  state.viewer.setPathOffset(dx, dy, 0);
+  requestDraw();
+}
+
 // ---------- 3-D view ----------
 
 function requestDraw() {
   if (!state.viewer || state.redraw) return;
   state.redraw = requestAnimationFrame(() => {
     state.redraw = 0;
+    state.frames++;
     state.viewer.draw();
   });
 }
@@ -1020,11 +1286,28 @@ function bindView() {
     drag = {
       x: e.clientX, y: e.clientY, x0: e.clientX, y0: e.clientY,
       pan: e.button === 2 || e.button === 1 || e.shiftKey,
+      move: null,
     };
+    // Move mode, or Ctrl/Alt/Cmd-drag in any mode: the drag moves the path.
+    const wantMove = e.button === 0 && !e.shiftKey && (state.moving || e.ctrlKey || e.altKey || e.metaKey);
+    if (wantMove && state.info) {
+      const z = dragPlaneZ();
+      const g = groundPoint(canvasPixel(canvas, e), z);
+      if (g) {
+        drag.move = { z, g0: g, px: num(settings.placement.x), py: num(settings.placement.y), moved: false };
+      }
+    }
     canvas.setPointerCapture(e.pointerId);
   });
   canvas.addEventListener('pointermove', (e) => {
     if (!drag) return;
+    if (drag.move) {
+      const g = groundPoint(canvasPixel(canvas, e), drag.move.z);
+      if (!g) return;
+      drag.move.moved = true;
+      movePlacementTo(drag.move.px + g[0] - drag.move.g0[0], drag.move.py + g[1] - drag.move.g0[1]);
+      return;
+    }
     const dpr = window.devicePixelRatio || 1;
     const dx = (e.clientX - drag.x) * dpr;
     const dy = (e.clientY - drag.y) * dpr;
@@ -1034,13 +1317,16 @@ function bindView() {
     else state.viewer.orbit(dx, dy);
     requestDraw();
   });
-  const end = () => { drag = null; };
+  const end = () => {
+    if (drag && drag.move && drag.move.moved) endInteraction();
+    drag = null;
+  };
   canvas.addEventListener('pointerup', (e) => {
     // In pick mode a click (no drag) picks; a drag still turns the view.
-    if (drag && state.picking && !drag.pan && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) {
-      const rect = canvas.getBoundingClientRect();
-      pickAt((e.clientX - rect.left) * (canvas.width / rect.width),
-        (e.clientY - rect.top) * (canvas.height / rect.height));
+    if (drag && !drag.move && state.picking && !drag.pan
+      && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) {
+      const [px, py] = canvasPixel(canvas, e);
+      pickAt(px, py);
     }
     end();
   });
@@ -1050,8 +1336,19 @@ function bindView() {
     state.viewer.zoom(e.deltaMode === 1 ? e.deltaY * 20 : e.deltaY);
     requestDraw();
   }, { passive: false });
+  // In move mode the arrow keys nudge the path: 0.5 mm, 5 mm with Shift.
+  const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] };
+  canvas.addEventListener('keydown', (e) => {
+    const d = ARROWS[e.key];
+    if (!state.moving || !d) return;
+    e.preventDefault();
+    const step = e.shiftKey ? 5 : 0.5;
+    movePlacementTo(num(settings.placement.x) + d[0] * step, num(settings.placement.y) + d[1] * step);
+  });
+  canvas.addEventListener('keyup', (e) => { if (ARROWS[e.key]) endInteraction(); });
   $('reset-view').addEventListener('click', () => { state.viewer.resetView(); requestDraw(); });
   $('top-view').addEventListener('click', () => { state.viewer.topView(); requestDraw(); });
+  $('move-btn').addEventListener('click', () => setMoving(!state.moving));
 }
 
 // ---------- start ----------
@@ -1064,6 +1361,7 @@ async function start() {
     return;
   }
   $('version').textContent = `v${version()}`;
+  $('scan-limit').textContent = `${pageLimits().scan_bytes / (1 << 20)} MiB`;
   settings = loadSettings();
   bindForm();
   writeForm();
@@ -1085,7 +1383,7 @@ async function start() {
   });
   window.addEventListener('keydown', (e) => { if (e.key === 'Escape' && state.picking) setPicking(false); });
   state.worker = makeWorker();
-  state.scan = { key: 'demo', name: demoScanName(), bytes: demoScan() };
+  state.scan = demoScanEntry();
   $('scan-name').textContent = state.scan.name;
   // For tests and the curious: read-only access to the page's state.
   window.pcpp = { state, get settings() { return settings; } };

@@ -1,6 +1,9 @@
 // The error plot (the paper's Figure 3d): predicted filament error against
 // surface slope and against curvature, one dot per point, coloured by the
-// predicted defect. Drawn on a 2-D canvas from the report's series.
+// predicted defect. Drawn on a 2-D canvas from the plan's per-point arrays.
+
+// The planner's defect codes (src/wasm.rs, defect_code).
+const DEFECT_NAMES = ['good', 'contact', 'flattening', 'floating'];
 
 const COLORS = {
   good: '#28d246',
@@ -63,8 +66,10 @@ function panel(ctx, box, points, xLabel, xOf, d) {
   }
 }
 
-// Draws both panels; `report` is the parsed JSON report (null clears).
-export function drawPlot(canvas, report, nozzleD) {
+// Draws both panels from a plan's per-point arrays (`view` of the worker's
+// result: slope, kappa, error with NaN at contacts, defect codes); null
+// clears.
+export function drawPlot(canvas, view, nozzleD) {
   const dpr = window.devicePixelRatio || 1;
   const cw = canvas.clientWidth || 900;
   const ch = canvas.clientHeight || 260;
@@ -73,18 +78,17 @@ export function drawPlot(canvas, report, nozzleD) {
   const ctx = canvas.getContext('2d');
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, cw, ch);
-  if (!report) return;
+  if (!view) return;
   const points = [];
-  report.series.forEach((piece, k) => {
-    piece.forEach((s, j) => {
-      points.push({
-        slope: s.slope_deg,
-        kappa: s.kappa_per_mm,
-        e: s.error_mm,
-        defect: (report.defects[k] || [])[j] || 'good',
-      });
+  for (let i = 0; i < view.defects.length; i++) {
+    const e = view.error[i];
+    points.push({
+      slope: view.slope[i],
+      kappa: view.kappa[i],
+      e: Number.isNaN(e) ? null : e,
+      defect: DEFECT_NAMES[view.defects[i]] || 'good',
     });
-  });
+  }
   if (points.length === 0) return;
   const w = (cw - 130) / 2;
   panel(ctx, { x: 55, y: 10, w, h: ch - 50 }, points, 'slope (deg)', (p) => p.slope, nozzleD);

@@ -1,48 +1,126 @@
 // The planning Worker: all planning runs here, so the page never freezes;
 // cancelling terminates this worker. It keeps one wasm Session (the scan
 // imported, registered and indexed) while the scan and its registration
-// settings stay the same, so a placement or nozzle change re-plans without
-// re-importing.
-import { initSync, initPanicHook, Session } from '../pkg/pcpp.js';
+// settings stay the same, and the drawing set on it, so a placement or
+// nozzle change re-plans without re-importing or re-reading the SVG.
+//
+// The scan arrives as a File (or null: the demo). Posting a File copies no
+// bytes; this worker reads it in slices straight into wasm memory
+// (ScanBuffer), so the page's main thread never holds the scan and JS never
+// holds it whole. Results go back as typed arrays whose buffers are
+// transferred, not copied.
+import { initSync, initPanicHook, ScanBuffer } from '../pkg/pcpp.js';
+
+// Slices of the file read per step: progress every 8 MiB.
+const CHUNK = 8 << 20;
+// Above this size the previous scan is freed before the new one is read, so
+// a tab holds one large scan at a time (the page still has the previous
+// file and re-reads it if the new one fails).
+const FREE_FIRST_BYTES = 64 << 20;
 
 let session = null;
 let sessionKey = null;
+// The last drawing the page sent {key, name, bytes}, and the key of the
+// one set on the session.
+let svg = null;
+let pathKey = null;
 
 const post = (msg, transfer) => self.postMessage(msg, transfer || []);
+const mib = (n) => (n / (1 << 20)).toFixed(1);
 
 function errorOf(err) {
+  // A trap (out of memory, or a bug) leaves the wasm instance unusable:
+  // the page restarts this worker.
+  const crashed = typeof WebAssembly !== 'undefined' && err instanceof WebAssembly.RuntimeError;
   return {
     message: String((err && err.message) || err),
-    kind: (err && err.kind) || 'other',
+    kind: crashed ? 'crash' : (err && err.kind) || 'other',
   };
 }
 
-function plan(m) {
+function progress(id, step, label, fraction, first) {
+  post({ type: 'progress', id, stage: step === 'plan' ? 'plan' : 'scan', step, label, fraction, first });
+}
+
+// Reads, imports, registers and indexes the scan, with a progress message
+// between the steps.
+async function loadScan(m) {
   const { id } = m;
-  const key = JSON.stringify([m.scan.key, m.settings.scan, m.settings.registration]);
+  const { name, blob } = m.scan;
+  const t0 = performance.now();
+  if (session && blob && blob.size > FREE_FIRST_BYTES) {
+    session.free();
+    session = null;
+    sessionKey = null;
+  }
+  let buf;
+  if (blob) {
+    progress(id, 'read', `reading ${name} (${mib(blob.size)} MiB)`, 0, true);
+    buf = new ScanBuffer(name, blob.size);
+    try {
+      for (let at = 0; at < blob.size; at += CHUNK) {
+        const part = new Uint8Array(await blob.slice(at, at + CHUNK).arrayBuffer());
+        buf.write(part);
+        const done = at + part.length;
+        progress(id, 'read', `reading ${name}: ${mib(done)} of ${mib(blob.size)} MiB`, done / blob.size);
+      }
+    } catch (err) {
+      buf.free();
+      throw err;
+    }
+  } else {
+    buf = ScanBuffer.demo();
+  }
+  progress(id, 'import', `importing ${name}`, undefined, !blob);
+  const imp = buf.importScan(m.scanSettings);
+  let s;
+  try {
+    progress(id, 'register', `finding fiducial holes and registering ${imp.triangles().toLocaleString('en')} triangles`);
+    imp.register(m.registration);
+    progress(id, 'index', `building the search structure (BVH) over ${imp.triangles().toLocaleString('en')} triangles`);
+  } catch (err) {
+    imp.free();
+    throw err;
+  }
+  s = imp.index();
+  if (session) session.free();
+  session = s;
+  pathKey = null;
+  const info = s.info();
+  const positions = s.meshPositions();
+  const indices = s.meshIndices();
+  const seconds = (performance.now() - t0) / 1000;
+  progress(id, 'done', `done: ${name}, ${info.triangles.toLocaleString('en')} triangles in ${seconds.toFixed(1)} s`, 1);
+  post({ type: 'scan', id, key: m.scan.key, info, seconds, positions, indices },
+    [positions.buffer, indices.buffer]);
+}
+
+async function plan(m) {
+  const { id } = m;
+  const key = JSON.stringify([m.scan.key, m.scanSettings, m.registration]);
   let stage = 'scan';
   try {
     if (key !== sessionKey) {
-      post({ type: 'progress', id, stage, label: 'reading and registering the scan' });
-      const s = new Session(m.scan.bytes, m.scan.name, m.settings.scan, m.settings.registration);
-      if (session) session.free();
-      session = s;
+      await loadScan(m);
       sessionKey = key;
-      const positions = s.meshPositions();
-      const indices = s.meshIndices();
-      post({ type: 'scan', id, key: m.scan.key, info: s.info(), positions, indices },
-        [positions.buffer, indices.buffer]);
     }
     stage = 'plan';
-    post({ type: 'progress', id, stage, label: 'projecting and planning the tool path' });
-    const r = session.plan(m.svg.bytes, m.svg.name, m.settings.plan, m.dialect, m.acceptRisk,
-      m.profileFile);
-    post({ type: 'result', id, gcode: r.gcode, reportJson: r.report_json });
-    if (m.compare) {
-      stage = 'compare';
-      post({ type: 'progress', id, stage, label: 'comparing the four planners' });
-      post({ type: 'comparison', id, rows: session.compare(m.svg.bytes, m.svg.name, m.settings.plan) });
+    if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
+    if (!svg || svg.key !== m.svg.key) throw new Error(`the drawing ${m.svg.name} did not reach the planner; plan again`);
+    if (pathKey !== svg.key) {
+      session.setPath(svg.bytes, svg.name);
+      pathKey = svg.key;
     }
+    progress(id, 'plan', m.compare ? 'planning and comparing the four planners' : 'planning');
+    const t0 = performance.now();
+    const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare);
+    const planMs = performance.now() - t0;
+    const v = r.view;
+    post({
+      type: 'result', id, gcode: r.gcode, report: r.report, summary: r.summary, view: v,
+      comparison: r.comparison, planMs,
+    }, [r.gcode.buffer, r.report.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
+      v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer]);
     post({ type: 'done', id });
   } catch (err) {
     post({ type: 'error', id, stage, ...errorOf(err) });
