@@ -1,9 +1,10 @@
 //! Criterion benchmarks of the native stages on the generated workloads
 //! W1-W3 (src/demo/workloads.rs), single-threaded:
-//! - `import/W1 binary PLY + BVH`: what a Session does with the scan's bytes
-//!   (`job::prepare_scan`: import, fiducial holes, registration, BVH);
+//! - `import/W1 binary PLY + index`: what a Session does with the scan's
+//!   bytes (`job::prepare_scan`: import, fiducial holes, registration and
+//!   the surface's acceleration structure);
 //! - `import/W1 OBJ text`: the OBJ importer alone (throughput in bytes);
-//! - `import/W1 OBJ + BVH`: the OBJ's `prepare_scan`, what the wasm script
+//! - `import/W1 OBJ + index`: the OBJ's `prepare_scan`, what the wasm script
 //!   can time (its API imports only through a Session);
 //! - `plan/W2 ...`, `plan/W3 ...`: the planning stages (project, spline,
 //!   pcpp-guarded, quality: `pipeline::plan`) of the paper's spiral and a
@@ -110,14 +111,14 @@ fn benches(c: &mut Criterion<Clock>) {
     // ten samples take ten runs rather than criterion's linear 55.
     let mut g = c.benchmark_group("import");
     g.sample_size(10).sampling_mode(SamplingMode::Flat);
-    g.bench_function("W1 binary PLY + BVH", |b| {
+    g.bench_function("W1 binary PLY + index", |b| {
         b.iter(|| prepare(black_box(&ply), "W1.ply", &w2))
     });
     g.throughput(Throughput::Bytes(obj.len() as u64));
     g.bench_function("W1 OBJ text", |b| {
         b.iter(|| pcpp::mesh::import_mesh(black_box(obj.as_bytes()), "W1.obj", &w2.scan).unwrap())
     });
-    g.bench_function("W1 OBJ + BVH", |b| {
+    g.bench_function("W1 OBJ + index", |b| {
         b.iter(|| prepare(black_box(obj.as_bytes()), "W1.obj", &w2))
     });
     g.finish();

@@ -57,7 +57,7 @@ fn main() -> ExitCode {
         }
     };
     drop(bytes);
-    // Ready to plan: one projection query through the BVH.
+    // Ready to plan: one query through the surface's index.
     let (lo, hi) = scan.surface.bbox();
     let mid = 0.5 * (lo + hi);
     let hit = scan.surface.segment_first_hit(

@@ -1,12 +1,13 @@
 #!/usr/bin/env node
 // Times the issue-5 stages in the wasm build, in Node, single-threaded, on
 // the workloads written by `cargo run --release --example workloads`:
-//   - Session from W1.ply's bytes (import, fiducial holes, registration, BVH);
+//   - Session from W1.ply's bytes (import, fiducial holes, registration,
+//     the surface's acceleration structure);
 //   - Session from W1.obj's bytes (MB/s of the file; the API imports only
-//     through a Session, so this includes the BVH: a lower bound on the OBJ
+//     through a Session, so this includes the index: a lower bound on the OBJ
 //     importer's own speed);
 //   - Session.plan of W2 and W3 on W1 (plan, report and G-code, converted to
-//     JS: what the page's Plan button runs);
+//     JS);
 //   - wasm memory (memory.buffer.byteLength) holding W1 ready to plan. Wasm
 //     memory never shrinks, so this is also the peak while it was prepared.
 // Medians over a few runs; PCPP_BENCH_CLOCK=cpu times CPU time of the thread

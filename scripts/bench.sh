@@ -109,10 +109,10 @@ const wasm = JSON.parse(readFileSync('target/bench/wasm.json', 'utf8'));
 const mem = readFileSync('target/bench/native-memory.txt', 'utf8');
 const peakRss = Number(/peak_rss_bytes=(\d+)/.exec(mem)?.[1] ?? die('no peak_rss_bytes'));
 
-const plyS = bench('import/W1 binary PLY + BVH').median_s;
+const plyS = bench('import/W1 binary PLY + index').median_s;
 const obj = bench('import/W1 OBJ text');
 const objMbS = obj.bytes / 1e6 / obj.median_s;
-const objSessionS = bench('import/W1 OBJ + BVH').median_s;
+const objSessionS = bench('import/W1 OBJ + index').median_s;
 const w2S = bench('plan/W2 spiral on W1 (pcpp-guarded + quality)').median_s;
 const w3S = bench('plan/W3 raster on W1 (pcpp-guarded + quality)').median_s;
 const w2JobS = bench('job/W2 plan + report + G-code').median_s;
@@ -123,7 +123,7 @@ const ms = (s) => (s < 0.1 ? f(s * 1e3, 1) : f(s * 1e3, 0)) + ' ms';
 const yes = (ok) => (ok ? 'yes' : 'no');
 const rows = [
   // step, target native, measured native, ok, target wasm, measured wasm, ok
-  ['W1 binary PLY import + BVH', '<= 0.8 s', f(plyS, 2) + ' s', plyS <= 0.8,
+  ['W1 binary PLY import + acceleration structure', '<= 0.8 s', f(plyS, 2) + ' s', plyS <= 0.8,
     '<= 1.2 s', f(wasm.ply_session_s, 2) + ' s', wasm.ply_session_s <= 1.2],
   ['W1 OBJ import', '>= 200 MB/s', f(objMbS, 0) + ' MB/s', objMbS >= 200,
     '>= 120 MB/s', f(wasm.obj_session_mb_s, 0) + ' MB/s (a)', wasm.obj_session_mb_s >= 120],
@@ -152,16 +152,20 @@ for (const [step, tn, mn, okn, tw, mw, okw] of rows) {
   out.push(`| ${step} | ${tn} | ${mn} | ${tw} | ${mw} | ${yes(okn)} / ${yes(okw)} |`);
 }
 out.push('');
-out.push(`(a) Session from the OBJ's bytes, which also finds the holes and builds the BVH ` +
+out.push(`(a) Session from the OBJ's bytes, which also finds the holes and builds the index ` +
   `(the wasm API imports only through a Session): a lower bound; the same natively ` +
   `${f(obj.bytes / 1e6 / objSessionS, 0)} MB/s.`);
-out.push(`(b) Session.plan: the plan, its report and G-code, converted to JS (what the page runs); ` +
+out.push('');
+out.push(`(b) Session.plan: the plan, its report and G-code, converted to JS; ` +
   `the same job natively: W2 ${ms(w2JobS)}, W3 ${ms(w3JobS)}.`);
+out.push('');
 out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs: the file's bytes, the mesh and ` +
-  `its BVH; ${f(Number(/ rss_bytes=(\d+)/.exec(mem)?.[1] ?? 0) / 1e6, 0)} MB resident once ` +
+  `its index; ${f(Number(/ rss_bytes=(\d+)/.exec(mem)?.[1] ?? 0) / 1e6, 0)} MB resident once ` +
   `the bytes are dropped.`);
+out.push('');
 out.push(`(d) memory.buffer.byteLength holding a Session on W1.ply (wasm memory never shrinks: ` +
   `also the peak while preparing it).`);
+out.push('');
 out.push(`Medians (wasm: W1 imports ${wasm.runs.ply_ms.length}x, plans ${wasm.runs.w2_ms.length}x and ` +
   `${wasm.runs.w3_ms.length}x after a warm-up); the first W1.ply Session in a fresh Node took ` +
   `${f(wasm.ply_session_first_s, 2)} s (V8's baseline code). MB = 10^6 bytes.`);
