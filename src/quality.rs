@@ -114,9 +114,10 @@ pub fn predict(
         Some(c) => c.params().to_vec(),
         None => (0..back.len()).map(|i| i as f64).collect(),
     };
+    let hint = std::cell::Cell::new(usize::MAX);
     let eval = |u: f64| -> DVec3 {
         match &curve {
-            Some(c) => c.eval(u),
+            Some(c) => c.eval_near(u, &hint),
             None => {
                 let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
                 let f = u - i as f64;
@@ -141,23 +142,28 @@ pub fn predict(
         let f = |u: f64| (eval(u) - a).dot(g.tangent);
         let lo = j.saturating_sub(SEARCH);
         let hi = (j + SEARCH).min(back.len() - 1);
-        let mut best: Option<(usize, f64)> = None;
+        // The crossing span nearest to j (the first found on a tie), then
+        // its root: one root search per point.
+        let mut nearest: Option<(usize, usize, f64, f64)> = None;
         // The curve passes through F_k at u_k, so the window is scanned on
         // the F_k themselves; only the crossing span is searched. Where the
         // curve crosses three times within one span (the spline overshoots
         // at a vertical step) any of them is a crossing; regula falsi starts
         // from the chord's crossing and usually ends at the one nearest it.
         let fk = |k: usize| (back[k] - a).dot(g.tangent);
+        let mut f1 = fk(lo);
         for k in lo..hi {
-            let (u0, u1) = (params[k], params[k + 1]);
-            let (f0, f1) = (fk(k), fk(k + 1));
+            let f0 = f1;
+            f1 = fk(k + 1);
             if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
                 let dist = k.abs_diff(j).min((k + 1).abs_diff(j));
-                if best.is_none_or(|(bd, _)| dist < bd) {
-                    best = Some((dist, find_root(&f, u0, u1, f0, f1)));
+                if nearest.is_none_or(|(bd, ..)| dist < bd) {
+                    nearest = Some((dist, k, f0, f1));
                 }
             }
         }
+        let best = nearest
+            .map(|(dist, k, f0, f1)| (dist, find_root(&f, params[k], params[k + 1], f0, f1)));
         // At the path's end the curve of F_j stops short of the last normals:
         // the filament runs on to the tip, so extend c along its last chord.
         let end_point = || -> Option<DVec3> {
@@ -202,8 +208,8 @@ pub fn predict(
 /// signs (or one of them zero): the Illinois variant of regula falsi, which
 /// converges superlinearly on the smooth filament curve (a few evaluations
 /// where bisection took 48), with a bisection step whenever the secant
-/// leaves the bracket. Stops at |f| <= 1e-12 mm or a bracket of 2^-52 of
-/// the span.
+/// leaves the bracket. Stops at |f| <= 1e-12 mm or a bracket a few ulps
+/// wide.
 fn find_root(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut fb: f64) -> f64 {
     if fa == 0.0 {
         return a;
@@ -211,7 +217,8 @@ fn find_root(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut f
     if fb == 0.0 {
         return b;
     }
-    let width = (b - a).abs() * f64::EPSILON;
+    // A bracket a few ulps wide is as narrow as f64 gets.
+    let width = 4.0 * f64::EPSILON * a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
     let mut side = 0i8;
     for _ in 0..100 {
         let mut m = (a * fb - b * fa) / (fb - fa);

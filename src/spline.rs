@@ -240,9 +240,29 @@ impl Spline {
 
     /// The point at parameter `u` (clamped to [0, 1]).
     pub fn eval(&self, u: f64) -> DVec3 {
+        self.eval_near(u, &std::cell::Cell::new(usize::MAX))
+    }
+
+    /// [`Self::eval`] that first tries the knot span in `hint` (and its
+    /// neighbour) before searching, and leaves the span it used there: a
+    /// root search evaluates many times within one or two spans.
+    pub fn eval_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> DVec3 {
         let u = u.clamp(0.0, 1.0);
         let p = self.degree;
-        let span = self.find_span(u);
+        let n = self.ctrl.len().max(self.params.len()) - 1;
+        let h = hint.get();
+        let inside =
+            |k: usize| k >= p && k <= n && u >= self.knots[k] && (u < self.knots[k + 1] || k == n);
+        let span = if inside(h) {
+            h
+        } else if h < n && inside(h + 1) {
+            h + 1
+        } else if h > p && h != usize::MAX && inside(h - 1) {
+            h - 1
+        } else {
+            self.find_span(u)
+        };
+        hint.set(span);
         let mut basis = [0.0; 4];
         self.basis_funs(span, u, &mut basis);
         self.ctrl[span - p..=span]
@@ -297,8 +317,16 @@ pub fn local_geometry(points: &[DVec3]) -> Result<Vec<LocalGeometry>> {
 pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
     let mut out: Vec<LocalGeometry> = Vec::with_capacity(spline.params.len());
     let mut vertical = Vec::new();
-    for (j, &u) in spline.params.iter().enumerate() {
-        let [_, d1, d2] = spline.derivs(u);
+    // C' and C'' at each u_j, evaluated once for both passes.
+    let ders: Vec<[DVec3; 2]> = spline
+        .params
+        .iter()
+        .map(|&u| {
+            let [_, d1, d2] = spline.derivs(u);
+            [d1, d2]
+        })
+        .collect();
+    for (j, &[d1, d2]) in ders.iter().enumerate() {
         let len = d1.length();
         let tangent = if len > 0.0 { d1 / len } else { DVec3::Z };
         let h = d1.truncate().length();
@@ -331,8 +359,7 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
             out[j].v = out[k].v;
         }
     }
-    for (g, &u) in out.iter_mut().zip(&spline.params) {
-        let [_, d1, d2] = spline.derivs(u);
+    for (g, &[d1, d2]) in out.iter_mut().zip(&ders) {
         let a = g.tangent.truncate().length();
         g.n = (-g.tangent.z * g.v + a * DVec3::Z).normalize_or(DVec3::Z);
         // Signed curvature of the profile curve (s(u), z(u)) in the plane of V
