@@ -6,7 +6,7 @@
 //!
 //! The planner-independent work ([`SurfacePath`]) is kept apart so that the
 //! four planners of a comparison, or a change of planner or tolerance, reuse
-//! it; the [`Surface`] (mesh + BVH) is only rebuilt when the scan or its
+//! it; the [`Surface`] (mesh + spatial index) is only rebuilt when the scan or its
 //! registration changes.
 
 use glam::{DVec2, DVec3};

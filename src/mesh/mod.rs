@@ -24,7 +24,7 @@ pub use import::{detect_format, import_mesh};
 /// Largest scan file read (bytes). A 20 M triangle binary STL is 1 GB; a
 /// browser tab cannot hold much more than this plus its mesh in wasm memory.
 pub const MAX_SCAN_BYTES: usize = 1 << 30;
-/// Most triangles kept after import: ~1.5 GB of mesh and BVH at this count.
+/// Most triangles kept after import: ~1 GB of mesh and index at this count.
 pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// An indexed triangle mesh, f64 millimetres once imported.

@@ -1,9 +1,9 @@
-//! The registered scan Sa with its acceleration structure: a parry3d BVH
-//! over the triangles, built once and shared by projection (spec section 4),
+//! The registered scan Sa with its spatial index (a grid or parry3d's BVH,
+//! see `index.rs`), built once and shared by projection (spec section 4),
 //! the planners' disk and segment tests (section 6) and the quality
 //! prediction (section 7).
 //!
-//! The BVH holds f32 boxes rounded outward, so it only ever prunes; every
+//! The index holds f32 boxes rounded outward, so it only ever prunes; every
 //! exact test runs in f64 on the mesh's own vertices (projection must land
 //! within 1e-6 mm of the surface).
 
@@ -43,7 +43,7 @@ impl std::fmt::Debug for Surface {
 }
 
 impl Surface {
-    /// Builds the BVH. The mesh must be non-empty with finite vertices (the
+    /// Builds the spatial index. The mesh must be non-empty with finite vertices (the
     /// importers guarantee both; this re-checks for meshes built in code).
     pub fn new(mesh: TriMesh) -> Result<Surface> {
         Surface::with_index(mesh, SpatialIndex::Auto)
