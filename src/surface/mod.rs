@@ -126,7 +126,7 @@ impl Surface {
         let mut touch_count = 0usize;
         self.index.visit(&q, |i| {
             let t = self.mesh.triangle(i);
-            if !meets(&t, &q) {
+            if !meets(&t, &q) || !box_near_disk(&t, center.truncate(), radius) {
                 return;
             }
             for (p, s, w) in plane_cut(t, center.z) {
@@ -197,7 +197,7 @@ impl Surface {
             // wholly at or below the floor) cannot raise the answer above
             // the floor: its height over the disk is a mix of its vertices'.
             let t = self.mesh.triangle(i);
-            if !meets(&t, &q) {
+            if !meets(&t, &q) || !box_near_disk(&t, xy, radius) {
                 return;
             }
             if let Some(z) = triangle_max_z_in_disk(t, xy, radius) {
@@ -220,6 +220,16 @@ fn meets(t: &[DVec3; 3], q: &QueryBox) -> bool {
         && hi.y >= q.lo.y
         && lo.z <= q.hi.z
         && hi.z >= q.lo.z
+}
+
+/// Whether the triangle's XY box comes within `r` of `c` (with a hair of
+/// slack: this only skips triangles that cannot meet the disk).
+#[inline]
+fn box_near_disk(t: &[DVec3; 3], c: DVec2, r: f64) -> bool {
+    let lo = t[0].truncate().min(t[1].truncate()).min(t[2].truncate());
+    let hi = t[0].truncate().max(t[1].truncate()).max(t[2].truncate());
+    let gap = (lo - c).max(c - hi).max(DVec2::ZERO);
+    gap.length_squared() <= r * r * (1.0 + 1e-9)
 }
 
 /// Relative tolerance of the inclusive point-in-triangle tests, so a line
