@@ -155,30 +155,50 @@ fn mesh_extent(mesh: &TriMesh) -> Option<f64> {
 /// triangle scan costs one sort of 6M integers and no per-edge allocation.
 pub fn boundary_loops(mesh: &TriMesh) -> Vec<BoundaryLoop> {
     let n = mesh.vertices.len();
-    let mut keys: Vec<u64> = Vec::with_capacity(mesh.triangles.len() * 3);
-    for t in mesh.triangles.iter().filter(|t| valid_triangle(t, n)) {
+    // Each undirected edge (lo, hi) bucketed by lo (a counting sort, O(n)),
+    // then each bucket (a vertex's few higher neighbours) sorted by hi.
+    let mut start = vec![0u32; n + 1];
+    let valid = || mesh.triangles.iter().filter(|t| valid_triangle(t, n));
+    let edge = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
+    for t in valid() {
         for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-            keys.push((u64::from(lo) << 32) | u64::from(hi));
+            start[edge(a, b).0 as usize + 1] += 1;
         }
     }
-    keys.sort_unstable();
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut his = vec![0u32; start[n] as usize];
+    for t in valid() {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let (lo, hi) = edge(a, b);
+            his[fill[lo as usize] as usize] = hi;
+            fill[lo as usize] += 1;
+        }
+    }
+    drop(fill);
 
     // Used exactly once: boundary. Twice: interior. Three or more times:
     // non-manifold, neither a hole's rim nor interior; left out (spec 2).
     let mut edges: Vec<[u32; 2]> = Vec::new();
-    let mut i = 0;
-    while i < keys.len() {
-        let mut j = i + 1;
-        while j < keys.len() && keys[j] == keys[i] {
-            j += 1;
+    for lo in 0..n {
+        let bucket = &mut his[start[lo] as usize..start[lo + 1] as usize];
+        bucket.sort_unstable();
+        let mut i = 0;
+        while i < bucket.len() {
+            let mut j = i + 1;
+            while j < bucket.len() && bucket[j] == bucket[i] {
+                j += 1;
+            }
+            if j - i == 1 {
+                edges.push([lo as u32, bucket[i]]);
+            }
+            i = j;
         }
-        if j - i == 1 {
-            edges.push([(keys[i] >> 32) as u32, keys[i] as u32]);
-        }
-        i = j;
     }
-    drop(keys);
+    drop(his);
+    drop(start);
     if edges.is_empty() {
         return Vec::new();
     }
