@@ -781,3 +781,70 @@ fn triangular_monopole_round_trips() {
     assert!(hilbert_loop_svg(0, 1.0).is_err());
     assert!(triangular_monopole_svg(f64::NAN, 1.0, 1.0).is_err());
 }
+
+// ---------------------------------------------------------------------------
+// Limits (README "Limits"): each ends in a message that says what to check.
+// ---------------------------------------------------------------------------
+
+#[test]
+fn nesting_past_the_limit_is_refused_with_its_depth() {
+    let depth = pcpp::svg::MAX_NESTING_DEPTH + 5;
+    let body = format!(
+        "{}<path d=\"M0 0 L10 10\" stroke=\"black\"/>{}",
+        "<g>".repeat(depth),
+        "</g>".repeat(depth)
+    );
+    let e = import_svg(doc(MM, &body).as_bytes(), "deep.svg")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("deep.svg") && e.contains("nested more than 128 levels"),
+        "{e}"
+    );
+    // At the limit it still imports.
+    let ok = pcpp::svg::MAX_NESTING_DEPTH - 2;
+    let body = format!(
+        "{}<path d=\"M0 0 L10 10\" stroke=\"black\"/>{}",
+        "<g>".repeat(ok),
+        "</g>".repeat(ok)
+    );
+    assert_eq!(import(&doc(MM, &body)).len(), 1);
+}
+
+#[test]
+fn a_drawing_needing_too_many_points_names_the_limit_and_the_units() {
+    // Five circles of 9 km radius (under the 1e7 coordinate guard) need about
+    // 950,000 points each at the 5e-5 mm flattening tolerance.
+    let body: String = (0..5)
+        .map(|k| {
+            format!(
+                "<circle cx=\"{}\" cy=\"0\" r=\"9e6\" stroke=\"black\" fill=\"none\"/>",
+                k
+            )
+        })
+        .collect();
+    let e = import_svg(doc(MM, &body).as_bytes(), "huge.svg")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("huge.svg") && e.contains("more than 4000000 points") && e.contains("units"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_path_needing_too_many_samples_names_the_count_and_the_units() {
+    // A 9 km line at d/2 = 0.3 mm spacing: 30 M samples, past MAX_SAMPLES.
+    let subs = import(&doc(
+        MM,
+        r#"<path id="long" d="M0 0 L9000000 0" stroke="black"/>"#,
+    ));
+    let e = try_sample_subpath_marked(&subs[0], 0.3)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("samples needed at 0.3 mm spacing, more than 10000000")
+            && e.contains("check the drawing's units"),
+        "{e}"
+    );
+}
