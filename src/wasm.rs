@@ -8,6 +8,7 @@
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, test_part};
@@ -158,6 +159,20 @@ fn to_js<T: Serialize + ?Sized>(v: &T) -> Result<JsValue, JsError> {
 #[wasm_bindgen(js_name = initPanicHook)]
 pub fn init_panic_hook() {
     console_error_panic_hook::set_once();
+}
+
+/// Bytes of this thread's wasm memory: it grows to the peak of what was
+/// held (a scan's file, mesh and BVH at once) and never shrinks; wasm32
+/// allows 4 GiB.
+#[wasm_bindgen(js_name = memoryBytes)]
+pub fn memory_bytes() -> f64 {
+    wasm_bindgen::memory()
+        .dyn_into::<js_sys::WebAssembly::Memory>()
+        .map_or(0.0, |m| {
+            m.buffer()
+                .dyn_into::<js_sys::ArrayBuffer>()
+                .map_or(0.0, |b| f64::from(b.byte_length()))
+        })
 }
 
 /// The crate version (shown in the page footer).
@@ -389,6 +404,10 @@ pub struct ScanBuffer {
     name: String,
     size: usize,
     bytes: Vec<u8>,
+    /// The report's sha256, chunk by chunk as the bytes arrive: V8 runs a
+    /// long single call in its baseline tier (no on-stack replacement for
+    /// wasm), where hashing a large file at once took 16 times longer.
+    sha256: Sha256,
 }
 
 #[wasm_bindgen]
@@ -416,16 +435,20 @@ impl ScanBuffer {
             name: name.to_string(),
             size,
             bytes,
+            sha256: Sha256::new(),
         })
     }
 
     /// The demo scan (the paper's test part as binary PLY), already full.
     pub fn demo() -> ScanBuffer {
         let bytes = demo::demo_scan_bytes();
+        let mut sha256 = Sha256::new();
+        sha256.update(&bytes);
         ScanBuffer {
             name: demo::DEMO_SCAN_NAME.to_string(),
             size: bytes.len(),
             bytes,
+            sha256,
         }
     }
 
@@ -438,6 +461,7 @@ impl ScanBuffer {
             )));
         }
         self.bytes.extend_from_slice(chunk);
+        self.sha256.update(chunk);
         Ok(())
     }
 
@@ -462,7 +486,17 @@ impl ScanBuffer {
         }
         let options: ImportOptions = from_js("scan settings", scan)?;
         let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
-        let file = InputFile::new(&self.name, &self.bytes);
+        // What InputFile::new computes, from the digest made while reading.
+        let file = InputFile {
+            name: self.name.clone(),
+            bytes: self.bytes.len(),
+            sha256: self
+                .sha256
+                .finalize()
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect(),
+        };
         Ok(ScanImport {
             file,
             imported,

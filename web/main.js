@@ -60,6 +60,7 @@ const state = {
   redraw: 0,
   frames: 0, // frames the view has drawn (tests read the rate)
   debounce: 0,
+  memory: 0, // the worker's wasm memory after the last scan read (bytes)
   urls: [],
   picking: false, // "pick on mesh" mode: a click on the view adds a scan point
   moving: false, // "move path" mode: a drag in the view moves the placement
@@ -560,6 +561,7 @@ function onWorkerMessage(e) {
       if (state.pendingScan && state.pendingScan.key === m.key) {
         acceptScan();
       }
+      state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);
       break;
     case 'result': {
@@ -703,7 +705,8 @@ function showScan(info, positions, indices, seconds) {
   const [lo, hi] = info.bbox_mm;
   $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
     + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
-    + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s`;
+    + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s; `
+    + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`;
   if (state.viewer) {
     try {
       state.viewer.setMesh(positions, indices);

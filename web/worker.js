@@ -9,7 +9,7 @@
 // (ScanBuffer), so the page's main thread never holds the scan and JS never
 // holds it whole. Results go back as typed arrays whose buffers are
 // transferred, not copied.
-import { initSync, initPanicHook, ScanBuffer } from '../pkg/pcpp.js';
+import { initSync, initPanicHook, memoryBytes, ScanBuffer } from '../pkg/pcpp.js';
 
 // Slices of the file read per step: progress every 8 MiB.
 const CHUNK = 8 << 20;
@@ -91,7 +91,7 @@ async function loadScan(m) {
   const indices = s.meshIndices();
   const seconds = (performance.now() - t0) / 1000;
   progress(id, 'done', `done: ${name}, ${info.triangles.toLocaleString('en')} triangles in ${seconds.toFixed(1)} s`, 1);
-  post({ type: 'scan', id, key: m.scan.key, info, seconds, positions, indices },
+  post({ type: 'scan', id, key: m.scan.key, info, seconds, memory: memoryBytes(), positions, indices },
     [positions.buffer, indices.buffer]);
 }
 
@@ -118,7 +118,7 @@ async function plan(m) {
     const v = r.view;
     post({
       type: 'result', id, gcode: r.gcode, report: r.report, summary: r.summary, view: v,
-      comparison: r.comparison, planMs,
+      comparison: r.comparison, planMs, memory: memoryBytes(),
     }, [r.gcode.buffer, r.report.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
       v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer]);
     post({ type: 'done', id });
