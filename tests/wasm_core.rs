@@ -666,7 +666,7 @@ fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
     session
         .set_path(test_part::test_part_svg().as_bytes(), demo::DEMO_PATH_NAME)
         .unwrap();
-    // The demo's 466 mm of lines scaled 1000 times: ~1.5 million samples,
+    // The demo's 408 mm of lines scaled 1000 times: ~1.35 million samples,
     // past the page's limit but within the core's per subpath.
     let mut plan = settings.plan;
     plan.placement.scale = 1000.0;

@@ -4,6 +4,7 @@
 // and shows results. Text from files and errors is set with textContent.
 import { loadWasm, startWorker } from './engine.js';
 import { drawPlot } from './plot.js';
+import { keepInput, keptInput } from './store.js';
 import {
   Viewer,
   antennaSvg,
@@ -23,6 +24,9 @@ import {
 
 const $ = (id) => document.getElementById(id);
 const STORE_KEY = 'pcpp.settings.v1';
+// Set while a kept scan is reopened: still set at the next start means the
+// page closed or crashed reading it, and it is not reopened again.
+const RESTORING_KEY = 'pcpp.restoring.v1';
 // Common dispensing-tip gauges: inner / outer diameter, mm.
 const GAUGES = [
   ['20 G', 0.603, 0.908],
@@ -61,6 +65,7 @@ const state = {
   frames: 0, // frames the view has drawn (tests read the rate)
   debounce: 0,
   memory: 0, // the worker's wasm memory after the last scan read (bytes)
+  keeping: 0, // writes of the last inputs to the browser's store under way
   urls: [],
   picking: false, // "pick on mesh" mode: a click on the view adds a scan point
   moving: false, // "move path" mode: a drag in the view moves the placement
@@ -121,8 +126,7 @@ function loadSettings() {
   } catch {
     // Unreadable saved settings: start from the demo's.
   }
-  // Files are not stored, so a saved "SVG file" source starts as the demo.
-  if (base.pathSource === 'file') base.pathSource = 'demo';
+  // A saved "SVG file" source needs the kept SVG (restoreInputs).
   const cp = base.customProfile;
   if (!cp || typeof cp.text !== 'string' || typeof cp.name !== 'string') base.customProfile = null;
   if (base.dialect === 'custom' && !base.customProfile) base.dialect = 'marlin';
@@ -568,6 +572,7 @@ function onWorkerMessage(e) {
       if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {
         state.svgFile = state.pendingSvg;
         state.pendingSvg = null;
+        keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
       }
       state.lastPlan = keptPlan(m, busy);
       const latency = performance.now() - busy.t0;
@@ -611,6 +616,10 @@ function onPlanError(m, busy) {
     title = m.stage === 'scan' ? `The planner ran out of memory or failed reading ${busy.scan.name}` : 'The planner stopped';
     message += '\nThe planner was restarted';
     if (state.pendingScan && busy.scan === state.pendingScan) {
+      if (state.pendingScan.restored) {
+        endRestoring();
+        keep('scan', null);
+      }
       state.pendingScan = null;
       message += `; still using the previous scan, ${state.scan.name}`;
     }
@@ -620,6 +629,10 @@ function onPlanError(m, busy) {
     && state.pendingScan && busy.scan === state.pendingScan) {
     // The file could not be read: keep working with the previous scan.
     title = `Could not read the scan ${state.pendingScan.name}`;
+    if (state.pendingScan.restored) {
+      endRestoring();
+      keep('scan', null);
+    }
     state.pendingScan = null;
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
@@ -658,6 +671,8 @@ function acceptScan() {
   const scan = state.pendingScan;
   state.scan = scan;
   state.pendingScan = null;
+  if (scan.restored) endRestoring();
+  else keep('scan', scan.blob ? { name: scan.name, file: scan.blob } : null);
   if (scan.unregistered) {
     delete scan.unregistered;
     settings.fidSource = 'none';
@@ -1066,6 +1081,10 @@ function loadDemo() {
   settings.scanUp = '';
   state.pendingScan = null;
   state.scan = demoScanEntry();
+  state.svgFile = null;
+  state.pendingSvg = null;
+  keep('scan', null);
+  keep('svg', null);
   saveSettings();
   writeForm();
   schedulePlan(0);
@@ -1354,6 +1373,63 @@ function bindView() {
   $('move-btn').addEventListener('click', () => setMoving(!state.moving));
 }
 
+// ---------- the last inputs, kept for the next visit ----------
+
+// Writes to the browser's store in the background; `state.keeping` counts
+// the writes not finished (tests wait for 0 before reloading).
+function keep(kind, value) {
+  state.keeping++;
+  keepInput(kind, value)
+    .catch(() => {
+      // Not kept (quota, private mode): the next visit starts without it.
+    })
+    .finally(() => { state.keeping--; });
+}
+
+function endRestoring() {
+  try {
+    localStorage.removeItem(RESTORING_KEY);
+  } catch {
+    // Nothing to clear.
+  }
+}
+
+// Reopens the scan and SVG of the last visit, if the browser kept them.
+async function restoreInputs() {
+  let svg;
+  let scan;
+  try {
+    [svg, scan] = await Promise.all([keptInput('svg'), keptInput('scan')]);
+  } catch {
+    svg = null;
+    scan = null;
+  }
+  if (svg && svg.bytes instanceof Uint8Array && typeof svg.name === 'string') {
+    state.svgFile = { key: `file-${state.nextKey++}`, name: svg.name, bytes: svg.bytes };
+  } else if (settings.pathSource === 'file') {
+    settings.pathSource = 'demo';
+  }
+  if (!scan || !(scan.file instanceof Blob) || typeof scan.name !== 'string') return;
+  let crashed = null;
+  try {
+    crashed = localStorage.getItem(RESTORING_KEY);
+    localStorage.setItem(RESTORING_KEY, scan.name);
+  } catch {
+    // Without localStorage there is no crash guard; reopen anyway.
+  }
+  if (crashed !== null) {
+    endRestoring();
+    keep('scan', null);
+    showError(`The last scan, ${crashed}, was not reopened`,
+      'The page closed or stopped while reading it last time. Open it again if you need it.');
+    return;
+  }
+  state.pendingScan = {
+    key: `file-${state.nextKey++}`, name: scan.name, size: scan.file.size, blob: scan.file, restored: true,
+  };
+  $('scan-name').textContent = `${state.scan.name} (reopening ${scan.name}…)`;
+}
+
 // ---------- start ----------
 
 async function start() {
@@ -1388,6 +1464,8 @@ async function start() {
   state.worker = makeWorker();
   state.scan = demoScanEntry();
   $('scan-name').textContent = state.scan.name;
+  await restoreInputs();
+  writeForm();
   // For tests and the curious: read-only access to the page's state.
   window.pcpp = { state, get settings() { return settings; } };
   requestPlan();

@@ -1,10 +1,25 @@
 // Bad input shows the error panel naming the cause, keeps what was loaded
-// and the previous plan on screen, and offers no stale download.
+// and the previous plan on screen, and offers no stale download: not
+// after a failure, and not between a change and the plan for it.
 import assert from 'node:assert/strict';
-import { test } from 'node:test';
-import { download, openPage, viewPixels, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { after, before, test } from 'node:test';
+import {
+  download, openPage, startProbe, stopProbe, viewPixels, waitForPlan, waitIdle, waitKept, waitSettled,
+  withPageServer,
+} from './helpers.mjs';
 
 const env = withPageServer();
+
+let dir;
+before(() => {
+  dir = mkdtempSync(join(tmpdir(), 'pcpp-errors-'));
+});
+after(() => {
+  if (dir) rmSync(dir, { recursive: true, force: true });
+});
 
 const file = (name, text) => ({ name, mimeType: 'application/octet-stream', buffer: Buffer.from(text) });
 
@@ -95,6 +110,124 @@ test('cancel ends the worker; a dropped SVG then plans on a fresh one', async ()
   await waitIdle(page);
   await waitForPlan(page);
   assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.svgName), 'dropped.svg');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a change hides the G-code at once; a plan that ends after a change is shown but not offered', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await startProbe(page);
+  // In one task: a re-plan starts, then the placement changes while it
+  // runs. The running plan ends first (for the old placement).
+  const atOnce = await page.evaluate(() => {
+    document.getElementById('plan-btn').click();
+    const x = document.getElementById('pl-x');
+    x.value = '2.5';
+    x.dispatchEvent(new Event('input', { bubbles: true }));
+    const dl = document.getElementById('dl-gcode');
+    return { hidden: dl.hidden, href: dl.getAttribute('href'), busy: !!window.pcpp.state.busy };
+  });
+  assert.deepEqual(atOnce, { hidden: true, href: null, busy: true });
+  await waitSettled(page);
+  const probe = await stopProbe(page);
+  assert.deepEqual(probe.staleOffers, [], 'G-code of an older placement was offered');
+  const gcode = await download(page, 'dl-gcode');
+  assert.match(gcode.bytes.toString('utf8'), /placement: offset \(2\.5, 80\) mm/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+const TRACK_SVG = `<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
+  <path d="M 4 20 L 36 20 L 36 26 L 4 26" fill="none" stroke="black"/>
+</svg>
+`;
+
+// The values of every setting field of the page.
+const formValues = (page) => page.evaluate(() => Object.fromEntries(
+  [...document.querySelectorAll('.side input, .side select, .side textarea')]
+    .filter((el) => el.id && el.type !== 'file')
+    .map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]),
+));
+
+test('a failed plan keeps the inputs and settings, also across a reload; fixing the setting plans them', async () => {
+  const svgPath = join(dir, 'track.svg');
+  writeFileSync(svgPath, TRACK_SVG);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#svg-input', svgPath);
+  await page.fill('#pl-x', '20');
+  await page.fill('#pl-y', '60'); // SVG y points down: the track spans y 34-40 mm
+  await page.selectOption('#planner', 'slope');
+  await page.selectOption('#dialect', 'grbl');
+  await waitSettled(page);
+  const good = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  assert.match(good, /path file: track\.svg/);
+  const before = await formValues(page);
+
+  // Outer diameter below the inner one: the plan fails.
+  await page.fill('#nz-od', '0.5');
+  await page.waitForFunction(() => /outer diameter/.test(document.getElementById('error-message').textContent));
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.textContent('#plan-status'), 'plan failed: showing the previous plan, no download');
+  assert.deepEqual(await formValues(page), { ...before, 'nz-od': '0.5', gauge: 'custom' });
+  assert.equal(await page.textContent('#svg-name'), 'track.svg');
+  assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good, 'the previous plan stays');
+
+  // A broken SVG now: named, and track.svg stays the drawing.
+  await page.setInputFiles('#svg-input', { name: 'broken.svg', mimeType: 'image/svg+xml', buffer: Buffer.from('<svg><path d="M 0 0 L') });
+  await page.waitForFunction(() => /broken\.svg/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Still using the previous SVG, track\.svg\./);
+  assert.equal(await page.textContent('#svg-name'), 'track.svg');
+
+  // A reload keeps all of it: the settings as typed, and the SVG.
+  await waitKept(page);
+  await page.reload();
+  await page.waitForFunction(() => window.pcpp && window.pcpp.state.lastPlan === null
+    && !window.pcpp.state.busy && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  assert.deepEqual(await formValues(page), { ...before, 'nz-od': '0.5', gauge: 'custom' });
+  assert.equal(await page.textContent('#svg-name'), 'track.svg');
+  assert.match(await page.textContent('#error-message'), /outer diameter/);
+
+  // Fixed: the same inputs plan again, byte for byte.
+  await page.fill('#nz-od', '0.908');
+  await waitSettled(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a path too long for the page names the limit; past the core\'s limit the core\'s message shows', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const good = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  // The demo's lines at 1000 times: ~1.35 million samples at d/2.
+  await page.fill('#pl-scale', '1000');
+  await page.waitForSelector('#error-panel:not([hidden])');
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'The path is too long for the page');
+  const message = await page.textContent('#error-message');
+  assert.match(message, /^demo-test-part-lines\.svg: about 1\.35 million samples at 0\.3015 mm spacing \(d\/2\) after scaling by 1000, more than the 1 million this page plans/);
+  assert.match(message, /command line/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good);
+
+  // 50 000 times: one line alone needs more samples than the core plans.
+  await page.fill('#pl-scale', '50000');
+  await page.waitForFunction(() => /samples needed/.test(document.getElementById('error-message').textContent));
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'Planning failed');
+  assert.match(await page.textContent('#error-message'),
+    /samples needed at 0\.3015 mm spacing, more than 10000000; check the drawing's units or the nozzle diameter/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+
+  await page.fill('#pl-scale', '1');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good);
   assert.deepEqual(problems, []);
   await context.close();
 });

@@ -2,13 +2,14 @@
 // reads the File in slices into wasm memory) and its import shows progress
 // by stage; files past the page's limits are refused before a byte is
 // read, with a message naming the file and the limit, and what was loaded
-// (scan, drawing, plan, download) stays.
+// (scan, drawing, plan, download) stays. The last scan and SVG are kept by
+// the browser for the next visit.
 import assert from 'node:assert/strict';
-import { closeSync, mkdtempSync, openSync, rmSync, writeSync, ftruncateSync } from 'node:fs';
+import { closeSync, ftruncateSync, mkdtempSync, openSync, rmSync, writeFileSync, writeSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { download, openPage, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
+import { download, openPage, waitForPlan, waitIdle, waitKept, waitSettled, withPageServer } from './helpers.mjs';
 
 const env = withPageServer();
 const MIB = 1 << 20;
@@ -167,6 +168,46 @@ test('a 23 MiB scan is read in the worker with progress by stage, never on the m
   assert.match(await page.textContent('#scan-info'),
     /^PLY, 1,280,000 triangles, 80\.0 × 80\.0 × 0\.6 mm \(mm\); 23\.2 MiB read in \d+\.\d s; planner memory \d\.\d\d of 4 GiB$/);
   assert.equal(await page.textContent('#scan-name'), 'grid.ply');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('the last scan and SVG are reopened after a reload; a scan the page closed while reading is not', async () => {
+  const scanPath = gridPly('sheet.ply', 60);
+  const svgPath = join(dir, 'line.svg');
+  writeFileSync(svgPath, '<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80">'
+    + '<path d="M 10 40 L 70 40 L 70 50" fill="none" stroke="black"/></svg>\n');
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', scanPath);
+  await page.setInputFiles('#svg-input', svgPath);
+  await waitSettled(page);
+  assert.equal(await page.textContent('#scan-name'), 'sheet.ply');
+  const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  await waitKept(page);
+
+  await page.reload();
+  await waitSettled(page);
+  assert.equal(await page.textContent('#scan-name'), 'sheet.ply');
+  assert.equal(await page.textContent('#svg-name'), 'line.svg');
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), before);
+
+  // As if the tab had died while reopening it: not reopened again.
+  await page.evaluate(() => localStorage.setItem('pcpp.restoring.v1', 'sheet.ply'));
+  await page.reload();
+  await waitSettled(page);
+  assert.equal(await page.textContent('#error-title'), 'The last scan, sheet.ply, was not reopened');
+  assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
+  assert.equal(await page.textContent('#svg-name'), 'line.svg');
+
+  // Load demo forgets the kept files.
+  await page.click('#demo-btn');
+  await waitSettled(page);
+  await waitKept(page);
+  await page.reload();
+  await waitSettled(page);
+  assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
+  assert.equal(await page.inputValue('#path-source'), 'demo');
   assert.deepEqual(problems, []);
   await context.close();
 });

@@ -76,6 +76,57 @@ export async function waitIdle(page, timeout = 120_000) {
     && !window.pcpp.state.queued, null, { timeout });
 }
 
+// Waits until the browser has stored the last inputs (before a reload).
+export async function waitKept(page, timeout = 60_000) {
+  await page.waitForFunction(() => window.pcpp && window.pcpp.state.keeping === 0, null, { timeout });
+}
+
+// Settled: nothing in flight or waiting, no drag, the plan on screen is
+// for the current settings, compared, and offered for download.
+export async function waitSettled(page, timeout = 120_000) {
+  await page.waitForFunction(() => {
+    const s = window.pcpp && window.pcpp.state;
+    return s && !s.busy && !s.queued && !s.interacting && s.lastPlan && s.lastPlan.gen === s.gen
+      && s.lastPlan.compared && !document.getElementById('dl-gcode').hidden;
+  }, null, { timeout });
+}
+
+// Records, from now on, every moment a G-code download is offered whose
+// plan is not the one for the settings of that moment, and counts the
+// browser's frames.
+export async function startProbe(page) {
+  await page.evaluate(() => {
+    const probe = { raf: 0, staleOffers: [], t0: performance.now() };
+    window.__probe = probe;
+    const tick = () => {
+      probe.raf++;
+      probe.handle = requestAnimationFrame(tick);
+    };
+    probe.handle = requestAnimationFrame(tick);
+    const dl = document.getElementById('dl-gcode');
+    probe.observer = new MutationObserver(() => {
+      const s = window.pcpp.state;
+      if (dl.hidden || !dl.getAttribute('href')) return;
+      const p = s.lastPlan.placement;
+      const now = window.pcpp.settings.placement;
+      if (s.lastPlan.gen !== s.gen || p.offset_mm[0] !== now.x || p.offset_mm[1] !== now.y
+        || p.rotation_deg !== now.rot || p.scale !== now.scale) {
+        probe.staleOffers.push({ planned: p, current: { ...now } });
+      }
+    });
+    probe.observer.observe(dl, { attributes: true, attributeFilter: ['hidden', 'href'] });
+  });
+}
+
+export async function stopProbe(page) {
+  return page.evaluate(() => {
+    const p = window.__probe;
+    cancelAnimationFrame(p.handle);
+    p.observer.disconnect();
+    return { raf: p.raf, seconds: (performance.now() - p.t0) / 1000, staleOffers: p.staleOffers };
+  });
+}
+
 // Downloads through the page's link and returns the bytes and file name.
 export async function download(page, linkId) {
   const [dl] = await Promise.all([page.waitForEvent('download'), page.click(`#${linkId}`)]);

@@ -11,7 +11,7 @@ import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { ROOT, download, openPage, waitForPlan, withPageServer } from './helpers.mjs';
+import { ROOT, download, openPage, startProbe, stopProbe, waitSettled, withPageServer } from './helpers.mjs';
 
 const env = withPageServer();
 const CLI = join(ROOT, 'target/debug/pcpp');
@@ -23,52 +23,6 @@ before(() => {
 after(() => {
   if (dir) rmSync(dir, { recursive: true, force: true });
 });
-
-// Settled: nothing in flight or waiting, no drag, the plan on screen is
-// for the current settings, compared, and offered for download.
-async function waitSettled(page, timeout = 120_000) {
-  await page.waitForFunction(() => {
-    const s = window.pcpp && window.pcpp.state;
-    return s && !s.busy && !s.queued && !s.interacting && s.lastPlan && s.lastPlan.gen === s.gen
-      && s.lastPlan.compared && !document.getElementById('dl-gcode').hidden;
-  }, null, { timeout });
-}
-
-// Records, from now on, every moment a G-code download is offered whose
-// plan is not the one for the settings of that moment, and counts the
-// browser's frames.
-async function startProbe(page) {
-  await page.evaluate(() => {
-    const probe = { raf: 0, staleOffers: [], t0: performance.now() };
-    window.__probe = probe;
-    const tick = () => {
-      probe.raf++;
-      probe.handle = requestAnimationFrame(tick);
-    };
-    probe.handle = requestAnimationFrame(tick);
-    const dl = document.getElementById('dl-gcode');
-    probe.observer = new MutationObserver(() => {
-      const s = window.pcpp.state;
-      if (dl.hidden || !dl.getAttribute('href')) return;
-      const p = s.lastPlan.placement;
-      const now = window.pcpp.settings.placement;
-      if (s.lastPlan.gen !== s.gen || p.offset_mm[0] !== now.x || p.offset_mm[1] !== now.y
-        || p.rotation_deg !== now.rot || p.scale !== now.scale) {
-        probe.staleOffers.push({ planned: p, current: { ...now } });
-      }
-    });
-    probe.observer.observe(dl, { attributes: true, attributeFilter: ['hidden', 'href'] });
-  });
-}
-
-async function stopProbe(page) {
-  return page.evaluate(() => {
-    const p = window.__probe;
-    cancelAnimationFrame(p.handle);
-    p.observer.disconnect();
-    return { raf: p.raf, seconds: (performance.now() - p.t0) / 1000, staleOffers: p.staleOffers };
-  });
-}
 
 const median = (v) => {
   const s = [...v].sort((a, b) => a - b);
