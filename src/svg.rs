@@ -553,7 +553,8 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             if let Some(v) = svg_numbers(attr.value()).find(|v| v.abs() > MAX_COORDINATE) {
                 let pos = doc.text_pos_at(node.range().start);
                 return Err(format!(
-                    "line {}: <{}> attribute {} holds the number {v:e}, beyond the {MAX_COORDINATE:e}                      user units this program accepts (check the drawing's units)",
+                    "line {}: <{}> attribute {} holds the number {v:e}, beyond the \
+                     {MAX_COORDINATE:e} user units this program accepts (check the drawing's units)",
                     pos.row,
                     node.tag_name().name(),
                     attr.name()
