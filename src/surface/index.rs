@@ -156,9 +156,16 @@ pub(super) struct Grid {
     xys: Vec<[f32; 4]>,
     /// How far a triangle's box reaches out of its home cell, at most.
     reach: f64,
+    /// The z range of each block of BLOCK x BLOCK cells (row-major, `bnx`
+    /// blocks to a row): one test drops a block's cells from a query.
+    block_zs: Vec<[f32; 2]>,
+    bnx: usize,
     /// Triangles wider than 1.5 cells in X or Y, tested by their own box.
     big: Vec<(u32, Box32)>,
 }
+
+/// Cells per side of a block (see [`Grid::block_zs`]).
+const BLOCK: usize = 4;
 
 /// Largest grid, in cells.
 const MAX_CELLS: usize = 1 << 22;
@@ -278,6 +285,13 @@ impl Grid {
         }
         // Rounding in the home cell's index: a hair more.
         let reach = reach * (1.0 + 1e-9) + 1e-9 * cell;
+        let bnx = nx.div_ceil(BLOCK);
+        let mut block_zs = vec![[f32::INFINITY, f32::NEG_INFINITY]; bnx * ny.div_ceil(BLOCK)];
+        for (c, z) in zs.iter().enumerate() {
+            let b = &mut block_zs[(c / nx / BLOCK) * bnx + (c % nx) / BLOCK];
+            b[0] = b[0].min(z[0]);
+            b[1] = b[1].max(z[1]);
+        }
         Some(Grid {
             origin,
             inv_cell,
@@ -288,6 +302,8 @@ impl Grid {
             zs,
             xys,
             reach,
+            block_zs,
+            bnx,
             big,
         })
     }
@@ -318,26 +334,42 @@ impl Grid {
         let Some((y0, y1)) = self.range(q.lo.y, q.hi.y, self.origin.y, self.ny) else {
             return;
         };
+        // Row by row (the order the exact tests sum in stays fixed), a
+        // block's run of cells in the row skipped on the block's z range.
+        let z_out = |z: &[f32; 2]| (z[0] as f64) > q.hi.z || (z[1] as f64) < q.lo.z;
         for cy in y0..=y1 {
             let row = cy * self.nx;
-            for c in row + x0..=row + x1 {
-                let [zlo, zhi] = self.zs[c];
-                if (zlo as f64) > q.hi.z || (zhi as f64) < q.lo.z {
+            let brow = (cy / BLOCK) * self.bnx;
+            for bx in x0 / BLOCK..=x1 / BLOCK {
+                if z_out(&self.block_zs[brow + bx]) {
                     continue;
                 }
-                let [xlo, ylo, xhi, yhi] = self.xys[c];
-                if (xlo as f64) > q.hi.x
-                    || (xhi as f64) < q.lo.x
-                    || (ylo as f64) > q.hi.y
-                    || (yhi as f64) < q.lo.y
-                {
-                    continue;
-                }
-                let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
-                for &i in &self.items[s..e] {
-                    f(i as usize);
+                let cx0 = x0.max(bx * BLOCK);
+                let cx1 = x1.min(bx * BLOCK + BLOCK - 1);
+                for c in row + cx0..=row + cx1 {
+                    self.visit_cell(c, q, &mut f);
                 }
             }
+        }
+    }
+
+    #[inline]
+    fn visit_cell(&self, c: usize, q: &QueryBox, f: &mut impl FnMut(usize)) {
+        let [zlo, zhi] = self.zs[c];
+        if (zlo as f64) > q.hi.z || (zhi as f64) < q.lo.z {
+            return;
+        }
+        let [xlo, ylo, xhi, yhi] = self.xys[c];
+        if (xlo as f64) > q.hi.x
+            || (xhi as f64) < q.lo.x
+            || (ylo as f64) > q.hi.y
+            || (yhi as f64) < q.lo.y
+        {
+            return;
+        }
+        let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
+        for &i in &self.items[s..e] {
+            f(i as usize);
         }
     }
 }
