@@ -154,7 +154,7 @@ test('a drag moves the path on the scan and re-plans as it goes; the last placem
   }
 });
 
-test('the rotation and scale sliders and typed nozzle sizes re-plan as they change', async () => {
+test('the rotation and scale sliders, typed nozzle sizes and arrow keys re-plan as they change', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
   await startProbe(page);
@@ -194,6 +194,17 @@ test('the rotation and scale sliders and typed nozzle sizes re-plan as they chan
   await waitSettled(page);
   report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
   assert.deepEqual(report.settings.nozzle, { inner_diameter_mm: 0.41, outer_diameter_mm: 0.72 });
+
+  // In move mode the arrow keys nudge the path: 0.5 mm, 5 mm with Shift.
+  const at = await page.evaluate(() => ({ ...window.pcpp.settings.placement }));
+  await page.click('#move-btn');
+  await page.focus('#view');
+  await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('Shift+ArrowUp');
+  await waitSettled(page);
+  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  assert.deepEqual(report.settings.placement.offset_mm, [at.x + 0.5, at.y + 5]);
+
   const probe = await stopProbe(page);
   assert.deepEqual(probe.staleOffers, []);
   const st = await page.evaluate(() => window.pcpp.state.stats);
