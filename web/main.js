@@ -66,6 +66,8 @@ const state = {
   debounce: 0,
   memory: 0, // the worker's wasm memory after the last scan read (bytes)
   keeping: 0, // writes of the last inputs to the browser's store under way
+  progressTimer: 0,
+  progressLabel: '',
   urls: [],
   picking: false, // "pick on mesh" mode: a click on the view adds a scan point
   moving: false, // "move path" mode: a drag in the view moves the placement
@@ -419,7 +421,24 @@ function showProgress(stage, label, fraction) {
   if (!bar.hidden) bar.value = fraction;
 }
 
+// A plan's progress and Cancel appear only once it has taken a moment:
+// during a drag, plans of a few milliseconds would make the toolbar flicker.
+const PROGRESS_DELAY_MS = 250;
+
+function laterProgress(label) {
+  state.progressLabel = label;
+  if (state.progressTimer || !$('progress').hidden) return;
+  state.progressTimer = setTimeout(() => {
+    state.progressTimer = 0;
+    if (!state.busy) return;
+    $('cancel-btn').hidden = false;
+    showProgress('plan', state.progressLabel);
+  }, PROGRESS_DELAY_MS);
+}
+
 function endProgress() {
+  clearTimeout(state.progressTimer);
+  state.progressTimer = 0;
   $('progress').hidden = true;
   $('cancel-btn').hidden = true;
 }
@@ -482,9 +501,8 @@ function runPlan() {
   const compare = !state.interacting;
   state.busy = { id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, t0: performance.now() };
   state.queued = false;
-  $('cancel-btn').hidden = false;
-  showProgress('plan', 'starting');
-  setStatus('planning…');
+  laterProgress('starting');
+  if (!state.interacting) setStatus('planning…');
   // The worker keeps the last drawing it was sent: its bytes go only when
   // the drawing changes, as a copy whose buffer is transferred.
   const msgSvg = { key: svg.key, name: svg.name };
@@ -556,9 +574,12 @@ function onWorkerMessage(e) {
       if (m.stage === 'scan') {
         if (m.first) state.progressLog = [];
         state.progressLog.push(m.label);
+        // Reading a scan takes a while: shown at once.
+        $('cancel-btn').hidden = false;
         showProgress(m.step === 'done' ? 'plan' : m.step, m.label, m.fraction);
       } else {
-        showProgress('plan', m.label);
+        if ($('progress').hidden) laterProgress(m.label);
+        else showProgress('plan', m.label);
       }
       break;
     case 'scan':
