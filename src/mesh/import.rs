@@ -277,8 +277,13 @@ fn zero_area(a: DVec3, b: DVec3, c: DVec3) -> bool {
     ab.cross(ac).length() <= 1e-12 * longest
 }
 
-/// FxHash (rustc's hasher): welding hashes millions of positions, and the
-/// keys are not attacker-chosen collisions we need SipHash against.
+/// FxHash (rustc's hasher) with a final mix: welding hashes millions of
+/// positions, and the keys are not attacker-chosen collisions we need
+/// SipHash against. The mix matters: coordinates read as f32 have 29 zero
+/// low bits as f64, and Fx's multiply leaves its low bits (the hash map's
+/// bucket index) a function of the input's low bits only, so without it a
+/// real scan's vertices pile into a few buckets (a 10 M triangle PLY took
+/// 19.7 s to weld instead of 1.8 s).
 #[derive(Default)]
 struct FxHasher(u64);
 
@@ -297,7 +302,9 @@ impl Hasher for FxHasher {
         self.write_u64(n as u64);
     }
     fn finish(&self) -> u64 {
-        self.0
+        // Fold the high bits, which depend on every input bit, into the low.
+        let h = self.0 ^ (self.0 >> 32);
+        h.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (h >> 29)
     }
 }
 
@@ -335,6 +342,31 @@ impl Welder {
 #[cfg(test)]
 mod tests {
     use crate::mesh::{MAX_SCAN_BYTES, MAX_TRIANGLES};
+
+    #[test]
+    fn weld_hash_spreads_f32_coordinates_over_the_low_bits() {
+        use std::hash::{BuildHasher, BuildHasherDefault};
+        let build = BuildHasherDefault::<super::FxHasher>::default();
+        // A scan read as f32: 4096 positions on a 0.1 mm grid with noise.
+        let mut low = std::collections::HashSet::new();
+        for i in 0..64 {
+            for j in 0..64 {
+                let p = [
+                    i as f32 * 0.1 + 0.0013 * j as f32,
+                    j as f32 * 0.1,
+                    2.5 + 0.01 * i as f32,
+                ];
+                let key = p.map(|c| (c as f64).to_bits());
+                low.insert(build.hash_one(key) & 0xfff);
+            }
+        }
+        // 4096 keys into 4096 buckets: a good hash fills about 63%.
+        assert!(
+            low.len() > 2000,
+            "only {} of 4096 low-bit buckets used",
+            low.len()
+        );
+    }
 
     #[test]
     fn limits_are_errors_that_say_what_to_do() {
