@@ -422,27 +422,54 @@ pub fn run_on(
     settings.validate()?;
     let drawn = pipeline::load_path(svg, svg_name)?;
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
-    if !plan.uncleared.is_empty() && !accept_risk {
-        let list: Vec<String> = plan
-            .uncleared
-            .iter()
-            .take(10)
-            .map(|(k, j, p)| {
-                format!(
-                    "piece {k} point {j} at ({:.3}, {:.3}, {:.3})",
-                    p.x, p.y, p.z
-                )
-            })
-            .collect();
-        return Err(Error::Plan(format!(
-            "the nozzle would still touch the surface at {} point(s): {}; no G-code written",
-            plan.uncleared.len(),
-            list.join("; ")
-        )));
-    }
+    refuse_uncleared(&plan, accept_risk)?;
     let path_file = InputFile::new(svg_name, svg);
-    let mut report = report(scan, &path_file, &plan, settings);
-    report.warnings.extend(drawn.notes);
+    let (report, gcode) = write_outputs(scan, &path_file, &drawn.notes, &plan, settings, profile)?;
+    Ok(JobOutput {
+        plan,
+        report,
+        gcode,
+    })
+}
+
+/// The refusal of a plan whose guarded planner could not clear some point
+/// (no G-code then), unless the user accepts the risk: the error lists the
+/// first ten points.
+pub fn refuse_uncleared(plan: &Plan, accept_risk: bool) -> Result<()> {
+    if plan.uncleared.is_empty() || accept_risk {
+        return Ok(());
+    }
+    let list: Vec<String> = plan
+        .uncleared
+        .iter()
+        .take(10)
+        .map(|(k, j, p)| {
+            format!(
+                "piece {k} point {j} at ({:.3}, {:.3}, {:.3})",
+                p.x, p.y, p.z
+            )
+        })
+        .collect();
+    Err(Error::Plan(format!(
+        "the nozzle would still touch the surface at {} point(s): {}; no G-code written",
+        plan.uncleared.len(),
+        list.join("; ")
+    )))
+}
+
+/// The report and G-code of a finished plan (the drawing's `notes` join the
+/// report's warnings): what [`run_on`] and the page's live planning write,
+/// so both give the same bytes.
+pub fn write_outputs(
+    scan: &PreparedScan,
+    path_file: &InputFile,
+    notes: &[String],
+    plan: &Plan,
+    settings: &PlanSettings,
+    profile: &MachineProfile,
+) -> Result<(Report, String)> {
+    let mut report = report(scan, path_file, plan, settings);
+    report.warnings.extend(notes.iter().cloned());
     let header = provenance(&report);
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.toolpath.clone()).collect();
     let gcode = write_gcode(
@@ -455,11 +482,7 @@ pub fn run_on(
         },
         profile,
     )?;
-    Ok(JobOutput {
-        plan,
-        report,
-        gcode,
-    })
+    Ok((report, gcode))
 }
 
 /// Plans from bytes: the CLI's `plan` and the page's Plan button.

@@ -13,7 +13,7 @@ use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, test_part};
 use crate::fiducials::{find_fiducials, Fiducial};
-use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
+use crate::gcode::MachineProfile;
 use crate::job::{self, InputFile, JobSettings, PreparedScan, RegistrationSettings};
 use crate::mesh::{ImportOptions, ImportedMesh, MAX_SCAN_BYTES};
 use crate::params::Nozzle;
@@ -561,8 +561,6 @@ impl ScanImport {
 
 /// The drawing the session plans, read once per file.
 struct LoadedPath {
-    /// Kept for [`job::run_on`], whose refusal message the page shows.
-    bytes: Vec<u8>,
     file: InputFile,
     drawn: DrawnPath,
 }
@@ -886,7 +884,6 @@ impl Session {
         let drawn = pipeline::load_path(svg, svg_name).map_err(core_err)?;
         self.cache = None;
         self.path = Some(LoadedPath {
-            bytes: svg.to_vec(),
             file: InputFile::new(svg_name, svg),
             drawn,
         });
@@ -945,41 +942,17 @@ impl Session {
             .path
             .as_ref()
             .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
-        if !plan.uncleared.is_empty() && !accept_risk {
-            // The core's own refusal (and message): it plans once more, but
-            // only on this path, where no G-code is written anyway.
-            return Err(
-                match job::run_on(
-                    &self.scan,
-                    &path.bytes,
-                    &path.file.name,
-                    &settings,
-                    &profile,
-                    accept_risk,
-                ) {
-                    Err(e) => core_err(e),
-                    Ok(_) => {
-                        JsError::new("the nozzle would touch the surface; no G-code written").into()
-                    }
-                },
-            );
-        }
-        // From here as job::run_on, so the bytes are the CLI's.
-        let mut report = job::report(&self.scan, &path.file, &plan, &settings);
-        report.warnings.extend(path.drawn.notes.iter().cloned());
-        let header = job::provenance(&report);
-        let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.toolpath.clone()).collect();
-        let gcode = write_gcode(
-            &GcodeJob {
-                toolpaths: &toolpaths,
-                speed_mm_s: settings.process.speed_mm_s,
-                dwell_s: settings.process.dwell_s,
-                header: &header,
-                scan_top_z_mm: surface.top_z(),
-            },
+        // The core's own refusal and writer, so the bytes are the CLI's.
+        job::refuse_uncleared(&plan, accept_risk).map_err(core_err)?;
+        let (report, gcode) = job::write_outputs(
+            &self.scan,
+            &path.file,
+            &path.drawn.notes,
+            &plan,
+            &settings,
             &profile,
         )
-        .map_err(|e| core_err(e.into()))?;
+        .map_err(core_err)?;
         let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
         report_json.push(b'\n');
         let out = js_sys::Object::new();
