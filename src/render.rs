@@ -9,8 +9,8 @@ use glam::{DMat4, DVec3};
 use serde::Deserialize;
 use wasm_bindgen::{JsCast, JsValue};
 use web_sys::{
-    HtmlCanvasElement, WebGl2RenderingContext as Gl, WebGlBuffer, WebGlProgram, WebGlShader,
-    WebGlUniformLocation, WebGlVertexArrayObject,
+    HtmlCanvasElement, WebGl2RenderingContext as Gl, WebGlBuffer, WebGlFramebuffer, WebGlProgram,
+    WebGlShader, WebGlTexture, WebGlUniformLocation, WebGlVertexArrayObject,
 };
 
 use crate::quality::Defect;
@@ -155,27 +155,14 @@ void main() {
 }
 "#;
 
-/// Calls a WebGL method through the JS object: texture and framebuffer
-/// calls, whose web-sys bindings sit behind the `WebGlTexture` and
-/// `WebGlFramebuffer` features, which the crate does not enable.
-fn gl_call(gl: &Gl, method: &str, args: &[JsValue]) -> Result<JsValue, String> {
-    let f: js_sys::Function = js_sys::Reflect::get(gl, &method.into())
-        .ok()
-        .and_then(|f| f.dyn_into().ok())
-        .ok_or_else(|| format!("WebGL has no {method}"))?;
-    let list: js_sys::Array = args.iter().collect();
-    f.apply(gl, &list)
-        .map_err(|e| format!("WebGL {method} failed: {e:?}"))
-}
-
 /// The mesh drawn once into textures (colour and depth) and reused while
 /// the camera and the canvas size stay: moving the path, or a new plan,
 /// then redraws only the lines. A scan of a few million triangles costs
 /// a software renderer (or a weak GPU) hundreds of milliseconds a frame.
 struct MeshCache {
-    framebuffer: JsValue,
-    color: JsValue,
-    depth: JsValue,
+    framebuffer: WebGlFramebuffer,
+    color: WebGlTexture,
+    depth: WebGlTexture,
     width: u32,
     height: u32,
     /// The camera matrix the textures hold the mesh for; None: stale.
@@ -184,24 +171,23 @@ struct MeshCache {
 
 impl MeshCache {
     fn new(gl: &Gl, width: u32, height: u32) -> Result<MeshCache, String> {
-        let texture = |internal: u32, format: u32, kind: u32| -> Result<JsValue, String> {
-            let t = gl_call(gl, "createTexture", &[])?;
-            gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), t.clone()])?;
-            gl_call(
-                gl,
-                "texImage2D",
-                &[
-                    Gl::TEXTURE_2D.into(),
-                    0.into(),
-                    internal.into(),
-                    width.into(),
-                    height.into(),
-                    0.into(),
-                    format.into(),
-                    kind.into(),
-                    JsValue::NULL,
-                ],
-            )?;
+        let texture = |internal: u32, format: u32, kind: u32| -> Result<WebGlTexture, String> {
+            let t = gl
+                .create_texture()
+                .ok_or("WebGL could not create a texture")?;
+            gl.bind_texture(Gl::TEXTURE_2D, Some(&t));
+            gl.tex_image_2d_with_i32_and_i32_and_i32_and_format_and_type_and_opt_u8_array(
+                Gl::TEXTURE_2D,
+                0,
+                internal as i32,
+                width as i32,
+                height as i32,
+                0,
+                format,
+                kind,
+                None,
+            )
+            .map_err(|e| format!("WebGL texImage2D failed: {e:?}"))?;
             for p in [Gl::TEXTURE_MIN_FILTER, Gl::TEXTURE_MAG_FILTER] {
                 gl.tex_parameteri(Gl::TEXTURE_2D, p, Gl::NEAREST as i32);
             }
@@ -209,35 +195,19 @@ impl MeshCache {
         };
         let color = texture(Gl::RGBA8, Gl::RGBA, Gl::UNSIGNED_BYTE)?;
         let depth = texture(Gl::DEPTH_COMPONENT24, Gl::DEPTH_COMPONENT, Gl::UNSIGNED_INT)?;
-        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
-        let framebuffer = gl_call(gl, "createFramebuffer", &[])?;
-        gl_call(
-            gl,
-            "bindFramebuffer",
-            &[Gl::FRAMEBUFFER.into(), framebuffer.clone()],
-        )?;
+        gl.bind_texture(Gl::TEXTURE_2D, None);
+        let framebuffer = gl
+            .create_framebuffer()
+            .ok_or("WebGL could not create a framebuffer")?;
+        gl.bind_framebuffer(Gl::FRAMEBUFFER, Some(&framebuffer));
         for (attachment, t) in [
             (Gl::COLOR_ATTACHMENT0, &color),
             (Gl::DEPTH_ATTACHMENT, &depth),
         ] {
-            gl_call(
-                gl,
-                "framebufferTexture2D",
-                &[
-                    Gl::FRAMEBUFFER.into(),
-                    attachment.into(),
-                    Gl::TEXTURE_2D.into(),
-                    t.clone(),
-                    0.into(),
-                ],
-            )?;
+            gl.framebuffer_texture_2d(Gl::FRAMEBUFFER, attachment, Gl::TEXTURE_2D, Some(t), 0);
         }
         let complete = gl.check_framebuffer_status(Gl::FRAMEBUFFER) == Gl::FRAMEBUFFER_COMPLETE;
-        gl_call(
-            gl,
-            "bindFramebuffer",
-            &[Gl::FRAMEBUFFER.into(), JsValue::NULL],
-        )?;
+        gl.bind_framebuffer(Gl::FRAMEBUFFER, None);
         let cache = MeshCache {
             framebuffer,
             color,
@@ -255,11 +225,9 @@ impl MeshCache {
     }
 
     fn delete(self, gl: &Gl) {
-        // Deleting cannot fail in a way that matters: the context drops
-        // them with the canvas anyway.
-        let _ = gl_call(gl, "deleteFramebuffer", &[self.framebuffer]);
-        let _ = gl_call(gl, "deleteTexture", &[self.color]);
-        let _ = gl_call(gl, "deleteTexture", &[self.depth]);
+        gl.delete_framebuffer(Some(&self.framebuffer));
+        gl.delete_texture(Some(&self.color));
+        gl.delete_texture(Some(&self.depth));
     }
 }
 
@@ -771,25 +739,14 @@ impl Renderer {
         if cache.mvp.as_ref() == Some(mvp) {
             return true;
         }
-        let fb = cache.framebuffer.clone();
-        let bound = gl_call(&self.gl, "bindFramebuffer", &[Gl::FRAMEBUFFER.into(), fb]).is_ok();
-        if bound {
-            let gl = &self.gl;
-            let [r, g, b] = BACKGROUND;
-            gl.clear_color(r, g, b, 1.0);
-            gl.clear(Gl::COLOR_BUFFER_BIT | Gl::DEPTH_BUFFER_BIT);
-            self.draw_mesh(mesh, mvp);
-        }
-        let unbound = gl_call(
-            &self.gl,
-            "bindFramebuffer",
-            &[Gl::FRAMEBUFFER.into(), JsValue::NULL],
-        )
-        .is_ok();
-        if !(bound && unbound) {
-            self.cache_failed = true;
-            return false;
-        }
+        self.gl
+            .bind_framebuffer(Gl::FRAMEBUFFER, Some(&cache.framebuffer));
+        let gl = &self.gl;
+        let [r, g, b] = BACKGROUND;
+        gl.clear_color(r, g, b, 1.0);
+        gl.clear(Gl::COLOR_BUFFER_BIT | Gl::DEPTH_BUFFER_BIT);
+        self.draw_mesh(mesh, mvp);
+        self.gl.bind_framebuffer(Gl::FRAMEBUFFER, None);
         if let Some(c) = &mut self.cache {
             c.mvp = Some(*mvp);
         }
@@ -804,26 +761,18 @@ impl Renderer {
         };
         gl.use_program(Some(&p.program));
         gl.active_texture(Gl::TEXTURE0);
-        gl_call(
-            gl,
-            "bindTexture",
-            &[Gl::TEXTURE_2D.into(), cache.color.clone()],
-        )?;
+        gl.bind_texture(Gl::TEXTURE_2D, Some(&cache.color));
         gl.active_texture(Gl::TEXTURE1);
-        gl_call(
-            gl,
-            "bindTexture",
-            &[Gl::TEXTURE_2D.into(), cache.depth.clone()],
-        )?;
+        gl.bind_texture(Gl::TEXTURE_2D, Some(&cache.depth));
         gl.uniform1i(p.color_tex.as_ref(), 0);
         gl.uniform1i(p.depth_tex.as_ref(), 1);
         gl.depth_func(Gl::ALWAYS);
         gl.bind_vertex_array(Some(&self.blit_vao));
         gl.draw_arrays(Gl::TRIANGLES, 0, 3);
         gl.depth_func(Gl::LESS);
-        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
+        gl.bind_texture(Gl::TEXTURE_2D, None);
         gl.active_texture(Gl::TEXTURE0);
-        gl_call(gl, "bindTexture", &[Gl::TEXTURE_2D.into(), JsValue::NULL])?;
+        gl.bind_texture(Gl::TEXTURE_2D, None);
         Ok(())
     }
 
