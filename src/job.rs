@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
-use crate::mesh::{ImportOptions, MeshFormat, ScanUnits};
+use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
 use crate::pipeline::{self, Plan, PlanSettings};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
@@ -147,11 +147,16 @@ pub struct InputFile {
 
 impl InputFile {
     pub fn new(name: &str, bytes: &[u8]) -> Self {
-        let digest = Sha256::digest(bytes);
+        InputFile::from_digest(name, bytes.len(), &Sha256::digest(bytes))
+    }
+
+    /// From a SHA-256 made elsewhere (the page hashes a scan as it reads
+    /// it, chunk by chunk).
+    pub fn from_digest(name: &str, bytes: usize, sha256: &[u8]) -> Self {
         InputFile {
             name: name.to_string(),
-            bytes: bytes.len(),
-            sha256: digest.iter().map(|b| format!("{b:02x}")).collect(),
+            bytes,
+            sha256: sha256.iter().map(|b| format!("{b:02x}")).collect(),
         }
     }
 }
@@ -241,17 +246,39 @@ pub fn prepare_scan(
     let imported = pipeline::load_scan(bytes, name, scan)?;
     let fiducials = find_fiducials(&imported.mesh);
     let reg = registration_for(&fiducials, registration)?;
-    let surface = pipeline::registered_surface(imported.mesh, &reg)?;
-    Ok(PreparedScan {
-        file: InputFile::new(name, bytes),
-        format: imported.format,
-        units: imported.units,
-        warnings: imported.warnings,
+    PreparedScan::assemble(
+        InputFile::new(name, bytes),
+        imported,
         fiducials,
-        registration: reg,
-        method: registration.method,
-        surface,
-    })
+        reg,
+        registration.method,
+    )
+}
+
+impl PreparedScan {
+    /// The last stage of [`prepare_scan`]: the registered surface and its
+    /// index over an imported scan whose holes were found (in the scanner
+    /// frame) and registered. The page runs the stages one by one to show
+    /// progress between them.
+    pub fn assemble(
+        file: InputFile,
+        imported: ImportedMesh,
+        fiducials: Vec<Fiducial>,
+        registration: Registration,
+        method: RegistrationMethod,
+    ) -> Result<PreparedScan> {
+        let surface = pipeline::registered_surface(imported.mesh, &registration)?;
+        Ok(PreparedScan {
+            file,
+            format: imported.format,
+            units: imported.units,
+            warnings: imported.warnings,
+            fiducials,
+            registration,
+            method,
+            surface,
+        })
+    }
 }
 
 /// The result of a job: the plan, its report, and the G-code text.

@@ -487,17 +487,7 @@ impl ScanBuffer {
         }
         let options: ImportOptions = from_js("scan settings", scan)?;
         let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
-        // What InputFile::new computes, from the digest made while reading.
-        let file = InputFile {
-            name: self.name.clone(),
-            bytes: self.bytes.len(),
-            sha256: self
-                .sha256
-                .finalize()
-                .iter()
-                .map(|b| format!("{b:02x}"))
-                .collect(),
-        };
+        let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize());
         Ok(ScanImport {
             file,
             imported,
@@ -535,8 +525,8 @@ impl ScanImport {
         Ok(())
     }
 
-    /// Builds the registered surface and its BVH: the [`Session`] that
-    /// plans. Call [`ScanImport::register`] first.
+    /// Builds the registered surface and its spatial index: the [`Session`]
+    /// that plans. Call [`ScanImport::register`] first.
     pub fn index(self) -> Result<Session, JsValue> {
         let Some((registration, method)) = self.registration else {
             return Err(JsError::new("the scan must be registered before it is indexed").into());
@@ -544,18 +534,10 @@ impl ScanImport {
         let fiducials = self
             .fiducials
             .unwrap_or_else(|| find_fiducials(&self.imported.mesh));
-        let surface =
-            pipeline::registered_surface(self.imported.mesh, &registration).map_err(core_err)?;
-        Ok(Session::from_prepared(PreparedScan {
-            file: self.file,
-            format: self.imported.format,
-            units: self.imported.units,
-            warnings: self.imported.warnings,
-            fiducials,
-            registration,
-            method,
-            surface,
-        }))
+        let prepared =
+            PreparedScan::assemble(self.file, self.imported, fiducials, registration, method)
+                .map_err(core_err)?;
+        Ok(Session::from_prepared(prepared))
     }
 }
 
