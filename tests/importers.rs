@@ -79,7 +79,7 @@ pub(crate) fn assert_error(bytes: &[u8], file: &str, needles: &[&str]) {
 
 /// Triangles as vertex triples, each rotated to start at its smallest
 /// corner so winding is compared but the starting corner is not.
-fn triangle_set(mesh: &TriMesh) -> BTreeSet<[u64; 9]> {
+pub(crate) fn triangle_set(mesh: &TriMesh) -> BTreeSet<[u64; 9]> {
     (0..mesh.triangle_count())
         .map(|t| {
             let c = mesh.triangle(t).map(|v| v.to_array().map(f64::to_bits));

@@ -25,7 +25,7 @@ macro_rules! data {
     };
 }
 
-use crate::importers::{assert_error as assert_import_error, error as import_error};
+use crate::importers::{assert_error as assert_import_error, error as import_error, triangle_set};
 
 fn import(bytes: &[u8], file: &str) -> ImportedMesh {
     crate::importers::import(bytes, file, &ImportOptions::DEFAULT)
@@ -42,22 +42,6 @@ fn assert_bbox(mesh: &TriMesh, lo: [f64; 3], hi: [f64; 3], tol: f64) {
     let (l, h) = mesh.bbox().expect("empty mesh");
     assert_close(l, DVec3::from_array(lo), tol, "bbox min");
     assert_close(h, DVec3::from_array(hi), tol, "bbox max");
-}
-
-/// Triangles as vertex triples rotated to start at their smallest corner:
-/// winding is compared, the starting corner and vertex numbering are not.
-fn triangle_set(mesh: &TriMesh) -> BTreeSet<[u64; 9]> {
-    (0..mesh.triangle_count())
-        .map(|t| {
-            let c = mesh.triangle(t).map(|v| v.to_array().map(f64::to_bits));
-            let first = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
-            let mut key = [0u64; 9];
-            for k in 0..3 {
-                key[3 * k..3 * k + 3].copy_from_slice(&c[(first + k) % 3]);
-            }
-            key
-        })
-        .collect()
 }
 
 fn degenerate_warning(m: &ImportedMesh) -> Option<&str> {

@@ -106,18 +106,23 @@ fn golden_settings() -> JobSettings {
     s
 }
 
+/// The demo scan prepared with `settings`' scan and registration options.
+fn demo_prepared(scan: &[u8], settings: &JobSettings) -> job::PreparedScan {
+    job::prepare_scan(
+        scan,
+        demo::DEMO_SCAN_NAME,
+        &settings.scan,
+        &settings.registration,
+    )
+    .unwrap()
+}
+
 #[wasm_bindgen_test]
 fn demo_gcode_equals_the_native_golden_files() {
     let scan = demo::demo_scan_bytes();
     let svg = test_part::test_part_svg();
     let settings = golden_settings();
-    let prepared = job::prepare_scan(
-        &scan,
-        demo::DEMO_SCAN_NAME,
-        &settings.scan,
-        &settings.registration,
-    )
-    .unwrap();
+    let prepared = demo_prepared(&scan, &settings);
     for (dialect, golden) in [("marlin", GOLDEN_MARLIN), ("grbl", GOLDEN_GRBL)] {
         let profile = MachineProfile::builtin(dialect).unwrap();
         let out = job::run_on(
@@ -157,13 +162,7 @@ fn planners_compare_and_the_guarded_one_never_touches() {
     let scan = demo::demo_scan_bytes();
     let svg = test_part::test_part_svg();
     let settings = golden_settings();
-    let prepared = job::prepare_scan(
-        &scan,
-        demo::DEMO_SCAN_NAME,
-        &settings.scan,
-        &settings.registration,
-    )
-    .unwrap();
+    let prepared = demo_prepared(&scan, &settings);
     let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan)
         .unwrap()
         .rows;
@@ -475,13 +474,7 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
     // fiducials): the staged session must prepare the scan as
     // job::prepare_scan does.
     for settings in [golden_settings(), demo_page_settings()] {
-        let prepared = job::prepare_scan(
-            &scan,
-            demo::DEMO_SCAN_NAME,
-            &settings.scan,
-            &settings.registration,
-        )
-        .unwrap();
+        let prepared = demo_prepared(&scan, &settings);
         let mut session = staged_session(&scan, demo::DEMO_SCAN_NAME, &settings);
         session
             .set_path(svg.as_bytes(), demo::DEMO_PATH_NAME)

@@ -484,17 +484,11 @@ mod tests {
         m
     }
 
+    /// Every triangle whose box meets `q`, by the surface's own exact box
+    /// test, over all triangles.
     fn brute(mesh: &TriMesh, q: &QueryBox) -> Vec<usize> {
         (0..mesh.triangles.len())
-            .filter(|&i| {
-                let (lo, hi) = triangle_box(mesh, i);
-                lo.x <= q.hi.x
-                    && hi.x >= q.lo.x
-                    && lo.y <= q.hi.y
-                    && hi.y >= q.lo.y
-                    && lo.z <= q.hi.z
-                    && hi.z >= q.lo.z
-            })
+            .filter(|&i| crate::surface::meets(&mesh.triangle(i), q))
             .collect()
     }
 
