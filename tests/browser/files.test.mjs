@@ -181,6 +181,12 @@ test('the last scan and SVG are reopened after a reload; a scan the page closed 
   await waitSettled(page);
   await page.setInputFiles('#scan-input', scanPath);
   await page.setInputFiles('#svg-input', svgPath);
+  // The SVG is read asynchronously: until its plan starts, the scan's plan
+  // (on the demo drawing) looks settled.
+  await page.waitForFunction(() => {
+    const p = window.pcpp.state.lastPlan;
+    return p && p.gcode && p.gcode.includes('; path file: line.svg');
+  }, null, { timeout: 120_000 });
   await waitSettled(page);
   assert.equal(await page.textContent('#scan-name'), 'sheet.ply');
   const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
