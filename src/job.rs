@@ -11,7 +11,7 @@ use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
 use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
-use crate::pipeline::{self, Plan, PlanSettings};
+use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
 use crate::registration::{register, Registration, RegistrationError, RegistrationMethod};
@@ -498,7 +498,7 @@ pub fn write_outputs(
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     let header = provenance(&report);
-    let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.toolpath.clone()).collect();
+    let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
     let gcode = write_gcode(
         &GcodeJob {
             toolpaths: &toolpaths,
@@ -535,14 +535,34 @@ pub fn run(
     )
 }
 
-/// The four planners side by side, with what the user should know.
+/// One planner's row of a comparison: its predicted quality and what the
+/// motion check found of its print moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ComparisonRow {
+    pub planner: PlannerKind,
+    pub quality: QualitySummary,
+    pub motion: PlanMotion,
+}
+
+impl ComparisonRow {
+    pub fn of(plan: &Plan) -> ComparisonRow {
+        ComparisonRow {
+            planner: plan.planner,
+            quality: plan.quality,
+            motion: plan.motion,
+        }
+    }
+}
+
+/// The planners side by side, with what the user should know.
 pub struct Comparison {
-    pub rows: Vec<(PlannerKind, QualitySummary)>,
+    pub rows: Vec<ComparisonRow>,
     /// Notes on the drawing, projection gaps and planner warnings, each once.
     pub warnings: Vec<String>,
 }
 
-/// The four planners' summaries side by side (the paper's Figure 3e-f).
+/// Every planner's summary side by side (the paper's Figure 3e-f, with
+/// our two guarded planners).
 pub fn compare_on(
     scan: &PreparedScan,
     svg: &[u8],
@@ -558,27 +578,48 @@ pub fn compare_on(
         }
     }
     Ok(Comparison {
-        rows: plans.into_iter().map(|p| (p.planner, p.quality)).collect(),
+        rows: plans.iter().map(ComparisonRow::of).collect(),
         warnings,
     })
 }
 
-/// The comparison as a plain-text table.
-pub fn comparison_table(rows: &[(PlannerKind, QualitySummary)]) -> String {
+/// The comparison as a plain-text table: the quality of section 7, then
+/// the backward moves along the drawn path, the smallest clearance along
+/// the print moves (below tol: the nozzle touches) and the waypoints added.
+pub fn comparison_table(rows: &[ComparisonRow]) -> String {
     let mut s = format!(
-        "{:<13} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8}\n",
-        "planner", "mean|e|", "mean e-", "mean e+", "contact", "flatten", "floating"
+        "{:<13} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}\n",
+        "planner",
+        "mean|e|",
+        "mean e-",
+        "mean e+",
+        "contact",
+        "flatten",
+        "floating",
+        "defects",
+        "backward",
+        "min clear",
+        "waypoints"
     );
-    for (k, q) in rows {
+    for r in rows {
+        let q = &r.quality;
+        let clear = r
+            .motion
+            .min_clearance_mm
+            .map_or("-".to_string(), |c| format!("{c:.3}"));
         s.push_str(&format!(
-            "{:<13} {:>9.4} {:>9.4} {:>9.4} {:>7.2}% {:>7.2}% {:>7.2}%\n",
-            k.name(),
+            "{:<13} {:>8.4} {:>8.4} {:>8.4} {:>7.2}% {:>7.2}% {:>7.2}% {:>7.2}% {:>8} {:>9} {:>9}\n",
+            r.planner.name(),
             q.mean_abs_error_mm,
             q.mean_negative_error_mm,
             q.mean_positive_error_mm,
             q.contact_pct,
             q.flattening_pct,
-            q.floating_pct
+            q.floating_pct,
+            q.defect_pct(),
+            r.motion.backward_moves,
+            clear,
+            r.motion.waypoints
         ));
     }
     s
@@ -662,7 +703,7 @@ mod tests {
             ..Default::default()
         };
         let c = compare_on(&scan, svg, "off.svg", &settings).unwrap();
-        assert_eq!(c.rows.len(), 4);
+        assert_eq!(c.rows.len(), PlannerKind::ALL.len());
         assert!(
             c.warnings.iter().any(|w| w.contains("off the scan")),
             "{:?}",

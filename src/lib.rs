@@ -36,6 +36,7 @@ pub mod fiducials;
 pub mod gcode;
 pub mod job;
 pub mod mesh;
+pub mod motion;
 pub mod params;
 pub mod pipeline;
 pub mod planners;

@@ -14,6 +14,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, TriMesh};
+use crate::motion::{
+    backward_moves, check_moves, insert_waypoints, Clearance, PLANNING_MARGIN_MM,
+};
 use crate::params::{Nozzle, Process};
 use crate::planners::{plan_points, PlannerKind};
 use crate::projection::project_subpath;
@@ -152,7 +155,12 @@ pub fn surface_path(
 pub struct PlannedPiece {
     pub source: String,
     pub surface_path: Vec<DVec3>,
+    /// T*, one point per sample (what the quality stage measures).
     pub toolpath: Vec<DVec3>,
+    /// The points the nozzle visits: T* with the waypoints the guarded
+    /// planners added between them (spec section 6f); what the G-code
+    /// prints.
+    pub moves: Vec<DVec3>,
     pub geometry: Vec<LocalGeometry>,
     pub quality: Vec<PointQuality>,
 }
@@ -166,8 +174,31 @@ pub struct Plan {
     pub stats: PathStats,
     pub warnings: Vec<String>,
     /// Points (piece, index, x, y, z) where the nozzle still meets the
-    /// surface; always empty for `pcpp-guarded` unless it failed.
+    /// surface; always empty for the guarded planners unless they failed.
     pub uncleared: Vec<(usize, usize, DVec3)>,
+    /// The print moves checked along their whole length (spec section 6f).
+    pub motion: PlanMotion,
+}
+
+/// What the motion check says of a plan's print moves (the G-code's other
+/// moves, travel and descents, are checked when it is written).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct PlanMotion {
+    /// Print moves (between consecutive points the nozzle visits).
+    pub moves: usize,
+    /// The smallest clearance along them: the height of the tip over the
+    /// highest surface point within do/2 + tol of its axis (`None` when no
+    /// move passes over the scan). At least tol means no contact.
+    pub min_clearance_mm: Option<f64>,
+    /// Print moves that come closer than tol.
+    pub touching_moves: usize,
+    /// Waypoints the guarded planners added.
+    pub waypoints: usize,
+    /// Length they added, mm.
+    pub extra_length_mm: f64,
+    /// Tool-path points that fall back along the drawn path by 2 or more
+    /// samples ([`crate::motion::backward_moves`]).
+    pub backward_moves: usize,
 }
 
 /// Stage 5: a planner over a surface path, then quality (spec section 7)
@@ -184,6 +215,9 @@ pub fn plan_surface_path(
     let mut uncleared = Vec::new();
     let mut lifted = 0usize;
     let mut max_lift: (f64, DVec3) = (0.0, DVec3::ZERO);
+    let clearance = Clearance::new(nozzle, process.tolerance_mm);
+    let mut motion = PlanMotion::default();
+    let mut print_moves: Vec<(DVec3, DVec3, Option<usize>)> = Vec::new();
     for (k, piece) in sp.pieces.iter().enumerate() {
         let planned = plan_points(
             planner,
@@ -193,6 +227,22 @@ pub fn plan_surface_path(
             nozzle,
             process,
         );
+        let moves = if planner.is_guarded() {
+            let planning = clearance.with_margin(PLANNING_MARGIN_MM);
+            let safe = insert_waypoints(surface, &planned.toolpath, &planning);
+            motion.waypoints += safe.waypoints;
+            motion.extra_length_mm += safe.extra_length_mm;
+            for &j in &safe.unresolved {
+                if !planned.uncleared.contains(&j) {
+                    uncleared.push((k, j, planned.toolpath[j]));
+                }
+            }
+            safe.points
+        } else {
+            planned.toolpath.clone()
+        };
+        print_moves.extend(moves.windows(2).map(|w| (w[0], w[1], None)));
+        motion.backward_moves += backward_moves(&piece.ta, &planned.toolpath);
         for &(j, lift) in &planned.lifted {
             // A lift of more than d leaves the filament floating: the nozzle is
             // wider than the feature it must pass there.
@@ -218,6 +268,7 @@ pub fn plan_surface_path(
             source: piece.source.clone(),
             surface_path: piece.ta.clone(),
             toolpath: planned.toolpath,
+            moves,
             geometry: piece.geometry.clone(),
             quality,
         });
@@ -231,6 +282,10 @@ pub fn plan_surface_path(
             nozzle.outer_diameter_mm, max_lift.0, p.x, p.y, p.z
         ));
     }
+    let checked = check_moves(surface, print_moves, &clearance);
+    motion.moves = checked.moves;
+    motion.min_clearance_mm = checked.min_clearance_mm;
+    motion.touching_moves = checked.touching_moves;
     let quality = summarize(pieces.iter().flat_map(|p| &p.quality));
     let stats = path_stats(
         pieces
@@ -245,6 +300,7 @@ pub fn plan_surface_path(
         stats,
         warnings,
         uncleared,
+        motion,
     }
 }
 
@@ -261,7 +317,7 @@ pub fn plan(surface: &Surface, drawn: &[Subpath2], settings: &PlanSettings) -> R
     ))
 }
 
-/// All four planners side by side (the paper's Figure 3e-f), sharing one
+/// All five planners side by side (the paper's Figure 3e-f), sharing one
 /// surface path.
 pub fn compare(
     surface: &Surface,

@@ -102,14 +102,23 @@ pub fn predict(
     let d = nozzle.inner_diameter_mm;
     let r = 0.5 * nozzle.outer_diameter_mm;
     let tol = process.tolerance_mm;
-    let back: Vec<DVec3> = toolpath
+    let contact: Vec<bool> = toolpath
         .iter()
-        .zip(geometry)
-        .map(|(&t, g)| nozzle_back(t, g, nozzle))
+        .map(|&t| surface.disk_contact(t, r).is_some())
         .collect();
-    // c(t): the cubic spline through the F_j. Where consecutive F_j coincide
-    // (the planner stopped the tip), fall back to the polyline.
-    let curve = Spline::interpolate(&back).ok();
+    // c(t) runs through the F_j of the points without contact only
+    // (Algorithm 5 sets F_j <- [ ] at a contact, spec section 7): the
+    // simulated filament does not pass where the nozzle hits the surface.
+    let kept: Vec<usize> = (0..toolpath.len()).filter(|&j| !contact[j]).collect();
+    let back: Vec<DVec3> = kept
+        .iter()
+        .map(|&j| nozzle_back(toolpath[j], &geometry[j], nozzle))
+        .collect();
+    // Where consecutive F_j coincide (the planner stopped the tip), fall
+    // back to the polyline.
+    let curve = (back.len() >= 2)
+        .then(|| Spline::interpolate(&back).ok())
+        .flatten();
     let params: Vec<f64> = match &curve {
         Some(c) => c.params().to_vec(),
         None => (0..back.len()).map(|i| i as f64).collect(),
@@ -127,8 +136,10 @@ pub fn predict(
     };
 
     let mut out = Vec::with_capacity(ta.len());
+    // The position of each kept point in `back`.
+    let mut slot = 0usize;
     for j in 0..ta.len() {
-        if surface.disk_contact(toolpath[j], r).is_some() {
+        if contact[j] {
             out.push(PointQuality {
                 defect: Defect::Contact,
                 thickness_mm: None,
@@ -136,48 +147,13 @@ pub fn predict(
             });
             continue;
         }
+        let pj = slot;
+        slot += 1;
         let (a, g) = (ta[j], &geometry[j]);
-        // p_j: where c crosses the plane through Ta_j normal to t_j, which
-        // holds the normal line {Ta_j + lambda N_j}; nearest crossing to j.
-        let f = |u: f64| (eval(u) - a).dot(g.tangent);
-        let lo = j.saturating_sub(SEARCH);
-        let hi = (j + SEARCH).min(back.len() - 1);
-        // The crossing span nearest to j (the first found on a tie), then
-        // its root: one root search per point.
-        let mut nearest: Option<(usize, usize, f64, f64)> = None;
-        // The curve passes through F_k at u_k, so the window is scanned on
-        // the F_k themselves; only the crossing span is searched. Where the
-        // curve crosses three times within one span (the spline overshoots
-        // at a vertical step) any of them is a crossing; regula falsi starts
-        // from the chord's crossing and usually ends at the one nearest it.
-        let fk = |k: usize| (back[k] - a).dot(g.tangent);
-        let mut f1 = fk(lo);
-        for k in lo..hi {
-            let f0 = f1;
-            f1 = fk(k + 1);
-            if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
-                let dist = k.abs_diff(j).min((k + 1).abs_diff(j));
-                if nearest.is_none_or(|(bd, ..)| dist < bd) {
-                    nearest = Some((dist, k, f0, f1));
-                }
-            }
-        }
-        let best = nearest
-            .map(|(dist, k, f0, f1)| (dist, find_root(&f, params[k], params[k + 1], f0, f1)));
-        // At the path's end the curve of F_j stops short of the last normals:
-        // the filament runs on to the tip, so extend c along its last chord.
-        let end_point = || -> Option<DVec3> {
-            let m = back.len();
-            let last = back[m - 1];
-            let dir = last - back[m.checked_sub(2)?];
-            let den = dir.dot(g.tangent);
-            let s = (a - last).dot(g.tangent) / den;
-            (den.abs() > 1e-12 && s > 0.0 && s.is_finite()).then(|| last + dir * s)
-        };
-        let crossing = match best {
-            Some((_, u)) => Some(eval(u)),
-            None if j + SEARCH >= back.len() => end_point(),
-            None => None,
+        let crossing = if back.len() < 2 {
+            None
+        } else {
+            crossing_near(&back, &params, &eval, pj, a, g.tangent)
         };
         let thickness = crossing.and_then(|p| {
             let lambda = (p - a).dot(g.n);
@@ -202,6 +178,57 @@ pub fn predict(
         });
     }
     out
+}
+
+/// p_j: where the filament curve c (through `back`, parameters `params`,
+/// evaluated by `eval`) crosses the plane through `a` = Ta_j normal to the
+/// tangent t_j, which holds the normal line {Ta_j + lambda N_j}; the
+/// crossing nearest to `pj`, the point's own place among the F_k.
+fn crossing_near(
+    back: &[DVec3],
+    params: &[f64],
+    eval: &impl Fn(f64) -> DVec3,
+    pj: usize,
+    a: DVec3,
+    tangent: DVec3,
+) -> Option<DVec3> {
+    let f = |u: f64| (eval(u) - a).dot(tangent);
+    let lo = pj.saturating_sub(SEARCH);
+    let hi = (pj + SEARCH).min(back.len() - 1);
+    // The crossing span nearest to j (the first found on a tie), then
+    // its root: one root search per point.
+    let mut nearest: Option<(usize, usize, f64, f64)> = None;
+    // The curve passes through F_k at u_k, so the window is scanned on
+    // the F_k themselves; only the crossing span is searched. Where the
+    // curve crosses three times within one span (the spline overshoots
+    // at a vertical step) any of them is a crossing; regula falsi starts
+    // from the chord's crossing and usually ends at the one nearest it.
+    let fk = |k: usize| (back[k] - a).dot(tangent);
+    let mut f1 = fk(lo);
+    for k in lo..hi {
+        let f0 = f1;
+        f1 = fk(k + 1);
+        if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
+            let dist = k.abs_diff(pj).min((k + 1).abs_diff(pj));
+            if nearest.is_none_or(|(bd, ..)| dist < bd) {
+                nearest = Some((dist, k, f0, f1));
+            }
+        }
+    }
+    if let Some((_, k, f0, f1)) = nearest {
+        return Some(eval(find_root(&f, params[k], params[k + 1], f0, f1)));
+    }
+    // At the path's end the curve of F_j stops short of the last normals:
+    // the filament runs on to the tip, so extend c along its last chord.
+    if pj + SEARCH < back.len() {
+        return None;
+    }
+    let m = back.len();
+    let last = back[m - 1];
+    let dir = last - back[m - 2];
+    let den = dir.dot(tangent);
+    let s = (a - last).dot(tangent) / den;
+    (den.abs() > 1e-12 && s > 0.0 && s.is_finite()).then(|| last + dir * s)
 }
 
 /// The root of `f` on [a, b], given f(a) = `fa` and f(b) = `fb` of opposite

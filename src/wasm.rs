@@ -573,12 +573,6 @@ struct PlanResult {
     warnings: Vec<String>,
 }
 
-#[derive(Serialize)]
-struct CompareRow {
-    planner: crate::planners::PlannerKind,
-    quality: crate::quality::QualitySummary,
-}
-
 /// What the page shows of a plan besides the per-point arrays.
 #[derive(Serialize)]
 struct PlanSummary<'a> {
@@ -905,15 +899,14 @@ impl Session {
         };
         let plan = plan_with(settings.planner);
         let comparison = if compare {
-            let rows: Vec<CompareRow> = PlannerKind::ALL
+            let rows: Vec<job::ComparisonRow> = PlannerKind::ALL
                 .iter()
-                .map(|&k| CompareRow {
-                    planner: k,
-                    quality: if k == settings.planner {
-                        plan.quality
+                .map(|&k| {
+                    if k == settings.planner {
+                        job::ComparisonRow::of(&plan)
                     } else {
-                        plan_with(k).quality
-                    },
+                        job::ComparisonRow::of(&plan_with(k))
+                    }
                 })
                 .collect();
             to_js(&rows)?
@@ -971,12 +964,7 @@ impl Session {
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
         let comparison = job::compare_on(&self.scan, svg, svg_name, &settings).map_err(core_err)?;
-        let rows: Vec<CompareRow> = comparison
-            .rows
-            .into_iter()
-            .map(|(planner, quality)| CompareRow { planner, quality })
-            .collect();
-        to_js(&rows).map_err(JsValue::from)
+        to_js(&comparison.rows).map_err(JsValue::from)
     }
 }
 

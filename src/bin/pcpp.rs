@@ -14,13 +14,13 @@ use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use pcpp::demo::parts::DemoPart;
 use pcpp::demo::{self, antennas, test_part};
 use pcpp::fiducials::find_fiducials;
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{self, FiducialSource, InputFile, JobSettings, PreparedScan};
 use pcpp::mesh::{ScanUnits, UpAxis};
 use pcpp::planners::PlannerKind;
-use pcpp::quality::QualitySummary;
 use pcpp::registration::{parse_points, register, Registration, RegistrationMethod};
 use pcpp::svg::Placement;
 use pcpp::{DVec2, DVec3, Error};
@@ -241,6 +241,7 @@ const COMMANDS: &[Command] = &[
                 value: true,
             },
             valued("dialect"),
+            valued("part"),
         ],
         run: cmd_demo,
     },
@@ -768,17 +769,14 @@ fn cmd_plan(a: &Args) -> CliResult<()> {
 fn comparison_json(
     inputs: &[InputFile],
     settings: &pcpp::pipeline::PlanSettings,
-    rows: &[(PlannerKind, QualitySummary)],
+    rows: &[job::ComparisonRow],
 ) -> serde_json::Value {
     serde_json::json!({
         "program": "pcpp",
         "version": VERSION,
         "inputs": inputs,
         "settings": settings,
-        "planners": rows
-            .iter()
-            .map(|(k, q)| serde_json::json!({ "planner": k, "quality": q }))
-            .collect::<Vec<_>>(),
+        "planners": rows,
     })
 }
 
@@ -894,53 +892,66 @@ fn cmd_register(a: &Args) -> CliResult<()> {
 // demo
 
 /// The demo's G-code file name for a planner.
-fn demo_gcode_name(k: PlannerKind) -> String {
-    format!("demo-{}.gcode", k.name())
+/// The start of the demo's file names: `demo` for the test part, else
+/// `demo-<part>`.
+fn demo_prefix(part: DemoPart) -> String {
+    match part {
+        DemoPart::TestPart => "demo".into(),
+        _ => format!("demo-{part}"),
+    }
+}
+
+fn demo_gcode_name(part: DemoPart, k: PlannerKind) -> String {
+    format!("{}-{}.gcode", demo_prefix(part), k.name())
 }
 
 fn cmd_demo(a: &Args) -> CliResult<()> {
     let out = PathBuf::from(a.get("out").unwrap_or("pcpp-demo"));
     let profile = builtin_profile(a.command, a.get("dialect").unwrap_or("marlin"))?;
+    let part = a.parsed::<DemoPart>("part")?.unwrap_or_default();
     let progress = Progress::new();
     let fail = |what: &str, e: &dyn std::fmt::Display| Failure::Input(format!("demo {what}: {e}"));
 
-    progress.say("building the demo test part...");
-    let scan = demo::demo_scan_bytes();
-    let svg = test_part::test_part_svg();
+    progress.say(&format!("building the demo part {part}..."));
+    let scan = demo::to_binary_ply(&part.mesh());
+    let svg = part.svg();
+    let (scan_name, path_name) = (part.scan_name(), part.path_name());
     let mut settings = JobSettings::default();
-    settings.plan.placement = test_part::placement();
-    let prepared = job::prepare_scan(
-        &scan,
-        demo::DEMO_SCAN_NAME,
-        &settings.scan,
-        &settings.registration,
-    )
-    .map_err(|e| fail("scan", &e))?;
+    settings.plan.placement = part.placement();
+    let prepared = job::prepare_scan(&scan, &scan_name, &settings.scan, &settings.registration)
+        .map_err(|e| fail("scan", &e))?;
     progress.say(&format!(
         "scan: {} triangles",
         thousands(prepared.triangle_count())
     ));
 
     // Registration as a user would run it: the holes found in the scan
-    // matched to the printer points. The demo scan is already in the
+    // matched to the printer points. The test part is already in the
     // printer frame, so G is the identity and the residuals are ~0.
-    progress.say("registering the scan on its fiducial holes...");
-    let reg_settings = job::RegistrationSettings {
-        fiducials: FiducialSource::Auto,
-        printer_points: test_part::FIDUCIALS_MM.to_vec(),
-        method: RegistrationMethod::Lsq,
+    let registration = if part == DemoPart::TestPart {
+        progress.say("registering the scan on its fiducial holes...");
+        let reg_settings = job::RegistrationSettings {
+            fiducials: FiducialSource::Auto,
+            printer_points: test_part::FIDUCIALS_MM.to_vec(),
+            method: RegistrationMethod::Lsq,
+        };
+        Some(
+            job::registration_for(&prepared.fiducials, &reg_settings)
+                .map_err(|e| fail("registration", &e))?,
+        )
+    } else {
+        None
     };
-    let registration = job::registration_for(&prepared.fiducials, &reg_settings)
-        .map_err(|e| fail("registration", &e))?;
 
-    // One G-code per planner. Only the guarded planner refuses to write a
-    // path that would touch the part; the others are written anyway since
-    // they are there to be compared.
+    // One G-code per planner. The guarded planners never touch the part;
+    // the paper's three are written even where they do (their headers say
+    // so), since they are there to be compared.
     std::fs::create_dir_all(&out)
         .map_err(|e| Failure::Input(format!("cannot create {}: {e}", out.display())))?;
     let mut staged = Staged::default();
     let mut rows = Vec::new();
-    let mut guarded_report = None;
+    let mut default_report = None;
+    let default_planner = PlannerKind::default();
     for k in PlannerKind::ALL {
         progress.say(&format!("planning ({k})..."));
         let mut plan = settings.plan;
@@ -948,28 +959,28 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         let o = job::run_on(
             &prepared,
             svg.as_bytes(),
-            demo::DEMO_PATH_NAME,
+            &path_name,
             &plan,
             &profile,
-            k != PlannerKind::PcppGuarded,
+            !k.is_guarded(),
         )
         .map_err(|e| fail("plan", &e))?;
-        rows.push((k, o.plan.quality));
-        staged.add(&out.join(demo_gcode_name(k)), o.gcode.as_bytes())?;
-        if k == PlannerKind::PcppGuarded {
-            guarded_report = Some(o.report);
+        rows.push(job::ComparisonRow::of(&o.plan));
+        staged.add(&out.join(demo_gcode_name(part, k)), o.gcode.as_bytes())?;
+        if k == default_planner {
+            default_report = Some(o.report);
         }
     }
-    let antenna = |r: Result<String, antennas::AntennaError>| r.map_err(|e| fail("antenna", &e));
-    let files: Vec<(String, Vec<u8>)> = vec![
-        (demo::DEMO_SCAN_NAME.into(), scan.clone()),
-        (demo::DEMO_PATH_NAME.into(), svg.clone().into_bytes()),
+    let prefix = demo_prefix(part);
+    let mut files: Vec<(String, Vec<u8>)> = vec![
+        (scan_name.clone(), scan.clone()),
+        (path_name.clone(), svg.clone().into_bytes()),
         (
-            "demo-comparison.json".into(),
+            format!("{prefix}-comparison.json"),
             to_json(&comparison_json(
                 &[
-                    InputFile::new(demo::DEMO_SCAN_NAME, &scan),
-                    InputFile::new(demo::DEMO_PATH_NAME, svg.as_bytes()),
+                    InputFile::new(&scan_name, &scan),
+                    InputFile::new(&path_name, svg.as_bytes()),
                 ],
                 &settings.plan,
                 &rows,
@@ -977,54 +988,63 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
             .into_bytes(),
         ),
         (
-            "demo-pcpp-guarded-report.json".into(),
-            to_json(&guarded_report)?.into_bytes(),
-        ),
-        (
-            "demo-registration.json".into(),
-            to_json(&serde_json::json!({
-                "fiducials": "auto",
-                "printer_points": test_part::FIDUCIALS_MM,
-                "registration": &registration,
-            }))?
-            .into_bytes(),
-        ),
-        (
-            "antenna-spiral.svg".into(),
-            antennas::paper_spiral_svg().into_bytes(),
-        ),
-        (
-            "antenna-hilbert.svg".into(),
-            antenna(antennas::hilbert_loop_svg(4, 40.0))?.into_bytes(),
-        ),
-        (
-            "antenna-monopole.svg".into(),
-            antenna(antennas::triangular_monopole_svg(30.0, 20.0, 5.0))?.into_bytes(),
+            format!("{prefix}-{default_planner}-report.json"),
+            to_json(&default_report)?.into_bytes(),
         ),
     ];
+    if let Some(registration) = &registration {
+        let antenna =
+            |r: Result<String, antennas::AntennaError>| r.map_err(|e| fail("antenna", &e));
+        files.extend([
+            (
+                "demo-registration.json".into(),
+                to_json(&serde_json::json!({
+                    "fiducials": "auto",
+                    "printer_points": test_part::FIDUCIALS_MM,
+                    "registration": registration,
+                }))?
+                .into_bytes(),
+            ),
+            (
+                "antenna-spiral.svg".into(),
+                antennas::paper_spiral_svg().into_bytes(),
+            ),
+            (
+                "antenna-hilbert.svg".into(),
+                antenna(antennas::hilbert_loop_svg(4, 40.0))?.into_bytes(),
+            ),
+            (
+                "antenna-monopole.svg".into(),
+                antenna(antennas::triangular_monopole_svg(30.0, 20.0, 5.0))?.into_bytes(),
+            ),
+        ]);
+    }
     for (name, bytes) in &files {
         staged.add(&out.join(name), bytes)?;
     }
     let mut written: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
-    written.extend(PlannerKind::ALL.iter().map(|&k| demo_gcode_name(k)));
+    written.extend(PlannerKind::ALL.iter().map(|&k| demo_gcode_name(part, k)));
     staged.commit()?;
 
-    if let Some(r) = &guarded_report {
+    if let Some(r) = &default_report {
         warn_all(&r.warnings);
     }
     let mut s = format!("wrote {} files to {}:\n", written.len(), out.display());
     for n in &written {
         let _ = writeln!(s, "  {n}");
     }
+    if let Some(registration) = &registration {
+        let _ = writeln!(
+            s,
+            "{} (fiducials auto against the part's 3 holes)",
+            registration_line(registration, RegistrationMethod::Lsq)
+        );
+    }
     let _ = writeln!(
         s,
-        "{} (fiducials auto against the part's 3 holes)",
-        registration_line(&registration, RegistrationMethod::Lsq)
-    );
-    let _ = writeln!(
-        s,
-        "G-code dialect {}; planner comparison on the demo test part:",
-        profile.name
+        "G-code dialect {}; planner comparison on the demo part {part} ({}):",
+        profile.name,
+        part.description()
     );
     s.push_str(&job::comparison_table(&rows));
     print!("{s}");
@@ -1133,15 +1153,23 @@ prints them as JSON.
 const DEMO_HELP: &str = "\
 pcpp demo: the built-in demo, no input needed
 
-usage: pcpp demo [--out DIR] [--dialect marlin|aerotech|grbl]
+usage: pcpp demo [--part NAME] [--out DIR] [--dialect marlin|aerotech|grbl]
 
-Writes to DIR (default ./pcpp-demo): the test part scan (binary PLY), its line
-paths (SVG), one G-code per planner (demo-<planner>.gcode; all but
-pcpp-guarded are written even where the nozzle would touch the part, for
-comparison), the comparison and the guarded plan's report (JSON), the
-registration of the scan on its fiducial holes (JSON), and three antenna SVGs
-(the paper's spiral, a Hilbert loop, a triangular monopole). Prints the
-comparison table.
+Writes to DIR (default ./pcpp-demo): the part's scan (binary PLY), its drawing
+(SVG), one G-code per planner (demo-<planner>.gcode; the paper's three planners,
+constant, slope and pcpp, are written even where the nozzle would touch the
+part, for comparison, and their headers say so), the comparison and the default
+planner's report (JSON). For the test part also the registration of the scan
+on its fiducial holes (JSON) and three antenna SVGs (the paper's spiral, a
+Hilbert loop, a triangular monopole). Prints the comparison table.
+
+Parts (--part, default test-part):
+  test-part            the paper's 80 x 80 mm test part with straight lines
+  stepped-block        2 mm steps with vertical walls, lines across them
+  dimpled-hemisphere   R 27 mm hemisphere with R 1-3 mm dimples, the paper's spiral
+  folded-film          film folded in sharp 80 degree creases, a Hilbert loop
+  wrinkled-film        film with smooth wrinkles, the paper's spiral
+Files of parts other than the test part are named demo-<part>-....
 ";
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! Built-in demo inputs, generated (no files a user must find): the paper's
 //! test part with its line paths, and antenna path generators.
 pub mod antennas;
+pub mod parts;
 pub mod test_part;
 pub mod workloads;
 

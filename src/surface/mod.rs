@@ -8,12 +8,14 @@
 //! within 1e-6 mm of the surface).
 
 mod index;
+mod sweep;
 
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 pub use index::SpatialIndex;
+pub use sweep::SweepGap;
 use index::{Index, QueryBox};
 
 /// A scan in the printer frame, ready for queries.

@@ -4,14 +4,24 @@
 //! - `constant`: T* = Ta + d Z (paper Algorithm 2).
 //! - `slope`: T* = Ta + d N + (do/2) V (Algorithm 3, eq. 2).
 //! - `pcpp`: the paper's one-pass correction (Algorithm 4, eq. 6-14).
-//! - `pcpp-guarded` (beyond the paper): `pcpp`, then re-tested until the
-//!   nozzle clears the surface by at least tol.
+//! - `pcpp-guarded` (beyond the paper, section 6d): `pcpp`, then re-tested
+//!   until the nozzle clears the surface by at least tol.
+//! - `even` (ours, section 6e, [`even`]): the filament thickness of
+//!   section 7 as close to d as the surface allows, with no contact along
+//!   any move and a tool path that always progresses.
+//!
+//! The two guarded planners (`pcpp-guarded`, `even`) then get waypoints
+//! wherever a straight move between two of their points would come closer
+//! to the surface than tol ([`crate::motion`], section 6f).
+
+mod even;
 
 use std::{fmt, str::FromStr};
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::motion::{Clearance, PLANNING_MARGIN_MM};
 use crate::params::{Nozzle, Process};
 use crate::spline::LocalGeometry;
 use crate::surface::Surface;
@@ -23,18 +33,27 @@ pub enum PlannerKind {
     Constant,
     Slope,
     Pcpp,
-    #[default]
     PcppGuarded,
+    #[default]
+    Even,
 }
 
 impl PlannerKind {
-    /// All four, in the order the paper compares them.
-    pub const ALL: [PlannerKind; 4] = [
+    /// All five: the paper's three in the order it compares them, then
+    /// the two guarded ones.
+    pub const ALL: [PlannerKind; 5] = [
         PlannerKind::Constant,
         PlannerKind::Slope,
         PlannerKind::Pcpp,
         PlannerKind::PcppGuarded,
+        PlannerKind::Even,
     ];
+
+    /// Whether the planner makes every move safe with waypoints (spec
+    /// section 6f); the paper's three are planned as the paper plans them.
+    pub fn is_guarded(self) -> bool {
+        matches!(self, PlannerKind::PcppGuarded | PlannerKind::Even)
+    }
 
     pub fn name(self) -> &'static str {
         match self {
@@ -42,6 +61,7 @@ impl PlannerKind {
             PlannerKind::Slope => "slope",
             PlannerKind::Pcpp => "pcpp",
             PlannerKind::PcppGuarded => "pcpp-guarded",
+            PlannerKind::Even => "even",
         }
     }
 }
@@ -59,7 +79,9 @@ impl FromStr for PlannerKind {
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
             .ok_or_else(|| {
-                format!("unknown planner '{s}' (expected constant, slope, pcpp or pcpp-guarded)")
+                format!(
+                    "unknown planner '{s}' (expected even, pcpp-guarded, pcpp, slope or constant)"
+                )
             })
     }
 }
@@ -104,23 +126,78 @@ fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, 
             t += m * g.v; // eq. 11
         }
     } else if descending {
-        // Case 3: surface behind the tip within d (eq. 12-14).
-        if let Some(hit) = surface.segment_first_hit(t, t - d * g.v) {
-            let m2 = r - t.distance(hit) + m;
-            t += m2 * g.v;
-        }
+        // Case 3 (eq. 12-14, spec decision "revised"): the segment
+        // [Ta_j, Ta_j - d V_j] starts at the surface point, as the main
+        // text's eq. 12-13 write it, so its first point on S is Ta_j itself
+        // (q_j = Ta_j) and M'_j = do/2 - |Ta_j - q_j| + M_j = do/2 + M_j.
+        t += (r + m) * g.v;
     }
     t
 }
 
 /// The guarded clearance: no surface within the footprint of the nozzle
-/// (radius do/2 + tol) higher than tol below the tip. This covers the tip
-/// disk and the nozzle body above it (a vertical cylinder of diameter do).
-fn clears(surface: &Surface, t: DVec3, r_clear: f64, tol: f64) -> Option<f64> {
-    surface.max_height_in_disk_above(t.truncate(), r_clear, t.z - tol + 1e-9)
+/// (radius do/2 + tol, plus the planning margin) higher than tol below the
+/// tip. This covers the tip disk and the nozzle body above it (a vertical
+/// cylinder of diameter do); it is the point case of [`Clearance`].
+fn blocked(surface: &Surface, t: DVec3, c: &Clearance) -> Option<f64> {
+    surface.max_height_in_disk_above(t.truncate(), c.radius_mm, t.z - c.tol_mm)
 }
 
-/// Plans one subpath. `ta` and `geometry` have the same length.
+/// One point of `pcpp-guarded` (spec section 6d): the `pcpp` point, pushed
+/// again by eq. 6-10 with the clearance radius until the nozzle clears, and
+/// lifted clear where pushing does not do it.
+fn guarded_point(
+    surface: &Surface,
+    j: usize,
+    p: DVec3,
+    g: &LocalGeometry,
+    nozzle: &Nozzle,
+    tol: f64,
+    out: &mut PlannedPoints,
+) -> DVec3 {
+    let c = Clearance::new(nozzle, tol).with_margin(PLANNING_MARGIN_MM);
+    let start = pcpp_point(surface, p, g, nozzle, tol);
+    let mut t = start;
+    // The highest surface too close under the nozzle at t, if any.
+    let mut high = blocked(surface, t, &c);
+    for _ in 0..GUARD_MAX_PUSHES {
+        if high.is_none() {
+            break;
+        }
+        // Re-apply eq. 6-10 with the clearance radius.
+        let Some(contact) = surface.disk_contact(t, c.radius_mm) else {
+            break;
+        };
+        let away = t - contact.centroid;
+        let dist = away.length();
+        let q = if dist > 1e-9 { away / dist } else { g.n };
+        t += (c.radius_mm - dist + 1e-6) * q;
+        high = blocked(surface, t, &c);
+    }
+    // Pushing sideways must not carry the tip off the path.
+    if (t - p).truncate().length() > nozzle.outer_diameter_mm {
+        t = start;
+        high = blocked(surface, t, &c);
+    }
+    if let Some(h) = high {
+        // A hair above tol, so an exact tie never fails on rounding.
+        let z = h + c.tol_mm + 1e-6;
+        let lift = z - t.z;
+        t.z = z;
+        out.lifted.push((j, lift));
+        // Lifting to h + tol clears by construction; checked again, so
+        // rounding can never pass an uncleared point.
+        high = blocked(surface, t, &c);
+    }
+    if !t.is_finite() || high.is_some() {
+        out.uncleared.push(j);
+    }
+    t
+}
+
+/// Plans one subpath's points (one per sample; the guarded planners'
+/// waypoints come after, see [`crate::motion::insert_waypoints`]). `ta`
+/// and `geometry` have the same length.
 pub fn plan_points(
     kind: PlannerKind,
     surface: &Surface,
@@ -141,44 +218,9 @@ pub fn plan_points(
             PlannerKind::Constant => p + d * DVec3::Z,
             PlannerKind::Slope => p + d * g.n + r * g.v,
             PlannerKind::Pcpp => pcpp_point(surface, p, g, nozzle, tol),
-            PlannerKind::PcppGuarded => {
-                let start = pcpp_point(surface, p, g, nozzle, tol);
-                let r_clear = r + tol;
-                let mut t = start;
-                // The highest surface too close under the nozzle at t, if any.
-                let mut blocked = clears(surface, t, r_clear, tol);
-                for _ in 0..GUARD_MAX_PUSHES {
-                    if blocked.is_none() {
-                        break;
-                    }
-                    // Re-apply eq. 6-10 with the clearance radius.
-                    let Some(c) = surface.disk_contact(t, r_clear) else {
-                        break;
-                    };
-                    let away = t - c.centroid;
-                    let dist = away.length();
-                    let q = if dist > 1e-9 { away / dist } else { g.n };
-                    t += (r_clear - dist + 1e-6) * q;
-                    blocked = clears(surface, t, r_clear, tol);
-                }
-                // Pushing sideways must not carry the tip off the path.
-                if (t - p).truncate().length() > nozzle.outer_diameter_mm {
-                    t = start;
-                    blocked = clears(surface, t, r_clear, tol);
-                }
-                if let Some(h) = blocked {
-                    let lift = h + tol - t.z;
-                    t.z = h + tol;
-                    out.lifted.push((j, lift));
-                    // Lifting to h + tol clears by construction; checked
-                    // again, so rounding can never pass an uncleared point.
-                    blocked = clears(surface, t, r_clear, tol);
-                }
-                if !t.is_finite() || blocked.is_some() {
-                    out.uncleared.push(j);
-                }
-                t
-            }
+            PlannerKind::PcppGuarded => guarded_point(surface, j, p, g, nozzle, tol, &mut out),
+            // Planned as a whole, not point by point.
+            PlannerKind::Even => return even::plan(surface, ta, geometry, nozzle, process),
         };
         out.toolpath.push(t);
     }

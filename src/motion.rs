@@ -1,0 +1,442 @@
+//! Safe motion (spec section 6f): the stage moves in straight lines between
+//! consecutive points, so safety is a property of every move, not of the
+//! planned points.
+//!
+//! One check serves the planners, the G-code writer's output, `pcpp check`
+//! and the page: [`Clearance::gap`], the exact swept test of
+//! [`Surface::sweep_gap`] with the nozzle's footprint. The nozzle is the tip
+//! disk of diameter do and the body above it (a vertical cylinder of the
+//! same diameter); a position is clear when every surface point within
+//! do/2 + tol of the nozzle's axis lies at least tol below the tip. That
+//! keeps the whole nozzle at least tol away from the surface in every
+//! direction (the dilation of the nozzle by a ball of radius tol lies inside
+//! that cylinder), conservatively by at most (sqrt 2 - 1) tol at the tip's
+//! rim.
+//!
+//! Where a straight move between two planned points would come closer, the
+//! guarded planners add waypoints on it ([`insert_waypoints`]): at the
+//! place where the move is worst, as high as the footprint there needs and
+//! no higher, recursively, so a move up a step rises before the step and a
+//! move down one passes the edge before it descends.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::params::Nozzle;
+use crate::surface::{Surface, SweepGap};
+
+/// The safe-motion criterion for one nozzle and tolerance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clearance {
+    /// Radius of the footprint tested: do/2 + tol.
+    pub radius_mm: f64,
+    /// How far below the tip the footprint's surface must stay: tol.
+    pub tol_mm: f64,
+}
+
+/// The margin the planners keep beyond [`Clearance`], so that rounding the
+/// coordinates to the G-code's decimals (0.0005 mm at 3 decimals) never
+/// turns a clear move into a touching one.
+pub const PLANNING_MARGIN_MM: f64 = 0.002;
+
+/// Gaps this close below tol count as tol: a planned point set at exactly
+/// tol must not fail on rounding (the planning margin is what absorbs the
+/// G-code's rounding).
+const TIE_MM: f64 = 1e-9;
+
+/// Most waypoints added to one move before falling back to rising over the
+/// whole move at once.
+const MAX_WAYPOINTS_PER_MOVE: usize = 12;
+
+impl Clearance {
+    /// The check of spec section 6(f) for `nozzle` and tolerance `tol_mm`.
+    pub fn new(nozzle: &Nozzle, tol_mm: f64) -> Clearance {
+        Clearance {
+            radius_mm: 0.5 * nozzle.outer_diameter_mm + tol_mm,
+            tol_mm,
+        }
+    }
+
+    /// The same check, stricter by `margin` in radius and height.
+    pub fn with_margin(self, margin: f64) -> Clearance {
+        Clearance {
+            radius_mm: self.radius_mm + margin,
+            tol_mm: self.tol_mm + margin,
+        }
+    }
+
+    /// The gap of the straight move `a` -> `b` (the smallest height of the
+    /// tip over the highest surface point within the footprint), or `None`
+    /// when it is at least `limit`.
+    pub fn gap(&self, surface: &Surface, a: DVec3, b: DVec3, limit: f64) -> Option<SweepGap> {
+        surface.sweep_gap(a, b, self.radius_mm, limit)
+    }
+
+    /// Whether the straight move `a` -> `b` stays clear.
+    pub fn is_clear(&self, surface: &Surface, a: DVec3, b: DVec3) -> bool {
+        self.touching(surface, a, b).is_none()
+    }
+
+    /// The gap of the move `a` -> `b` if it is below tol.
+    pub fn touching(&self, surface: &Surface, a: DVec3, b: DVec3) -> Option<SweepGap> {
+        self.gap(surface, a, b, self.tol_mm - TIE_MM)
+    }
+
+    /// The lowest tip height that clears the surface at `xy`'s footprint.
+    fn safe_height(&self, surface: &Surface, p: DVec3) -> Option<f64> {
+        surface
+            .max_height_in_disk(p.truncate(), self.radius_mm)
+            // A hair above tol, so the waypoint's own moves do not fail on
+            // an exact tie with rounding.
+            .map(|h| h + self.tol_mm + 1e-6)
+    }
+}
+
+/// A planned piece with the waypoints that make its moves safe.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SafePath {
+    /// The points the nozzle visits: the planned points with waypoints
+    /// between them.
+    pub points: Vec<DVec3>,
+    /// Waypoints added.
+    pub waypoints: usize,
+    /// Length added to the path by the waypoints, mm.
+    pub extra_length_mm: f64,
+    /// Planned points j whose move to j + 1 could not be made safe (the
+    /// planned point itself does not clear).
+    pub unresolved: Vec<usize>,
+}
+
+/// Adds waypoints where a straight move between consecutive `planned`
+/// points would come closer than `clearance` allows (spec section 6f):
+/// at the worst place of the move, raised to the lowest safe height there,
+/// then the two halves checked again. A move that needs more than
+/// [`MAX_WAYPOINTS_PER_MOVE`] rises over its whole footprint at once
+/// (vertical rise, level move, vertical descent), which is always safe
+/// when its two ends are.
+pub fn insert_waypoints(surface: &Surface, planned: &[DVec3], clearance: &Clearance) -> SafePath {
+    let mut out = SafePath {
+        points: Vec::with_capacity(planned.len()),
+        ..Default::default()
+    };
+    let Some(&first) = planned.first() else {
+        return out;
+    };
+    out.points.push(first);
+    for (j, pair) in planned.windows(2).enumerate() {
+        let (p, q) = (pair[0], pair[1]);
+        let mut added = Vec::new();
+        if !resolve(surface, clearance, p, q, &mut added) {
+            added = rise_over(surface, clearance, p, q);
+            if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
+                out.unresolved.push(j);
+                added.clear();
+            }
+        }
+        if !added.is_empty() {
+            let before = p.distance(q);
+            let mut after = 0.0;
+            let mut prev = p;
+            for &w in added.iter().chain(std::iter::once(&q)) {
+                after += prev.distance(w);
+                prev = w;
+            }
+            out.extra_length_mm += after - before;
+            out.waypoints += added.len();
+            out.points.extend_from_slice(&added);
+        }
+        out.points.push(q);
+    }
+    out
+}
+
+fn path_clear(surface: &Surface, c: &Clearance, p: DVec3, mid: &[DVec3], q: DVec3) -> bool {
+    let mut prev = p;
+    for &w in mid.iter().chain(std::iter::once(&q)) {
+        if !c.is_clear(surface, prev, w) {
+            return false;
+        }
+        prev = w;
+    }
+    true
+}
+
+/// Waypoints for p -> q by recursive splitting at the worst place; false
+/// when that did not succeed within the budget.
+fn resolve(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3, out: &mut Vec<DVec3>) -> bool {
+    let Some(worst) = c.touching(surface, p, q) else {
+        return true;
+    };
+    if out.len() >= MAX_WAYPOINTS_PER_MOVE {
+        return false;
+    }
+    let x = p.lerp(q, worst.at);
+    let Some(h) = c.safe_height(surface, x) else {
+        return false;
+    };
+    let w = DVec3::new(x.x, x.y, x.z.max(h));
+    // A waypoint that coincides with an end changes nothing: the end
+    // itself does not clear.
+    if w.distance(p) < 1e-9 || w.distance(q) < 1e-9 {
+        return false;
+    }
+    resolve(surface, c, p, w, out) && {
+        out.push(w);
+        resolve(surface, c, w, q, out)
+    }
+}
+
+/// Rise, level move and descent over the whole footprint of p -> q.
+fn rise_over(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3) -> Vec<DVec3> {
+    let probe = surface.top_z() + 1.0;
+    let (a, b) = (
+        DVec3::new(p.x, p.y, probe),
+        DVec3::new(q.x, q.y, probe),
+    );
+    let top = match c.gap(surface, a, b, f64::INFINITY) {
+        Some(g) => probe - g.gap_mm,
+        None => return Vec::new(),
+    };
+    let z = (top + c.tol_mm).max(p.z).max(q.z);
+    let mut mid = Vec::with_capacity(2);
+    if z > p.z {
+        mid.push(DVec3::new(p.x, p.y, z));
+    }
+    if z > q.z {
+        mid.push(DVec3::new(q.x, q.y, z));
+    }
+    mid
+}
+
+/// Counts the tool-path points that move backwards along the drawn path:
+/// where the drawn sample nearest (in XY) to a tool-path point falls back
+/// by 2 or more samples from the furthest one reached before it. `ta` and
+/// `toolpath` have one point per sample.
+pub fn backward_moves(ta: &[DVec3], toolpath: &[DVec3]) -> usize {
+    // The nearest sample is searched near the last one found: a point
+    // further back than the window still counts as a step back.
+    const WINDOW: usize = 24;
+    let mut count = 0;
+    let mut reached = 0usize;
+    let mut prev = 0usize;
+    for (j, t) in toolpath.iter().enumerate() {
+        let lo = prev.saturating_sub(WINDOW);
+        let hi = (prev + WINDOW).min(ta.len().saturating_sub(1));
+        let nearest = (lo..=hi)
+            .min_by(|&a, &b| {
+                let da = (ta[a] - *t).truncate().length_squared();
+                let db = (ta[b] - *t).truncate().length_squared();
+                da.total_cmp(&db)
+            })
+            .unwrap_or(0);
+        if j > 0 && nearest + 2 <= reached {
+            count += 1;
+        }
+        reached = reached.max(nearest);
+        prev = nearest;
+    }
+    count
+}
+
+/// What the motion check found over a set of moves.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MotionSummary {
+    /// Moves checked.
+    pub moves: usize,
+    /// The smallest gap over all moves (`None` if no move passes over the
+    /// scan within the footprint).
+    pub min_clearance_mm: Option<f64>,
+    /// Where it is smallest: the tip's position.
+    pub min_clearance_at: Option<[f64; 3]>,
+    /// Moves whose gap is below tol.
+    pub touching_moves: usize,
+    /// The first touching moves (at most [`MAX_LISTED`]), in order.
+    pub touching: Vec<Touch>,
+}
+
+/// How many touching moves a summary lists.
+pub const MAX_LISTED: usize = 20;
+
+/// A move that comes closer than tol.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Touch {
+    /// Which move (index into the checked list), and its G-code line
+    /// where known.
+    pub index: usize,
+    pub line: Option<usize>,
+    pub from: [f64; 3],
+    pub to: [f64; 3],
+    /// The tip's position where the move is worst.
+    pub at: [f64; 3],
+    /// The gap there (negative: the surface within the footprint rises
+    /// above the tip by that much).
+    pub gap_mm: f64,
+}
+
+fn arr(p: DVec3) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+impl std::fmt::Display for Touch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(line) = self.line {
+            write!(f, "line {line}: ")?;
+        }
+        let [a, b, c] = self.from;
+        let [x, y, z] = self.to;
+        let [px, py, pz] = self.at;
+        write!(
+            f,
+            "the move ({a:.3}, {b:.3}, {c:.3}) -> ({x:.3}, {y:.3}, {z:.3}) comes to {:.3} mm of \
+             the surface at ({px:.3}, {py:.3}, {pz:.3})",
+            self.gap_mm
+        )?;
+        if self.gap_mm < 0.0 {
+            write!(f, " (the surface is {:.3} mm above the tip)", -self.gap_mm)?;
+        }
+        Ok(())
+    }
+}
+
+/// Checks every move (`from`, `to`, G-code line where known) against the
+/// surface: the smallest gap, and every move below tol.
+pub fn check_moves(
+    surface: &Surface,
+    moves: impl IntoIterator<Item = (DVec3, DVec3, Option<usize>)>,
+    clearance: &Clearance,
+) -> MotionSummary {
+    let mut s = MotionSummary::default();
+    let mut min = f64::INFINITY;
+    for (index, (a, b, line)) in moves.into_iter().enumerate() {
+        s.moves += 1;
+        // Only a gap below tol or below the smallest so far matters.
+        let limit = if min.is_finite() {
+            min.max(clearance.tol_mm)
+        } else {
+            f64::INFINITY
+        };
+        let Some(g) = clearance.gap(surface, a, b, limit) else {
+            continue;
+        };
+        let at = a.lerp(b, g.at);
+        if g.gap_mm < min {
+            min = g.gap_mm;
+            s.min_clearance_mm = Some(g.gap_mm);
+            s.min_clearance_at = Some(arr(at));
+        }
+        if g.gap_mm < clearance.tol_mm - TIE_MM {
+            s.touching_moves += 1;
+            if s.touching.len() < MAX_LISTED {
+                s.touching.push(Touch {
+                    index,
+                    line,
+                    from: arr(a),
+                    to: arr(b),
+                    at: arr(at),
+                    gap_mm: g.gap_mm,
+                });
+            }
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriMesh;
+
+    /// A block 2 mm high from x = 5 on, true vertical wall.
+    fn step() -> Surface {
+        let xs = [0.0, 5.0, 5.0, 10.0];
+        let ys = [0.0, 10.0];
+        let mut m = TriMesh::default();
+        for &y in &ys {
+            for (i, &x) in xs.iter().enumerate() {
+                m.vertices.push(DVec3::new(x, y, if i >= 2 { 2.0 } else { 0.0 }));
+            }
+        }
+        for i in 0..3u32 {
+            m.triangles.push([i, i + 1, i + 5]);
+            m.triangles.push([i, i + 5, i + 4]);
+        }
+        Surface::new(m).unwrap()
+    }
+
+    #[test]
+    fn waypoints_rise_before_a_step_up_and_pass_a_step_down() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        // Up: the low point clears, the high one too; the line between cuts.
+        let p = DVec3::new(4.0, 5.0, 0.7);
+        let q = DVec3::new(4.6, 5.0, 2.2);
+        assert!(c.gap(&s, p, p, f64::INFINITY).unwrap().gap_mm >= 0.1);
+        assert!(c.gap(&s, q, q, f64::INFINITY).unwrap().gap_mm >= 0.1);
+        assert!(!c.is_clear(&s, p, q));
+        let safe = insert_waypoints(&s, &[p, q], &c);
+        assert!(safe.unresolved.is_empty());
+        assert!(safe.waypoints >= 1, "{safe:?}");
+        for w in safe.points.windows(2) {
+            assert!(c.is_clear(&s, w[0], w[1]), "{safe:?}");
+        }
+        // The waypoint is where the wall enters the footprint (x = 5 - R),
+        // at the top plus tol: the lowest safe place there.
+        let w = safe.points[1];
+        assert!((w.x - (5.0 - c.radius_mm)).abs() < 1e-6, "{w}");
+        assert!((w.z - 2.1).abs() < 1e-5, "{w}");
+        assert!(safe.extra_length_mm > 0.0);
+        // Down: mirror image.
+        let safe = insert_waypoints(&s, &[q, p], &c);
+        for w in safe.points.windows(2) {
+            assert!(c.is_clear(&s, w[0], w[1]), "{safe:?}");
+        }
+        assert_eq!(safe.waypoints, 1);
+    }
+
+    #[test]
+    fn a_clear_path_gets_no_waypoints_and_an_unclear_point_is_reported() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        let pts: Vec<DVec3> = (0..10).map(|i| DVec3::new(0.5 + 0.3 * i as f64, 5.0, 0.7)).collect();
+        let safe = insert_waypoints(&s, &pts, &c);
+        assert_eq!(safe.points, pts);
+        assert_eq!(safe.waypoints, 0);
+        // A point inside the block cannot be fixed by waypoints.
+        let bad = [DVec3::new(3.0, 5.0, 0.7), DVec3::new(6.0, 5.0, 1.0)];
+        let safe = insert_waypoints(&s, &bad, &c);
+        assert_eq!(safe.unresolved, vec![0]);
+    }
+
+    #[test]
+    fn check_moves_lists_the_touching_ones() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        let moves = vec![
+            (DVec3::new(1.0, 5.0, 1.0), DVec3::new(2.0, 5.0, 1.0), Some(10)),
+            (DVec3::new(4.0, 5.0, 0.7), DVec3::new(4.6, 5.0, 2.2), Some(11)),
+            (DVec3::new(6.0, 5.0, 3.0), DVec3::new(8.0, 5.0, 3.0), Some(12)),
+        ];
+        let sum = check_moves(&s, moves, &c);
+        assert_eq!(sum.moves, 3);
+        assert_eq!(sum.touching_moves, 1);
+        assert_eq!(sum.touching[0].line, Some(11));
+        assert!(sum.touching[0].gap_mm < 0.0);
+        assert!(sum.min_clearance_mm.unwrap() < 0.0);
+        let text = sum.touching[0].to_string();
+        assert!(text.starts_with("line 11: the move (4.000, 5.000, 0.700)"), "{text}");
+    }
+
+    #[test]
+    fn backward_moves_count_falls_back_by_two_or_more() {
+        let ta: Vec<DVec3> = (0..20).map(|i| DVec3::new(i as f64 * 0.3, 0.0, 0.0)).collect();
+        let mut tp = ta.clone();
+        assert_eq!(backward_moves(&ta, &tp), 0);
+        // One point thrown back three samples.
+        tp[10] = ta[7];
+        assert_eq!(backward_moves(&ta, &tp), 1);
+        // One sample back is noise, not counted.
+        let mut tp = ta.clone();
+        tp[10] = ta[9];
+        assert_eq!(backward_moves(&ta, &tp), 0);
+    }
+}

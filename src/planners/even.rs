@@ -1,0 +1,201 @@
+//! `even`, our own planner (spec section 6e): the filament thickness of
+//! section 7 as close to d as the surface allows at every point, with no
+//! contact anywhere along the motion (section 6f) and a tool path that is
+//! smooth and always progresses along the drawn path.
+//!
+//! Section 7 measures the filament at the back of the nozzle, F_j, on the
+//! normal line of the surface point Ta_j. So the target is the slope
+//! planner's principle carried to its end: F_j = Ta_j + d N_j exactly, and
+//! the tip T*_j = F_j + k_j V_j, where k_j is how far the back of the tip
+//! lies behind its centre (do/2 on descents, d/2 otherwise, section 7).
+//! Then the filament curve c passes through Ta_j + d N_j and D_j = d.
+//!
+//! Three things stand between that target and the tool path, each resolved
+//! with the least change:
+//! 1. k_j switches with the sign of t_z, so a noise-level slope would make
+//!    the tip jump by (do - d)/2 back and forth. k_j blends smoothly from
+//!    d/2 to do/2 over slopes from +[`BLEND_DEG`] to -[`BLEND_DEG`]; on
+//!    such slopes the horizontal difference moves F_j along a nearly level
+//!    surface, which changes D_j by at most (do - d)/2 sin(3 deg), 0.008 mm
+//!    for the paper's tip.
+//! 2. Where the normal turns fast (steps, creases), N_j swings F_j back and
+//!    forth along the path. The tip's position along the path is made to
+//!    advance by at least [`MIN_ADVANCE`] of the sample spacing at every
+//!    step: the least-squares closest such positions to the targets
+//!    (isotonic regression, pool-adjacent-violators, O(n)).
+//! 3. Where the tip at its target would come within tol of the surface
+//!    (steep ascents, narrow valleys, the foot of a step), it is raised to
+//!    the lowest height that clears (the drop-cutter height of its
+//!    footprint plus tol): no sideways push, so it never leaves the path.
+//!    Under section 7's model no other position does better on a straight
+//!    ascent: with the tip as low as the clearance allows, D_j does not
+//!    depend on where along the slope the tip sits.
+//!
+//! The moves between the points are then made safe with waypoints
+//! ([`crate::motion::insert_waypoints`], applied to every guarded planner).
+//! The same constants serve every part: nothing here is tuned per part.
+
+use glam::DVec3;
+
+use super::PlannedPoints;
+use crate::motion::{Clearance, PLANNING_MARGIN_MM};
+use crate::params::{Nozzle, Process};
+use crate::spline::LocalGeometry;
+use crate::surface::Surface;
+
+/// Descents gentler than this many degrees blend the back offset k_j
+/// between its ascent and descent values (level keeps the ascent's, as
+/// section 7 does for t_z = 0).
+pub const BLEND_DEG: f64 = 6.0;
+
+/// The least advance of the tip along the path at each step, as a share of
+/// the drawn samples' spacing there.
+pub const MIN_ADVANCE: f64 = 0.25;
+
+/// How far the back of the tip lies behind its centre (section 7: do/2
+/// moving down, d/2 otherwise), blended smoothly over gentle descents.
+fn back_offset(nozzle: &Nozzle, slope_rad: f64) -> f64 {
+    let half_d = 0.5 * nozzle.inner_diameter_mm;
+    let half_do = 0.5 * nozzle.outer_diameter_mm;
+    // smoothstep from 0 (level or ascending) to 1 (descending by BLEND_DEG)
+    let u = (-slope_rad.to_degrees() / BLEND_DEG).clamp(0.0, 1.0);
+    let w = u * u * (3.0 - 2.0 * u);
+    half_d + (half_do - half_d) * w
+}
+
+/// Section 7's own back offset (its switch on the sign of t_z).
+fn model_back_offset(nozzle: &Nozzle, g: &LocalGeometry) -> f64 {
+    if g.tangent.z < 0.0 {
+        0.5 * nozzle.outer_diameter_mm
+    } else {
+        0.5 * nozzle.inner_diameter_mm
+    }
+}
+
+/// How far behind the first surface point the back of the tip starts: the
+/// filament starts at the back of the tip, so a start ahead of Ta_0 would
+/// leave Ta_0 without filament (section 7 finds no crossing there).
+const START_BEHIND_MM: f64 = 1e-4;
+
+pub(super) fn plan(
+    surface: &Surface,
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    nozzle: &Nozzle,
+    process: &Process,
+) -> PlannedPoints {
+    let d = nozzle.inner_diameter_mm;
+    let n = ta.len();
+    // The target of every point: its shift along V_j and its height.
+    let mut shift = Vec::with_capacity(n);
+    let mut height = Vec::with_capacity(n);
+    for (j, (&a, g)) in ta.iter().zip(geometry).enumerate() {
+        let f = a + d * g.n;
+        let k = if j == 0 {
+            model_back_offset(nozzle, g) - START_BEHIND_MM
+        } else {
+            back_offset(nozzle, g.slope_rad)
+        };
+        shift.push(d * g.n.dot(g.v) + k);
+        height.push(f.z);
+    }
+    // Progress: the tip's place along the path, w_j = u_j + shift_j, must
+    // advance by MIN_ADVANCE of each step; closest in least squares.
+    let mut u = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    for j in 0..n {
+        if j > 0 {
+            acc += (ta[j] - ta[j - 1]).truncate().length();
+        }
+        u.push(acc);
+    }
+    let mut floor = 0.0;
+    let mut lifted: Vec<f64> = Vec::with_capacity(n);
+    for j in 0..n {
+        if j > 0 {
+            floor += MIN_ADVANCE * (u[j] - u[j - 1]);
+        }
+        lifted.push(u[j] + shift[j] - floor);
+    }
+    let fitted = isotonic(&lifted);
+    let c = Clearance::new(nozzle, process.tolerance_mm).with_margin(PLANNING_MARGIN_MM);
+    let mut out = PlannedPoints {
+        toolpath: Vec::with_capacity(n),
+        ..Default::default()
+    };
+    let mut floor = 0.0;
+    for j in 0..n {
+        if j > 0 {
+            floor += MIN_ADVANCE * (u[j] - u[j - 1]);
+        }
+        let s = fitted[j] + floor - u[j];
+        let g = &geometry[j];
+        let mut t = DVec3::new(ta[j].x, ta[j].y, height[j]) + s * g.v;
+        // Raise to the lowest height that clears, where the target does
+        // not.
+        if let Some(h) = surface.max_height_in_disk_above(t.truncate(), c.radius_mm, t.z - c.tol_mm) {
+            let z = h + c.tol_mm + 1e-6;
+            out.lifted.push((j, z - t.z));
+            t.z = z;
+        }
+        if !t.is_finite() {
+            out.uncleared.push(j);
+        }
+        out.toolpath.push(t);
+    }
+    out
+}
+
+/// The nondecreasing sequence closest to `y` in least squares
+/// (pool-adjacent-violators).
+fn isotonic(y: &[f64]) -> Vec<f64> {
+    // Blocks of (mean, count).
+    let mut blocks: Vec<(f64, usize)> = Vec::with_capacity(y.len());
+    for &v in y {
+        let mut cur = (v, 1usize);
+        while let Some(&(m, k)) = blocks.last() {
+            if m <= cur.0 {
+                break;
+            }
+            blocks.pop();
+            let total = k + cur.1;
+            cur = ((m * k as f64 + cur.0 * cur.1 as f64) / total as f64, total);
+        }
+        blocks.push(cur);
+    }
+    let mut out = Vec::with_capacity(y.len());
+    for (m, k) in blocks {
+        out.extend(std::iter::repeat_n(m, k));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn isotonic_pools_violators() {
+        assert_eq!(isotonic(&[1.0, 2.0, 3.0]), vec![1.0, 2.0, 3.0]);
+        assert_eq!(isotonic(&[1.0, 3.0, 2.0, 4.0]), vec![1.0, 2.5, 2.5, 4.0]);
+        assert_eq!(isotonic(&[3.0, 2.0, 1.0]), vec![2.0, 2.0, 2.0]);
+        assert!(isotonic(&[]).is_empty());
+    }
+
+    #[test]
+    fn back_offset_blends_across_level() {
+        let n = Nozzle::DEFAULT;
+        let up = back_offset(&n, 10f64.to_radians());
+        let down = back_offset(&n, -10f64.to_radians());
+        assert!((up - 0.3015).abs() < 1e-12 && (down - 0.454).abs() < 1e-12);
+        assert_eq!(back_offset(&n, 0.0), 0.3015);
+        let mid = back_offset(&n, -3f64.to_radians());
+        assert!((mid - 0.5 * (0.3015 + 0.454)).abs() < 1e-12);
+        // Continuous: no jump anywhere, in particular not at level.
+        for k in -1000..1000 {
+            let a = back_offset(&n, (k as f64 * 0.01).to_radians());
+            let b = back_offset(&n, ((k + 1) as f64 * 0.01).to_radians());
+            assert!((a - b).abs() < 1e-3, "{k}");
+        }
+    }
+}
