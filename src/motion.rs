@@ -3,15 +3,13 @@
 //! planned points.
 //!
 //! One check serves the planners, the G-code writer's output, `pcpp check`
-//! and the page: [`Clearance::gap`], the exact swept test of
-//! [`Surface::sweep_gap`] with the nozzle's footprint. The nozzle is the tip
-//! disk of diameter do and the body above it (a vertical cylinder of the
-//! same diameter); a position is clear when every surface point within
-//! do/2 + tol of the nozzle's axis lies at least tol below the tip. That
-//! keeps the whole nozzle at least tol away from the surface in every
-//! direction (the dilation of the nozzle by a ball of radius tol lies inside
-//! that cylinder), conservatively by at most (sqrt 2 - 1) tol at the tip's
-//! rim.
+//! and the page: [`Clearance::gap`], the swept test of
+//! [`Surface::nozzle_gap`]. The nozzle is the tip disk of diameter do and
+//! the body above it (a vertical cylinder of the same diameter); a move is
+//! clear when the nozzle keeps at least tol from the surface at every
+//! position along it, in every direction (exact where the nearest surface
+//! is a facet, conservative by a few hundredths of tol at corners and
+//! edges; see the sweep's module comment).
 //!
 //! Where a straight move between two planned points would come closer, the
 //! guarded planners add waypoints on it ([`insert_waypoints`]): at the
@@ -28,9 +26,9 @@ use crate::surface::{Surface, SweepGap};
 /// The safe-motion criterion for one nozzle and tolerance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clearance {
-    /// Radius of the footprint tested: do/2 + tol.
+    /// The tip's radius, do/2.
     pub radius_mm: f64,
-    /// How far below the tip the footprint's surface must stay: tol.
+    /// The distance the nozzle keeps from the surface: tol.
     pub tol_mm: f64,
 }
 
@@ -52,24 +50,24 @@ impl Clearance {
     /// The check of spec section 6(f) for `nozzle` and tolerance `tol_mm`.
     pub fn new(nozzle: &Nozzle, tol_mm: f64) -> Clearance {
         Clearance {
-            radius_mm: 0.5 * nozzle.outer_diameter_mm + tol_mm,
+            radius_mm: 0.5 * nozzle.outer_diameter_mm,
             tol_mm,
         }
     }
 
-    /// The same check, stricter by `margin` in radius and height.
+    /// The same check, keeping `margin` more distance.
     pub fn with_margin(self, margin: f64) -> Clearance {
         Clearance {
-            radius_mm: self.radius_mm + margin,
             tol_mm: self.tol_mm + margin,
+            ..self
         }
     }
 
-    /// The gap of the straight move `a` -> `b` (the smallest height of the
-    /// tip over the highest surface point within the footprint), or `None`
-    /// when it is at least `limit`.
+    /// The clearance of the straight move `a` -> `b` (at least tol when
+    /// the nozzle keeps tol from the surface all along it; see
+    /// [`Surface::nozzle_gap`]), or `None` when it is at least `limit`.
     pub fn gap(&self, surface: &Surface, a: DVec3, b: DVec3, limit: f64) -> Option<SweepGap> {
-        surface.sweep_gap(a, b, self.radius_mm, limit)
+        surface.nozzle_gap(a, b, self.radius_mm, self.tol_mm, limit)
     }
 
     /// Whether the straight move `a` -> `b` stays clear.
@@ -82,13 +80,14 @@ impl Clearance {
         self.gap(surface, a, b, self.tol_mm - TIE_MM)
     }
 
-    /// The lowest tip height that clears the surface at `xy`'s footprint.
-    fn safe_height(&self, surface: &Surface, p: DVec3) -> Option<f64> {
-        surface
-            .max_height_in_disk(p.truncate(), self.radius_mm)
-            // A hair above tol, so the waypoint's own moves do not fail on
-            // an exact tie with rounding.
-            .map(|h| h + self.tol_mm + 1e-6)
+    /// How far the tip at `p` must rise to keep tol from the surface (0
+    /// when it does), with a hair more so that the raised point's own
+    /// moves never fail on an exact tie with rounding.
+    pub fn rise_needed(&self, surface: &Surface, p: DVec3) -> f64 {
+        match self.touching(surface, p, p) {
+            Some(g) => self.tol_mm - g.gap_mm + 1e-6,
+            None => 0.0,
+        }
     }
 }
 
@@ -171,10 +170,7 @@ fn resolve(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3, out: &mut Vec<D
         return false;
     }
     let x = p.lerp(q, worst.at);
-    let Some(h) = c.safe_height(surface, x) else {
-        return false;
-    };
-    let w = DVec3::new(x.x, x.y, x.z.max(h));
+    let w = x + DVec3::Z * c.rise_needed(surface, x);
     // A waypoint that coincides with an end changes nothing: the end
     // itself does not clear.
     if w.distance(p) < 1e-9 || w.distance(q) < 1e-9 {
@@ -193,11 +189,15 @@ fn rise_over(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3) -> Vec<DVec3>
         DVec3::new(p.x, p.y, probe),
         DVec3::new(q.x, q.y, probe),
     );
+    // The level move at `probe` clears by gap: the lowest level that keeps
+    // tol lies gap - tol below it.
     let top = match c.gap(surface, a, b, f64::INFINITY) {
         Some(g) => probe - g.gap_mm,
         None => return Vec::new(),
     };
-    let z = (top + c.tol_mm).max(p.z).max(q.z);
+    // The clearance of a level move is tol plus the slack over the
+    // highest need under it: rising by tol - clearance clears all of it.
+    let z = (top + c.tol_mm + 1e-6).max(p.z).max(q.z);
     let mut mid = Vec::with_capacity(2);
     if z > p.z {
         mid.push(DVec3::new(p.x, p.y, z));
@@ -379,11 +379,11 @@ mod tests {
         for w in safe.points.windows(2) {
             assert!(c.is_clear(&s, w[0], w[1]), "{safe:?}");
         }
-        // The waypoint is where the wall enters the footprint (x = 5 - R),
-        // at the top plus tol: the lowest safe place there.
+        // The waypoint is where the wall's edge first comes within reach
+        // of the rim, as low as keeping tol from the edge allows there.
         let w = safe.points[1];
-        assert!((w.x - (5.0 - c.radius_mm)).abs() < 1e-6, "{w}");
-        assert!((w.z - 2.1).abs() < 1e-5, "{w}");
+        assert!(w.x > 5.0 - c.radius_mm - c.tol_mm - 1e-9 && w.x < 5.0 - c.radius_mm, "{w}");
+        assert!(w.z > 2.0 && w.z < 2.1 + 1e-5, "{w}");
         assert!(safe.extra_length_mm > 0.0);
         // Down: mirror image.
         let safe = insert_waypoints(&s, &[q, p], &c);

@@ -25,8 +25,8 @@
 //!    (isotonic regression, pool-adjacent-violators, O(n)).
 //! 3. Where the tip at its target would come within tol of the surface
 //!    (steep ascents, narrow valleys, the foot of a step), it is raised to
-//!    the lowest height that clears (the drop-cutter height of its
-//!    footprint plus tol): no sideways push, so it never leaves the path.
+//!    the lowest height that keeps tol ([`Clearance::rise_needed`]): no
+//!    sideways push, so it never leaves the path.
 //!    Under section 7's model no other position does better on a straight
 //!    ascent: with the tip as low as the clearance allows, D_j does not
 //!    depend on where along the slope the tip sits.
@@ -131,12 +131,12 @@ pub(super) fn plan(
         let s = fitted[j] + floor - u[j];
         let g = &geometry[j];
         let mut t = DVec3::new(ta[j].x, ta[j].y, height[j]) + s * g.v;
-        // Raise to the lowest height that clears, where the target does
-        // not.
-        if let Some(h) = surface.max_height_in_disk_above(t.truncate(), c.radius_mm, t.z - c.tol_mm) {
-            let z = h + c.tol_mm + 1e-6;
-            out.lifted.push((j, z - t.z));
-            t.z = z;
+        // Raise to the lowest height that keeps tol, where the target
+        // does not.
+        let lift = c.rise_needed(surface, t);
+        if lift > 0.0 {
+            out.lifted.push((j, lift));
+            t.z += lift;
         }
         if !t.is_finite() {
             out.uncleared.push(j);

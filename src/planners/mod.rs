@@ -135,17 +135,10 @@ fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, 
     t
 }
 
-/// The guarded clearance: no surface within the footprint of the nozzle
-/// (radius do/2 + tol, plus the planning margin) higher than tol below the
-/// tip. This covers the tip disk and the nozzle body above it (a vertical
-/// cylinder of diameter do); it is the point case of [`Clearance`].
-fn blocked(surface: &Surface, t: DVec3, c: &Clearance) -> Option<f64> {
-    surface.max_height_in_disk_above(t.truncate(), c.radius_mm, t.z - c.tol_mm)
-}
-
 /// One point of `pcpp-guarded` (spec section 6d): the `pcpp` point, pushed
-/// again by eq. 6-10 with the clearance radius until the nozzle clears, and
-/// lifted clear where pushing does not do it.
+/// again by eq. 6-10 with the clearance radius do/2 + tol until the nozzle
+/// (tip disk and body) keeps tol from the surface ([`Clearance`]), and lifted
+/// clear where pushing does not do it.
 fn guarded_point(
     surface: &Surface,
     j: usize,
@@ -156,40 +149,35 @@ fn guarded_point(
     out: &mut PlannedPoints,
 ) -> DVec3 {
     let c = Clearance::new(nozzle, tol).with_margin(PLANNING_MARGIN_MM);
+    let r_clear = c.radius_mm + c.tol_mm;
     let start = pcpp_point(surface, p, g, nozzle, tol);
     let mut t = start;
-    // The highest surface too close under the nozzle at t, if any.
-    let mut high = blocked(surface, t, &c);
+    let mut clear = c.is_clear(surface, t, t);
     for _ in 0..GUARD_MAX_PUSHES {
-        if high.is_none() {
+        if clear {
             break;
         }
         // Re-apply eq. 6-10 with the clearance radius.
-        let Some(contact) = surface.disk_contact(t, c.radius_mm) else {
+        let Some(contact) = surface.disk_contact(t, r_clear) else {
             break;
         };
         let away = t - contact.centroid;
         let dist = away.length();
         let q = if dist > 1e-9 { away / dist } else { g.n };
-        t += (c.radius_mm - dist + 1e-6) * q;
-        high = blocked(surface, t, &c);
+        t += (r_clear - dist + 1e-6) * q;
+        clear = c.is_clear(surface, t, t);
     }
     // Pushing sideways must not carry the tip off the path.
     if (t - p).truncate().length() > nozzle.outer_diameter_mm {
         t = start;
-        high = blocked(surface, t, &c);
     }
-    if let Some(h) = high {
-        // A hair above tol, so an exact tie never fails on rounding.
-        let z = h + c.tol_mm + 1e-6;
-        let lift = z - t.z;
-        t.z = z;
+    let lift = c.rise_needed(surface, t);
+    if lift > 0.0 {
+        t.z += lift;
         out.lifted.push((j, lift));
-        // Lifting to h + tol clears by construction; checked again, so
-        // rounding can never pass an uncleared point.
-        high = blocked(surface, t, &c);
     }
-    if !t.is_finite() || high.is_some() {
+    // Checked again, so rounding can never pass an uncleared point.
+    if !t.is_finite() || !c.is_clear(surface, t, t) {
         out.uncleared.push(j);
     }
     t

@@ -2,92 +2,119 @@
 //! moves in straight lines, so safety is a property of every move, not of
 //! the planned points.
 //!
-//! The question asked of a move from `a` to `b` (tip positions, the tip
-//! height varying linearly) is the one CAM's drop-cutter asks of a
-//! flat-end cutter, asked along the whole move at once: over every
-//! position of the tip on the move, how far does the tip stay above the
-//! highest surface point within `radius` of its axis in XY? This is the
-//! smallest value of `z(s) - q_z` over every pair (s, q) of a fraction s of
-//! the move and a surface point q with |q_xy - p_xy(s)| <= radius.
+//! The nozzle is the tip disk of radius r at the tip's height and the body
+//! above it (a vertical cylinder of the same radius). It keeps a distance
+//! of at least tol from a surface point x exactly when the tip is at least
+//! x_z + psi(rho) high, where rho is x's horizontal distance from the axis
+//! and psi(rho) = tol for rho <= r, sqrt(tol^2 - (rho - r)^2) up to
+//! rho = r + tol, and nothing beyond (the nozzle grown by a ball of radius
+//! tol: a flat disk with a rounded rim, CAM's bull-nose cutter). Over a
+//! straight move from `a` to `b` (the tip height varying linearly), the
+//! question is the smallest value of z(s) - x_z - psi(rho_s(x)) over every
+//! fraction s of the move and every surface point x: the move keeps tol
+//! from the surface when it is not negative. [`Surface::nozzle_gap`]
+//! returns it plus tol, the *clearance*: the tip's height over the surface
+//! where the surface nearest the nozzle lies under the tip, and tol plus
+//! how far the nozzle could sink before it came within tol otherwise.
 //!
-//! It is computed exactly, triangle by triangle. For one triangle and a
-//! fixed s, the highest point of the triangle inside the disk lies at a
-//! corner inside the disk, where an edge crosses the circle, or where the
-//! circle meets the plane's steepest ascent (inside the triangle). As s
-//! runs over [0, 1]:
-//! - a corner stays inside the disk over an interval of s, and z(s) is
-//!   linear, so its worst s is an end of that interval;
-//! - the steepest-ascent point moves in a straight line, so the s over
-//!   which it lies in the triangle form an interval, over which the gap is
-//!   linear: again an end;
-//! - an edge crossing is a point (t, s) on the boundary of the ellipse
-//!   |e(t) - p(s)| <= radius in the (t, s) square, where the gap is
-//!   linear in (t, s): its minimum lies on the square's sides (a corner's
-//!   interval, or the chord of the edge at s = 0 or s = 1) or at the one
-//!   point of the ellipse where the gap's gradient is normal to it, which
-//!   has a closed form.
+//! It is computed triangle by triangle, from three kinds of contact:
+//! - a facet: the rounded rim touches a tilted plane where the rim's
+//!   ball centre lies r + tol sin(theta) from the axis in the direction of
+//!   steepest ascent, tol cos(theta) below the tip (theta the tilt). That
+//!   point moves in a straight line as s runs, so the s for which it lies
+//!   in the triangle form an interval over which the value is linear: its
+//!   minimum is at an end. Exact.
+//! - a corner, and an edge: the rim's profile psi is replaced by a
+//!   staircase above it ([`RIM_STEPS`]): flat cutters of radius r + a_i whose
+//!   bottom lies h_i = psi(r + a_(i-1)) below the tip. For a flat cutter, a
+//!   corner stays under the disk over an interval of s (worst at an end, the
+//!   tip height being linear), and an edge crossing is a point (t, s) on the
+//!   boundary of the ellipse |e(t) - p(s)| <= radius in the (t, s) square,
+//!   where the value is linear in (t, s): its minimum lies on the square's
+//!   sides (a corner's interval, or the edge's chord at s = 0 or s = 1) or
+//!   at the one point of the ellipse where the value's gradient is normal
+//!   to it, which has a closed form. Exact for the staircase, which is
+//!   conservative by at most tol (a_i - a_(i-1)) times the slope at the
+//!   contact.
 //!
-//! So the few candidates per triangle contain the exact minimum; only
-//! rounding (about 1e-12 mm) separates the result from it, and the coverage
-//! tests take a relative hair of slack so that rounding can only make the
-//! gap smaller. Vertical triangles need no facet term: their highest point
-//! over any XY region lies on their edges.
+//! Vertical triangles need no facet term: their highest point over any XY
+//! region lies on their edges. The coverage tests take a relative hair of
+//! slack so rounding can only make the clearance smaller. With tol = 0 the
+//! nozzle is a plain flat cutter of radius r and the result is exact.
 
 use glam::{DVec2, DVec3};
 
 use super::index::QueryBox;
 use super::{meets, Surface};
 
-/// The smallest gap of a move (see the module comment).
+/// The clearance of a move (see the module comment).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SweepGap {
-    /// The smallest height of the tip over the highest surface point
-    /// within the radius of its axis, along the move (negative: the
-    /// surface rises above the tip).
+    /// The smallest clearance along the move: at least tol when the
+    /// nozzle keeps tol from the surface everywhere on it; tol minus it is
+    /// how far the tip would have to rise at the worst place.
     pub gap_mm: f64,
     /// The fraction of the move (0 at its start, 1 at its end) where the
-    /// gap is smallest.
+    /// clearance is smallest.
     pub at: f64,
-    /// The surface point that sets the gap there.
+    /// The surface point that sets it.
     pub surface_point: DVec3,
 }
+
+/// The rim's staircase for corner and edge contacts: angles theta_i with
+/// a_i = tol sin(theta_i); the first step's bottom lies tol below the tip,
+/// step i's psi(r + a_(i-1)) = tol cos(theta_(i-1)). On a contact where the
+/// surface rises at 45 degrees away from the axis it asks at most 0.15 tol
+/// more height than the exact rim.
+pub const RIM_STEPS: [f64; 5] = [20.0, 40.0, 55.0, 70.0, 90.0];
 
 /// Relative slack of the coverage tests: a point this close to the disk's
 /// edge counts as under it, so rounding never hides a surface point.
 const SLACK: f64 = 1e-9;
 
 impl Surface {
-    /// The smallest gap along the straight move of the tip from `a` to `b`
-    /// between the tip and the highest surface point within `radius` (in
-    /// XY) of the nozzle's axis (see the module comment for the method).
+    /// The smallest clearance (see the module comment) of the nozzle of
+    /// tip radius `radius` kept `tol` from the surface, along the straight
+    /// move of its tip from `a` to `b`.
     ///
-    /// Guarantee: exact up to floating-point rounding (the coverage tests
-    /// lean towards counting a point, so rounding errs on the side of a
-    /// smaller gap). `None` when no surface point within `radius` of the
-    /// move lies less than `limit` below the tip at any position (so the
-    /// gap is at least `limit`); pass `f64::INFINITY` for the gap whatever
-    /// it is.
-    pub fn sweep_gap(&self, a: DVec3, b: DVec3, radius: f64, limit: f64) -> Option<SweepGap> {
+    /// Guarantee: exact for facet contacts, conservative for corners and
+    /// edges by the staircase of [`RIM_STEPS`] (never a larger clearance
+    /// than the true one), up to floating-point rounding, which the
+    /// coverage tests bias towards a smaller clearance. `None` when the
+    /// clearance is at least `limit` (no surface near the move, or all of
+    /// it far enough below); pass `f64::INFINITY` to have it whatever it is.
+    pub fn nozzle_gap(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        radius: f64,
+        tol: f64,
+        limit: f64,
+    ) -> Option<SweepGap> {
         let d = (b - a).truncate();
         let dz = b.z - a.z;
-        let lo_xy = a.truncate().min(b.truncate()) - DVec2::splat(radius);
-        let hi_xy = a.truncate().max(b.truncate()) + DVec2::splat(radius);
-        // A triangle wholly lower than the lowest tip position by `limit`
-        // cannot make the gap smaller than `limit`.
+        let reach = radius + tol;
+        let lo_xy = a.truncate().min(b.truncate()) - DVec2::splat(reach);
+        let hi_xy = a.truncate().max(b.truncate()) + DVec2::splat(reach);
+        // A surface point lower than the lowest tip position by `limit`
+        // leaves a clearance of at least `limit`.
         let floor = a.z.min(b.z) - limit;
         let q = QueryBox {
             lo: lo_xy.extend(floor),
             hi: hi_xy.extend(f64::INFINITY),
         };
+        // Values are z(s) - x_z - h; the clearance is the value plus tol.
         let mut best = Best {
-            gap: limit,
+            gap: limit - tol,
             found: None,
         };
+        let steps = rim_steps(radius, tol);
         let move_ = Move {
             a,
             d,
             dz,
             r: radius,
+            tol,
         };
         let low_tip = a.z.min(b.z);
         self.index.visit(&q, |i| {
@@ -95,19 +122,42 @@ impl Surface {
             if !meets(&t, &q) {
                 return;
             }
-            // No point of this triangle can beat the best gap so far.
+            // No point of this triangle can beat the best value so far
+            // (every contact's h is at most tol).
             let top = t[0].z.max(t[1].z).max(t[2].z);
-            if low_tip - top >= best.gap {
+            if low_tip - top - tol >= best.gap {
                 return;
             }
-            move_.triangle(t, &mut best);
+            move_.triangle(t, &steps, &mut best);
         });
         best.found.map(|(at, surface_point)| SweepGap {
-            gap_mm: best.gap,
+            gap_mm: best.gap + tol,
             at,
             surface_point,
         })
     }
+
+    /// The smallest gap along the move between the tip and the highest
+    /// surface point within `radius` of its axis (a flat cutter of that
+    /// radius; [`Self::nozzle_gap`] with tol = 0).
+    pub fn sweep_gap(&self, a: DVec3, b: DVec3, radius: f64, limit: f64) -> Option<SweepGap> {
+        self.nozzle_gap(a, b, radius, 0.0, limit)
+    }
+}
+
+/// The staircase (radius, depth of its bottom below the tip) for the rim.
+fn rim_steps(r: f64, tol: f64) -> Vec<(f64, f64)> {
+    if tol <= 0.0 {
+        return vec![(r, 0.0)];
+    }
+    let mut out = Vec::with_capacity(RIM_STEPS.len());
+    let mut prev = 0.0f64;
+    for deg in RIM_STEPS {
+        let th = deg.to_radians();
+        out.push((r + tol * libm::sin(th), tol * libm::cos(prev)));
+        prev = th;
+    }
+    out
 }
 
 struct Best {
@@ -116,30 +166,33 @@ struct Best {
 }
 
 /// A move in the form the candidates need: tip XY p(s) = a_xy + s d,
-/// tip height z(s) = a_z + s dz, disk radius r.
+/// tip height z(s) = a_z + s dz, tip radius r, tolerance tol.
 struct Move {
     a: DVec3,
     d: DVec2,
     dz: f64,
     r: f64,
+    tol: f64,
 }
 
 impl Move {
+    /// Takes the value z(s) - q_z - h of a contact of surface point `q`
+    /// whose cutter bottom lies `h` below the tip.
     #[inline]
-    fn consider(&self, s: f64, q: DVec3, best: &mut Best) {
+    fn consider(&self, s: f64, q: DVec3, h: f64, best: &mut Best) {
         let s = s.clamp(0.0, 1.0);
-        let gap = self.a.z + s * self.dz - q.z;
+        let gap = self.a.z + s * self.dz - q.z - h;
         if gap < best.gap {
             best.gap = gap;
             best.found = Some((s, q));
         }
     }
 
-    /// The s in [0, 1] for which the XY point `v` lies within the disk,
-    /// `None` if there are none.
-    fn covered(&self, v: DVec2) -> Option<(f64, f64)> {
+    /// The s in [0, 1] for which the XY point `v` lies within `radius` of
+    /// the axis, `None` if there are none.
+    fn covered(&self, v: DVec2, radius: f64) -> Option<(f64, f64)> {
         let w = v - self.a.truncate();
-        let r2 = self.r * self.r * (1.0 + SLACK);
+        let r2 = radius * radius * (1.0 + SLACK);
         let dd = self.d.length_squared();
         if dd <= 1e-30 {
             return (w.length_squared() <= r2).then_some((0.0, 1.0));
@@ -154,29 +207,32 @@ impl Move {
         (s0 <= s1).then_some((s0, s1))
     }
 
-    fn triangle(&self, t: [DVec3; 3], best: &mut Best) {
-        // Corners: the worst s of each corner's interval is its lower end
-        // when the tip rises, its upper end when it descends.
-        for v in t {
-            if let Some((s0, s1)) = self.covered(v.truncate()) {
-                self.consider(if self.dz >= 0.0 { s0 } else { s1 }, v, best);
+    fn triangle(&self, t: [DVec3; 3], steps: &[(f64, f64)], best: &mut Best) {
+        for &(radius, h) in steps {
+            // Corners: the worst s of each corner's interval is its lower
+            // end when the tip rises, its upper end when it descends.
+            for v in t {
+                if let Some((s0, s1)) = self.covered(v.truncate(), radius) {
+                    self.consider(if self.dz >= 0.0 { s0 } else { s1 }, v, h, best);
+                }
             }
-        }
-        for k in 0..3 {
-            self.edge(t[k], t[(k + 1) % 3], best);
+            for k in 0..3 {
+                self.edge(t[k], t[(k + 1) % 3], radius, h, best);
+            }
         }
         self.facet(t, best);
     }
 
-    /// Edge crossings: the chords at s = 0 and s = 1, and the point of the
-    /// (t, s) ellipse where the gap is smallest.
-    fn edge(&self, p: DVec3, q: DVec3, best: &mut Best) {
+    /// Edge crossings of the flat cutter of `radius` whose bottom lies `h`
+    /// below the tip: the chords at s = 0 and s = 1, and the point of the
+    /// (t, s) ellipse where the value is smallest.
+    fn edge(&self, p: DVec3, q: DVec3, radius: f64, h: f64, best: &mut Best) {
         let e = (q - p).truncate();
         let ee = e.length_squared();
         if ee <= 1e-30 {
             return; // a vertical edge: its top corner is a corner above
         }
-        let r2 = self.r * self.r * (1.0 + SLACK);
+        let r2 = radius * radius * (1.0 + SLACK);
         let a_xy = self.a.truncate();
         for s in [0.0, 1.0] {
             let f = p.truncate() - (a_xy + s * self.d);
@@ -188,7 +244,7 @@ impl Move {
             let sq = disc.sqrt();
             for t in [(-b - sq) / ee, (-b + sq) / ee] {
                 if (0.0..=1.0).contains(&t) {
-                    self.consider(s, p + (q - p) * t, best);
+                    self.consider(s, p + (q - p) * t, h, best);
                 }
             }
         }
@@ -206,18 +262,20 @@ impl Move {
         if gl <= 1e-300 {
             return; // the gap is constant on the ellipse: the sides suffice
         }
-        let y = -self.r * g / gl - (p.truncate() - a_xy);
+        let y = -radius * g / gl - (p.truncate() - a_xy);
         // v = M^-1 y, M^-1 = [[-d.y, d.x], [-e.y, e.x]] / det.
         let t = (-d.y * y.x + d.x * y.y) * inv;
         let s = (-e.y * y.x + e.x * y.y) * inv;
         let eps = 1e-12;
         if (-eps..=1.0 + eps).contains(&t) && (-eps..=1.0 + eps).contains(&s) {
-            self.consider(s, p + (q - p) * t.clamp(0.0, 1.0), best);
+            self.consider(s, p + (q - p) * t.clamp(0.0, 1.0), h, best);
         }
     }
 
-    /// The facet term: where the plane's steepest ascent meets the circle,
-    /// p(s) + r g^ (for a level triangle any point will do: p(s) itself).
+    /// The facet term: the rim's ball centre on the plane, r + tol
+    /// sin(theta) from the axis along the steepest ascent, its top
+    /// tol cos(theta) over the plane (for a level triangle any point under
+    /// the disk will do: p(s) itself).
     fn facet(&self, t: [DVec3; 3], best: &mut Best) {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         if n.z.abs() <= 1e-12 * n.length() {
@@ -226,7 +284,11 @@ impl Move {
         let grad = DVec2::new(-n.x / n.z, -n.y / n.z);
         let gl = grad.length();
         let dir = if gl > 1e-15 { grad / gl } else { DVec2::ZERO };
-        let q0 = self.a.truncate() + self.r * dir;
+        // tan(theta) = |grad|.
+        let cos_t = 1.0 / (1.0 + gl * gl).sqrt();
+        let sin_t = gl * cos_t;
+        let (reach, h) = (self.r + self.tol * sin_t, self.tol * cos_t);
+        let q0 = self.a.truncate() + reach * dir;
         // Inside the triangle's XY projection: three half-planes, each
         // linear in s.
         let orient = n.z.signum();
@@ -237,7 +299,7 @@ impl Move {
             let f0 = orient * e.perp_dot(q0 - pi);
             let f1 = orient * e.perp_dot(self.d);
             // f0 + s f1 >= -slack
-            let slack = SLACK * e.length() * (self.r + (q0 - pi).length() + self.d.length());
+            let slack = SLACK * e.length() * (reach + (q0 - pi).length() + self.d.length());
             if f1.abs() <= 1e-300 {
                 if f0 < -slack {
                     return;
@@ -257,7 +319,7 @@ impl Move {
         };
         for s in [s0, s1] {
             let xy = q0 + s * self.d;
-            self.consider(s, xy.extend(z_at(s)), best);
+            self.consider(s, xy.extend(z_at(s)), h, best);
         }
     }
 }
