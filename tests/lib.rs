@@ -1,4 +1,5 @@
 //! All integration tests in one binary, a module per area (as parry does).
+mod bruteforce;
 mod cli;
 mod fuzz_regressions;
 mod gcode;
