@@ -9,7 +9,8 @@ use sha2::{Digest, Sha256};
 use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
-use crate::gcode::{write_gcode, GcodeJob, MachineProfile};
+use crate::gcode::{write_program, GcodeJob, MachineProfile};
+use crate::motion::{check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::planners::PlannerKind;
@@ -207,6 +208,60 @@ pub struct Report {
     pub series: Vec<Vec<PointSeries>>,
     /// Defect per point ("good", "contact", ...), one array per piece.
     pub defects: Vec<Vec<crate::quality::Defect>>,
+    /// The motion check of every move the G-code commands (spec section
+    /// 6f), and what the planner did for it.
+    pub motion: MotionReport,
+}
+
+/// The safe-motion part of a report (spec section 6f).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MotionReport {
+    /// The G-code's moves, checked along their whole length.
+    pub program: MotionSummary,
+    /// The clearance kept: tol (mm).
+    pub tol_mm: f64,
+    /// Waypoints the planner added so that no move comes too close.
+    pub waypoints: usize,
+    /// Length they added to the print moves (mm).
+    pub extra_length_mm: f64,
+    /// Tool-path points that fall back along the drawn path.
+    pub backward_moves: usize,
+    /// Whether G-code with moves closer than tol was written because the
+    /// user accepted the risk.
+    pub risk_accepted: bool,
+}
+
+impl MotionReport {
+    /// One line for the G-code header and the CLI.
+    pub fn summary_line(&self) -> String {
+        let p = &self.program;
+        let clear = p
+            .min_clearance_mm
+            .map_or("no move passes near the scan".to_string(), |c| {
+                format!("min clearance {c:.3} mm")
+            });
+        let mut s = if p.touching_moves > 0 {
+            format!(
+                "WARNING: {} of {} moves come closer to the surface than tol {} mm ({clear}{}); \
+                 written only because the risk was accepted",
+                p.touching_moves,
+                p.moves,
+                self.tol_mm,
+                p.min_clearance_line
+                    .map_or(String::new(), |l| format!(" at line {l}"))
+            )
+        } else {
+            format!(
+                "{clear} (tol {} mm) along all {} moves",
+                self.tol_mm, p.moves
+            )
+        };
+        s.push_str(&format!(
+            "; {} waypoint(s) added (+{:.3} mm)",
+            self.waypoints, self.extra_length_mm
+        ));
+        s
+    }
 }
 
 fn arr(p: &DVec3) -> [f64; 3] {
@@ -348,6 +403,13 @@ pub fn report(
             .iter()
             .map(|p| p.quality.iter().map(|q| q.defect).collect())
             .collect(),
+        motion: MotionReport {
+            tol_mm: settings.process.tolerance_mm,
+            waypoints: plan.motion.waypoints,
+            extra_length_mm: plan.motion.extra_length_mm,
+            backward_moves: plan.motion.backward_moves,
+            ..Default::default()
+        },
     }
 }
 
@@ -432,6 +494,7 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         ),
     ));
     h.push(("predicted quality".into(), report.quality.to_string()));
+    h.push(("safe motion".into(), report.motion.summary_line()));
     h.push(("warnings".into(), report.warnings.len().to_string()));
     h
 }
@@ -451,7 +514,15 @@ pub fn run_on(
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
     refuse_uncleared(&plan, accept_risk)?;
     let path_file = InputFile::new(svg_name, svg);
-    let (report, gcode) = write_outputs(scan, &path_file, &drawn.notes, &plan, settings, profile)?;
+    let (report, gcode) = write_outputs(
+        scan,
+        &path_file,
+        &drawn.notes,
+        &plan,
+        settings,
+        profile,
+        accept_risk,
+    )?;
     Ok(JobOutput {
         plan,
         report,
@@ -487,6 +558,12 @@ pub fn refuse_uncleared(plan: &Plan, accept_risk: bool) -> Result<()> {
 /// The report and G-code of a finished plan (the drawing's `notes` join the
 /// report's warnings): what [`run_on`] and the page's live planning write,
 /// so both give the same bytes.
+///
+/// Every move the G-code commands (travel, descents, print moves, lifts)
+/// is checked along its length with the coordinates as written (spec
+/// section 6f); G-code with a move closer to the surface than tol is
+/// refused ([`Error::Touching`]) unless `accept_risk`, and then says so in
+/// its header.
 pub fn write_outputs(
     scan: &PreparedScan,
     path_file: &InputFile,
@@ -494,21 +571,39 @@ pub fn write_outputs(
     plan: &Plan,
     settings: &PlanSettings,
     profile: &MachineProfile,
+    accept_risk: bool,
 ) -> Result<(Report, String)> {
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
-    let header = provenance(&report);
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
-    let gcode = write_gcode(
-        &GcodeJob {
-            toolpaths: &toolpaths,
-            speed_mm_s: settings.process.speed_mm_s,
-            dwell_s: settings.process.dwell_s,
-            header: &header,
-            scan_top_z_mm: scan.surface.top_z(),
-        },
-        profile,
-    )?;
+    let write = |header: &[(String, String)]| {
+        write_program(
+            &GcodeJob {
+                toolpaths: &toolpaths,
+                speed_mm_s: settings.process.speed_mm_s,
+                dwell_s: settings.process.dwell_s,
+                header,
+                scan_top_z_mm: scan.surface.top_z(),
+            },
+            profile,
+        )
+    };
+    // The header has the same lines whatever the check finds, so the moves'
+    // line numbers from this first writing hold for the final one.
+    let first = write(&provenance(&report))?;
+    let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
+    let checked = check_program(&scan.surface, &first.moves, &clearance);
+    if checked.touching_moves > 0 && !accept_risk {
+        return Err(Error::Touching(TouchingMoves {
+            planner: plan.planner.name().into(),
+            outer_diameter_mm: settings.nozzle.outer_diameter_mm,
+            tol_mm: settings.process.tolerance_mm,
+            summary: checked,
+        }));
+    }
+    report.motion.risk_accepted = checked.touching_moves > 0;
+    report.motion.program = checked;
+    let gcode = write(&provenance(&report))?.text;
     Ok((report, gcode))
 }
 

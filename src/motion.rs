@@ -20,6 +20,7 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::gcode::WrittenMove;
 use crate::params::Nozzle;
 use crate::surface::{Surface, SweepGap};
 
@@ -243,12 +244,14 @@ pub fn backward_moves(ta: &[DVec3], toolpath: &[DVec3]) -> usize {
 pub struct MotionSummary {
     /// Moves checked.
     pub moves: usize,
-    /// The smallest gap over all moves (`None` if no move passes over the
-    /// scan within the footprint).
+    /// The smallest clearance over all moves (`None` if no move passes
+    /// near the scan).
     pub min_clearance_mm: Option<f64>,
     /// Where it is smallest: the tip's position.
     pub min_clearance_at: Option<[f64; 3]>,
-    /// Moves whose gap is below tol.
+    /// G-code line of that move, where known.
+    pub min_clearance_line: Option<usize>,
+    /// Moves whose clearance is below tol.
     pub touching_moves: usize,
     /// The first touching moves (at most [`MAX_LISTED`]), in order.
     pub touching: Vec<Touch>,
@@ -268,9 +271,11 @@ pub struct Touch {
     pub to: [f64; 3],
     /// The tip's position where the move is worst.
     pub at: [f64; 3],
-    /// The gap there (negative: the surface within the footprint rises
-    /// above the tip by that much).
-    pub gap_mm: f64,
+    /// The clearance there (see [`Surface::nozzle_gap`]).
+    pub clearance_mm: f64,
+    /// How much higher the tip would have to be there to keep tol: the
+    /// depth of the violation.
+    pub rise_mm: f64,
 }
 
 fn arr(p: DVec3) -> [f64; 3] {
@@ -287,19 +292,15 @@ impl std::fmt::Display for Touch {
         let [px, py, pz] = self.at;
         write!(
             f,
-            "the move ({a:.3}, {b:.3}, {c:.3}) -> ({x:.3}, {y:.3}, {z:.3}) comes to {:.3} mm of \
-             the surface at ({px:.3}, {py:.3}, {pz:.3})",
-            self.gap_mm
-        )?;
-        if self.gap_mm < 0.0 {
-            write!(f, " (the surface is {:.3} mm above the tip)", -self.gap_mm)?;
-        }
-        Ok(())
+            "the move ({a:.3}, {b:.3}, {c:.3}) -> ({x:.3}, {y:.3}, {z:.3}) comes too close at \
+             ({px:.3}, {py:.3}, {pz:.3}): the nozzle would have to be {:.3} mm higher there",
+            self.rise_mm
+        )
     }
 }
 
 /// Checks every move (`from`, `to`, G-code line where known) against the
-/// surface: the smallest gap, and every move below tol.
+/// surface: the smallest clearance, and every move below tol.
 pub fn check_moves(
     surface: &Surface,
     moves: impl IntoIterator<Item = (DVec3, DVec3, Option<usize>)>,
@@ -309,7 +310,7 @@ pub fn check_moves(
     let mut min = f64::INFINITY;
     for (index, (a, b, line)) in moves.into_iter().enumerate() {
         s.moves += 1;
-        // Only a gap below tol or below the smallest so far matters.
+        // Only a clearance below tol or below the smallest so far matters.
         let limit = if min.is_finite() {
             min.max(clearance.tol_mm)
         } else {
@@ -323,6 +324,7 @@ pub fn check_moves(
             min = g.gap_mm;
             s.min_clearance_mm = Some(g.gap_mm);
             s.min_clearance_at = Some(arr(at));
+            s.min_clearance_line = line;
         }
         if g.gap_mm < clearance.tol_mm - TIE_MM {
             s.touching_moves += 1;
@@ -333,12 +335,50 @@ pub fn check_moves(
                     from: arr(a),
                     to: arr(b),
                     at: arr(at),
-                    gap_mm: g.gap_mm,
+                    clearance_mm: g.gap_mm,
+                    rise_mm: clearance.tol_mm - g.gap_mm,
                 });
             }
         }
     }
     s
+}
+
+/// Checks the moves a G-code program commands (spec section 6f): every
+/// move whose start is known along its length, a move from an unknown
+/// start (the program's first travel) at its end.
+pub fn check_program(
+    surface: &Surface,
+    moves: &[WrittenMove],
+    clearance: &Clearance,
+) -> MotionSummary {
+    check_moves(
+        surface,
+        moves
+            .iter()
+            .filter(|m| m.to.is_finite())
+            .map(|m| (m.from.unwrap_or(m.to), m.to, Some(m.line))),
+        clearance,
+    )
+}
+
+/// G-code whose moves come closer to the surface than tol (spec section
+/// 6f): refused unless the user accepts the risk.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{count} G-code move(s) of planner {planner} would bring the nozzle (outer diameter \
+     {outer_diameter_mm} mm) closer to the surface than tol = {tol_mm} mm, checked along each \
+     straight move; {first}; no G-code written. Plan with a guarded planner (even, the \
+     default, or pcpp-guarded), or accept the risk (--accept-risk; in the page, the box \
+     'write G-code even where the nozzle may touch') to write it anyway",
+    count = .summary.touching_moves,
+    first = .summary.touching.iter().take(3).map(|t| t.to_string()).collect::<Vec<_>>().join("; ")
+)]
+pub struct TouchingMoves {
+    pub planner: String,
+    pub outer_diameter_mm: f64,
+    pub tol_mm: f64,
+    pub summary: MotionSummary,
 }
 
 #[cfg(test)]
@@ -420,8 +460,10 @@ mod tests {
         assert_eq!(sum.moves, 3);
         assert_eq!(sum.touching_moves, 1);
         assert_eq!(sum.touching[0].line, Some(11));
-        assert!(sum.touching[0].gap_mm < 0.0);
+        assert!(sum.touching[0].clearance_mm < 0.0);
+        assert!(sum.touching[0].rise_mm > 0.1);
         assert!(sum.min_clearance_mm.unwrap() < 0.0);
+        assert_eq!(sum.min_clearance_line, Some(11));
         let text = sum.touching[0].to_string();
         assert!(text.starts_with("line 11: the move (4.000, 5.000, 0.700)"), "{text}");
     }

@@ -926,6 +926,7 @@ impl Session {
             &plan,
             &settings,
             &profile,
+            accept_risk,
         )
         .map_err(core_err)?;
         let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;

@@ -8,4 +8,5 @@ mod planning;
 mod properties;
 mod realworld;
 mod registration;
+mod safety;
 mod svg;

@@ -43,7 +43,7 @@ pub use profile::{
     BuildVolume, CommentStyle, FeedUnits, MachineProfile, BLOCK_TOKENS, DEFAULT_DECIMALS,
     DWELL_TOKENS,
 };
-pub use writer::{write_gcode, GcodeJob};
+pub use writer::{write_gcode, write_program, GcodeJob, MoveKind, WrittenMove, WrittenProgram};
 
 /// Why a profile cannot be loaded or a job cannot be written. Each variant
 /// names the file and field, or the subpath and point, at fault.

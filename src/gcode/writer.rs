@@ -31,6 +31,41 @@ pub struct GcodeJob<'a> {
     pub scan_top_z_mm: f64,
 }
 
+/// What kind of motion a written move is (spec section 9).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MoveKind {
+    /// The first rise to the safe height, from wherever the head is.
+    Rise,
+    /// Travel at the safe height over a subpath's first point.
+    Travel,
+    /// The vertical descent onto a subpath's first point.
+    Descend,
+    /// A print move (the valve open).
+    Print,
+    /// The lift back to the safe height.
+    Lift,
+}
+
+/// One straight move as written: coordinates exactly as the controller
+/// reads them (rounded to the profile's decimals), with the program's
+/// 1-based line number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WrittenMove {
+    pub line: usize,
+    /// `None` for the first rise: where the head starts is not known.
+    pub from: Option<DVec3>,
+    pub to: DVec3,
+    pub kind: MoveKind,
+}
+
+/// A written program and the moves it commands.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WrittenProgram {
+    pub text: String,
+    pub moves: Vec<WrittenMove>,
+}
+
 /// Writes the job as one program in the dialect of `profile`.
 ///
 /// Checks first (profile fields, speed, dwell, every point finite and inside
@@ -38,6 +73,16 @@ pub struct GcodeJob<'a> {
 /// output depends only on the inputs, so it can be compared with golden
 /// files.
 pub fn write_gcode(job: &GcodeJob, profile: &MachineProfile) -> Result<String, GcodeError> {
+    write_program(job, profile).map(|p| p.text)
+}
+
+/// [`write_gcode`], with every move it commands (what the motion check of
+/// spec section 6f follows; moves in the profile's own start and end
+/// blocks are the machine's business and not listed).
+pub fn write_program(
+    job: &GcodeJob,
+    profile: &MachineProfile,
+) -> Result<WrittenProgram, GcodeError> {
     let source = format!("{} (in memory)", profile.name);
     profile.validate(&source)?;
     check_job(job)?;
@@ -45,6 +90,9 @@ pub fn write_gcode(job: &GcodeJob, profile: &MachineProfile) -> Result<String, G
 
     let mut w = Program {
         out: String::new(),
+        lines: 0,
+        at: None,
+        moves: Vec::new(),
         profile,
         source,
         decimals: profile.decimals,
@@ -69,7 +117,10 @@ pub fn write_gcode(job: &GcodeJob, profile: &MachineProfile) -> Result<String, G
         w.print(index, points, dwell.as_deref())?;
     }
     w.block("end", &profile.end)?;
-    Ok(w.out)
+    Ok(WrittenProgram {
+        text: w.out,
+        moves: w.moves,
+    })
 }
 
 fn check_job(job: &GcodeJob) -> Result<(), GcodeError> {
@@ -144,6 +195,11 @@ fn feed_word(profile: &MachineProfile, speed_mm_s: f64) -> String {
 
 struct Program<'p> {
     out: String,
+    /// Lines written so far.
+    lines: usize,
+    /// Where the head is, once known (after the first full move).
+    at: Option<DVec3>,
+    moves: Vec<WrittenMove>,
     profile: &'p MachineProfile,
     /// Labels template errors (which cannot happen after `validate`).
     source: String,
@@ -157,6 +213,25 @@ impl Program<'_> {
     fn line(&mut self, text: &str) {
         self.out.push_str(text);
         self.out.push('\n');
+        self.lines += 1 + text.matches('\n').count();
+    }
+
+    /// A coordinate as the controller reads it.
+    fn read_back(&self, v: f64) -> f64 {
+        fixed(v, self.decimals).parse().unwrap_or(v)
+    }
+
+    /// Records the move the last written line commands, to `to` (rounded
+    /// as written); the safe height is `self.safe_z` as written.
+    fn moved(&mut self, to: DVec3, kind: MoveKind) {
+        let to = DVec3::new(self.read_back(to.x), self.read_back(to.y), self.read_back(to.z));
+        self.moves.push(WrittenMove {
+            line: self.lines,
+            from: self.at,
+            to,
+            kind,
+        });
+        self.at = Some(to);
     }
 
     fn comment(&mut self, text: &str) {
@@ -233,9 +308,25 @@ impl Program<'_> {
         self.line(&line);
     }
 
+    /// The rise (first) or lift (after a print) to the safe height.
     fn rapid_z(&mut self) {
         let words = format!("Z{}", self.safe_z);
         self.rapid(&words);
+        let z: f64 = self.safe_z.parse().unwrap_or(f64::NAN);
+        match self.at {
+            Some(p) => self.moved(DVec3::new(p.x, p.y, z), MoveKind::Lift),
+            None => {
+                // Where the head starts is not known: the rise is listed
+                // with its height only, and the head's XY becomes known
+                // with the first travel.
+                self.moves.push(WrittenMove {
+                    line: self.lines,
+                    from: None,
+                    to: DVec3::new(f64::NAN, f64::NAN, z),
+                    kind: MoveKind::Rise,
+                });
+            }
+        }
     }
 
     fn print(
@@ -262,8 +353,25 @@ impl Program<'_> {
             self.safe_z
         );
         self.rapid(&over);
+        let safe: f64 = self.safe_z.parse().unwrap_or(f64::NAN);
+        let over_at = DVec3::new(first.x, first.y, safe);
+        if self.at.is_none() {
+            // After the first rise only z is known; travel from there is
+            // at the safe height whatever the XY.
+            let to = DVec3::new(self.read_back(first.x), self.read_back(first.y), safe);
+            self.moves.push(WrittenMove {
+                line: self.lines,
+                from: None,
+                to,
+                kind: MoveKind::Travel,
+            });
+            self.at = Some(to);
+        } else {
+            self.moved(over_at, MoveKind::Travel);
+        }
         let descend = format!("G1 {} F{}", self.xyz(*first), self.travel_f);
         self.line(&descend);
+        self.moved(*first, MoveKind::Descend);
         let profile = self.profile;
         self.block("dispense_on", &profile.dispense_on)?;
         if let Some(dwell) = dwell {
@@ -276,6 +384,7 @@ impl Program<'_> {
                 format!("G1 {}", self.xyz(*p))
             };
             self.line(&line);
+            self.moved(*p, MoveKind::Print);
         }
         if let Some(dwell) = dwell {
             self.line(dwell);

@@ -1,0 +1,363 @@
+//! Integration tests: safe motion (spec section 6f). Every claim that the
+//! nozzle does not touch the part is checked here by the independent
+//! brute-force oracle of `bruteforce.rs`, which follows every move of the
+//! written G-code and shares no code with the planner.
+
+use proptest::prelude::*;
+
+use pcpp::demo::parts::DemoPart;
+use pcpp::demo::test_part;
+use pcpp::gcode::MachineProfile;
+use pcpp::job::{prepare_scan, run_on, JobOutput, RegistrationSettings};
+use pcpp::mesh::{ImportOptions, TriMesh};
+use pcpp::pipeline::PlanSettings;
+use pcpp::planners::PlannerKind;
+use pcpp::svg::Placement;
+use pcpp::{DVec3, Error, Nozzle, Process};
+
+use crate::bruteforce::{check_gcode, SafetyReport};
+
+const DO: f64 = Nozzle::DEFAULT.outer_diameter_mm;
+const TOL: f64 = Process::DEFAULT.tolerance_mm;
+
+fn marlin() -> MachineProfile {
+    MachineProfile::builtin("marlin").expect("marlin profile")
+}
+
+/// Plans `svg` on `mesh` (already in the printer frame) with `planner`.
+fn plan(
+    mesh: &TriMesh,
+    svg: &str,
+    placement: Placement,
+    planner: PlannerKind,
+    accept_risk: bool,
+) -> Result<JobOutput, Error> {
+    let bytes = pcpp::demo::to_binary_ply(mesh);
+    let scan = prepare_scan(
+        &bytes,
+        "part.ply",
+        &ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )?;
+    let settings = PlanSettings {
+        placement,
+        planner,
+        ..PlanSettings::default()
+    };
+    run_on(
+        &scan,
+        svg.as_bytes(),
+        "path.svg",
+        &settings,
+        &marlin(),
+        accept_risk,
+    )
+}
+
+fn describe(r: &SafetyReport) -> String {
+    format!(
+        "{} moves, {} samples, min distance {:.4} mm, {} too close, deepest {:.3} mm, first: {:?}",
+        r.moves,
+        r.samples,
+        r.min_distance_mm,
+        r.too_close,
+        r.deepest_mm,
+        r.first_too_close.first()
+    )
+}
+
+/// The guarded planners' G-code keeps tol along every move on the test
+/// part and every generated substrate, by the oracle; and the core's own
+/// check, written in the G-code header and the report, agrees.
+#[test]
+fn guarded_planners_never_touch_any_demo_part_along_their_moves() {
+    for part in DemoPart::ALL {
+        let mesh = part.mesh();
+        for planner in [PlannerKind::Even, PlannerKind::PcppGuarded] {
+            let out = plan(&mesh, &part.svg(), part.placement(), planner, false)
+                .unwrap_or_else(|e| panic!("{part} {planner}: {e}"));
+            let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+            eprintln!("{part} {planner}: {}", describe(&oracle));
+            assert_eq!(oracle.too_close, 0, "{part} {planner}: {}", describe(&oracle));
+            assert!(oracle.min_distance_mm >= TOL, "{part} {planner}");
+            assert!(oracle.moves > 100, "{part} {planner}: {}", oracle.moves);
+            let m = &out.report.motion;
+            assert_eq!(m.program.touching_moves, 0, "{part} {planner}");
+            assert!(!m.risk_accepted);
+            assert!(m.program.min_clearance_mm.unwrap() >= TOL, "{part} {planner}");
+            let header = out.gcode.lines().find(|l| l.contains("safe motion:"));
+            assert!(
+                header.is_some_and(|l| l.contains("min clearance") && !l.contains("WARNING")),
+                "{part} {planner}: {header:?}"
+            );
+        }
+    }
+}
+
+/// Issue 11's example: the guarded planner's demo G-code moved from
+/// (15.446, 16, 5.603) to (16.230, 16, 7.603), both ends clear of the
+/// region-1 block, the straight line between them through its edge.
+#[test]
+fn demo_move_through_the_region_1_block_edge_is_caught_and_no_longer_planned() {
+    let mesh = test_part::test_part();
+    let cut = "G90\nG21\nG0 X15.446 Y16 Z5.603\nG1 X16.230 Y16 Z7.603\n";
+    let oracle = check_gcode(cut, &mesh, DO, TOL);
+    assert!(oracle.too_close > 0, "{}", describe(&oracle));
+    assert!(oracle.deepest_mm > 1.0, "{}", describe(&oracle));
+    // The core's check finds it too, by line.
+    let surface = pcpp::surface::Surface::new(mesh.clone()).unwrap();
+    let c = pcpp::motion::Clearance::new(&Nozzle::DEFAULT, TOL);
+    let a = DVec3::new(15.446, 16.0, 5.603);
+    let b = DVec3::new(16.230, 16.0, 7.603);
+    let sum = pcpp::motion::check_moves(&surface, [(a, b, Some(4))], &c);
+    assert_eq!(sum.touching_moves, 1);
+    assert_eq!(sum.touching[0].line, Some(4));
+    assert!(sum.touching[0].rise_mm > 1.0, "{:?}", sum.touching[0]);
+    // Every planner the page offers by default now climbs that step
+    // without cutting it.
+    for planner in [PlannerKind::Even, PlannerKind::PcppGuarded] {
+        let out = plan(
+            &mesh,
+            &test_part::test_part_svg(),
+            test_part::placement(),
+            planner,
+            false,
+        )
+        .unwrap();
+        let near: String = out
+            .gcode
+            .lines()
+            .filter(|l| l.contains("Y16.000"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let oracle = check_gcode(&format!("G90\n{near}\n"), &mesh, DO, TOL);
+        assert_eq!(oracle.too_close, 0, "{planner}: {}", describe(&oracle));
+    }
+}
+
+/// `slope` on the stepped block cuts the steps: refused, naming a move
+/// with its line and depth; accepted, written with a warning in the header,
+/// and the oracle confirms the touching.
+#[test]
+fn slope_on_the_stepped_block_is_refused_unless_the_risk_is_accepted() {
+    let part = DemoPart::SteppedBlock;
+    let mesh = part.mesh();
+    let e = plan(&mesh, &part.svg(), part.placement(), PlannerKind::Slope, false)
+        .err()
+        .expect("slope must be refused");
+    let text = e.to_string();
+    assert!(matches!(e, Error::Touching(_)), "{text}");
+    assert!(text.contains("G-code move(s) of planner slope"), "{text}");
+    assert!(text.contains("line "), "{text}");
+    assert!(text.contains("mm higher there"), "{text}");
+    assert!(text.contains("--accept-risk"), "{text}");
+    let Error::Touching(t) = &e else { unreachable!() };
+    let first = &t.summary.touching[0];
+    let line = first.line.expect("a line number");
+
+    let out = plan(&mesh, &part.svg(), part.placement(), PlannerKind::Slope, true).unwrap();
+    let header = out
+        .gcode
+        .lines()
+        .find(|l| l.contains("safe motion:"))
+        .unwrap();
+    assert!(header.contains("WARNING") && header.contains("risk was accepted"), "{header}");
+    assert!(out.report.motion.risk_accepted);
+    // The named line is the move it says.
+    let written = out.gcode.lines().nth(line - 1).unwrap();
+    let [x, y, z] = first.to;
+    assert!(
+        written.contains(&format!("X{x:.3} Y{y:.3} Z{z:.3}")),
+        "line {line}: {written} vs {first:?}"
+    );
+    let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+    assert!(oracle.too_close > 0, "{}", describe(&oracle));
+}
+
+/// Where the core's check says the paper planners' moves touch, the
+/// oracle finds it too (and the other way round), on every part.
+#[test]
+fn core_check_and_oracle_agree_on_the_paper_planners() {
+    for part in DemoPart::ALL {
+        let mesh = part.mesh();
+        for planner in [PlannerKind::Constant, PlannerKind::Pcpp] {
+            let out = plan(&mesh, &part.svg(), part.placement(), planner, true).unwrap();
+            let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+            let core = out.report.motion.program.touching_moves;
+            eprintln!("{part} {planner}: core {core} touching moves; oracle {}", describe(&oracle));
+            assert_eq!(core > 0, oracle.too_close > 0, "{part} {planner}");
+        }
+    }
+}
+
+// ------------------------------------------------------------ properties
+
+/// A random substrate on a 24 x 24 mm plate at z = 5: a step, a dimple or a
+/// crease (ridge or valley), with its size drawn at random.
+#[derive(Debug, Clone)]
+enum Feature {
+    /// A step of `height` (up or down) at x = `at`.
+    Step { at: f64, height: f64 },
+    /// A spherical dimple of radius `radius`, `depth` deep, at `centre`.
+    Dimple {
+        centre: (f64, f64),
+        radius: f64,
+        depth: f64,
+    },
+    /// A crease along y at x = `at`, flanks at `angle_deg`, `height` high
+    /// (negative: a valley).
+    Crease { at: f64, angle_deg: f64, height: f64 },
+}
+
+const SIZE: f64 = 24.0;
+
+impl Feature {
+    fn height(&self, x: f64, y: f64) -> f64 {
+        5.0 + match *self {
+            Feature::Step { at, height } => {
+                if x >= at {
+                    height.max(0.0)
+                } else {
+                    (-height).max(0.0)
+                }
+            }
+            Feature::Dimple {
+                centre,
+                radius,
+                depth,
+            } => {
+                let q = (x - centre.0).powi(2) + (y - centre.1).powi(2);
+                // A ball of `radius` sunk so its lowest point is `depth`
+                // below the plate: 2 mm of plate under it.
+                let c = 2.0 - depth + radius;
+                if q < radius * radius {
+                    let z = c - (radius * radius - q).sqrt();
+                    z.min(2.0)
+                } else {
+                    2.0
+                }
+            }
+            Feature::Crease {
+                at,
+                angle_deg,
+                height,
+            } => {
+                let run = height.abs() / angle_deg.to_radians().tan();
+                let u = (1.0 - (x - at).abs() / run).max(0.0);
+                3.0 + height * u
+            }
+        }
+    }
+
+    fn mesh(&self) -> TriMesh {
+        // 0.1 mm across the features' direction, with a step's wall
+        // coordinate repeated (evaluated either side) for a true wall.
+        let mut xs: Vec<f64> = (0..=240).map(|i| i as f64 * 0.1).collect();
+        if let Feature::Step { at, .. } = *self {
+            xs.retain(|x| (x - at).abs() > 1e-6);
+            xs.push(at);
+            xs.push(at);
+            xs.sort_by(f64::total_cmp);
+        }
+        let ys: Vec<f64> = (0..=48).map(|i| i as f64 * 0.5).collect();
+        let w = xs.len();
+        let mut m = TriMesh::default();
+        for &y in &ys {
+            for (i, &x) in xs.iter().enumerate() {
+                let past = i > 0 && xs[i - 1] == x;
+                let xe = if past { x + 1e-7 } else { x - 1e-7 };
+                m.vertices.push(DVec3::new(x, y, self.height(xe, y)));
+            }
+        }
+        for j in 0..ys.len() - 1 {
+            for i in 0..w - 1 {
+                let a = (j * w + i) as u32;
+                let (b, c, d) = (a + 1, a + 1 + w as u32, a + w as u32);
+                for t in [[a, b, c], [a, c, d]] {
+                    let [p, q, r] = t.map(|k| m.vertices[k as usize]);
+                    if (q - p).cross(r - p).length() > 1e-12 {
+                        m.triangles.push(t);
+                    }
+                }
+            }
+        }
+        m
+    }
+}
+
+fn feature() -> impl Strategy<Value = Feature> {
+    prop_oneof![
+        (6.0f64..18.0, prop_oneof![0.5f64..3.0, -3.0f64..-0.5])
+            .prop_map(|(at, height)| Feature::Step { at, height }),
+        ((8.0f64..16.0, 8.0f64..16.0), 1.0f64..3.0, 0.2f64..1.0).prop_map(
+            |(centre, radius, k)| Feature::Dimple {
+                centre,
+                radius,
+                depth: k * radius,
+            }
+        ),
+        (
+            8.0f64..16.0,
+            20.0f64..75.0,
+            prop_oneof![0.5f64..3.0, -2.5f64..-0.5]
+        )
+            .prop_map(|(at, angle_deg, height)| Feature::Crease {
+                at,
+                angle_deg,
+                height
+            }),
+    ]
+}
+
+/// A straight line through the plate's middle at `angle`, or an arc of
+/// radius `radius` around it, as SVG in mm (y down, the page 24 mm high).
+fn path_svg(straight: bool, angle_deg: f64, radius: f64) -> String {
+    let a = angle_deg.to_radians();
+    let (cx, cy) = (SIZE / 2.0, SIZE / 2.0);
+    let d = if straight {
+        let (dx, dy) = (9.0 * a.cos(), 9.0 * a.sin());
+        format!(
+            "M {} {} L {} {}",
+            cx - dx,
+            SIZE - (cy - dy),
+            cx + dx,
+            SIZE - (cy + dy)
+        )
+    } else {
+        let (x0, y0) = (cx + radius * a.cos(), cy + radius * a.sin());
+        let (x1, y1) = (cx - radius * a.cos(), cy - radius * a.sin());
+        format!(
+            "M {x0} {} A {radius} {radius} 0 0 1 {x1} {}",
+            SIZE - y0,
+            SIZE - y1
+        )
+    };
+    format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{SIZE}mm\" height=\"{SIZE}mm\" \
+         viewBox=\"0 0 {SIZE} {SIZE}\"><path d=\"{d}\" stroke=\"black\" fill=\"none\"/></svg>"
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Random steps, dimples and creases under random straight and curved
+    /// paths: the default planner's G-code never comes within tol of the
+    /// surface along any move, by the oracle.
+    #[test]
+    fn default_planner_never_touches_random_substrates(
+        f in feature(),
+        straight in any::<bool>(),
+        angle in 0.0f64..360.0,
+        radius in 3.0f64..9.0,
+    ) {
+        let mesh = f.mesh();
+        let svg = path_svg(straight, angle, radius);
+        let placement = Placement { offset_mm: pcpp::DVec2::new(0.0, SIZE), ..Placement::IDENTITY };
+        let out = plan(&mesh, &svg, placement, PlannerKind::default(), false)
+            .map_err(|e| TestCaseError::fail(format!("{f:?}: {e}")))?;
+        let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+        prop_assert_eq!(oracle.too_close, 0, "{:?}: {}", f, describe(&oracle));
+        prop_assert_eq!(out.report.motion.program.touching_moves, 0);
+    }
+}
