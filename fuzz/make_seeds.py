@@ -198,9 +198,13 @@ def main():
     d.mkdir(parents=True)
     fmt_scans = [(0, obj(v, t)), (1, ply_binary(v, t)), (2, stl_binary(v, t)), (3, gltf(v, t)), (4, glb(v, t))]
     for k, (fmt, scan) in enumerate(fmt_scans):
-        for planner in range(4):
+        for planner in range(5):
             name = list(SVGS)[(k + planner) % len(SVGS)]
-            data = pipeline_input(fmt, planner, scan, svg(SVGS[name]))
+            # Planner index: bits 0-1 and bit 5. The paper's three planners
+            # (0-2) may come closer than tol on the bumpy field: their seeds
+            # accept the risk (bit 4), so every seed reaches the writer.
+            flags = (planner & 3) | ((planner >> 2) << 5) | (16 if planner < 3 else 0)
+            data = pipeline_input(fmt, flags, scan, svg(SVGS[name]))
             (d / f"fmt{fmt}_planner{planner}_{name.removesuffix('.svg')}").write_bytes(data)
     # Bigger nozzle, tighter tolerance, rotated and scaled placement, risk accepted.
     data = pipeline_input(1, 3 | 16, ply_ascii(v, t), svg(SVGS["path_all.svg"]), (200, 255, 5, 228, 233, 45, 140))

@@ -168,8 +168,9 @@ fn demo_writes_every_file_and_the_golden_gcode() {
         "demo-slope.gcode",
         "demo-pcpp.gcode",
         "demo-pcpp-guarded.gcode",
+        "demo-even.gcode",
         "demo-comparison.json",
-        "demo-pcpp-guarded-report.json",
+        "demo-even-report.json",
         "demo-registration.json",
         "antenna-spiral.svg",
         "antenna-hilbert.svg",
@@ -187,11 +188,11 @@ fn demo_writes_every_file_and_the_golden_gcode() {
         std::fs::read(dir.join(demo::DEMO_SCAN_NAME)).unwrap(),
         demo::demo_scan_bytes()
     );
-    let gcode = std::fs::read_to_string(dir.join("demo-pcpp-guarded.gcode")).unwrap();
+    let gcode = std::fs::read_to_string(dir.join("demo-even.gcode")).unwrap();
     if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
         assert!(
             gcode == std::fs::read_to_string(golden_path("marlin")).unwrap(),
-            "pcpp demo's guarded G-code differs from tests/golden/demo-marlin.gcode"
+            "pcpp demo's default (even) G-code differs from tests/golden/demo-marlin.gcode"
         );
     }
     // Registration on the part's own holes: identity, residuals ~0.
@@ -202,7 +203,11 @@ fn demo_writes_every_file_and_the_golden_gcode() {
     assert!(rms < 1e-3, "{rms}");
     let cmp: Value =
         serde_json::from_slice(&std::fs::read(dir.join("demo-comparison.json")).unwrap()).unwrap();
-    assert_eq!(cmp["planners"].as_array().unwrap().len(), 4);
+    assert_eq!(cmp["planners"].as_array().unwrap().len(), 5);
+    // Each row carries the motion check of its print moves.
+    for row in cmp["planners"].as_array().unwrap() {
+        assert!(row["motion"]["min_clearance_mm"].is_number(), "{row}");
+    }
 }
 
 #[test]
@@ -211,10 +216,10 @@ fn demo_prints_the_table_and_takes_a_dialect() {
     let o = pcpp(&["demo", "-o", s(&dir), "--dialect", "aerotech"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let out = stdout(&o);
-    for k in ["constant", "slope", "pcpp", "pcpp-guarded", "rms"] {
+    for k in ["constant", "slope", "pcpp", "pcpp-guarded", "even", "rms"] {
         assert!(out.contains(k), "{k} missing from:\n{out}");
     }
-    let gcode = std::fs::read_to_string(dir.join("demo-pcpp-guarded.gcode")).unwrap();
+    let gcode = std::fs::read_to_string(dir.join("demo-even.gcode")).unwrap();
     if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
         assert!(gcode == std::fs::read_to_string(golden_path("aerotech")).unwrap());
     }
@@ -318,7 +323,7 @@ fn plan_report_has_every_field() {
 }
 
 #[test]
-fn compare_prints_four_rows_and_writes_json() {
+fn compare_prints_five_rows_and_writes_json() {
     let dir = temp_dir("compare");
     let report = dir.join("cmp.json");
     let o = pcpp(&[
@@ -335,19 +340,24 @@ fn compare_prints_four_rows_and_writes_json() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let out = stdout(&o);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines.len(), 5, "{out}");
+    assert_eq!(lines.len(), 6, "{out}");
+    assert!(lines[0].contains("backward") && lines[0].contains("min clear"), "{out}");
     for (line, k) in lines[1..]
         .iter()
-        .zip(["constant", "slope", "pcpp", "pcpp-guarded"])
+        .zip(["constant", "slope", "pcpp", "pcpp-guarded", "even"])
     {
         assert!(line.split_whitespace().next() == Some(k), "{line}");
-        assert_eq!(line.matches('%').count(), 3, "{line}");
+        assert_eq!(line.matches('%').count(), 4, "{line}");
     }
     let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     let rows = r["planners"].as_array().unwrap();
-    assert_eq!(rows.len(), 4);
-    assert_eq!(rows[3]["planner"], "pcpp-guarded");
-    assert_eq!(rows[3]["quality"]["contact_pct"].as_f64(), Some(0.0));
+    assert_eq!(rows.len(), 5);
+    for (i, k) in [(3, "pcpp-guarded"), (4, "even")] {
+        assert_eq!(rows[i]["planner"], k);
+        assert_eq!(rows[i]["quality"]["contact_pct"].as_f64(), Some(0.0));
+        assert_eq!(rows[i]["motion"]["touching_moves"].as_u64(), Some(0));
+    }
+    assert_eq!(rows[4]["motion"]["backward_moves"].as_u64(), Some(0));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -7,7 +7,7 @@
 //! | bytes | meaning |
 //! |-------|---------|
 //! | 0 | scan format: `% 5` picks obj, ply, stl, gltf, glb (the file extension) |
-//! | 1 | bits 0-1 planner (constant, slope, pcpp, pcpp-guarded); bit 2 fiducials `auto` against the demo part's three printer points; bit 3 registration method `paper`; bit 4 accept risk |
+//! | 1 | bits 0-1 and 5: planner index mod 5 (constant, slope, pcpp, pcpp-guarded, even); bit 2 fiducials `auto` against the demo part's three printer points; bit 3 registration method `paper`; bit 4 accept risk |
 //! | 2 | inner diameter d = 0.1 + 1.9 * b / 255 mm |
 //! | 3 | outer diameter do = d * (1.01 + 2 * b / 255) |
 //! | 4 | tolerance = 0.01 + 0.5 * b / 255 mm |
@@ -62,7 +62,8 @@ pub fn decode(data: &[u8]) -> PipelineCase<'_> {
         rotation_deg: b(7) * 360.0 / 256.0,
         scale: 2f64.powf((b(8) - 128.0) / 32.0),
     };
-    let planner = PlannerKind::ALL[usize::from(flags & 3)];
+    let index = usize::from(flags & 3) | (usize::from((flags >> 5) & 1) << 2);
+    let planner = PlannerKind::ALL[index % PlannerKind::ALL.len()];
     let registration = RegistrationSettings {
         fiducials: if flags & 4 != 0 {
             FiducialSource::Auto
