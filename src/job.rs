@@ -226,6 +226,9 @@ pub struct MotionReport {
     pub extra_length_mm: f64,
     /// Tool-path points that fall back along the drawn path.
     pub backward_moves: usize,
+    /// The largest sideways offset of a tool-path point from the drawn
+    /// path (mm).
+    pub max_sideways_mm: f64,
     /// Whether G-code with moves closer than tol was written because the
     /// user accepted the risk.
     pub risk_accepted: bool,
@@ -408,6 +411,7 @@ pub fn report(
             waypoints: plan.motion.waypoints,
             extra_length_mm: plan.motion.extra_length_mm,
             backward_moves: plan.motion.backward_moves,
+            max_sideways_mm: plan.motion.max_sideways_mm,
             ..Default::default()
         },
     }

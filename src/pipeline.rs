@@ -199,6 +199,9 @@ pub struct PlanMotion {
     /// Tool-path points that fall back along the drawn path by 2 or more
     /// samples ([`crate::motion::backward_moves`]).
     pub backward_moves: usize,
+    /// The largest sideways offset of a tool-path point from its surface
+    /// point, across the printing direction V_j (mm).
+    pub max_sideways_mm: f64,
 }
 
 /// Stage 5: a planner over a surface path, then quality (spec section 7)
@@ -243,6 +246,10 @@ pub fn plan_surface_path(
         };
         print_moves.extend(moves.windows(2).map(|w| (w[0], w[1], None)));
         motion.backward_moves += backward_moves(&piece.ta, &planned.toolpath);
+        for ((t, a), g) in planned.toolpath.iter().zip(&piece.ta).zip(&piece.geometry) {
+            let side = DVec3::new(-g.v.y, g.v.x, 0.0);
+            motion.max_sideways_mm = motion.max_sideways_mm.max((*t - *a).dot(side).abs());
+        }
         for &(j, lift) in &planned.lifted {
             // A lift of more than d leaves the filament floating: the nozzle is
             // wider than the feature it must pass there.

@@ -951,6 +951,7 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
     let mut staged = Staged::default();
     let mut rows = Vec::new();
     let mut default_report = None;
+    let mut regions = Vec::new();
     let default_planner = PlannerKind::default();
     for k in PlannerKind::ALL {
         progress.say(&format!("planning ({k})..."));
@@ -966,6 +967,9 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         )
         .map_err(|e| fail("plan", &e))?;
         rows.push(job::ComparisonRow::of(&o.plan));
+        if part == DemoPart::TestPart {
+            regions.push((k, test_part::region_summaries(&o.plan)));
+        }
         staged.add(&out.join(demo_gcode_name(part, k)), o.gcode.as_bytes())?;
         if k == default_planner {
             default_report = Some(o.report);
@@ -1047,6 +1051,25 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
         part.description()
     );
     s.push_str(&job::comparison_table(&rows));
+    if !regions.is_empty() {
+        s.push_str("\ndefects per region (contact / flattening / floating, % of the region's points):\n");
+        let _ = write!(s, "{:<13}", "planner");
+        for (name, _, _) in test_part::REGIONS {
+            let _ = write!(s, " {name:>26}");
+        }
+        s.push('\n');
+        for (k, per) in &regions {
+            let _ = write!(s, "{:<13}", k.name());
+            for (_, q) in per {
+                let cell = format!(
+                    "{:.1} / {:.1} / {:.1}",
+                    q.contact_pct, q.flattening_pct, q.floating_pct
+                );
+                let _ = write!(s, " {cell:>26}");
+            }
+            s.push('\n');
+        }
+    }
     print!("{s}");
     Ok(())
 }

@@ -256,6 +256,33 @@ pub fn test_part_svg() -> String {
     s
 }
 
+/// Which region (index into [`REGIONS`]) a point of the part lies in, by
+/// its y.
+pub fn region_of(y: f64) -> Option<usize> {
+    REGIONS.iter().position(|&(_, a, b)| (a..b).contains(&y))
+}
+
+/// A plan's quality summary per region of the part (the paper compares the
+/// planners region by region), from the pieces' surface points.
+pub fn region_summaries(
+    plan: &crate::pipeline::Plan,
+) -> Vec<(&'static str, crate::quality::QualitySummary)> {
+    REGIONS
+        .iter()
+        .enumerate()
+        .map(|(k, &(name, _, _))| {
+            let points = plan.pieces.iter().flat_map(|p| {
+                p.surface_path
+                    .iter()
+                    .zip(&p.quality)
+                    .filter(move |(a, _)| region_of(a.y) == Some(k))
+                    .map(|(_, q)| q)
+            });
+            (name, crate::quality::summarize(points))
+        })
+        .collect()
+}
+
 /// Where [`test_part_svg`] goes in printer XY.
 pub fn placement() -> crate::svg::Placement {
     crate::svg::Placement {

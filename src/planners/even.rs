@@ -72,6 +72,15 @@ fn model_back_offset(nozzle: &Nozzle, g: &LocalGeometry) -> f64 {
     }
 }
 
+/// How far sideways (across the path, downhill) the tip may step where it
+/// would otherwise have to rise, and in how many steps it is searched.
+pub const LATERAL_MAX_MM: f64 = 0.2;
+const LATERAL_STEPS: usize = 4;
+
+/// The step of the search for a place behind the target that clears (the
+/// slide goes back at most do).
+const SLIDE_STEP_MM: f64 = 0.02;
+
 /// How far behind the first surface point the back of the tip starts: the
 /// filament starts at the back of the tip, so a start ahead of Ta_0 would
 /// leave Ta_0 without filament (section 7 finds no crossing there).
@@ -119,24 +128,95 @@ pub(super) fn plan(
     }
     let fitted = isotonic(&lifted);
     let c = Clearance::new(nozzle, process.tolerance_mm).with_margin(PLANNING_MARGIN_MM);
+    // Targets along the path (absolute w) and the least advance per step.
+    let mut target = Vec::with_capacity(n);
+    let mut advance = vec![0.0; n];
+    let mut floor = 0.0;
+    for j in 0..n {
+        if j > 0 {
+            advance[j] = MIN_ADVANCE * (u[j] - u[j - 1]);
+            floor += advance[j];
+        }
+        target.push(fitted[j] + floor);
+    }
+    let at = |j: usize, w: f64, z: f64| {
+        DVec3::new(ta[j].x, ta[j].y, z) + (w - u[j]) * geometry[j].v
+    };
+    // Where a target is too close to the surface, the tip may stay back at
+    // its height instead of rising (up to do behind, as far forward as
+    // clears): before a step up this keeps the nozzle on the floor until
+    // the step rather than lifting it early into the air. Staying back by
+    // D on a slope of angle a moves the back of the tip D sin(a) further
+    // from the surface, rising by e moves it e cos(a): the tip stays back
+    // only where that costs less than half the rise, so a plain slope is
+    // still handled by rising.
+    let low_cap: Vec<Option<f64>> = (0..n)
+        .map(|j| {
+            let rise = c.rise_needed(surface, at(j, target[j], height[j]));
+            if rise == 0.0 {
+                return Some(target[j]);
+            }
+            let a = geometry[j].slope_rad;
+            let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
+            (1..=steps)
+                .map(|k| k as f64 * SLIDE_STEP_MM)
+                .take_while(|&back| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a))
+                .map(|back| target[j] - back)
+                .find(|&w| c.rise_needed(surface, at(j, w, height[j])) == 0.0)
+        })
+        .collect();
+    // Backward: every point at most its cap and at least one advance
+    // behind the next; a point that cannot stay low within the slide is
+    // raised where progress puts it.
+    let mut w = vec![0.0; n];
+    for j in (0..n).rev() {
+        let next = if j + 1 < n {
+            w[j + 1] - advance[j + 1]
+        } else {
+            f64::INFINITY
+        };
+        match low_cap[j] {
+            Some(cap) if cap.min(next) >= target[j] - nozzle.outer_diameter_mm => {
+                w[j] = cap.min(next);
+            }
+            _ => w[j] = target[j].min(next),
+        }
+    }
     let mut out = PlannedPoints {
         toolpath: Vec::with_capacity(n),
         ..Default::default()
     };
-    let mut floor = 0.0;
     for j in 0..n {
-        if j > 0 {
-            floor += MIN_ADVANCE * (u[j] - u[j - 1]);
-        }
-        let s = fitted[j] + floor - u[j];
-        let g = &geometry[j];
-        let mut t = DVec3::new(ta[j].x, ta[j].y, height[j]) + s * g.v;
-        // Raise to the lowest height that keeps tol, where the target
-        // does not.
+        let mut t = at(j, w[j], height[j]);
+        // Raise to the lowest height that keeps tol, where staying back
+        // did not clear (or progress moved the point off its cap); on a
+        // slope across the path a small step sideways, downhill, may need
+        // much less rise (section 7 measures the filament's distance from
+        // Ta_j, so a sideways offset w and a rise e give about
+        // sqrt(w^2 + (d + e cos a)^2)).
         let lift = c.rise_needed(surface, t);
         if lift > 0.0 {
-            out.lifted.push((j, lift));
-            t.z += lift;
+            let g = &geometry[j];
+            let side = DVec3::new(-g.v.y, g.v.x, 0.0);
+            let cos_a = libm::cos(g.slope_rad);
+            let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+            let mut best = (cost(0.0, lift), t, lift);
+            for k in 1..=LATERAL_STEPS {
+                let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+                for sgn in [-1.0, 1.0] {
+                    let q = t + sgn * w * side;
+                    let e = c.rise_needed(surface, q);
+                    let cq = cost(w, e);
+                    if cq < best.0 {
+                        best = (cq, q, e);
+                    }
+                }
+            }
+            t = best.1;
+            if best.2 > 0.0 {
+                out.lifted.push((j, best.2));
+                t.z += best.2;
+            }
         }
         if !t.is_finite() {
             out.uncleared.push(j);
