@@ -160,6 +160,62 @@ def svg(body):
     return (SVG_HEAD + body + "</svg>\n").encode()
 
 
+# One line of every construct the G-code reader handles (see src/gcode/read.rs).
+GCODE_FEATURES = """%
+; RepRap/Marlin
+N1 G21*27
+N2 G90 G0 X0 Y0 Z5 F3000
+G1X1Y2Z.5E0.1 (inline) ; comment
+M201 X1000 Y1000
+M117 Printing (50%
+G91
+G1 X1 Y-1.5 Z+0.25
+G90
+G20
+G1 X0.1 Y0.2
+G21
+G92 X0 Y0 Z0
+G92
+G92.2
+G92.3
+G92.1
+G28 X Y
+G1 X1 Y1 Z1
+G53 G0 Z0
+G29
+$H
+$J=G91 X1
+/G1 X2
+G10
+G11
+G4 P100
+G17 G40 G49 G61 G64 G80 G94
+G1 Z2
+X3 Y3
+M291 P"a ""quoted"" string" S1
+' aerotech
+G71 G76
+$DO[0].X = 1
+DWELL 0.5
+HOME X Y Z
+G70
+G1 X1 // aerotech comment
+%
+"""
+
+
+def gcode_seeds():
+    d = SEEDS / "read_gcode"
+    if d.exists():
+        shutil.rmtree(d)
+    d.mkdir(parents=True)
+    for dialect in ("marlin", "aerotech", "grbl"):
+        lines = (REPO / "tests" / "golden" / f"demo-{dialect}.gcode").read_text().splitlines(keepends=True)
+        (d / f"demo-{dialect}-head-tail.gcode").write_text("".join(lines[:40] + lines[-6:]))
+    (d / "features.gcode").write_text(GCODE_FEATURES)
+    (d / "features-crlf.gcode").write_bytes(GCODE_FEATURES.replace("\n", "\r\n").encode())
+
+
 def pipeline_input(fmt, flags, scan, svg_bytes, params=(68, 63, 46, 228, 233, 0, 128)):
     return bytes([fmt, flags, *params]) + struct.pack("<I", len(scan)) + scan + svg_bytes
 
@@ -209,6 +265,7 @@ def main():
     # Bigger nozzle, tighter tolerance, rotated and scaled placement, risk accepted.
     data = pipeline_input(1, 3 | 16, ply_ascii(v, t), svg(SVGS["path_all.svg"]), (200, 255, 5, 228, 233, 45, 140))
     (d / "ply_guarded_rotated").write_bytes(data)
+    gcode_seeds()
     total = sum(p.stat().st_size for p in SEEDS.rglob("*") if p.is_file())
     print(f"wrote seeds under {SEEDS} ({total} bytes)")
 

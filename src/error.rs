@@ -2,7 +2,10 @@
 //! stage's own typed error (which carries the file, line or point at fault).
 
 use crate::{
-    gcode::GcodeError, mesh::MeshError, registration::RegistrationError, sampling::SamplingError,
+    gcode::{GcodeError, GcodeReadError},
+    mesh::MeshError,
+    registration::RegistrationError,
+    sampling::SamplingError,
     svg::SvgError,
 };
 
@@ -25,6 +28,9 @@ pub enum Error {
     /// The G-code could not be written (names the subpath and point).
     #[error(transparent)]
     Gcode(#[from] GcodeError),
+    /// A G-code program could not be read (names the file, line and word).
+    #[error(transparent)]
+    GcodeRead(#[from] GcodeReadError),
     /// A parameter is out of its valid range (names the parameter and value).
     #[error("invalid parameter {name} = {value}: {reason}")]
     Parameter {

@@ -4,9 +4,10 @@
 //!
 //! - Every file in `tests/data/fuzz/` is replayed by the prefix of its name,
 //!   which is the fuzz target that found it (`import_obj-`, `import_ply-`,
-//!   `import_stl-`, `import_gltf-`, `load_svg-`, `pipeline-`). A case found
-//!   by the fuzzer goes there, minimised (`cargo fuzz tmin`), and gets a
-//!   named test below as well, named after the bug it pins (ripgrep style).
+//!   `import_stl-`, `import_gltf-`, `load_svg-`, `pipeline-`, `read_gcode-`).
+//!   A case found by the fuzzer goes there, minimised (`cargo fuzz tmin`),
+//!   and gets a named test below as well, named after the bug it pins
+//!   (ripgrep style).
 //! - The committed seed corpora (`fuzz/seeds/<target>/`) are replayed too:
 //!   they keep the fuzz crate's input layout (`fuzz/src/lib.rs`, compiled
 //!   here as a module) building against the library as it changes.
@@ -15,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use pcpp::gcode::read_gcode;
 use pcpp::mesh::{import_mesh, ImportOptions};
 use pcpp::pipeline::load_path;
 
@@ -38,17 +40,19 @@ fn replay(target: &str, data: &[u8]) {
         }
         "load_svg" => drop(load_path(data, "fuzz.svg")),
         "pipeline" => drop(fuzz_input::run(&fuzz_input::decode(data))),
+        "read_gcode" => drop(read_gcode(&String::from_utf8_lossy(data), "fuzz.gcode")),
         other => panic!("no fuzz target '{other}'"),
     }
 }
 
-const TARGETS: [&str; 6] = [
+const TARGETS: [&str; 7] = [
     "import_obj",
     "import_ply",
     "import_stl",
     "import_gltf",
     "load_svg",
     "pipeline",
+    "read_gcode",
 ];
 
 /// The fuzz targets' time limit: an input slower than this is a hang.

@@ -15,6 +15,10 @@
 //! - `grbl`: Grbl and LinuxCNC, mm/min, `M8`/`M9` (or `M3`/`M5` with a user
 //!   profile), `G4 P<s>`, `( )` comments.
 //!
+//! [`read_gcode`] reads any program back, ours or another tool's, as the
+//! straight moves a controller would make (absolute mm, with their lines),
+//! so that `pcpp check` can test them against the scan.
+//!
 //! ```
 //! use pcpp::gcode::{write_gcode, GcodeJob, MachineProfile};
 //! use pcpp::DVec3;
@@ -34,6 +38,7 @@
 
 mod format;
 mod profile;
+mod read;
 mod template;
 mod writer;
 
@@ -42,6 +47,10 @@ use glam::DVec3;
 pub use profile::{
     BuildVolume, CommentStyle, FeedUnits, MachineProfile, BLOCK_TOKENS, DEFAULT_DECIMALS,
     DWELL_TOKENS,
+};
+pub use read::{
+    read_gcode, GcodeLineProblem, GcodeMove, GcodeProgram, GcodeReadError, UnknownMove,
+    UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,
 };
 pub use writer::{write_gcode, write_program, GcodeJob, MoveKind, WrittenMove, WrittenProgram};
 
