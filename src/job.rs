@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeJob, MachineProfile};
-use crate::motion::{check_program, Clearance, MotionSummary, TouchingMoves};
+use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::planners::PlannerKind;
@@ -609,6 +609,122 @@ pub fn write_outputs(
     report.motion.program = checked;
     let gcode = write(&provenance(&report))?.text;
     Ok((report, gcode))
+}
+
+/// What `pcpp check` found in a G-code file (spec section 6f).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GcodeCheck {
+    pub file: InputFile,
+    /// Lines in the file.
+    pub lines: usize,
+    /// The straight moves followed, and what they came to.
+    pub summary: MotionSummary,
+    /// Moves whose position the file does not give (before every axis is
+    /// known, homing, probing, machine coordinates) and that could not be
+    /// cleared as high above the whole scan: their lines.
+    pub unchecked_lines: Vec<usize>,
+    /// What the reader skipped or assumed, and the moves cleared only by
+    /// their height.
+    pub notes: Vec<String>,
+    /// The clearance checked: tol (mm) and the nozzle's outer diameter.
+    pub tol_mm: f64,
+    pub outer_diameter_mm: f64,
+}
+
+impl GcodeCheck {
+    /// Whether no move comes closer than tol.
+    pub fn is_clear(&self) -> bool {
+        self.summary.touching_moves == 0
+    }
+}
+
+/// Checks any G-code program against a prepared scan (printer frame): every
+/// straight move along its length with the nozzle of `nozzle` kept `tol_mm`
+/// from the surface (spec section 6f). Moves the file does not place are
+/// cleared when both their ends' known heights keep tol above the scan's
+/// highest point (a level travel at the safe height from an unknown XY),
+/// else listed as unchecked. Arcs and frames the reader cannot follow are
+/// errors naming the line ([`crate::gcode::GcodeReadError`]).
+pub fn check_gcode(
+    scan: &PreparedScan,
+    text: &str,
+    file: &str,
+    nozzle: &crate::params::Nozzle,
+    tol_mm: f64,
+) -> Result<GcodeCheck> {
+    nozzle.validate()?;
+    crate::params::Process::DEFAULT
+        .with_tolerance_mm(tol_mm)
+        .validate()?;
+    let program = crate::gcode::read_gcode(text, file)?;
+    let clearance = Clearance::new(nozzle, tol_mm);
+    let summary = check_moves(
+        &scan.surface,
+        program.moves.iter().map(|m| (m.from, m.to, Some(m.line))),
+        &clearance,
+    );
+    // Above the highest point by tol the nozzle clears everything, wherever
+    // it is.
+    let high = scan.surface.top_z() + tol_mm;
+    let mut notes = program.notes.clone();
+    let mut unchecked_lines = Vec::new();
+    let mut cleared_high = Vec::new();
+    let mut from_start = Vec::new();
+    for (i, m) in program.unknown_moves.iter().enumerate() {
+        let above = [m.from[2], m.to[2]]
+            .iter()
+            .all(|z| z.is_some_and(|z| z >= high));
+        // The program's leading rises from a position nothing gives.
+        let first_rise = from_start.len() == i
+            && m.from.iter().all(Option::is_none)
+            && m.to[2].is_some_and(|z| z >= high);
+        if above {
+            cleared_high.push(m.line);
+        } else if first_rise {
+            from_start.push(m.line);
+        } else {
+            unchecked_lines.push(m.line);
+        }
+    }
+    if let Some(l) = from_start.first() {
+        notes.push(format!(
+            "line {l}: the program starts by rising above the scan from wherever the head \
+             stands; that starting position is not in the file, so the rise itself is not \
+             checked"
+        ));
+    }
+    if !cleared_high.is_empty() {
+        notes.push(format!(
+            "{} move(s) from or to a position the file does not give (first at line {}) lie \
+             wholly {:.3} mm or more above the scan's top: clear wherever they are",
+            cleared_high.len(),
+            cleared_high[0],
+            tol_mm
+        ));
+    }
+    if !unchecked_lines.is_empty() {
+        notes.push(format!(
+            "{} move(s) could not be checked: the file does not give where they start or end \
+             and they come lower than tol above the scan's top (lines {}{})",
+            unchecked_lines.len(),
+            unchecked_lines
+                .iter()
+                .take(10)
+                .map(|l| l.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            if unchecked_lines.len() > 10 { ", ..." } else { "" }
+        ));
+    }
+    Ok(GcodeCheck {
+        file: InputFile::new(file, text.as_bytes()),
+        lines: program.lines,
+        summary,
+        unchecked_lines,
+        notes,
+        tol_mm,
+        outer_diameter_mm: nozzle.outer_diameter_mm,
+    })
 }
 
 /// Plans from bytes: the CLI's `plan` and the page's Plan button.

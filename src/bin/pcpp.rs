@@ -231,6 +231,25 @@ const COMMANDS: &[Command] = &[
         run: cmd_register,
     },
     Command {
+        name: "check",
+        job_help: false,
+        help: CHECK_HELP,
+        flags: &[
+            valued("scan"),
+            valued("gcode"),
+            valued("report"),
+            valued("nozzle-id"),
+            valued("nozzle-od"),
+            valued("tol"),
+            valued("scan-units"),
+            valued("up-axis"),
+            valued("fiducials"),
+            valued("printer-points"),
+            valued("registration"),
+        ],
+        run: cmd_check,
+    },
+    Command {
         name: "demo",
         job_help: false,
         help: DEMO_HELP,
@@ -658,11 +677,27 @@ struct Inputs {
 }
 
 fn load_inputs(a: &Args, settings: &JobSettings, progress: &Progress) -> CliResult<Inputs> {
-    let scan_path = PathBuf::from(a.required("scan")?);
     let svg_path = PathBuf::from(a.required("path")?);
+    let (scan_path, prepared) = load_scan(a, settings, progress)?;
+    let svg = read_bytes(&svg_path, "path")?;
+    Ok(Inputs {
+        svg_name: file_name(&svg_path),
+        scan_path,
+        svg_path,
+        svg,
+        prepared,
+    })
+}
+
+/// Reads, registers and indexes `--scan`.
+fn load_scan(
+    a: &Args,
+    settings: &JobSettings,
+    progress: &Progress,
+) -> CliResult<(PathBuf, PreparedScan)> {
+    let scan_path = PathBuf::from(a.required("scan")?);
     progress.say(&format!("reading scan {}...", scan_path.display()));
     let scan = read_bytes(&scan_path, "scan")?;
-    let svg = read_bytes(&svg_path, "path")?;
     let scan_name = file_name(&scan_path);
     let prepared = job::prepare_scan(&scan, &scan_name, &settings.scan, &settings.registration)
         .map_err(|e| match e {
@@ -678,19 +713,14 @@ fn load_inputs(a: &Args, settings: &JobSettings, progress: &Progress) -> CliResu
     if settings.registration.fiducials != FiducialSource::None {
         progress.say(&registration_line(&prepared.registration, prepared.method));
     }
-    Ok(Inputs {
-        svg_name: file_name(&svg_path),
-        scan_path,
-        svg_path,
-        svg,
-        prepared,
-    })
+    Ok((scan_path, prepared))
 }
 
 /// Errors of planning on a prepared scan: the drawn path's file is named.
 fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
     match e {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
+        Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
             inputs.svg_path.display()
@@ -811,6 +841,74 @@ fn cmd_compare(a: &Args) -> CliResult<()> {
     warn_all(&comparison.warnings);
     print!("{}", job::comparison_table(&rows));
     Ok(())
+}
+
+// ---------------------------------------------------------------------------
+// check
+
+fn cmd_check(a: &Args) -> CliResult<()> {
+    let settings = job_settings(a)?;
+    let gcode_path = PathBuf::from(a.required("gcode")?);
+    let report_path = a.get("report").map(PathBuf::from);
+    let progress = Progress::new();
+    let text = read_text(&gcode_path, "gcode")?;
+    let (scan_path, prepared) = load_scan(a, &settings, &progress)?;
+    progress.say("checking every move...");
+    let name = file_name(&gcode_path);
+    let check = job::check_gcode(
+        &prepared,
+        &text,
+        &name,
+        &settings.plan.nozzle,
+        settings.plan.process.tolerance_mm,
+    )
+    .map_err(|e| Failure::Input(in_file(&gcode_path, &name, &e.to_string())))?;
+    if let Some(r) = &report_path {
+        let mut staged = Staged::default();
+        staged.add(r, to_json(&check)?.as_bytes())?;
+        staged.commit()?;
+    }
+    warn_all(&prepared.warnings);
+    warn_all(&check.notes);
+    let sum = &check.summary;
+    let clear = sum
+        .min_clearance_mm
+        .map_or("no move passes near the scan".to_string(), |c| {
+            format!(
+                "min clearance {c:.3} mm{}",
+                sum.min_clearance_line
+                    .map_or(String::new(), |l| format!(" (line {l})"))
+            )
+        });
+    let head = format!(
+        "{}: {} moves checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
+        gcode_path.display(),
+        sum.moves,
+        scan_path.display(),
+        check.outer_diameter_mm,
+        check.tol_mm
+    );
+    if check.is_clear() {
+        println!("{head}; no move comes closer than tol");
+        if !check.unchecked_lines.is_empty() {
+            println!(
+                "{} move(s) not checked: their position is not in the file (see the warning)",
+                check.unchecked_lines.len()
+            );
+        }
+        return Ok(());
+    }
+    let mut s = format!(
+        "{head}; {} move(s) come closer than tol:",
+        sum.touching_moves
+    );
+    for t in &sum.touching {
+        let _ = write!(s, "\n  {t}");
+    }
+    if sum.touching_moves > sum.touching.len() {
+        let _ = write!(s, "\n  ... and {} more", sum.touching_moves - sum.touching.len());
+    }
+    Err(Failure::Input(s))
 }
 
 // ---------------------------------------------------------------------------
@@ -1084,7 +1182,8 @@ usage: pcpp <command> [flags]
 
 commands:
   plan        plan a drawn path (SVG) on a scan and write G-code
-  compare     compare the four planners' predicted print quality
+  compare     compare the planners' predicted print quality and motion
+  check       check any G-code file's moves against a scan
   fiducials   list the holes of a scan that could be fiducials (JSON)
   register    the rigid transform scanner -> printer from fiducial points
   demo        write the built-in test part, its paths, G-code and antenna SVGs
@@ -1128,11 +1227,12 @@ usage: pcpp plan --scan FILE --path FILE.svg -o OUT.gcode [flags]
 
   -o, --output FILE        the G-code to write (required; not created on failure)
   --report FILE.json       also write the JSON report (quality, stats, paths)
-  --planner P              constant, slope, pcpp or pcpp-guarded (default)
+  --planner P              even (default), pcpp-guarded, pcpp, slope or constant
   --dialect D              marlin (default), aerotech or grbl
   --profile FILE.json      a machine profile instead of a built-in dialect
-  --accept-risk            write G-code even where the guarded planner could
-                           not keep the nozzle off the surface
+  --accept-risk            write G-code even where a move comes closer to the
+                           surface than tol (its header then says so); without
+                           it such a plan fails, naming the first moves
 
 The summary goes to stdout, warnings to stderr.
 
@@ -1140,14 +1240,19 @@ inputs:
 ";
 
 const COMPARE_HELP: &str = "\
-pcpp compare: the four planners side by side (the paper's Figure 3e-f)
+pcpp compare: the planners side by side (the paper's Figure 3e-f)
 
 usage: pcpp compare --scan FILE --path FILE.svg [flags]
 
   --report FILE.json       also write the comparison as JSON
 
-Prints mean |e|, mean negative and positive e (mm), and the contact,
-flattening and floating shares of the points for each planner.
+Prints for each planner (constant, slope, pcpp, pcpp-guarded, even): mean |e|,
+mean negative and positive e (mm); the contact, flattening and floating shares
+of the points and their sum; the points that move backwards along the drawn
+path; the smallest clearance along the print moves (below tol the nozzle comes
+too close: the tip's height over the surface where the nearest surface is under
+it, else tol plus how far it could sink before coming within tol); and the
+waypoints the guarded planners added.
 
 inputs:
 ";
@@ -1171,6 +1276,28 @@ usage: pcpp register --scan-points \"x,y,z;...\" --printer-points \"x,y,z;...\"
 Points are in mm, in the same order in both frames (at least 3). Prints the
 4x4 matrix (row-major), the residual of each fiducial and their RMS; --json
 prints them as JSON.
+";
+
+const CHECK_HELP: &str = "\
+pcpp check: check every move of a G-code file against a scan
+
+usage: pcpp check --scan FILE --gcode FILE [flags]
+
+  --scan FILE              the scanned surface (OBJ, PLY, STL, glTF or GLB)
+  --gcode FILE             the program to check: ours or another tool's
+  --report FILE.json       also write the result as JSON
+  --nozzle-od MM           nozzle outer diameter do (default 0.908)
+  --tol MM                 the distance the nozzle must keep (default 0.1)
+  --scan-units, --up-axis, --fiducials, --printer-points, --registration
+                           as for plan: put the scan in the printer frame
+
+Follows every G0/G1 move in straight lines (G90/G91, G20/G21 and G70/G71, G92,
+N line numbers, *checksums, ; and ( ) comments) and tests the nozzle, its tip
+disk and the body above it, along each whole move. Arcs (G2/G3), other work
+offsets and program flow are refused with the line named. Exit status 0 when
+no move comes closer than tol (prints the smallest clearance), 1 listing the
+first moves that do (line, position, how much higher the nozzle would have to
+be) and their count, 2 on a usage error.
 ";
 
 const DEMO_HELP: &str = "\
