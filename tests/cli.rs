@@ -790,3 +790,193 @@ fn no_progress_chatter_when_stderr_is_not_a_terminal() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// ------------------------------------------------------------------ check
+
+#[test]
+fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
+    for name in ["demo-even.gcode", "demo-pcpp-guarded.gcode"] {
+        let o = pcpp(&[
+            "check",
+            "--scan",
+            s(&demo_file(demo::DEMO_SCAN_NAME)),
+            "--gcode",
+            s(&demo_file(name)),
+        ]);
+        assert_eq!(code(&o), 0, "{name}: {}{}", stdout(&o), stderr(&o));
+        let out = stdout(&o);
+        assert!(out.contains("no move comes closer than tol"), "{out}");
+        assert!(out.contains("min clearance 0.10"), "{out}");
+    }
+    // The golden programs in the three dialects check alike.
+    for dialect in DIALECTS {
+        let o = pcpp(&[
+            "check",
+            "--scan",
+            s(&demo_file(demo::DEMO_SCAN_NAME)),
+            "--gcode",
+            s(&golden_path(dialect)),
+        ]);
+        assert_eq!(code(&o), 0, "{dialect}: {}{}", stdout(&o), stderr(&o));
+    }
+}
+
+/// A hand-made program that climbs the region-1 block's wall in one
+/// straight move (issue 11's example): exit 1, naming the line.
+#[test]
+fn check_names_the_line_of_a_cutting_move() {
+    let dir = temp_dir("check-cut");
+    let g = dir.join("cut.gcode");
+    std::fs::write(
+        &g,
+        "; hand-made\nG21\nG90\nG0 Z20\nG0 X10 Y16 Z20\nG1 X15.4 Y16 Z5.603 F300\n\
+         G1 X16.230 Y16 Z7.603\nG1 X20 Y16 Z7.603\nG0 Z20\n",
+    )
+    .unwrap();
+    let report = dir.join("check.json");
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--gcode",
+        s(&g),
+        "--report",
+        s(&report),
+    ]);
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("line 7: the move (15.400, 16.000, 5.603) -> (16.230, 16.000, 7.603)"),
+        "{err}"
+    );
+    assert!(err.contains("come closer than tol"), "{err}");
+    let v: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert!(v["summary"]["touching_moves"].as_u64().unwrap() >= 1, "{v}");
+    assert_eq!(v["summary"]["touching"][0]["line"].as_u64(), Some(7));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The same moves written absolute in mm, relative (G91), in inches (G20)
+/// and with a G92 offset check to the same result; an arc is refused with
+/// its line named.
+#[test]
+fn check_reads_relative_inch_and_offset_programs_alike() {
+    let dir = temp_dir("check-modes");
+    let mm = [
+        (10.0, 16.0, 20.0),
+        (15.4, 16.0, 5.603),
+        (16.230, 16.0, 7.603),
+        (20.0, 16.0, 7.603),
+    ];
+    let abs: String = mm
+        .iter()
+        .map(|(x, y, z)| format!("G1 X{x:.4} Y{y:.4} Z{z:.4}\n"))
+        .collect();
+    let mut rel = format!("G1 X{:.4} Y{:.4} Z{:.4}\nG91\n", mm[0].0, mm[0].1, mm[0].2);
+    for w in mm.windows(2) {
+        rel += &format!(
+            "G1 X{:.4} Y{:.4} Z{:.4}\n",
+            w[1].0 - w[0].0,
+            w[1].1 - w[0].1,
+            w[1].2 - w[0].2
+        );
+    }
+    let inch: String = mm
+        .iter()
+        .map(|(x, y, z)| format!("G1 X{:.6} Y{:.6} Z{:.6}\n", x / 25.4, y / 25.4, z / 25.4))
+        .collect();
+    let offset: String = mm
+        .iter()
+        .map(|(x, y, z)| format!("G1 X{:.4} Y{:.4} Z{:.4}\n", x - 100.0, y, z))
+        .collect();
+    let programs = [
+        ("abs", format!("G21\nG90\n{abs}")),
+        ("rel", format!("G21\nG90\n{rel}")),
+        ("inch", format!("G20\nG90\n{inch}")),
+        ("g92", format!("G21\nG90\nG1 X10 Y16 Z20\nG92 X-90\n{offset}")),
+    ];
+    let mut reports = Vec::new();
+    for (name, text) in &programs {
+        let g = dir.join(format!("{name}.gcode"));
+        std::fs::write(&g, text).unwrap();
+        let report = dir.join(format!("{name}.json"));
+        let o = pcpp(&[
+            "check",
+            "--scan",
+            s(&demo_file(demo::DEMO_SCAN_NAME)),
+            "--gcode",
+            s(&g),
+            "--report",
+            s(&report),
+        ]);
+        assert_eq!(code(&o), 1, "{name}: {}{}", stdout(&o), stderr(&o));
+        let v: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        reports.push((name, v["summary"].clone()));
+    }
+    let (_, first) = &reports[0];
+    for (name, r) in &reports[1..] {
+        assert_eq!(r["touching_moves"], first["touching_moves"], "{name}");
+        let (a, b) = (
+            r["min_clearance_mm"].as_f64().unwrap(),
+            first["min_clearance_mm"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() < 1e-3, "{name}: {a} vs {b}");
+        let (p, q) = (&r["touching"][0]["at"], &first["touching"][0]["at"]);
+        for k in 0..3 {
+            assert!((p[k].as_f64().unwrap() - q[k].as_f64().unwrap()).abs() < 1e-3, "{name}");
+        }
+    }
+    let g = dir.join("arc.gcode");
+    std::fs::write(&g, "G21\nG90\nG1 X10 Y16 Z20\nG2 X20 Y16 I5 J0\n").unwrap();
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--gcode",
+        s(&g),
+    ]);
+    assert_eq!(code(&o), 1);
+    let err = stderr(&o);
+    assert!(err.contains("line 4") && err.contains("arcs"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `plan --planner slope` on the stepped block: refused, naming a line;
+/// with --accept-risk written, and its header says it touches.
+#[test]
+fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
+    let dir = temp_dir("accept-risk");
+    let o = pcpp(&["demo", "--part", "stepped-block", "--out", s(&dir)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let scan = dir.join("demo-stepped-block.ply");
+    let path = dir.join("demo-stepped-block-path.svg");
+    let out = dir.join("slope.gcode");
+    let args = |extra: &[&'static str]| {
+        let mut v: Vec<String> = [
+            "plan", "--scan", s(&scan), "--path", s(&path), "--place", "0,40", "--planner",
+            "slope", "-o", s(&out),
+        ]
+        .iter()
+        .map(|a| a.to_string())
+        .collect();
+        v.extend(extra.iter().map(|a| a.to_string()));
+        v
+    };
+    let a = args(&[]);
+    let o = pcpp(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("of planner slope") && err.contains("line "), "{err}");
+    assert!(err.contains("--accept-risk"), "{err}");
+    assert!(!out.exists(), "no G-code may be written");
+    let a = args(&["--accept-risk"]);
+    let o = pcpp(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let header = text.lines().find(|l| l.contains("safe motion:")).unwrap();
+    assert!(header.contains("WARNING") && header.contains("risk was accepted"), "{header}");
+    // And check agrees.
+    let o = pcpp(&["check", "--scan", s(&scan), "--gcode", s(&out)]);
+    assert_eq!(code(&o), 1);
+    let _ = std::fs::remove_dir_all(&dir);
+}
