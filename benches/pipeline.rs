@@ -10,7 +10,12 @@
 //!   pcpp-guarded, quality: `pipeline::plan`) of the paper's spiral and a
 //!   100k-point raster on the 2 M triangle film;
 //! - `job/W2 ...`, `job/W3 ...`: the whole `job::run_on` (SVG read, plan,
-//!   report, G-code), what the wasm `Session.plan` runs.
+//!   report, G-code), what the wasm `Session.plan` runs;
+//! - `motion/demo ...`: the demo test part's lines planned by
+//!   `pcpp-guarded` without and with the safe-motion stage (waypoints and
+//!   the swept check of every print move, spec section 6f), and by `even`
+//!   (issue 11: with the check within 1.5x of without; issue 12: `even`
+//!   within 2x of `pcpp-guarded`), and the same on W2.
 //!
 //! `PCPP_BENCH_N` shrinks the film (grid cells per side, default 1000).
 //! `PCPP_BENCH_CLOCK=cpu` times the bench thread's CPU time instead of wall
@@ -97,6 +102,39 @@ impl Measurement for Clock {
     }
 }
 
+fn motion_benches(c: &mut Criterion<Clock>) {
+    use pcpp::demo::test_part;
+    use pcpp::planners::PlannerKind;
+    let surface = pcpp::surface::Surface::new(test_part::test_part()).unwrap();
+    let drawn = pipeline::load_path(test_part::test_part_svg().as_bytes(), "demo.svg").unwrap();
+    let settings = pipeline::PlanSettings {
+        placement: test_part::placement(),
+        ..Default::default()
+    };
+    let (nozzle, process) = (&settings.nozzle, &settings.process);
+    let sp =
+        pipeline::surface_path(&surface, &drawn.subpaths, nozzle, &settings.placement).unwrap();
+    let mut g = c.benchmark_group("motion");
+    g.sample_size(20);
+    g.bench_function("demo pcpp-guarded without motion check", |b| {
+        b.iter(|| {
+            pipeline::plan_surface_path_without_motion(
+                &surface,
+                black_box(&sp),
+                PlannerKind::PcppGuarded,
+                nozzle,
+                process,
+            )
+        })
+    });
+    for k in [PlannerKind::PcppGuarded, PlannerKind::Even] {
+        g.bench_function(format!("demo {k} with motion check"), |b| {
+            b.iter(|| pipeline::plan_surface_path(&surface, black_box(&sp), k, nozzle, process))
+        });
+    }
+    g.finish();
+}
+
 fn benches(c: &mut Criterion<Clock>) {
     let film = workloads::wrinkled_film(n());
     let ply = to_binary_ply(&film);
@@ -162,6 +200,6 @@ fn benches(c: &mut Criterion<Clock>) {
 criterion_group! {
     name = pipeline_benches;
     config = Criterion::default().with_measurement(Clock::from_env());
-    targets = benches
+    targets = motion_benches, benches
 }
 criterion_main!(pipeline_benches);

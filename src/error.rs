@@ -41,7 +41,7 @@ pub enum Error {
     /// The G-code's moves would bring the nozzle too close to the surface
     /// (names the first moves, with their lines).
     #[error(transparent)]
-    Touching(#[from] crate::motion::TouchingMoves),
+    Touching(#[from] Box<crate::motion::TouchingMoves>),
     /// Planning could not produce a tool path (names the path and point).
     #[error("{0}")]
     Plan(String),

@@ -10,8 +10,8 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeJob, MachineProfile};
-use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
+use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
@@ -598,12 +598,12 @@ pub fn write_outputs(
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
     if checked.touching_moves > 0 && !accept_risk {
-        return Err(Error::Touching(TouchingMoves {
+        return Err(Error::Touching(Box::new(TouchingMoves {
             planner: plan.planner.name().into(),
             outer_diameter_mm: settings.nozzle.outer_diameter_mm,
             tol_mm: settings.process.tolerance_mm,
             summary: checked,
-        }));
+        })));
     }
     report.motion.risk_accepted = checked.touching_moves > 0;
     report.motion.program = checked;
@@ -713,7 +713,11 @@ pub fn check_gcode(
                 .map(|l| l.to_string())
                 .collect::<Vec<_>>()
                 .join(", "),
-            if unchecked_lines.len() > 10 { ", ..." } else { "" }
+            if unchecked_lines.len() > 10 {
+                ", ..."
+            } else {
+                ""
+            }
         ));
     }
     Ok(GcodeCheck {
@@ -818,10 +822,15 @@ pub fn comparison_table(rows: &[ComparisonRow]) -> String {
     );
     for r in rows {
         let q = &r.quality;
-        let clear = r
-            .motion
-            .min_clearance_mm
-            .map_or("-".to_string(), |c| format!("{c:.3}"));
+        let clear = r.motion.min_clearance_mm.map_or_else(
+            || {
+                format!(
+                    ">{:.3}",
+                    r.motion.tol_mm + crate::pipeline::CLEARANCE_CAP_ABOVE_TOL_MM
+                )
+            },
+            |c| format!("{c:.3}"),
+        );
         s.push_str(&format!(
             "{:<13} {:>8.4} {:>8.4} {:>8.4} {:>7.2}% {:>7.2}% {:>7.2}% {:>7.2}% {:>8} {:>9} {:>9}\n",
             r.planner.name(),

@@ -105,6 +105,11 @@ pub struct SafePath {
     /// Planned points j whose move to j + 1 could not be made safe (the
     /// planned point itself does not clear).
     pub unresolved: Vec<usize>,
+    /// The smallest clearance of the moves between planned points that
+    /// needed no waypoint (by `clearance`, so with its margin: a lower
+    /// bound of the clearance without it), and tol for the moves made by
+    /// waypoints; `None` when no move passes near the scan.
+    pub min_clearance_mm: Option<f64>,
 }
 
 /// Adds waypoints where a straight move between consecutive `planned`
@@ -115,6 +120,18 @@ pub struct SafePath {
 /// (vertical rise, level move, vertical descent), which is always safe
 /// when its two ends are.
 pub fn insert_waypoints(surface: &Surface, planned: &[DVec3], clearance: &Clearance) -> SafePath {
+    insert_waypoints_capped(surface, planned, clearance, f64::INFINITY)
+}
+
+/// [`insert_waypoints`], finding the smallest clearance only below `cap`
+/// (above it, `min_clearance_mm` stays `None`): far fewer triangles are
+/// visited when the nozzle is well clear.
+pub fn insert_waypoints_capped(
+    surface: &Surface,
+    planned: &[DVec3],
+    clearance: &Clearance,
+    cap: f64,
+) -> SafePath {
     let mut out = SafePath {
         points: Vec::with_capacity(planned.len()),
         ..Default::default()
@@ -123,9 +140,25 @@ pub fn insert_waypoints(surface: &Surface, planned: &[DVec3], clearance: &Cleara
         return out;
     };
     out.points.push(first);
-    for (j, pair) in planned.windows(2).enumerate() {
-        let (p, q) = (pair[0], pair[1]);
+    // The moves' clearances first, with shared index queries; the limit
+    // only matters below the smallest so far and the cap.
+    let pairs: Vec<(DVec3, DVec3)> = planned.windows(2).map(|w| (w[0], w[1])).collect();
+    let mut gaps = Vec::with_capacity(pairs.len());
+    let mut min = f64::INFINITY;
+    let cap = cap.max(clearance.tol_mm);
+    for &(p, q) in &pairs {
+        let g = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
+        if let Some(g) = g {
+            min = min.min(g.gap_mm.max(clearance.tol_mm - TIE_MM));
+        }
+        gaps.push(g);
+    }
+    for (j, &(p, q)) in pairs.iter().enumerate() {
         let mut added = Vec::new();
+        if gaps[j].is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
+            out.points.push(q);
+            continue;
+        }
         if !resolve(surface, clearance, p, q, &mut added) {
             added = rise_over(surface, clearance, p, q);
             if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
@@ -147,6 +180,7 @@ pub fn insert_waypoints(surface: &Surface, planned: &[DVec3], clearance: &Cleara
         }
         out.points.push(q);
     }
+    out.min_clearance_mm = min.is_finite().then_some(min);
     out
 }
 
@@ -171,7 +205,13 @@ fn resolve(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3, out: &mut Vec<D
         return false;
     }
     let x = p.lerp(q, worst.at);
-    let w = x + DVec3::Z * c.rise_needed(surface, x);
+    // As high as the footprint there needs, and at least tol over the
+    // surface point that sets the worst clearance: that point usually
+    // enters the rounded rim there and then the flat tip as the move goes
+    // on (a step's edge), and clearing it by the full tol at once spares
+    // a waypoint per step of the rim for a few hundredths of a mm.
+    let need = x.z + c.rise_needed(surface, x);
+    let w = DVec3::new(x.x, x.y, need.max(worst.surface_point.z + c.tol_mm + 1e-6));
     // A waypoint that coincides with an end changes nothing: the end
     // itself does not clear.
     if w.distance(p) < 1e-9 || w.distance(q) < 1e-9 {
@@ -186,10 +226,7 @@ fn resolve(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3, out: &mut Vec<D
 /// Rise, level move and descent over the whole footprint of p -> q.
 fn rise_over(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3) -> Vec<DVec3> {
     let probe = surface.top_z() + 1.0;
-    let (a, b) = (
-        DVec3::new(p.x, p.y, probe),
-        DVec3::new(q.x, q.y, probe),
-    );
+    let (a, b) = (DVec3::new(p.x, p.y, probe), DVec3::new(q.x, q.y, probe));
     // The level move at `probe` clears by gap: the lowest level that keeps
     // tol lies gap - tol below it.
     let top = match c.gap(surface, a, b, f64::INFINITY) {
@@ -216,7 +253,7 @@ fn rise_over(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3) -> Vec<DVec3>
 pub fn backward_moves(ta: &[DVec3], toolpath: &[DVec3]) -> usize {
     // The nearest sample is searched near the last one found: a point
     // further back than the window still counts as a step back.
-    const WINDOW: usize = 24;
+    const WINDOW: usize = 8;
     let mut count = 0;
     let mut reached = 0usize;
     let mut prev = 0usize;
@@ -306,17 +343,29 @@ pub fn check_moves(
     moves: impl IntoIterator<Item = (DVec3, DVec3, Option<usize>)>,
     clearance: &Clearance,
 ) -> MotionSummary {
-    let mut s = MotionSummary::default();
+    check_moves_capped(surface, moves, clearance, f64::INFINITY)
+}
+
+/// [`check_moves`], finding the smallest clearance only below `cap` (above
+/// it, `min_clearance_mm` stays `None`); every move below tol is found
+/// whatever the cap.
+pub fn check_moves_capped(
+    surface: &Surface,
+    moves: impl IntoIterator<Item = (DVec3, DVec3, Option<usize>)>,
+    clearance: &Clearance,
+    cap: f64,
+) -> MotionSummary {
+    let moves: Vec<(DVec3, DVec3, Option<usize>)> = moves.into_iter().collect();
+    let mut s = MotionSummary {
+        moves: moves.len(),
+        ..MotionSummary::default()
+    };
     let mut min = f64::INFINITY;
-    for (index, (a, b, line)) in moves.into_iter().enumerate() {
-        s.moves += 1;
-        // Only a clearance below tol or below the smallest so far matters.
-        let limit = if min.is_finite() {
-            min.max(clearance.tol_mm)
-        } else {
-            f64::INFINITY
-        };
-        let Some(g) = clearance.gap(surface, a, b, limit) else {
+    let cap = cap.max(clearance.tol_mm);
+    for (index, &(a, b, line)) in moves.iter().enumerate() {
+        // Only a clearance below tol, or below the smallest so far and the
+        // cap, matters.
+        let Some(g) = clearance.gap(surface, a, b, min.min(cap).max(clearance.tol_mm)) else {
             continue;
         };
         let at = a.lerp(b, g.at);
@@ -393,7 +442,8 @@ mod tests {
         let mut m = TriMesh::default();
         for &y in &ys {
             for (i, &x) in xs.iter().enumerate() {
-                m.vertices.push(DVec3::new(x, y, if i >= 2 { 2.0 } else { 0.0 }));
+                m.vertices
+                    .push(DVec3::new(x, y, if i >= 2 { 2.0 } else { 0.0 }));
             }
         }
         for i in 0..3u32 {
@@ -422,7 +472,10 @@ mod tests {
         // The waypoint is where the wall's edge first comes within reach
         // of the rim, as low as keeping tol from the edge allows there.
         let w = safe.points[1];
-        assert!(w.x > 5.0 - c.radius_mm - c.tol_mm - 1e-9 && w.x < 5.0 - c.radius_mm, "{w}");
+        assert!(
+            w.x > 5.0 - c.radius_mm - c.tol_mm - 1e-9 && w.x < 5.0 - c.radius_mm,
+            "{w}"
+        );
         assert!(w.z > 2.0 && w.z < 2.1 + 1e-5, "{w}");
         assert!(safe.extra_length_mm > 0.0);
         // Down: the mirror image; the rounded rim passing the edge can take
@@ -441,7 +494,9 @@ mod tests {
     fn a_clear_path_gets_no_waypoints_and_an_unclear_point_is_reported() {
         let s = step();
         let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
-        let pts: Vec<DVec3> = (0..10).map(|i| DVec3::new(0.5 + 0.3 * i as f64, 5.0, 0.7)).collect();
+        let pts: Vec<DVec3> = (0..10)
+            .map(|i| DVec3::new(0.5 + 0.3 * i as f64, 5.0, 0.7))
+            .collect();
         let safe = insert_waypoints(&s, &pts, &c);
         assert_eq!(safe.points, pts);
         assert_eq!(safe.waypoints, 0);
@@ -456,9 +511,21 @@ mod tests {
         let s = step();
         let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
         let moves = vec![
-            (DVec3::new(1.0, 5.0, 1.0), DVec3::new(2.0, 5.0, 1.0), Some(10)),
-            (DVec3::new(4.0, 5.0, 0.7), DVec3::new(4.6, 5.0, 2.2), Some(11)),
-            (DVec3::new(6.0, 5.0, 3.0), DVec3::new(8.0, 5.0, 3.0), Some(12)),
+            (
+                DVec3::new(1.0, 5.0, 1.0),
+                DVec3::new(2.0, 5.0, 1.0),
+                Some(10),
+            ),
+            (
+                DVec3::new(4.0, 5.0, 0.7),
+                DVec3::new(4.6, 5.0, 2.2),
+                Some(11),
+            ),
+            (
+                DVec3::new(6.0, 5.0, 3.0),
+                DVec3::new(8.0, 5.0, 3.0),
+                Some(12),
+            ),
         ];
         let sum = check_moves(&s, moves, &c);
         assert_eq!(sum.moves, 3);
@@ -469,12 +536,17 @@ mod tests {
         assert!(sum.min_clearance_mm.unwrap() < 0.0);
         assert_eq!(sum.min_clearance_line, Some(11));
         let text = sum.touching[0].to_string();
-        assert!(text.starts_with("line 11: the move (4.000, 5.000, 0.700)"), "{text}");
+        assert!(
+            text.starts_with("line 11: the move (4.000, 5.000, 0.700)"),
+            "{text}"
+        );
     }
 
     #[test]
     fn backward_moves_count_falls_back_by_two_or_more() {
-        let ta: Vec<DVec3> = (0..20).map(|i| DVec3::new(i as f64 * 0.3, 0.0, 0.0)).collect();
+        let ta: Vec<DVec3> = (0..20)
+            .map(|i| DVec3::new(i as f64 * 0.3, 0.0, 0.0))
+            .collect();
         let mut tp = ta.clone();
         assert_eq!(backward_moves(&ta, &tp), 0);
         // One point thrown back three samples.

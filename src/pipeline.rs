@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, TriMesh};
 use crate::motion::{
-    backward_moves, check_moves, insert_waypoints, Clearance, PLANNING_MARGIN_MM,
+    backward_moves, check_moves_capped, insert_waypoints_capped, Clearance, PLANNING_MARGIN_MM,
 };
 use crate::params::{Nozzle, Process};
 use crate::planners::{plan_points, PlannerKind};
@@ -180,15 +180,28 @@ pub struct Plan {
     pub motion: PlanMotion,
 }
 
+/// A plan's smallest clearance is found exactly up to tol plus this (mm);
+/// above it a comparison says only that it is more (the G-code's own check,
+/// when it is written, is exact whatever the clearance). A small cap keeps
+/// the check to the triangles near the nozzle.
+pub const CLEARANCE_CAP_ABOVE_TOL_MM: f64 = 0.05;
+
 /// What the motion check says of a plan's print moves (the G-code's other
 /// moves, travel and descents, are checked when it is written).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct PlanMotion {
+    /// The distance the nozzle keeps from the surface: tol (mm).
+    pub tol_mm: f64,
     /// Print moves (between consecutive points the nozzle visits).
     pub moves: usize,
-    /// The smallest clearance along them: the height of the tip over the
-    /// highest surface point within do/2 + tol of its axis (`None` when no
-    /// move passes over the scan). At least tol means no contact.
+    /// The smallest clearance along them (see
+    /// [`crate::surface::Surface::nozzle_gap`]; `None` when no move passes
+    /// near the scan): at least tol means the nozzle keeps tol from the
+    /// surface. For the guarded planners, a lower bound from the check
+    /// their waypoints were placed with (tol plus
+    /// [`crate::motion::PLANNING_MARGIN_MM`]); the G-code's own moves are
+    /// checked exactly when it is written. `None` also when every move
+    /// clears by more than tol + [`CLEARANCE_CAP_ABOVE_TOL_MM`].
     pub min_clearance_mm: Option<f64>,
     /// Print moves that come closer than tol.
     pub touching_moves: usize,
@@ -204,8 +217,9 @@ pub struct PlanMotion {
     pub max_sideways_mm: f64,
 }
 
-/// Stage 5: a planner over a surface path, then quality (spec section 7)
-/// and statistics (section 8).
+/// Stage 5: a planner over a surface path, then safe motion (spec section
+/// 6f: the guarded planners' waypoints, every print move checked), quality
+/// (section 7) and statistics (section 8).
 pub fn plan_surface_path(
     surface: &Surface,
     sp: &SurfacePath,
@@ -213,13 +227,43 @@ pub fn plan_surface_path(
     nozzle: &Nozzle,
     process: &Process,
 ) -> Plan {
+    plan_stage(surface, sp, planner, nozzle, process, true)
+}
+
+/// [`plan_surface_path`] without the safe-motion stage: the planner's points
+/// as they are, no waypoints, no move checked (`motion` stays empty). For
+/// benchmarks that measure what the motion stage costs; G-code from such a
+/// plan is still checked when it is written.
+pub fn plan_surface_path_without_motion(
+    surface: &Surface,
+    sp: &SurfacePath,
+    planner: PlannerKind,
+    nozzle: &Nozzle,
+    process: &Process,
+) -> Plan {
+    plan_stage(surface, sp, planner, nozzle, process, false)
+}
+
+fn plan_stage(
+    surface: &Surface,
+    sp: &SurfacePath,
+    planner: PlannerKind,
+    nozzle: &Nozzle,
+    process: &Process,
+    safe_motion: bool,
+) -> Plan {
     let mut warnings = sp.warnings.clone();
     let mut pieces = Vec::with_capacity(sp.pieces.len());
     let mut uncleared = Vec::new();
     let mut lifted = 0usize;
     let mut max_lift: (f64, DVec3) = (0.0, DVec3::ZERO);
     let clearance = Clearance::new(nozzle, process.tolerance_mm);
-    let mut motion = PlanMotion::default();
+    let cap = process.tolerance_mm + CLEARANCE_CAP_ABOVE_TOL_MM;
+    let mut motion = PlanMotion {
+        tol_mm: process.tolerance_mm,
+        ..PlanMotion::default()
+    };
+    let mut guarded_min: Option<f64> = None;
     let mut print_moves: Vec<(DVec3, DVec3, Option<usize>)> = Vec::new();
     for (k, piece) in sp.pieces.iter().enumerate() {
         let planned = plan_points(
@@ -230,9 +274,13 @@ pub fn plan_surface_path(
             nozzle,
             process,
         );
-        let moves = if planner.is_guarded() {
+        let moves = if safe_motion && planner.is_guarded() {
             let planning = clearance.with_margin(PLANNING_MARGIN_MM);
-            let safe = insert_waypoints(surface, &planned.toolpath, &planning);
+            let safe = insert_waypoints_capped(surface, &planned.toolpath, &planning, cap);
+            guarded_min = match (guarded_min, safe.min_clearance_mm) {
+                (Some(a), Some(b)) => Some(f64::min(a, b)),
+                (a, b) => a.or(b),
+            };
             motion.waypoints += safe.waypoints;
             motion.extra_length_mm += safe.extra_length_mm;
             for &j in &safe.unresolved {
@@ -244,7 +292,12 @@ pub fn plan_surface_path(
         } else {
             planned.toolpath.clone()
         };
-        print_moves.extend(moves.windows(2).map(|w| (w[0], w[1], None)));
+        // The guarded planners' moves were checked as their waypoints were
+        // placed, with the planning margin; the others' are checked here.
+        if safe_motion && !planner.is_guarded() {
+            print_moves.extend(moves.windows(2).map(|w| (w[0], w[1], None)));
+        }
+        motion.moves += moves.len().saturating_sub(1);
         motion.backward_moves += backward_moves(&piece.ta, &planned.toolpath);
         for ((t, a), g) in planned.toolpath.iter().zip(&piece.ta).zip(&piece.geometry) {
             let side = DVec3::new(-g.v.y, g.v.x, 0.0);
@@ -289,10 +342,13 @@ pub fn plan_surface_path(
             nozzle.outer_diameter_mm, max_lift.0, p.x, p.y, p.z
         ));
     }
-    let checked = check_moves(surface, print_moves, &clearance);
-    motion.moves = checked.moves;
-    motion.min_clearance_mm = checked.min_clearance_mm;
-    motion.touching_moves = checked.touching_moves;
+    if planner.is_guarded() {
+        motion.min_clearance_mm = guarded_min;
+    } else if safe_motion {
+        let checked = check_moves_capped(surface, print_moves, &clearance, cap);
+        motion.min_clearance_mm = checked.min_clearance_mm;
+        motion.touching_moves = checked.touching_moves;
+    }
     let quality = summarize(pieces.iter().flat_map(|p| &p.quality));
     let stats = path_stats(
         pieces

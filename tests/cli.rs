@@ -341,7 +341,10 @@ fn compare_prints_five_rows_and_writes_json() {
     let out = stdout(&o);
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(lines.len(), 6, "{out}");
-    assert!(lines[0].contains("backward") && lines[0].contains("min clear"), "{out}");
+    assert!(
+        lines[0].contains("backward") && lines[0].contains("min clear"),
+        "{out}"
+    );
     for (line, k) in lines[1..]
         .iter()
         .zip(["constant", "slope", "pcpp", "pcpp-guarded", "even"])
@@ -893,7 +896,10 @@ fn check_reads_relative_inch_and_offset_programs_alike() {
         ("abs", format!("G21\nG90\n{abs}")),
         ("rel", format!("G21\nG90\n{rel}")),
         ("inch", format!("G20\nG90\n{inch}")),
-        ("g92", format!("G21\nG90\nG1 X10 Y16 Z20\nG92 X-90\n{offset}")),
+        (
+            "g92",
+            format!("G21\nG90\nG1 X10 Y16 Z20\nG92 X-90\n{offset}"),
+        ),
     ];
     let mut reports = Vec::new();
     for (name, text) in &programs {
@@ -923,7 +929,10 @@ fn check_reads_relative_inch_and_offset_programs_alike() {
         assert!((a - b).abs() < 1e-3, "{name}: {a} vs {b}");
         let (p, q) = (&r["touching"][0]["at"], &first["touching"][0]["at"]);
         for k in 0..3 {
-            assert!((p[k].as_f64().unwrap() - q[k].as_f64().unwrap()).abs() < 1e-3, "{name}");
+            assert!(
+                (p[k].as_f64().unwrap() - q[k].as_f64().unwrap()).abs() < 1e-3,
+                "{name}"
+            );
         }
     }
     let g = dir.join("arc.gcode");
@@ -953,8 +962,17 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     let out = dir.join("slope.gcode");
     let args = |extra: &[&'static str]| {
         let mut v: Vec<String> = [
-            "plan", "--scan", s(&scan), "--path", s(&path), "--place", "0,40", "--planner",
-            "slope", "-o", s(&out),
+            "plan",
+            "--scan",
+            s(&scan),
+            "--path",
+            s(&path),
+            "--place",
+            "0,40",
+            "--planner",
+            "slope",
+            "-o",
+            s(&out),
         ]
         .iter()
         .map(|a| a.to_string())
@@ -966,7 +984,10 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     let o = pcpp(&a.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
-    assert!(err.contains("of planner slope") && err.contains("line "), "{err}");
+    assert!(
+        err.contains("of planner slope") && err.contains("line "),
+        "{err}"
+    );
     assert!(err.contains("--accept-risk"), "{err}");
     assert!(!out.exists(), "no G-code may be written");
     let a = args(&["--accept-risk"]);
@@ -974,7 +995,10 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&out).unwrap();
     let header = text.lines().find(|l| l.contains("safe motion:")).unwrap();
-    assert!(header.contains("WARNING") && header.contains("risk was accepted"), "{header}");
+    assert!(
+        header.contains("WARNING") && header.contains("risk was accepted"),
+        "{header}"
+    );
     // And check agrees.
     let o = pcpp(&["check", "--scan", s(&scan), "--gcode", s(&out)]);
     assert_eq!(code(&o), 1);

@@ -280,7 +280,11 @@ fn demo_part_figures_per_region() {
         let regions = per(k);
         assert_eq!(regions.len(), 3);
         let total: usize = regions.iter().map(|(_, q)| q.points).sum();
-        assert_eq!(total, by(k).quality.points, "{k}: every point in one region");
+        assert_eq!(
+            total,
+            by(k).quality.points,
+            "{k}: every point in one region"
+        );
         let contacts: f64 = regions
             .iter()
             .map(|(_, q)| q.contact_pct * q.points as f64)
@@ -304,7 +308,10 @@ fn demo_part_figures_per_region() {
         // defects than constant (on the smooth bumps the constant offset
         // barely touches: its defect there is flattening).
         assert!(pcpp[r].1.contact_pct < slope[r].1.contact_pct, "region {r}");
-        assert!(pcpp[r].1.defect_pct() < constant[r].1.defect_pct(), "region {r}");
+        assert!(
+            pcpp[r].1.defect_pct() < constant[r].1.defect_pct(),
+            "region {r}"
+        );
         for k in [PlannerKind::PcppGuarded, PlannerKind::Even] {
             assert_eq!(per(k)[r].1.contact_pct, 0.0, "{k} region {r}");
         }

@@ -78,13 +78,21 @@ fn guarded_planners_never_touch_any_demo_part_along_their_moves() {
                 .unwrap_or_else(|e| panic!("{part} {planner}: {e}"));
             let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
             eprintln!("{part} {planner}: {}", describe(&oracle));
-            assert_eq!(oracle.too_close, 0, "{part} {planner}: {}", describe(&oracle));
+            assert_eq!(
+                oracle.too_close,
+                0,
+                "{part} {planner}: {}",
+                describe(&oracle)
+            );
             assert!(oracle.min_distance_mm >= TOL, "{part} {planner}");
             assert!(oracle.moves > 100, "{part} {planner}: {}", oracle.moves);
             let m = &out.report.motion;
             assert_eq!(m.program.touching_moves, 0, "{part} {planner}");
             assert!(!m.risk_accepted);
-            assert!(m.program.min_clearance_mm.unwrap() >= TOL, "{part} {planner}");
+            assert!(
+                m.program.min_clearance_mm.unwrap() >= TOL,
+                "{part} {planner}"
+            );
             let header = out.gcode.lines().find(|l| l.contains("safe motion:"));
             assert!(
                 header.is_some_and(|l| l.contains("min clearance") && !l.contains("WARNING")),
@@ -142,26 +150,44 @@ fn demo_move_through_the_region_1_block_edge_is_caught_and_no_longer_planned() {
 fn slope_on_the_stepped_block_is_refused_unless_the_risk_is_accepted() {
     let part = DemoPart::SteppedBlock;
     let mesh = part.mesh();
-    let e = plan(&mesh, &part.svg(), part.placement(), PlannerKind::Slope, false)
-        .err()
-        .expect("slope must be refused");
+    let e = plan(
+        &mesh,
+        &part.svg(),
+        part.placement(),
+        PlannerKind::Slope,
+        false,
+    )
+    .err()
+    .expect("slope must be refused");
     let text = e.to_string();
     assert!(matches!(e, Error::Touching(_)), "{text}");
     assert!(text.contains("G-code move(s) of planner slope"), "{text}");
     assert!(text.contains("line "), "{text}");
     assert!(text.contains("mm higher there"), "{text}");
     assert!(text.contains("--accept-risk"), "{text}");
-    let Error::Touching(t) = &e else { unreachable!() };
+    let Error::Touching(t) = &e else {
+        unreachable!()
+    };
     let first = &t.summary.touching[0];
     let line = first.line.expect("a line number");
 
-    let out = plan(&mesh, &part.svg(), part.placement(), PlannerKind::Slope, true).unwrap();
+    let out = plan(
+        &mesh,
+        &part.svg(),
+        part.placement(),
+        PlannerKind::Slope,
+        true,
+    )
+    .unwrap();
     let header = out
         .gcode
         .lines()
         .find(|l| l.contains("safe motion:"))
         .unwrap();
-    assert!(header.contains("WARNING") && header.contains("risk was accepted"), "{header}");
+    assert!(
+        header.contains("WARNING") && header.contains("risk was accepted"),
+        "{header}"
+    );
     assert!(out.report.motion.risk_accepted);
     // The named line is the move it says.
     let written = out.gcode.lines().nth(line - 1).unwrap();
@@ -184,7 +210,10 @@ fn core_check_and_oracle_agree_on_the_paper_planners() {
             let out = plan(&mesh, &part.svg(), part.placement(), planner, true).unwrap();
             let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
             let core = out.report.motion.program.touching_moves;
-            eprintln!("{part} {planner}: core {core} touching moves; oracle {}", describe(&oracle));
+            eprintln!(
+                "{part} {planner}: core {core} touching moves; oracle {}",
+                describe(&oracle)
+            );
             assert_eq!(core > 0, oracle.too_close > 0, "{part} {planner}");
         }
     }
@@ -206,7 +235,11 @@ enum Feature {
     },
     /// A crease along y at x = `at`, flanks at `angle_deg`, `height` high
     /// (negative: a valley).
-    Crease { at: f64, angle_deg: f64, height: f64 },
+    Crease {
+        at: f64,
+        angle_deg: f64,
+        height: f64,
+    },
 }
 
 const SIZE: f64 = 24.0;
@@ -289,13 +322,13 @@ fn feature() -> impl Strategy<Value = Feature> {
     prop_oneof![
         (6.0f64..18.0, prop_oneof![0.5f64..3.0, -3.0f64..-0.5])
             .prop_map(|(at, height)| Feature::Step { at, height }),
-        ((8.0f64..16.0, 8.0f64..16.0), 1.0f64..3.0, 0.2f64..1.0).prop_map(
-            |(centre, radius, k)| Feature::Dimple {
+        ((8.0f64..16.0, 8.0f64..16.0), 1.0f64..3.0, 0.2f64..1.0).prop_map(|(centre, radius, k)| {
+            Feature::Dimple {
                 centre,
                 radius,
                 depth: k * radius,
             }
-        ),
+        }),
         (
             8.0f64..16.0,
             20.0f64..75.0,

@@ -166,12 +166,15 @@ fn planners_compare_and_the_guarded_one_never_touches() {
     let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan)
         .unwrap()
         .rows;
-    let kinds: Vec<PlannerKind> = rows.iter().map(|r| r.0).collect();
+    let kinds: Vec<PlannerKind> = rows.iter().map(|r| r.planner).collect();
     assert_eq!(kinds, PlannerKind::ALL.to_vec());
-    let guarded = rows[3].1;
-    assert_eq!(guarded.contact_pct, 0.0);
+    for guarded in &rows[3..] {
+        assert_eq!(guarded.quality.contact_pct, 0.0);
+        assert_eq!(guarded.motion.touching_moves, 0);
+    }
     // The constant stand-off runs into the part's steps (the paper's point).
-    assert!(rows[0].1.contact_pct > guarded.contact_pct);
+    assert!(rows[0].quality.contact_pct > 0.0);
+    assert!(rows[0].motion.touching_moves > 0);
 
     // Projection: every Ta point of the first line lies on the part.
     let out = job::run_on(
@@ -256,7 +259,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
         .unwrap();
     assert!(report.ends_with("}\n"));
     let parsed: serde_json::Value = serde_json::from_str(&report).unwrap();
-    assert_eq!(parsed["planner"], "pcpp-guarded");
+    assert_eq!(parsed["planner"], "even");
 
     // A placement change re-plans on the same session (no re-import).
     let mut moved = settings.plan;
@@ -557,10 +560,17 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
                     job::compare_on(&prepared, svg.as_bytes(), demo::DEMO_PATH_NAME, &plan)
                         .unwrap()
                         .rows;
-                assert_eq!(rows.len(), 4);
-                for (row, (k, q)) in rows.iter().zip(&want_rows) {
-                    assert_eq!(row["planner"], k.name());
-                    assert_eq!(row["quality"]["mean_abs_error_mm"], q.mean_abs_error_mm);
+                assert_eq!(rows.len(), PlannerKind::ALL.len());
+                for (row, want) in rows.iter().zip(&want_rows) {
+                    assert_eq!(row["planner"], want.planner.name());
+                    assert_eq!(
+                        row["quality"]["mean_abs_error_mm"],
+                        want.quality.mean_abs_error_mm
+                    );
+                    assert_eq!(
+                        row["motion"]["backward_moves"],
+                        want.motion.backward_moves as u64
+                    );
                 }
             } else {
                 assert!(comparison.is_null());

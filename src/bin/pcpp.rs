@@ -906,7 +906,11 @@ fn cmd_check(a: &Args) -> CliResult<()> {
         let _ = write!(s, "\n  {t}");
     }
     if sum.touching_moves > sum.touching.len() {
-        let _ = write!(s, "\n  ... and {} more", sum.touching_moves - sum.touching.len());
+        let _ = write!(
+            s,
+            "\n  ... and {} more",
+            sum.touching_moves - sum.touching.len()
+        );
     }
     Err(Failure::Input(s))
 }
@@ -1150,7 +1154,9 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
     );
     s.push_str(&job::comparison_table(&rows));
     if !regions.is_empty() {
-        s.push_str("\ndefects per region (contact / flattening / floating, % of the region's points):\n");
+        s.push_str(
+            "\ndefects per region (contact / flattening / floating, % of the region's points):\n",
+        );
         let _ = write!(s, "{:<13}", "planner");
         for (name, _, _) in test_part::REGIONS {
             let _ = write!(s, " {name:>26}");

@@ -451,8 +451,11 @@ mod tests {
         let (lo, hi) = (p + dir * 0.5, p + dir * 0.6);
         let slope = (folded_height(hi.x, hi.y) - folded_height(lo.x, lo.y)).abs() / 0.1;
         assert!((slope.atan().to_degrees() - 50.0).abs() < 1e-6, "{slope}");
-        let zs: Vec<f64> = (0..400).map(|i| folded_height(i as f64 * 0.1, 3.0)).collect();
-        let span = zs.iter().cloned().fold(f64::MIN, f64::max) - zs.iter().cloned().fold(f64::MAX, f64::min);
+        let zs: Vec<f64> = (0..400)
+            .map(|i| folded_height(i as f64 * 0.1, 3.0))
+            .collect();
+        let span = zs.iter().cloned().fold(f64::MIN, f64::max)
+            - zs.iter().cloned().fold(f64::MAX, f64::min);
         assert!((span - 6.0).abs() < 0.05, "{span}");
     }
 }

@@ -224,7 +224,11 @@ impl Program<'_> {
     /// Records the move the last written line commands, to `to` (rounded
     /// as written); the safe height is `self.safe_z` as written.
     fn moved(&mut self, to: DVec3, kind: MoveKind) {
-        let to = DVec3::new(self.read_back(to.x), self.read_back(to.y), self.read_back(to.z));
+        let to = DVec3::new(
+            self.read_back(to.x),
+            self.read_back(to.y),
+            self.read_back(to.z),
+        );
         self.moves.push(WrittenMove {
             line: self.lines,
             from: self.at,

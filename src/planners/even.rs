@@ -139,9 +139,8 @@ pub(super) fn plan(
         }
         target.push(fitted[j] + floor);
     }
-    let at = |j: usize, w: f64, z: f64| {
-        DVec3::new(ta[j].x, ta[j].y, z) + (w - u[j]) * geometry[j].v
-    };
+    let at =
+        |j: usize, w: f64, z: f64| DVec3::new(ta[j].x, ta[j].y, z) + (w - u[j]) * geometry[j].v;
     // Where a target is too close to the surface, the tip may stay back at
     // its height instead of rising (up to do behind, as far forward as
     // clears): before a step up this keeps the nozzle on the floor until

@@ -143,7 +143,8 @@ impl Index {
 /// The uniform XY grid (see the module comment).
 pub(super) struct Grid {
     origin: DVec2,
-    inv_cell: f64,
+    /// 1 / the cell's size in x and y (cells take the triangles' aspect).
+    inv_cell: DVec2,
     nx: usize,
     ny: usize,
     /// Cell c holds `items[start[c]..start[c + 1]]`.
@@ -154,8 +155,9 @@ pub(super) struct Grid {
     zs: Vec<[f32; 2]>,
     /// The XY box of each cell's triangles: lo x, lo y, hi x, hi y.
     xys: Vec<[f32; 4]>,
-    /// How far a triangle's box reaches out of its home cell, at most.
-    reach: f64,
+    /// How far a triangle's box reaches out of its home cell, at most, in x
+    /// and in y.
+    reach: DVec2,
     /// The z range of each block of BLOCK x BLOCK cells (row-major, `bnx`
     /// blocks to a row): one test drops a block's cells from a query.
     block_zs: Vec<[f32; 2]>,
@@ -186,25 +188,33 @@ impl Grid {
         let ext = (bbox.1 - bbox.0).truncate().max(DVec2::splat(1e-9));
         // About nine triangles to a cell on a height field (the fewest
         // instructions per footprint query on W1 among 2, 4.5, 9, 16 and
-        // 36), never a cell smaller than the typical triangle (the median
-        // of up to 65,536 evenly spread triangles).
-        let mut cell = 3.0 * (ext.x * ext.y / n as f64).sqrt();
+        // 36), never a cell narrower than the typical triangle in either
+        // direction (the upper quartile of the widths of up to 65,536
+        // evenly spread triangles): cells take the triangles' aspect, so a
+        // line scanner's grid, fine across its lines and coarse along its
+        // travel, still gets a few triangles to a cell.
         let stride = n.div_ceil(1 << 16).max(1);
-        let mut widths: Vec<f64> = (0..n)
+        let (mut wx, mut wy): (Vec<f64>, Vec<f64>) = (0..n)
             .step_by(stride)
             .map(|i| {
                 let (lo, hi) = triangle_box(mesh, i);
-                (hi.x - lo.x).max(hi.y - lo.y)
+                (hi.x - lo.x, hi.y - lo.y)
             })
-            .collect();
-        let mid = widths.len() / 2;
-        let median = *widths.select_nth_unstable_by(mid, f64::total_cmp).1;
-        drop(widths);
-        cell = cell.max(median).max(1e-9);
-        let dims = |cell: f64| {
+            .unzip();
+        let upper = |w: &mut Vec<f64>| {
+            let k = w.len() * 3 / 4;
+            (*w.select_nth_unstable_by(k, f64::total_cmp).1).max(1e-9)
+        };
+        let (qx, qy) = (upper(&mut wx), upper(&mut wy));
+        drop((wx, wy));
+        // A cell of area 9 A / n with the quartiles' aspect, grown to them.
+        let aspect = (qx / qy).clamp(1e-3, 1e3);
+        let side = 3.0 * (ext.x * ext.y / n as f64 / aspect).sqrt();
+        let mut cell = DVec2::new((side * aspect).max(qx), side.max(qy));
+        let dims = |cell: DVec2| {
             (
-                ((ext.x / cell).ceil() as usize).max(1),
-                ((ext.y / cell).ceil() as usize).max(1),
+                ((ext.x / cell.x).ceil() as usize).max(1),
+                ((ext.y / cell.y).ceil() as usize).max(1),
             )
         };
         let max_cells = (2 * n).clamp(1, MAX_CELLS);
@@ -214,10 +224,10 @@ impl Grid {
             (nx, ny) = dims(cell);
         }
         let origin = bbox.0.truncate();
-        let inv_cell = 1.0 / cell;
+        let inv_cell = DVec2::ONE / cell;
         let cell_of = |p: DVec2| -> usize {
-            let cx = (((p.x - origin.x) * inv_cell) as usize).min(nx - 1);
-            let cy = (((p.y - origin.y) * inv_cell) as usize).min(ny - 1);
+            let cx = (((p.x - origin.x) * inv_cell.x) as usize).min(nx - 1);
+            let cy = (((p.y - origin.y) * inv_cell.y) as usize).min(ny - 1);
             cy * nx + cx
         };
         // Counting sort of the triangles by cell, in index order within one.
@@ -227,7 +237,7 @@ impl Grid {
         let mut big = Vec::new();
         for (i, slot) in home.iter_mut().enumerate() {
             let (lo, hi) = triangle_box(mesh, i);
-            if hi.x - lo.x > wide || hi.y - lo.y > wide {
+            if hi.x - lo.x > wide.x || hi.y - lo.y > wide.y {
                 big.push((i as u32, box32(lo, hi)));
             } else {
                 let c = cell_of(0.5 * (lo.truncate() + hi.truncate()));
@@ -261,7 +271,7 @@ impl Grid {
             ];
             nx * ny
         ];
-        let mut reach = 0.0f64;
+        let mut reach = DVec2::ZERO;
         for (i, &c) in home.iter().enumerate() {
             if c == u32::MAX {
                 continue;
@@ -279,9 +289,9 @@ impl Grid {
             xy[2] = xy[2].max(b[3]);
             xy[3] = xy[3].max(b[4]);
             let cell_lo = origin + DVec2::new((c % nx) as f64, (c / nx) as f64) * cell;
-            let cell_hi = cell_lo + DVec2::splat(cell);
+            let cell_hi = cell_lo + cell;
             let out = (cell_lo - lo.truncate()).max(hi.truncate() - cell_hi);
-            reach = reach.max(out.x).max(out.y);
+            reach = reach.max(out);
         }
         // Rounding in the home cell's index: a hair more.
         let reach = reach * (1.0 + 1e-9) + 1e-9 * cell;
@@ -311,9 +321,17 @@ impl Grid {
     /// The cell range (inclusive) whose triangles can reach into the
     /// coordinate range [lo, hi].
     #[inline]
-    fn range(&self, lo: f64, hi: f64, origin: f64, n: usize) -> Option<(usize, usize)> {
-        let a = ((lo - self.reach - origin) * self.inv_cell).floor();
-        let b = ((hi + self.reach - origin) * self.inv_cell).floor();
+    fn range(
+        &self,
+        lo: f64,
+        hi: f64,
+        origin: f64,
+        n: usize,
+        reach: f64,
+        inv_cell: f64,
+    ) -> Option<(usize, usize)> {
+        let a = ((lo - reach - origin) * inv_cell).floor();
+        let b = ((hi + reach - origin) * inv_cell).floor();
         // NaN fails both tests and so visits nothing.
         if !(b >= 0.0 && a <= (n - 1) as f64) {
             return None;
@@ -328,10 +346,24 @@ impl Grid {
                 f(*i as usize);
             }
         }
-        let Some((x0, x1)) = self.range(q.lo.x, q.hi.x, self.origin.x, self.nx) else {
+        let Some((x0, x1)) = self.range(
+            q.lo.x,
+            q.hi.x,
+            self.origin.x,
+            self.nx,
+            self.reach.x,
+            self.inv_cell.x,
+        ) else {
             return;
         };
-        let Some((y0, y1)) = self.range(q.lo.y, q.hi.y, self.origin.y, self.ny) else {
+        let Some((y0, y1)) = self.range(
+            q.lo.y,
+            q.hi.y,
+            self.origin.y,
+            self.ny,
+            self.reach.y,
+            self.inv_cell.y,
+        ) else {
             return;
         };
         // Row by row (the order the exact tests sum in stays fixed), a

@@ -15,8 +15,8 @@ use glam::{DVec2, DVec3};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 pub use index::SpatialIndex;
-pub use sweep::SweepGap;
 use index::{Index, QueryBox};
+pub use sweep::{SweepGap, RIM_STEPS};
 
 /// A scan in the printer frame, ready for queries.
 pub struct Surface {

@@ -64,9 +64,9 @@ pub struct SweepGap {
 /// The rim's staircase for corner and edge contacts: angles theta_i with
 /// a_i = tol sin(theta_i); the first step's bottom lies tol below the tip,
 /// step i's psi(r + a_(i-1)) = tol cos(theta_(i-1)). On a contact where the
-/// surface rises at 45 degrees away from the axis it asks at most 0.15 tol
+/// surface rises at 45 degrees away from the axis it asks at most 0.2 tol
 /// more height than the exact rim.
-pub const RIM_STEPS: [f64; 5] = [20.0, 40.0, 55.0, 70.0, 90.0];
+pub const RIM_STEPS: [f64; 4] = [25.0, 45.0, 65.0, 90.0];
 
 /// Relative slack of the coverage tests: a point this close to the disk's
 /// edge counts as under it, so rounding never hides a surface point.
@@ -91,50 +91,13 @@ impl Surface {
         tol: f64,
         limit: f64,
     ) -> Option<SweepGap> {
-        let d = (b - a).truncate();
-        let dz = b.z - a.z;
-        let reach = radius + tol;
-        let lo_xy = a.truncate().min(b.truncate()) - DVec2::splat(reach);
-        let hi_xy = a.truncate().max(b.truncate()) + DVec2::splat(reach);
-        // A surface point lower than the lowest tip position by `limit`
-        // leaves a clearance of at least `limit`.
-        let floor = a.z.min(b.z) - limit;
-        let q = QueryBox {
-            lo: lo_xy.extend(floor),
-            hi: hi_xy.extend(f64::INFINITY),
-        };
-        // Values are z(s) - x_z - h; the clearance is the value plus tol.
-        let mut best = Best {
-            gap: limit - tol,
-            found: None,
-        };
-        let steps = rim_steps(radius, tol);
-        let move_ = Move {
-            a,
-            d,
-            dz,
-            r: radius,
-            tol,
-        };
-        let low_tip = a.z.min(b.z);
-        self.index.visit(&q, |i| {
-            let t = self.mesh.triangle(i);
-            if !meets(&t, &q) {
-                return;
-            }
-            // No point of this triangle can beat the best value so far
-            // (every contact's h is at most tol).
-            let top = t[0].z.max(t[1].z).max(t[2].z);
-            if low_tip - top - tol >= best.gap {
-                return;
-            }
-            move_.triangle(t, &steps, &mut best);
-        });
-        best.found.map(|(at, surface_point)| SweepGap {
-            gap_mm: best.gap + tol,
-            at,
-            surface_point,
-        })
+        let (lo, hi) = move_box(a, b, radius + tol, limit);
+        let q = QueryBox { lo, hi };
+        let sweep = Sweep::new(a, b, radius, tol, limit);
+        let mut best = sweep.start();
+        self.index
+            .visit(&q, |i| sweep.visit(self.mesh.triangle(i), &q, &mut best));
+        sweep.finish(best)
     }
 
     /// The smallest gap along the move between the tip and the highest
@@ -145,19 +108,91 @@ impl Surface {
     }
 }
 
-/// The staircase (radius, depth of its bottom below the tip) for the rim.
-fn rim_steps(r: f64, tol: f64) -> Vec<(f64, f64)> {
+/// The query box of a move: its XY box grown by `reach`, from `limit`
+/// below its lowest tip position up.
+fn move_box(a: DVec3, b: DVec3, reach: f64, limit: f64) -> (DVec3, DVec3) {
+    let lo_xy = a.truncate().min(b.truncate()) - DVec2::splat(reach);
+    let hi_xy = a.truncate().max(b.truncate()) + DVec2::splat(reach);
+    // A surface point lower than the lowest tip position by `limit` leaves
+    // a clearance of at least `limit`.
+    (
+        lo_xy.extend(a.z.min(b.z) - limit),
+        hi_xy.extend(f64::INFINITY),
+    )
+}
+
+/// sin(theta_i) and cos(theta_(i-1)) of [`RIM_STEPS`] (25, 45, 65, 90
+/// degrees).
+const RIM_SIN_COS: [(f64, f64); 4] = [
+    (0.422_618_261_740_699_4, 1.0),
+    (std::f64::consts::FRAC_1_SQRT_2, 0.906_307_787_036_649_9),
+    (0.906_307_787_036_649_9, std::f64::consts::FRAC_1_SQRT_2),
+    (1.0, 0.422_618_261_740_699_4),
+];
+
+/// The staircase (radius, depth of its bottom below the tip) for the rim;
+/// one flat cutter when tol is 0.
+fn rim_steps(r: f64, tol: f64) -> ([(f64, f64); 4], usize) {
     if tol <= 0.0 {
-        return vec![(r, 0.0)];
+        return ([(r, 0.0); 4], 1);
     }
-    let mut out = Vec::with_capacity(RIM_STEPS.len());
-    let mut prev = 0.0f64;
-    for deg in RIM_STEPS {
-        let th = deg.to_radians();
-        out.push((r + tol * libm::sin(th), tol * libm::cos(prev)));
-        prev = th;
+    (RIM_SIN_COS.map(|(s, c)| (r + tol * s, tol * c)), 4)
+}
+
+/// One move's query.
+struct Sweep {
+    m: Move,
+    steps: ([(f64, f64); 4], usize),
+    low_tip: f64,
+    limit: f64,
+}
+
+impl Sweep {
+    fn new(a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> Sweep {
+        Sweep {
+            m: Move {
+                a,
+                d: (b - a).truncate(),
+                dz: b.z - a.z,
+                r: radius,
+                tol,
+            },
+            steps: rim_steps(radius, tol),
+            low_tip: a.z.min(b.z),
+            limit,
+        }
     }
-    out
+
+    /// Values are z(s) - x_z - h; the clearance is the value plus tol.
+    fn start(&self) -> Best {
+        Best {
+            gap: self.limit - self.m.tol,
+            found: None,
+        }
+    }
+
+    #[inline]
+    fn visit(&self, t: [DVec3; 3], q: &QueryBox, best: &mut Best) {
+        if !meets(&t, q) {
+            return;
+        }
+        // No point of this triangle can beat the best value so far (every
+        // contact's h is at most tol).
+        let top = t[0].z.max(t[1].z).max(t[2].z);
+        if self.low_tip - top - self.m.tol >= best.gap {
+            return;
+        }
+        let steps = &self.steps.0[..self.steps.1];
+        self.m.triangle(t, self.low_tip - top, steps, best);
+    }
+
+    fn finish(&self, best: Best) -> Option<SweepGap> {
+        best.found.map(|(at, surface_point)| SweepGap {
+            gap_mm: best.gap + self.m.tol,
+            at,
+            surface_point,
+        })
+    }
 }
 
 struct Best {
@@ -188,87 +223,142 @@ impl Move {
         }
     }
 
-    /// The s in [0, 1] for which the XY point `v` lies within `radius` of
-    /// the axis, `None` if there are none.
-    fn covered(&self, v: DVec2, radius: f64) -> Option<(f64, f64)> {
-        let w = v - self.a.truncate();
-        let r2 = radius * radius * (1.0 + SLACK);
-        let dd = self.d.length_squared();
-        if dd <= 1e-30 {
-            return (w.length_squared() <= r2).then_some((0.0, 1.0));
+    /// `headroom` is the lowest tip height less the triangle's top: no
+    /// contact of it can have a value below `headroom - h`.
+    fn triangle(&self, t: [DVec3; 3], headroom: f64, steps: &[(f64, f64)], best: &mut Best) {
+        // The steps that could still beat the best value (their h is what
+        // a contact of this triangle can gain at most).
+        let mut live = [false; 4];
+        let mut any = false;
+        for (k, &(_, h)) in steps.iter().enumerate() {
+            live[k] = headroom - h < best.gap;
+            any |= live[k];
         }
-        let wd = w.dot(self.d);
-        let disc = wd * wd - dd * (w.length_squared() - r2);
-        if disc < 0.0 {
-            return None;
-        }
-        let sq = disc.sqrt();
-        let (s0, s1) = (((wd - sq) / dd).max(0.0), ((wd + sq) / dd).min(1.0));
-        (s0 <= s1).then_some((s0, s1))
-    }
-
-    fn triangle(&self, t: [DVec3; 3], steps: &[(f64, f64)], best: &mut Best) {
-        for &(radius, h) in steps {
-            // Corners: the worst s of each corner's interval is its lower
-            // end when the tip rises, its upper end when it descends.
-            for v in t {
-                if let Some((s0, s1)) = self.covered(v.truncate(), radius) {
-                    self.consider(if self.dz >= 0.0 { s0 } else { s1 }, v, h, best);
-                }
+        if any {
+            // How far (in XY) each corner and edge lies from the move: a
+            // step narrower than that meets it nowhere.
+            let (dv, de) = self.distances2(t);
+            for (v, d2) in t.iter().zip(dv) {
+                self.corner(*v, d2, steps, &live, best);
             }
             for k in 0..3 {
-                self.edge(t[k], t[(k + 1) % 3], radius, h, best);
+                self.edge(t[k], t[(k + 1) % 3], de[k], steps, &live, best);
             }
         }
         self.facet(t, best);
     }
 
-    /// Edge crossings of the flat cutter of `radius` whose bottom lies `h`
-    /// below the tip: the chords at s = 0 and s = 1, and the point of the
-    /// (t, s) ellipse where the value is smallest.
-    fn edge(&self, p: DVec3, q: DVec3, radius: f64, h: f64, best: &mut Best) {
+    /// A corner under each live step: the worst s of its interval is its
+    /// lower end when the tip rises, its upper end when it descends.
+    fn corner(&self, v: DVec3, d2: f64, steps: &[(f64, f64)], live: &[bool; 4], best: &mut Best) {
+        let w = v.truncate() - self.a.truncate();
+        let (ww, dd) = (w.length_squared(), self.d.length_squared());
+        let wd = w.dot(self.d);
+        for (k, &(radius, h)) in steps.iter().enumerate() {
+            let r2 = radius * radius * (1.0 + SLACK);
+            if !live[k] || d2 > r2 {
+                continue;
+            }
+            let (s0, s1) = if dd <= 1e-30 {
+                if ww > r2 {
+                    continue;
+                }
+                (0.0, 1.0)
+            } else {
+                let disc = wd * wd - dd * (ww - r2);
+                if disc < 0.0 {
+                    continue;
+                }
+                let sq = disc.sqrt();
+                let (s0, s1) = (((wd - sq) / dd).max(0.0), ((wd + sq) / dd).min(1.0));
+                if s0 > s1 {
+                    continue;
+                }
+                (s0, s1)
+            };
+            self.consider(if self.dz >= 0.0 { s0 } else { s1 }, v, h, best);
+        }
+    }
+
+    /// Squared XY distances of the corners and edges from the move.
+    fn distances2(&self, t: [DVec3; 3]) -> ([f64; 3], [f64; 3]) {
+        let (a, b) = (self.a.truncate(), self.a.truncate() + self.d);
+        let dv = t.map(|v| point_segment_dist2(v.truncate(), a, b));
+        let de: [f64; 3] = std::array::from_fn(|k| {
+            segment_segment_dist2(t[k].truncate(), t[(k + 1) % 3].truncate(), a, b)
+        });
+        (dv, de)
+    }
+
+    /// Edge crossings under each live step (a flat cutter of its radius
+    /// whose bottom lies its h below the tip): the chords at s = 0 and
+    /// s = 1, and the point of the (t, s) ellipse where the value is
+    /// smallest. What does not depend on the radius is found once.
+    fn edge(
+        &self,
+        p: DVec3,
+        q: DVec3,
+        d2: f64,
+        steps: &[(f64, f64)],
+        live: &[bool; 4],
+        best: &mut Best,
+    ) {
         let e = (q - p).truncate();
         let ee = e.length_squared();
         if ee <= 1e-30 {
             return; // a vertical edge: its top corner is a corner above
         }
-        let r2 = radius * radius * (1.0 + SLACK);
         let a_xy = self.a.truncate();
-        for s in [0.0, 1.0] {
-            let f = p.truncate() - (a_xy + s * self.d);
-            let b = f.dot(e);
-            let disc = b * b - ee * (f.length_squared() - r2);
-            if disc < 0.0 {
+        let w0 = p.truncate() - a_xy;
+        let moving = self.d.length_squared() > 1e-30;
+        // The chords' quadratics at s = 0 and s = 1.
+        let ends: [(f64, f64, f64); 2] = [0.0, 1.0].map(|s| {
+            let f = w0 - s * self.d;
+            (s, f.dot(e), f.length_squared())
+        });
+        // y = w0 + M v with v = (t, s), M = [e | -d]: the ellipse is
+        // |y| <= r. The value is c . v + const with c = (-(q_z - p_z), dz);
+        // over |y| = r its minimum is at y = -r g / |g|, g = M^-T c.
+        let d = self.d;
+        let det = d.perp_dot(e);
+        let ellipse = if moving && det.abs() > 1e-12 * d.length() * ee.sqrt() {
+            let c = DVec2::new(-(q.z - p.z), self.dz);
+            let inv = 1.0 / det;
+            let g = DVec2::new(-d.y * c.x - e.y * c.y, d.x * c.x + e.x * c.y) * inv;
+            let gl = g.length();
+            // A constant value on the ellipse: the square's sides suffice.
+            (gl > 1e-300).then_some((g / gl, inv))
+        } else {
+            // e parallel to the move: the square's sides suffice.
+            None
+        };
+        for (k, &(radius, h)) in steps.iter().enumerate() {
+            let r2 = radius * radius * (1.0 + SLACK);
+            if !live[k] || d2 > r2 {
                 continue;
             }
-            let sq = disc.sqrt();
-            for t in [(-b - sq) / ee, (-b + sq) / ee] {
-                if (0.0..=1.0).contains(&t) {
-                    self.consider(s, p + (q - p) * t, h, best);
+            for &(s, b, ff) in &ends[..if moving { 2 } else { 1 }] {
+                let disc = b * b - ee * (ff - r2);
+                if disc < 0.0 {
+                    continue;
+                }
+                let sq = disc.sqrt();
+                for t in [(-b - sq) / ee, (-b + sq) / ee] {
+                    if (0.0..=1.0).contains(&t) {
+                        self.consider(s, p + (q - p) * t, h, best);
+                    }
                 }
             }
-        }
-        // y = w0 + M v with v = (t, s), M = [e | -d]: the ellipse is
-        // |y| <= r. The gap is c . v + const with c = (-(q_z - p_z), dz);
-        // over |y| = r its minimum is at y = -r g / |g|, g = M^-T c.
-        let det = self.d.perp_dot(e);
-        if det.abs() <= 1e-12 * self.d.length() * ee.sqrt() {
-            return; // e parallel to the move: the square's sides suffice
-        }
-        let c = DVec2::new(-(q.z - p.z), self.dz);
-        let (d, inv) = (self.d, 1.0 / det);
-        let g = DVec2::new(-d.y * c.x - e.y * c.y, d.x * c.x + e.x * c.y) * inv;
-        let gl = g.length();
-        if gl <= 1e-300 {
-            return; // the gap is constant on the ellipse: the sides suffice
-        }
-        let y = -radius * g / gl - (p.truncate() - a_xy);
-        // v = M^-1 y, M^-1 = [[-d.y, d.x], [-e.y, e.x]] / det.
-        let t = (-d.y * y.x + d.x * y.y) * inv;
-        let s = (-e.y * y.x + e.x * y.y) * inv;
-        let eps = 1e-12;
-        if (-eps..=1.0 + eps).contains(&t) && (-eps..=1.0 + eps).contains(&s) {
-            self.consider(s, p + (q - p) * t.clamp(0.0, 1.0), h, best);
+            if let Some((gn, inv)) = ellipse {
+                let y = -radius * gn - w0;
+                // v = M^-1 y, M^-1 = [[-d.y, d.x], [-e.y, e.x]] / det.
+                let t = (-d.y * y.x + d.x * y.y) * inv;
+                let s = (-e.y * y.x + e.x * y.y) * inv;
+                let eps = 1e-12;
+                if (-eps..=1.0 + eps).contains(&t) && (-eps..=1.0 + eps).contains(&s) {
+                    self.consider(s, p + (q - p) * t.clamp(0.0, 1.0), h, best);
+                }
+            }
         }
     }
 
@@ -324,6 +414,36 @@ impl Move {
     }
 }
 
+/// Squared distance from `p` to the segment [a, b] (2-D).
+fn point_segment_dist2(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let l = ab.length_squared();
+    let t = if l > 0.0 {
+        ((p - a).dot(ab) / l).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * t - p).length_squared()
+}
+
+/// Squared distance between the segments [p, q] and [a, b] (2-D): zero
+/// where they cross, else the least of the four end-to-segment distances.
+fn segment_segment_dist2(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let (r, s) = (q - p, b - a);
+    let den = r.perp_dot(s);
+    if den != 0.0 {
+        let t = (a - p).perp_dot(s) / den;
+        let u = (a - p).perp_dot(r) / den;
+        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+            return 0.0;
+        }
+    }
+    point_segment_dist2(p, a, b)
+        .min(point_segment_dist2(q, a, b))
+        .min(point_segment_dist2(a, p, q))
+        .min(point_segment_dist2(b, p, q))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::tests::grid;
@@ -354,7 +474,11 @@ mod tests {
         for &y in &ys {
             for (i, &x) in xs2.iter().enumerate() {
                 let past = i > 0 && xs2[i - 1] == x;
-                let z = if x > 5.0 || (x == 5.0 && past) { 2.0 } else { 0.0 };
+                let z = if x > 5.0 || (x == 5.0 && past) {
+                    2.0
+                } else {
+                    0.0
+                };
                 m.vertices.push(DVec3::new(x, y, z));
             }
         }
@@ -381,7 +505,10 @@ mod tests {
         let b = DVec3::new(5.7, 5.0, 2.5);
         let ga = s.sweep_gap(a, a, r, f64::INFINITY).unwrap().gap_mm;
         let gb = s.sweep_gap(b, b, r, f64::INFINITY).unwrap().gap_mm;
-        assert!((ga - 0.5).abs() < 1e-9 && (gb - 0.5).abs() < 1e-9, "{ga} {gb}");
+        assert!(
+            (ga - 0.5).abs() < 1e-9 && (gb - 0.5).abs() < 1e-9,
+            "{ga} {gb}"
+        );
         let g = s.sweep_gap(a, b, r, f64::INFINITY).unwrap();
         // The wall's top edge enters the disk when the axis reaches
         // x = 5 - r: s = (5 - r - 3.9) / 1.8, z there = 0.5 + 2 s.
@@ -433,13 +560,26 @@ mod tests {
             let dense = sampled(&surf, a, b, r, 4000);
             // Sampling can only miss the worst point: it is never below
             // the exact gap, and within a sample step's worth above it.
-            assert!(exact.gap_mm <= dense + 1e-9, "{a} {b}: {exact:?} vs {dense}");
+            assert!(
+                exact.gap_mm <= dense + 1e-9,
+                "{a} {b}: {exact:?} vs {dense}"
+            );
             assert!(dense - exact.gap_mm < 2e-3, "{a} {b}: {exact:?} vs {dense}");
             // The reported place is consistent with the gap.
             let p = a.lerp(b, exact.at);
             assert!((p.z - exact.surface_point.z - exact.gap_mm).abs() < 1e-9);
             let off = (exact.surface_point.truncate() - p.truncate()).length();
             assert!(off <= r * (1.0 + 1e-6), "{off}");
+        }
+    }
+
+    #[test]
+    fn rim_table_is_the_steps_sines_and_cosines() {
+        let mut prev = 0.0f64;
+        for (deg, (s, c)) in RIM_STEPS.iter().zip(RIM_SIN_COS) {
+            assert!((deg.to_radians().sin() - s).abs() < 1e-15);
+            assert!((prev.to_radians().cos() - c).abs() < 1e-15);
+            prev = *deg;
         }
     }
 
