@@ -494,17 +494,20 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
                 plan.nozzle.inner_diameter_mm = 0.413;
                 plan.nozzle.outer_diameter_mm = 0.718;
             }
+            // The paper's planners touch the part: their G-code needs the
+            // risk accepted, in the page as in the CLI.
+            let accept = !plan.planner.is_guarded();
             let want = job::run_on(
                 &prepared,
                 svg.as_bytes(),
                 demo::DEMO_PATH_NAME,
                 &plan,
                 &MachineProfile::builtin("grbl").unwrap(),
-                false,
+                accept,
             )
             .unwrap();
             let out = session
-                .plan_live(js(&plan), "grbl", false, None, step == 0)
+                .plan_live(js(&plan), "grbl", accept, None, step == 0)
                 .unwrap_or_else(|e| panic!("{e:?}"));
             // Compared without printing: a G-code file fills the screen.
             assert!(
