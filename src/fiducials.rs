@@ -29,6 +29,29 @@ pub const BOUNDARY_EXTENT_FRACTION: f64 = 0.25;
 /// which lengthens the perimeter), about 0.26 for a 10:1 slit.
 pub const ROUND_ENOUGH: f64 = 0.3;
 
+/// The fiducial dot diameter expected by default (the paper's ~1 mm dots).
+pub const DEFAULT_DOT_DIAMETER_MM: f64 = 1.0;
+
+/// Holes scoring below this are left out of the candidates: border notches,
+/// slits, scanner dropouts far smaller or larger than the dots (see
+/// [`score`]).
+pub const MIN_SCORE: f64 = 0.01;
+
+/// How well a hole of equivalent diameter `diameter_mm` and `roundness`
+/// matches a dot of `expected_mm`, from 0 to 1: the size factor
+/// exp(-(ln(D / E) / ln 1.6)^2) (1.6 times too large or too small halves
+/// it, about; three times scores under 0.01) times the roundness factor,
+/// 0 at roundness 0.2 (a 15:1 slit) rising to 1 at 0.6 (a dot that dropped
+/// out of a scanner's pixel grid has 0.4-0.6, its rim a staircase).
+pub fn score(diameter_mm: f64, roundness: f64, expected_mm: f64) -> f64 {
+    if !(diameter_mm > 0.0 && expected_mm > 0.0) {
+        return 0.0;
+    }
+    let size = (diameter_mm / expected_mm).ln() / 1.6f64.ln();
+    let round = ((roundness - 0.2) / 0.4).clamp(0.0, 1.0);
+    (-size * size).exp() * round
+}
+
 /// A candidate fiducial: one hole of the scan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Fiducial {
@@ -48,6 +71,16 @@ pub struct Fiducial {
     /// 4 pi A / perimeter^2: 1 for a circle, near 0 for a slit.
     #[serde(default)]
     pub roundness: f64,
+    /// How well it matches the expected dot ([`score`]), 0 to 1.
+    #[serde(default)]
+    pub score: f64,
+}
+
+impl Fiducial {
+    /// Whether it could be a fiducial dot at all (score >= [`MIN_SCORE`]).
+    pub fn is_candidate(&self) -> bool {
+        self.score >= MIN_SCORE
+    }
 }
 
 /// One closed loop of boundary edges.
@@ -90,10 +123,23 @@ impl BoundaryLoop {
 /// scan's small holes all stay). Loops of fewer than 3 vertices or zero area
 /// are dropped.
 ///
-/// Order: holes with roundness >= [`ROUND_ENOUGH`] first, then by ascending
-/// diameter (fiducials are small round dots; dropouts are irregular), ties by
-/// centroid x, y, z for a deterministic order.
+/// Ranked for dots of [`DEFAULT_DOT_DIAMETER_MM`]: see
+/// [`find_fiducials_sized`].
 pub fn find_fiducials(mesh: &TriMesh) -> Vec<Fiducial> {
+    find_fiducials_sized(mesh, DEFAULT_DOT_DIAMETER_MM)
+}
+
+/// The holes of a scan that could be fiducial dots of `dot_diameter_mm`,
+/// best first.
+///
+/// Loops that bound the scan are left out (see [`find_fiducials`]). Every
+/// other hole is listed with its [`score`] for the expected dot; those
+/// below [`MIN_SCORE`] (a ragged border's notches, slits, tiny dropouts,
+/// large gaps) come last, and the page and `auto` registration leave them
+/// out ([`Fiducial::is_candidate`]). Order: by score, ties by roundness >=
+/// [`ROUND_ENOUGH`] first, then ascending diameter, then centroid x, y, z
+/// for a deterministic order.
+pub fn find_fiducials_sized(mesh: &TriMesh, dot_diameter_mm: f64) -> Vec<Fiducial> {
     let loops = boundary_loops(mesh);
     let Some(mesh_extent) = mesh_extent(mesh) else {
         return Vec::new();
@@ -115,13 +161,20 @@ pub fn find_fiducials(mesh: &TriMesh) -> Vec<Fiducial> {
                 area_mm2: a,
                 perimeter_mm: l.perimeter_mm,
                 roundness: l.roundness(),
+                score: 0.0,
             }
+        })
+        .map(|mut f| {
+            f.score = score(f.diameter_mm, f.roundness, dot_diameter_mm);
+            f
         })
         .collect();
     out.sort_by(|a, b| {
         let ra = a.roundness < ROUND_ENOUGH;
         let rb = b.roundness < ROUND_ENOUGH;
-        ra.cmp(&rb)
+        b.score
+            .total_cmp(&a.score)
+            .then(ra.cmp(&rb))
             .then(a.diameter_mm.total_cmp(&b.diameter_mm))
             .then(a.centroid.x.total_cmp(&b.centroid.x))
             .then(a.centroid.y.total_cmp(&b.centroid.y))

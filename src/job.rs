@@ -7,12 +7,13 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::error::{Error, Result};
-use crate::fiducials::find_fiducials;
+use crate::fiducials::find_fiducials_sized;
 use crate::fiducials::Fiducial;
-use crate::gcode::{write_program, GcodeJob, MachineProfile};
+use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
+use crate::placement::{RegistrationStatus, ScanPlacement};
 use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
 use crate::registration::{register, Registration, RegistrationError, RegistrationMethod};
@@ -34,13 +35,58 @@ pub enum FiducialSource {
 }
 
 /// How the scan is put in the printer frame.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct RegistrationSettings {
     pub fiducials: FiducialSource,
     /// P: the fiducials in the printer frame (read off the controller).
     pub printer_points: Vec<DVec3>,
     pub method: RegistrationMethod,
+    /// The expected fiducial dot diameter: holes are ranked by how well
+    /// they match it (default 1 mm).
+    pub dot_diameter_mm: f64,
+    /// Where an unregistered scan goes (default: as it is); not with
+    /// fiducials.
+    pub scan_placement: ScanPlacement,
+}
+
+impl Default for RegistrationSettings {
+    fn default() -> Self {
+        RegistrationSettings {
+            fiducials: FiducialSource::None,
+            printer_points: Vec::new(),
+            method: RegistrationMethod::default(),
+            dot_diameter_mm: crate::fiducials::DEFAULT_DOT_DIAMETER_MM,
+            scan_placement: ScanPlacement::AsScanned,
+        }
+    }
+}
+
+impl RegistrationSettings {
+    /// Checks the dot diameter and the scan placement.
+    pub fn validate(&self) -> Result<()> {
+        let d = self.dot_diameter_mm;
+        if !(d.is_finite() && d > 0.0 && d <= 100.0) {
+            return Err(Error::Parameter {
+                name: "fiducial dot diameter (mm)",
+                value: format!("{d}"),
+                reason: "must be a number greater than 0 and at most 100".into(),
+            });
+        }
+        self.scan_placement.validate()?;
+        if self.scan_placement != ScanPlacement::AsScanned
+            && (self.fiducials != FiducialSource::None || !self.printer_points.is_empty())
+        {
+            return Err(Error::Parameter {
+                name: "scan placement",
+                value: "on the bed".into(),
+                reason: "a scan is either registered by its fiducials or placed on the bed, \
+                         not both: drop the fiducials or the placement"
+                    .into(),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Everything a job needs besides the bytes of its two files.
@@ -52,8 +98,45 @@ pub struct JobSettings {
     pub plan: PlanSettings,
 }
 
+/// The registration the settings ask for, placement on the bed included:
+/// `mesh` is the imported scan (scanner frame), `holes` its fiducial
+/// candidates.
+pub fn registration_for_scan(
+    mesh: &crate::mesh::TriMesh,
+    holes: &[Fiducial],
+    settings: &RegistrationSettings,
+) -> Result<Registration> {
+    settings.validate()?;
+    let Some(bbox) = mesh.bbox() else {
+        return registration_for(holes, settings);
+    };
+    match (
+        settings.scan_placement,
+        settings.scan_placement.transform(bbox),
+    ) {
+        (
+            ScanPlacement::OnBed {
+                rotation_deg,
+                offset_mm,
+                ..
+            },
+            Some(matrix),
+        ) => Ok(Registration {
+            matrix,
+            status: RegistrationStatus::PlacedOnBed {
+                rotation_deg,
+                offset_mm,
+            },
+            ..Registration::identity()
+        }),
+        _ => registration_for(holes, settings),
+    }
+}
+
 /// Finds the registration the settings ask for; `holes` are the scan's
-/// fiducial candidates ([`find_fiducials`]), used by `FiducialSource::Auto`.
+/// fiducial candidates ([`crate::fiducials::find_fiducials`]), used by
+/// `FiducialSource::Auto`.
+/// (A placement on the bed needs the scan: [`registration_for_scan`].)
 pub fn registration_for(
     holes: &[Fiducial],
     settings: &RegistrationSettings,
@@ -86,8 +169,11 @@ fn best_auto_match(
     if k < 3 {
         return Err(Error::Registration(RegistrationError::TooFew(k)));
     }
+    // The candidates that could be dots at all; all holes if too few are.
+    let likely = found.iter().filter(|f| f.is_candidate()).count();
     let cands: Vec<DVec3> = found
         .iter()
+        .filter(|f| likely < k || f.is_candidate())
         .take(AUTO_CANDIDATES.max(k))
         .map(|f| f.centroid)
         .collect();
@@ -171,6 +257,8 @@ pub struct MeshReport {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RegistrationReport {
+    /// Registered (how, how well), placed on the bed, or taken as it is.
+    pub status: RegistrationStatus,
     pub method: RegistrationMethod,
     /// 4 x 4, row-major, scanner -> printer.
     pub matrix: [[f64; 4]; 4],
@@ -301,9 +389,10 @@ pub fn prepare_scan(
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
+    registration.validate()?;
     let imported = pipeline::load_scan(bytes, name, scan)?;
-    let fiducials = find_fiducials(&imported.mesh);
-    let reg = registration_for(&fiducials, registration)?;
+    let fiducials = find_fiducials_sized(&imported.mesh, registration.dot_diameter_mm);
+    let reg = registration_for_scan(&imported.mesh, &fiducials, registration)?;
     PreparedScan::assemble(
         InputFile::new(name, bytes),
         imported,
@@ -366,6 +455,7 @@ pub fn report(
             bbox_mm: [arr(&lo), arr(&hi)],
         },
         registration: RegistrationReport {
+            status: scan.registration.status,
             method: scan.method,
             matrix: scan.registration.matrix_row_major(),
             residuals_mm: scan.registration.residuals_mm.clone(),
@@ -456,8 +546,8 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
     h.push((
         "registration".into(),
         format!(
-            "{} [{}]",
-            report.registration.method.name(),
+            "{}; G [{}]",
+            report.registration.status,
             m.iter()
                 .map(|r| r
                     .iter()
@@ -594,7 +684,21 @@ pub fn write_outputs(
     };
     // The header has the same lines whatever the check finds, so the moves'
     // line numbers from this first writing hold for the final one.
-    let first = write(&provenance(&report))?;
+    let first = write(&provenance(&report)).map_err(|e| {
+        let fit =
+            crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+        match e {
+            GcodeError::OutOfVolume { .. } | GcodeError::SafeHeightOutOfVolume { .. }
+                if !fit.inside =>
+            {
+                Error::OutsideVolume {
+                    source: Box::new(e),
+                    fit: fit.message,
+                }
+            }
+            e => Error::Gcode(e),
+        }
+    })?;
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
     if checked.touching_moves > 0 && !accept_risk {
@@ -879,8 +983,9 @@ mod tests {
             fiducials: FiducialSource::Auto,
             printer_points: p.clone(),
             method: RegistrationMethod::Lsq,
+            ..Default::default()
         };
-        let r = registration_for(&find_fiducials(&mesh), &settings).unwrap();
+        let r = registration_for(&crate::fiducials::find_fiducials(&mesh), &settings).unwrap();
         assert!(r.rms_mm < 0.05, "{}", r.rms_mm);
         // The recovered G is the inverse of the turn applied.
         let back = r.matrix * g;
@@ -897,6 +1002,7 @@ mod tests {
             fiducials: FiducialSource::Auto,
             printer_points: test_part::FIDUCIALS_MM.to_vec(),
             method: RegistrationMethod::Lsq,
+            ..Default::default()
         };
         let scan = prepare_scan(&bytes, "turned.ply", &ImportOptions::DEFAULT, &settings).unwrap();
         let found = &scan.fiducials;

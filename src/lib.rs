@@ -39,6 +39,7 @@ pub mod mesh;
 pub mod motion;
 pub mod params;
 pub mod pipeline;
+pub mod placement;
 pub mod planners;
 pub mod projection;
 pub mod quality;

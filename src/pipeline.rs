@@ -140,7 +140,8 @@ pub fn surface_path(
             format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
-                 placement offset and the registration",
+                 placement offset and the registration (--place centre, or the page's drawing \
+                 placement, puts the drawing on the scan's footprint)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
         } else {

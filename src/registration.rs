@@ -89,6 +89,10 @@ pub struct Registration {
     /// fiducials, fiducials the paper method ignored).
     #[serde(default)]
     pub notes: Vec<String>,
+    /// How the scan came into the printer frame (registered, placed on the
+    /// bed, or taken as it is).
+    #[serde(default)]
+    pub status: crate::placement::RegistrationStatus,
 }
 
 impl Default for Registration {
@@ -105,6 +109,7 @@ impl Registration {
             residuals_mm: Vec::new(),
             rms_mm: 0.0,
             notes: Vec::new(),
+            status: crate::placement::RegistrationStatus::AsScanned,
         }
     }
 
@@ -315,11 +320,17 @@ pub fn register(
         .collect();
     let rms_mm =
         (residuals_mm.iter().map(|r| r * r).sum::<f64>() / residuals_mm.len() as f64).sqrt();
+    let status = crate::placement::RegistrationStatus::Registered {
+        method,
+        fiducials: scan.len(),
+        rms_mm,
+    };
     Ok(Registration {
         matrix,
         residuals_mm,
         rms_mm,
         notes,
+        status,
     })
 }
 

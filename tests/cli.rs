@@ -1004,3 +1004,113 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     assert_eq!(code(&o), 1);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// ------------------------------------------------------------ placement
+
+/// Issue 13: a scan still in its scanner's frame (the demo part turned and
+/// moved 800 mm down) with a spiral: the plan fails naming the placement
+/// flag; placed on the bed with the drawing centred, it succeeds, the
+/// header says how the scan was placed and the drawing lies on the scan.
+#[test]
+fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
+    let dir = temp_dir("place-scan");
+    let mut mesh = test_part::test_part();
+    let g = pcpp::DMat4::from_translation(pcpp::DVec3::new(-300.0, 150.0, -800.0))
+        * pcpp::DMat4::from_rotation_z(0.5);
+    mesh.transform(&g);
+    let scan = dir.join("face-scan.ply");
+    std::fs::write(&scan, demo::to_binary_ply(&mesh)).unwrap();
+    let svg = dir.join("spiral.svg");
+    std::fs::write(&svg, demo::antennas::paper_spiral_svg()).unwrap();
+    let out = dir.join("out.gcode");
+    let report = dir.join("report.json");
+    // Where the drawing lands off the scan, the message says how to put
+    // it on.
+    let o = pcpp(&["plan", "--scan", s(&scan), "--path", s(&svg), "-o", s(&out)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--place centre"), "{}", stderr(&o));
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&svg),
+        "--place",
+        "centre",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("--place-scan bed") && err.contains("outside the build volume"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&svg),
+        "--place-scan",
+        "bed",
+        "--place",
+        "centre",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("scan: unregistered, placed on the bed"),
+        "{}",
+        stdout(&o)
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("; registration: unregistered, placed on the bed")),
+        "{}",
+        &text[..1500]
+    );
+    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(r["registration"]["status"]["kind"], "placed-on-bed");
+    let bbox = &r["mesh"]["bbox_mm"];
+    let (lo, hi) = (&bbox[0], &bbox[1]);
+    assert!(
+        lo[2].as_f64().unwrap().abs() < 1e-6,
+        "lowest point on the bed: {bbox}"
+    );
+    for piece in r["toolpath"].as_array().unwrap() {
+        for p in piece.as_array().unwrap() {
+            for k in 0..2 {
+                let v = p[k].as_f64().unwrap();
+                assert!(
+                    v > lo[k].as_f64().unwrap() && v < hi[k].as_f64().unwrap(),
+                    "{p} outside the scan's footprint {bbox}"
+                );
+            }
+        }
+    }
+    // Fiducials and a placement exclude each other.
+    let o = pcpp(&[
+        "plan",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&svg),
+        "--place-scan",
+        "bed",
+        "--fiducials",
+        "auto",
+        "--printer-points",
+        "4,4,5;76,4,5;4,76,5",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("not both"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}

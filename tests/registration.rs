@@ -619,3 +619,65 @@ fn found_fiducials_register_a_moved_scan() {
     let reg = register(&a, &b, RegistrationMethod::Lsq).unwrap();
     assert_recovers(&reg, &truth, 1e-9, "moved scan");
 }
+
+/// Issue 13: on the demo part with extra holes that are not fiducials
+/// (dropouts smaller and larger than the 1 mm dots, a slit, an irregular
+/// gap) and a ragged border, the three real dots rank first for 1 mm dots.
+#[test]
+fn real_dots_rank_first_among_noise_holes_and_a_ragged_border() {
+    use pcpp::demo::test_part;
+    use pcpp::fiducials::find_fiducials_sized;
+    let mut mesh = test_part::test_part();
+    let holes: [(f64, f64, f64); 5] = [
+        (10.0, 4.5, 0.15), // a tiny dropout, 0.3 mm
+        (20.0, 75.0, 0.2), // another, 0.4 mm
+        (40.0, 4.0, 1.25), // a 2.5 mm gap
+        (60.0, 76.0, 1.6), // a 3.2 mm gap
+        (70.0, 4.2, 0.8),  // 1.6 mm: larger than a dot
+    ];
+    mesh.triangles.retain(|t| {
+        let c = (mesh.vertices[t[0] as usize]
+            + mesh.vertices[t[1] as usize]
+            + mesh.vertices[t[2] as usize])
+            / 3.0;
+        let in_hole = holes
+            .iter()
+            .any(|&(x, y, r)| (c.x - x).powi(2) + (c.y - y).powi(2) < r * r);
+        // A slit 3 mm long, 0.2 mm wide, near the first dot.
+        let slit = (c.y - 5.0).abs() < 0.1 && (8.0..11.0).contains(&c.x);
+        // A ragged border: notches of varying depth along the rim.
+        let notch = |u: f64| 0.15 + 0.6 * ((u * 1.7).sin() * (u * 0.53).cos()).abs();
+        let ragged = c.y < notch(c.x)
+            || c.y > 80.0 - notch(c.x + 3.0)
+            || c.x < notch(c.y)
+            || c.x > 80.0 - notch(c.y + 7.0);
+        !(in_hole || slit || ragged)
+    });
+    let found = find_fiducials_sized(&mesh, 1.0);
+    assert!(found.len() >= 3, "{found:?}");
+    for f in test_part::FIDUCIALS_MM {
+        let rank = found
+            .iter()
+            .position(|c| c.centroid.truncate().distance(f.truncate()) < 0.1)
+            .unwrap_or_else(|| panic!("dot at {f:?} not found: {found:?}"));
+        assert!(
+            rank < 3,
+            "dot at {f:?} ranks {rank}: {:?}",
+            &found[..4.min(found.len())]
+        );
+    }
+    // The noise holes are found too, ranked below the dots.
+    assert!(found.len() > 3, "{found:?}");
+    assert!(found[3].score < found[2].score);
+    // Expecting 2.5 mm dots, the 2.5 mm gap ranks first instead.
+    let big = find_fiducials_sized(&mesh, 2.5);
+    assert!(
+        big[0]
+            .centroid
+            .truncate()
+            .distance(pcpp::DVec2::new(40.0, 4.0))
+            < 0.2,
+        "{:?}",
+        big[0]
+    );
+}

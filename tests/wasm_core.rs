@@ -209,6 +209,7 @@ fn auto_fiducials_register_the_demo() {
         fiducials: FiducialSource::Auto,
         printer_points: test_part::FIDUCIALS_MM.to_vec(),
         method: RegistrationMethod::Lsq,
+        ..Default::default()
     };
     let prepared =
         job::prepare_scan(&scan, demo::DEMO_SCAN_NAME, &ImportOptions::DEFAULT, &reg).unwrap();
@@ -302,6 +303,7 @@ fn session_errors_name_the_cause_and_the_stage() {
         fiducials: FiducialSource::Auto,
         printer_points: vec![DVec3::ZERO],
         method: RegistrationMethod::Lsq,
+        ..Default::default()
     };
     let err = pcpp::wasm::Session::new(
         small_obj().as_bytes(),
@@ -465,6 +467,7 @@ fn demo_page_settings() -> JobSettings {
         fiducials: FiducialSource::Auto,
         printer_points: test_part::FIDUCIALS_MM.to_vec(),
         method: RegistrationMethod::Lsq,
+        ..Default::default()
     };
     s
 }

@@ -80,6 +80,7 @@ pub fn decode(data: &[u8]) -> PipelineCase<'_> {
         } else {
             RegistrationMethod::Lsq
         },
+        ..Default::default()
     };
     let rest = data.get(HEADER_LEN..).unwrap_or(&[]);
     let n = data

@@ -16,10 +16,11 @@ use std::process::ExitCode;
 
 use pcpp::demo::parts::DemoPart;
 use pcpp::demo::{self, antennas, test_part};
-use pcpp::fiducials::find_fiducials;
+use pcpp::fiducials::{find_fiducials_sized, DEFAULT_DOT_DIAMETER_MM};
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{self, FiducialSource, InputFile, JobSettings, PreparedScan};
 use pcpp::mesh::{ScanUnits, UpAxis};
+use pcpp::placement::ScanPlacement;
 use pcpp::planners::PlannerKind;
 use pcpp::registration::{parse_points, register, Registration, RegistrationMethod};
 use pcpp::svg::Placement;
@@ -181,6 +182,8 @@ macro_rules! job_flags {
             valued("fiducials"),
             valued("printer-points"),
             valued("registration"),
+            valued("place-scan"),
+            valued("dot-diameter"),
             $($extra),*
         ]
     };
@@ -208,14 +211,19 @@ const COMMANDS: &[Command] = &[
         name: "compare",
         job_help: true,
         help: COMPARE_HELP,
-        flags: job_flags![],
+        flags: job_flags![valued("dialect"), valued("profile")],
         run: cmd_compare,
     },
     Command {
         name: "fiducials",
         job_help: false,
         help: FIDUCIALS_HELP,
-        flags: &[valued("scan"), valued("scan-units"), valued("up-axis")],
+        flags: &[
+            valued("scan"),
+            valued("scan-units"),
+            valued("up-axis"),
+            valued("dot-diameter"),
+        ],
         run: cmd_fiducials,
     },
     Command {
@@ -246,6 +254,10 @@ const COMMANDS: &[Command] = &[
             valued("fiducials"),
             valued("printer-points"),
             valued("registration"),
+            valued("place-scan"),
+            valued("dot-diameter"),
+            valued("dialect"),
+            valued("profile"),
         ],
         run: cmd_check,
     },
@@ -382,11 +394,39 @@ fn parse_number(text: &str) -> Option<f64> {
 // ---------------------------------------------------------------------------
 // Settings from flags
 
-/// `--place X,Y[,ROT_DEG[,SCALE]]`.
+/// `--place X,Y[,ROT_DEG[,SCALE]]`, or `--place centre[,ROT_DEG[,SCALE]]`
+/// (the offset is found once the scan is read: [`centre_on_scan`]).
 fn placement(a: &Args) -> CliResult<Placement> {
     let Some(text) = a.get("place") else {
         return Ok(Placement::IDENTITY);
     };
+    if let Some(rest) = centre_word(text) {
+        let mut v = [0.0, 1.0];
+        let parts: Vec<&str> = rest
+            .split(',')
+            .map(str::trim)
+            .filter(|p| !p.is_empty())
+            .collect();
+        if parts.len() > 2 {
+            return Err(usage(
+                a.command,
+                "--place centre takes at most a rotation and a scale: centre[,ROT_DEG[,SCALE]]",
+            ));
+        }
+        for (slot, p) in v.iter_mut().zip(&parts) {
+            *slot = parse_number(p)
+                .ok_or_else(|| usage(a.command, format!("--place: '{p}' is not a number")))?;
+        }
+        let place = Placement {
+            offset_mm: DVec2::ZERO,
+            rotation_deg: v[0],
+            scale: v[1],
+        };
+        place
+            .validate()
+            .map_err(|e| usage(a.command, format!("--place: {e}")))?;
+        return Ok(place);
+    }
     let bad = |why: String| {
         usage(
             a.command,
@@ -412,10 +452,53 @@ fn placement(a: &Args) -> CliResult<Placement> {
     Ok(place)
 }
 
+/// `centre` or `center`, and what follows it.
+fn centre_word(text: &str) -> Option<&str> {
+    let t = text.trim();
+    ["centre", "center"].iter().find_map(|w| {
+        t.get(..w.len())
+            .filter(|h| h.eq_ignore_ascii_case(w))
+            .map(|_| t[w.len()..].trim_start_matches(','))
+    })
+}
+
+/// With `--place centre`, the drawing centred on the scan's footprint
+/// (scaled down to fit, with a warning, when it is larger).
+fn centre_on_scan(
+    a: &Args,
+    inputs: &Inputs,
+    plan: &mut pcpp::pipeline::PlanSettings,
+) -> CliResult<()> {
+    if !a.get("place").is_some_and(|t| centre_word(t).is_some()) {
+        return Ok(());
+    }
+    let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
+        .map_err(|e| Failure::Input(in_file(&inputs.svg_path, &inputs.svg_name, &e.to_string())))?;
+    let (lo, hi) = inputs.prepared.surface.bbox();
+    let Some((place, note)) = pcpp::placement::centre_drawing(
+        &drawn.subpaths,
+        (lo.truncate(), hi.truncate()),
+        &plan.placement,
+    ) else {
+        return Ok(());
+    };
+    if let Some(n) = note {
+        warn_all(&[n]);
+    }
+    plan.placement = place;
+    Ok(())
+}
+
 fn job_settings(a: &Args) -> CliResult<JobSettings> {
     let mut s = JobSettings::default();
     s.scan.units = a.parsed::<ScanUnits>("scan-units")?;
     s.scan.up_axis = a.parsed::<UpAxis>("up-axis")?;
+    if let Some(v) = a.number("dot-diameter")? {
+        s.registration.dot_diameter_mm = v;
+    }
+    if let Some(text) = a.get("place-scan") {
+        s.registration.scan_placement = scan_placement(a, text)?;
+    }
 
     let fiducials = match a.get("fiducials") {
         None => FiducialSource::None,
@@ -443,6 +526,12 @@ fn job_settings(a: &Args) -> CliResult<JobSettings> {
     if let Some(m) = a.parsed::<RegistrationMethod>("registration")? {
         s.registration.method = m;
     }
+    s.registration.validate().map_err(|e| {
+        usage(
+            a.command,
+            format!("--place-scan/--fiducials/--dot-diameter: {e}"),
+        )
+    })?;
 
     let p = &mut s.plan;
     if a.values.contains_key("planner") {
@@ -472,6 +561,45 @@ fn job_settings(a: &Args) -> CliResult<JobSettings> {
         .validate()
         .map_err(|e| usage(a.command, format!("--tol/--speed/--dwell: {e}")))?;
     Ok(s)
+}
+
+/// `--place-scan bed[,DX,DY,DZ[,ROT_DEG]]`: on the bed of the profile
+/// (`--dialect`/`--profile`), then moved and turned; `--place-scan as-is`.
+fn scan_placement(a: &Args, text: &str) -> CliResult<ScanPlacement> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts[0].to_ascii_lowercase().as_str() {
+        "as-is" | "asis" | "none" if parts.len() == 1 => Ok(ScanPlacement::AsScanned),
+        "bed" => {
+            let bad = |why: String| {
+                usage(
+                    a.command,
+                    format!("--place-scan: {why}; write bed or bed,DX,DY,DZ[,ROT_DEG]"),
+                )
+            };
+            if !(parts.len() == 1 || parts.len() == 4 || parts.len() == 5) {
+                return Err(bad(format!("expected 1, 4 or 5 fields, got {}", parts.len())));
+            }
+            let mut v = [0.0; 4];
+            for (slot, p) in v.iter_mut().zip(&parts[1..]) {
+                *slot = parse_number(p).ok_or_else(|| bad(format!("'{p}' is not a number")))?;
+            }
+            let mut place = ScanPlacement::on_bed(&profile(a)?);
+            if let ScanPlacement::OnBed {
+                rotation_deg,
+                offset_mm,
+                ..
+            } = &mut place
+            {
+                *offset_mm = DVec3::new(v[0], v[1], v[2]);
+                *rotation_deg = v[3];
+            }
+            Ok(place)
+        }
+        other => Err(usage(
+            a.command,
+            format!("--place-scan: '{other}' is not a placement; write bed, bed,DX,DY,DZ[,ROT_DEG] or as-is"),
+        )),
+    }
 }
 
 fn builtin_profile(command: &'static str, name: &str) -> CliResult<MachineProfile> {
@@ -720,6 +848,10 @@ fn load_scan(
 fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
     match e {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
+        e @ Error::OutsideVolume { .. } => Failure::Input(format!(
+            "writing G-code for {}: {e}",
+            inputs.scan_path.display()
+        )),
         Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
@@ -739,12 +871,13 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
 }
 
 fn cmd_plan(a: &Args) -> CliResult<()> {
-    let settings = job_settings(a)?;
+    let mut settings = job_settings(a)?;
     let profile = profile(a)?;
     let out = PathBuf::from(a.required("output")?);
     let report_path = a.get("report").map(PathBuf::from);
     let progress = Progress::new();
     let inputs = load_inputs(a, &settings, &progress)?;
+    centre_on_scan(a, &inputs, &mut settings.plan)?;
     progress.say(&format!("planning ({})...", settings.plan.planner));
     let output = job::run_on(
         &inputs.prepared,
@@ -787,7 +920,9 @@ fn cmd_plan(a: &Args) -> CliResult<()> {
             registration_line(&inputs.prepared.registration, inputs.prepared.method)
         );
     }
+    let _ = writeln!(s, "scan: {}", output.report.registration.status);
     let _ = writeln!(s, "predicted quality: {}", output.report.quality);
+    let _ = writeln!(s, "safe motion: {}", output.report.motion.summary_line());
     if let Some(r) = &report_path {
         let _ = writeln!(s, "report: {}", r.display());
     }
@@ -811,10 +946,11 @@ fn comparison_json(
 }
 
 fn cmd_compare(a: &Args) -> CliResult<()> {
-    let settings = job_settings(a)?;
+    let mut settings = job_settings(a)?;
     let report_path = a.get("report").map(PathBuf::from);
     let progress = Progress::new();
     let inputs = load_inputs(a, &settings, &progress)?;
+    centre_on_scan(a, &inputs, &mut settings.plan)?;
     progress.say("planning with all four planners...");
     let comparison = job::compare_on(
         &inputs.prepared,
@@ -934,7 +1070,14 @@ fn cmd_fiducials(a: &Args) -> CliResult<()> {
         thousands(imported.mesh.triangle_count())
     ));
     warn_all(&imported.warnings);
-    let found = find_fiducials(&imported.mesh);
+    let dot = a.number("dot-diameter")?.unwrap_or(DEFAULT_DOT_DIAMETER_MM);
+    if !(dot > 0.0 && dot <= 100.0) {
+        return Err(usage(
+            a.command,
+            "--dot-diameter: must be above 0 and at most 100 mm",
+        ));
+    }
+    let found = find_fiducials_sized(&imported.mesh, dot);
     print!("{}", to_json(&found)?);
     Ok(())
 }
@@ -1036,6 +1179,7 @@ fn cmd_demo(a: &Args) -> CliResult<()> {
             fiducials: FiducialSource::Auto,
             printer_points: test_part::FIDUCIALS_MM.to_vec(),
             method: RegistrationMethod::Lsq,
+            ..Default::default()
         };
         Some(
             job::registration_for(&prepared.fiducials, &reg_settings)
@@ -1222,8 +1366,16 @@ const JOB_FLAGS_HELP: &str =
                            the same fiducials in the printer frame
   --registration lsq|paper least-squares fit (default) or the paper's 3-point
                            construction
-Without --fiducials and --printer-points the scan is taken as already in the
-printer frame.
+  --dot-diameter MM        the fiducial dots' diameter: holes are ranked by how
+                           well they match it (default 1)
+  --place-scan bed[,DX,DY,DZ[,ROT]]
+                           an unregistered scan (still in the scanner's frame):
+                           lowest point on the bed, footprint centred on it, then
+                           moved by DX,DY,DZ mm and turned ROT degrees about z;
+                           the bed is the --dialect/--profile build volume's
+Without --fiducials and --printer-points, or --place-scan, the scan is taken as
+already in the printer frame. --place centre[,ROT[,SCALE]] centres the drawing on
+the scan's footprint (and scales it down to fit, with a warning).
 ";
 
 const PLAN_HELP: &str = "\

@@ -5,7 +5,7 @@
 ' process: tol 0.1 mm, speed 5 mm/s, dwell 0 s
 ' placement: offset (0, 80) mm, rotation 0 deg, scale 1
 ' planner: even
-' registration: lsq [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
+' registration: unregistered, taken as it is (the scan's frame is the printer's); G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
 ' residuals: [] mm, rms 0.0000 mm
 ' path: 6 piece(s), 1362 points, 457.516 mm, height change 4.504 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 91.5 s
 ' predicted quality: mean |e| 0.0136 mm, mean e- -0.0101 mm, mean e+ 0.0193 mm, contact 0.00%, flattening 1.03%, floating 1.76%

@@ -1,0 +1,384 @@
+//! Placement: where an unregistered scan and the drawing go in the printer
+//! frame (spec section 1 for the scan, section 4's decision "the user places
+//! the SVG in printer XY" for the drawing).
+//!
+//! A scan straight from a scanner is in the scanner's frame, often far from
+//! the stage's build volume (a structured-light head puts it hundreds of mm
+//! away). Until the user registers it by its fiducials, the planner can put
+//! it on the bed: lowest point on the bed, footprint centred on it,
+//! orientation kept (the up axis is the import's choice), then moved and
+//! turned by hand. [`volume_fit`] says where a scan lies against a build
+//! volume, so the page and the CLI can offer that before anything fails.
+//!
+//! A new drawing, or a drawing on a new scan, is centred on the scan's
+//! footprint and scaled down (with a note) when it does not fit:
+//! [`centre_drawing`].
+
+use glam::{DMat4, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::gcode::{BuildVolume, MachineProfile};
+use crate::svg::{Placement, Subpath2};
+
+/// The bed of a machine: the middle of its build volume in XY, at its
+/// lowest z.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Bed {
+    pub centre_mm: DVec2,
+    pub z_mm: f64,
+}
+
+impl Bed {
+    pub fn of(volume: &BuildVolume) -> Bed {
+        Bed {
+            centre_mm: 0.5 * (volume.min_mm + volume.max_mm).truncate(),
+            z_mm: volume.min_mm.z,
+        }
+    }
+
+    pub fn of_profile(profile: &MachineProfile) -> Bed {
+        Bed::of(&profile.build_volume)
+    }
+}
+
+/// How an unregistered scan is put in the printer frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "mode")]
+pub enum ScanPlacement {
+    /// As the file gives it: the scan is taken to be in the printer frame.
+    #[default]
+    AsScanned,
+    /// Lowest point on the bed, the footprint's middle on the bed's
+    /// middle, then turned by `rotation_deg` (counter-clockwise about z,
+    /// around the footprint's middle) and moved by `offset_mm`.
+    OnBed {
+        bed: Bed,
+        #[serde(default)]
+        rotation_deg: f64,
+        #[serde(default)]
+        offset_mm: DVec3,
+    },
+}
+
+impl ScanPlacement {
+    /// On the bed of `profile`, not turned or moved.
+    pub fn on_bed(profile: &MachineProfile) -> ScanPlacement {
+        ScanPlacement::OnBed {
+            bed: Bed::of_profile(profile),
+            rotation_deg: 0.0,
+            offset_mm: DVec3::ZERO,
+        }
+    }
+
+    /// Checks the numbers (finite, within a kilometre).
+    pub fn validate(&self) -> crate::Result<()> {
+        if let ScanPlacement::OnBed {
+            bed,
+            rotation_deg,
+            offset_mm,
+        } = self
+        {
+            let ok = bed.centre_mm.is_finite()
+                && bed.z_mm.is_finite()
+                && rotation_deg.is_finite()
+                && offset_mm.is_finite()
+                && offset_mm.abs().max_element() <= 1e6;
+            if !ok {
+                return Err(crate::Error::Parameter {
+                    name: "scan placement",
+                    value: format!("{self:?}"),
+                    reason: "the bed, rotation and offset must be finite numbers".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The rigid transform scanner -> printer for a scan whose bounds (in
+    /// the scanner frame, after import) are `bbox`; `None` for
+    /// [`ScanPlacement::AsScanned`].
+    pub fn transform(&self, bbox: (DVec3, DVec3)) -> Option<DMat4> {
+        let ScanPlacement::OnBed {
+            bed,
+            rotation_deg,
+            offset_mm,
+        } = self
+        else {
+            return None;
+        };
+        let (lo, hi) = bbox;
+        let middle = 0.5 * (lo + hi).truncate();
+        let to_origin = DMat4::from_translation(DVec3::new(-middle.x, -middle.y, -lo.z));
+        let turn = DMat4::from_rotation_z(rotation_deg.to_radians());
+        let to_bed = DMat4::from_translation(bed.centre_mm.extend(bed.z_mm) + *offset_mm);
+        Some(to_bed * turn * to_origin)
+    }
+}
+
+/// How a scan was put in the printer frame, for the report, the G-code
+/// header and the page.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum RegistrationStatus {
+    /// Not registered: taken as it is.
+    #[default]
+    AsScanned,
+    /// Not registered: placed on the bed.
+    PlacedOnBed { rotation_deg: f64, offset_mm: DVec3 },
+    /// Registered by its fiducials.
+    Registered {
+        method: crate::registration::RegistrationMethod,
+        fiducials: usize,
+        rms_mm: f64,
+    },
+}
+
+impl std::fmt::Display for RegistrationStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RegistrationStatus::AsScanned => {
+                f.write_str("unregistered, taken as it is (the scan's frame is the printer's)")
+            }
+            RegistrationStatus::PlacedOnBed {
+                rotation_deg,
+                offset_mm,
+            } => {
+                write!(f, "unregistered, placed on the bed")?;
+                if *rotation_deg != 0.0 || *offset_mm != DVec3::ZERO {
+                    write!(
+                        f,
+                        " (turned {rotation_deg} deg, moved ({}, {}, {}) mm)",
+                        offset_mm.x, offset_mm.y, offset_mm.z
+                    )?;
+                }
+                Ok(())
+            }
+            RegistrationStatus::Registered {
+                method,
+                fiducials,
+                rms_mm,
+            } => write!(
+                f,
+                "registered ({}, {fiducials} fiducials, RMS residual {rms_mm:.3} mm)",
+                method.name()
+            ),
+        }
+    }
+}
+
+/// Where a scan lies against a build volume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VolumeFit {
+    /// Whether the whole scan lies inside the volume.
+    pub inside: bool,
+    /// How far it sticks out beyond the volume on each axis (mm, 0 where it
+    /// does not).
+    pub outside_by_mm: DVec3,
+    /// Whether it would fit after placing it on the bed (its size fits).
+    pub fits_on_bed: bool,
+    /// One sentence for the user.
+    pub message: String,
+}
+
+/// Where a scan with bounds `bbox` (printer frame) lies against `volume` of
+/// profile `profile`.
+pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> VolumeFit {
+    let (lo, hi) = bbox;
+    let outside = (volume.min_mm - lo)
+        .max(hi - volume.max_mm)
+        .max(DVec3::ZERO);
+    let inside = outside == DVec3::ZERO;
+    let size = hi - lo;
+    let room = volume.max_mm - volume.min_mm;
+    let fits_on_bed = size.cmple(room).all();
+    let message = if inside {
+        format!("the scan lies inside the build volume of profile {profile}")
+    } else {
+        format!(
+            "the scan lies outside the build volume of profile {profile} ({volume}): it spans \
+             x {:.1}..{:.1}, y {:.1}..{:.1}, z {:.1}..{:.1} mm, out by up to {:.1} mm; if it is \
+             still in the scanner's frame, place it on the bed (--place-scan bed; in the page, \
+             'Place on the bed') or register it by its fiducials{}",
+            lo.x,
+            hi.x,
+            lo.y,
+            hi.y,
+            lo.z,
+            hi.z,
+            outside.max_element(),
+            if fits_on_bed {
+                ""
+            } else {
+                " (it is larger than the volume: check the scan's units)"
+            }
+        )
+    };
+    VolumeFit {
+        inside,
+        outside_by_mm: outside,
+        fits_on_bed,
+        message,
+    }
+}
+
+/// How much of the footprint a drawing may fill when it is scaled to fit.
+pub const FIT_SHARE: f64 = 0.9;
+
+/// The placement that puts the middle of the drawing's bounding box (as
+/// `current` turns and scales it) on the middle of a scan's footprint
+/// `footprint` (printer XY); when the drawing is larger than
+/// [`FIT_SHARE`] of the footprint it is scaled down to fit, and the note
+/// says so. `None` for a drawing without points.
+pub fn centre_drawing(
+    drawn: &[Subpath2],
+    footprint: (DVec2, DVec2),
+    current: &Placement,
+) -> Option<(Placement, Option<String>)> {
+    let turned = Placement {
+        offset_mm: DVec2::ZERO,
+        ..*current
+    };
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in drawn.iter().flat_map(|s| &s.points) {
+        let q = turned.apply(*p);
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let (flo, fhi) = footprint;
+    let room = (fhi - flo) * FIT_SHARE;
+    let size = hi - lo;
+    let mut scale = 1.0;
+    for k in 0..2 {
+        if size[k] > room[k] && room[k] > 0.0 {
+            scale = f64::min(scale, room[k] / size[k]);
+        }
+    }
+    let mut placement = turned;
+    let mut note = None;
+    if scale < 1.0 {
+        placement.scale *= scale;
+        note = Some(format!(
+            "the drawing ({:.1} x {:.1} mm) is larger than the scan's footprint ({:.1} x {:.1} \
+             mm): it was scaled by {:.3} to fit; set the scale to print it at its size",
+            size.x,
+            size.y,
+            fhi.x - flo.x,
+            fhi.y - flo.y,
+            scale
+        ));
+        lo *= scale;
+        hi *= scale;
+    }
+    placement.offset_mm = 0.5 * (flo + fhi) - 0.5 * (lo + hi);
+    Some((placement, note))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn volume() -> BuildVolume {
+        BuildVolume {
+            min_mm: DVec3::ZERO,
+            max_mm: DVec3::new(220.0, 220.0, 250.0),
+        }
+    }
+
+    #[test]
+    fn a_scan_in_the_scanner_frame_is_placed_on_the_bed() {
+        let bbox = (
+            DVec3::new(-60.0, 30.0, -820.0),
+            DVec3::new(40.0, 90.0, -790.0),
+        );
+        let fit = volume_fit(bbox, &volume(), "marlin");
+        assert!(!fit.inside && fit.fits_on_bed);
+        assert!(fit.message.contains("--place-scan bed"), "{}", fit.message);
+        let p = ScanPlacement::OnBed {
+            bed: Bed::of(&volume()),
+            rotation_deg: 0.0,
+            offset_mm: DVec3::ZERO,
+        };
+        let g = p.transform(bbox).unwrap();
+        let (lo, hi) = (g.transform_point3(bbox.0), g.transform_point3(bbox.1));
+        assert!((lo.z - 0.0).abs() < 1e-9 && (hi.z - 30.0).abs() < 1e-9);
+        let mid = 0.5 * (lo + hi);
+        assert!((mid.truncate() - DVec2::new(110.0, 110.0)).length() < 1e-9);
+        assert!(volume_fit((lo.min(hi), lo.max(hi)), &volume(), "marlin").inside);
+        // Turned a quarter and raised: the footprint turns about its
+        // middle, the lowest point stays on the bed plus the offset.
+        let p = ScanPlacement::OnBed {
+            bed: Bed::of(&volume()),
+            rotation_deg: 90.0,
+            offset_mm: DVec3::new(5.0, 0.0, 1.0),
+        };
+        let g = p.transform(bbox).unwrap();
+        let c = g.transform_point3(DVec3::new(-10.0, 60.0, -820.0));
+        assert!((c - DVec3::new(115.0, 110.0, 1.0)).length() < 1e-9, "{c}");
+        let x_end = g.transform_point3(DVec3::new(40.0, 60.0, -820.0));
+        assert!(
+            (x_end - DVec3::new(115.0, 160.0, 1.0)).length() < 1e-9,
+            "{x_end}"
+        );
+        assert!(ScanPlacement::AsScanned.transform(bbox).is_none());
+    }
+
+    #[test]
+    fn status_says_how_the_scan_got_there() {
+        assert!(RegistrationStatus::AsScanned
+            .to_string()
+            .starts_with("unregistered"));
+        let s = RegistrationStatus::PlacedOnBed {
+            rotation_deg: 0.0,
+            offset_mm: DVec3::ZERO,
+        };
+        assert_eq!(s.to_string(), "unregistered, placed on the bed");
+        let s = RegistrationStatus::Registered {
+            method: crate::registration::RegistrationMethod::Lsq,
+            fiducials: 3,
+            rms_mm: 0.165,
+        };
+        assert_eq!(
+            s.to_string(),
+            "registered (lsq, 3 fiducials, RMS residual 0.165 mm)"
+        );
+    }
+
+    #[test]
+    fn drawings_are_centred_and_scaled_to_fit() {
+        let square = Subpath2 {
+            points: vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(100.0, 0.0),
+                DVec2::new(100.0, 50.0),
+            ],
+            corner: vec![true; 3],
+            closed: false,
+            source: "s".into(),
+        };
+        let footprint = (DVec2::new(10.0, 20.0), DVec2::new(50.0, 60.0));
+        let (p, note) = centre_drawing(&[square.clone()], footprint, &Placement::IDENTITY).unwrap();
+        assert!(note.unwrap().contains("scaled by 0.360"));
+        assert!((p.scale - 0.36).abs() < 1e-12);
+        let placed = p.apply_subpath(&square);
+        let lo = placed.points.iter().fold(DVec2::INFINITY, |a, b| a.min(*b));
+        let hi = placed
+            .points
+            .iter()
+            .fold(DVec2::NEG_INFINITY, |a, b| a.max(*b));
+        assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
+        assert!(lo.cmpge(footprint.0).all() && hi.cmple(footprint.1).all());
+        // A small drawing keeps its scale and rotation.
+        let current = Placement {
+            rotation_deg: 30.0,
+            scale: 0.1,
+            ..Placement::IDENTITY
+        };
+        let (p, note) = centre_drawing(&[square], footprint, &current).unwrap();
+        assert!(note.is_none());
+        assert_eq!((p.rotation_deg, p.scale), (30.0, 0.1));
+        assert!(centre_drawing(&[], footprint, &current).is_none());
+    }
+}
