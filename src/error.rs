@@ -41,7 +41,10 @@ pub enum Error {
     /// The tool path leaves the machine's build volume and the scan lies
     /// outside it: says where the scan lies and how to place it.
     #[error("{source}; {fit}")]
-    OutsideVolume { source: Box<GcodeError>, fit: String },
+    OutsideVolume {
+        source: Box<GcodeError>,
+        fit: String,
+    },
     /// The G-code's moves would bring the nozzle too close to the surface
     /// (names the first moves, with their lines).
     #[error(transparent)]

@@ -359,7 +359,12 @@ mod tests {
             source: "s".into(),
         };
         let footprint = (DVec2::new(10.0, 20.0), DVec2::new(50.0, 60.0));
-        let (p, note) = centre_drawing(&[square.clone()], footprint, &Placement::IDENTITY).unwrap();
+        let (p, note) = centre_drawing(
+            std::slice::from_ref(&square),
+            footprint,
+            &Placement::IDENTITY,
+        )
+        .unwrap();
         assert!(note.unwrap().contains("scaled by 0.360"));
         assert!((p.scale - 0.36).abs() < 1e-12);
         let placed = p.apply_subpath(&square);
