@@ -469,7 +469,7 @@ fn centre_on_scan(
     inputs: &Inputs,
     plan: &mut pcpp::pipeline::PlanSettings,
 ) -> CliResult<()> {
-    if !a.get("place").is_some_and(|t| centre_word(t).is_some()) {
+    if a.get("place").is_none_or(|t| centre_word(t).is_none()) {
         return Ok(());
     }
     let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
