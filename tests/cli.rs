@@ -796,16 +796,21 @@ fn no_progress_chatter_when_stderr_is_not_a_terminal() {
 
 // ------------------------------------------------------------------ check
 
+/// `pcpp check` of `gcode` against the demo scan, with a JSON report where
+/// given.
+fn check_on_demo(gcode: &Path, report: Option<&Path>) -> Output {
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let mut args = vec!["check", "--scan", s(&scan), "--gcode", s(gcode)];
+    if let Some(r) = report {
+        args.extend(["--report", s(r)]);
+    }
+    pcpp(&args)
+}
+
 #[test]
 fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     for name in ["demo-even.gcode", "demo-pcpp-guarded.gcode"] {
-        let o = pcpp(&[
-            "check",
-            "--scan",
-            s(&demo_file(demo::DEMO_SCAN_NAME)),
-            "--gcode",
-            s(&demo_file(name)),
-        ]);
+        let o = check_on_demo(&demo_file(name), None);
         assert_eq!(code(&o), 0, "{name}: {}{}", stdout(&o), stderr(&o));
         let out = stdout(&o);
         assert!(out.contains("no move comes closer than tol"), "{out}");
@@ -813,13 +818,7 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     }
     // The golden programs in the three dialects check alike.
     for dialect in DIALECTS {
-        let o = pcpp(&[
-            "check",
-            "--scan",
-            s(&demo_file(demo::DEMO_SCAN_NAME)),
-            "--gcode",
-            s(&golden_path(dialect)),
-        ]);
+        let o = check_on_demo(&golden_path(dialect), None);
         assert_eq!(code(&o), 0, "{dialect}: {}{}", stdout(&o), stderr(&o));
     }
 }
@@ -837,15 +836,7 @@ fn check_names_the_line_of_a_cutting_move() {
     )
     .unwrap();
     let report = dir.join("check.json");
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--gcode",
-        s(&g),
-        "--report",
-        s(&report),
-    ]);
+    let o = check_on_demo(&g, Some(&report));
     assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -906,15 +897,7 @@ fn check_reads_relative_inch_and_offset_programs_alike() {
         let g = dir.join(format!("{name}.gcode"));
         std::fs::write(&g, text).unwrap();
         let report = dir.join(format!("{name}.json"));
-        let o = pcpp(&[
-            "check",
-            "--scan",
-            s(&demo_file(demo::DEMO_SCAN_NAME)),
-            "--gcode",
-            s(&g),
-            "--report",
-            s(&report),
-        ]);
+        let o = check_on_demo(&g, Some(&report));
         assert_eq!(code(&o), 1, "{name}: {}{}", stdout(&o), stderr(&o));
         let v: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
         reports.push((name, v["summary"].clone()));
@@ -937,13 +920,7 @@ fn check_reads_relative_inch_and_offset_programs_alike() {
     }
     let g = dir.join("arc.gcode");
     std::fs::write(&g, "G21\nG90\nG1 X10 Y16 Z20\nG2 X20 Y16 I5 J0\n").unwrap();
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--gcode",
-        s(&g),
-    ]);
+    let o = check_on_demo(&g, None);
     assert_eq!(code(&o), 1);
     let err = stderr(&o);
     assert!(err.contains("line 4") && err.contains("arcs"), "{err}");
