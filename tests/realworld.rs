@@ -578,4 +578,14 @@ fn plan_over_a_cad_export_writes_finite_gcode() {
         .map(|l| l.split(';').next().unwrap_or(""))
         .collect();
     assert!(!code.contains("NaN") && !code.contains("inf"));
+    // Safe along every move, by the independent oracle, on the registered
+    // scan.
+    let oracle = crate::bruteforce::check_gcode(
+        &out.gcode,
+        prepared.surface.mesh(),
+        settings.nozzle.outer_diameter_mm,
+        settings.process.tolerance_mm,
+    );
+    assert_eq!(oracle.too_close, 0, "{oracle:?}");
+    assert!(oracle.min_distance_mm >= settings.process.tolerance_mm);
 }
