@@ -170,8 +170,9 @@ fn guarded_point(
     // Pushing sideways must not carry the tip off the path.
     if (t - p).truncate().length() > nozzle.outer_diameter_mm {
         t = start;
+        clear = false;
     }
-    let lift = c.rise_needed(surface, t);
+    let lift = if clear { 0.0 } else { c.rise_needed(surface, t) };
     if lift > 0.0 {
         t.z += lift;
         out.lifted.push((j, lift));
