@@ -43,6 +43,10 @@ const _: () = assert!(PAGE_MAX_SCAN_BYTES < MAX_SCAN_BYTES);
 /// is 281 MiB), so ten million would not fit a tab's 4 GiB.
 pub const PAGE_MAX_SAMPLES: usize = 1_000_000;
 
+/// Most moves of a checked G-code program the page draws in the 3-D view
+/// (24 bytes each, twice: in wasm memory and in WebGL's buffer).
+pub const PAGE_MAX_DRAWN_MOVES: usize = 1_000_000;
+
 /// A core error as the JS `Error` the page shows: its message names the
 /// file, line or point at fault.
 fn js_err(e: impl std::fmt::Display) -> JsError {
@@ -1099,8 +1103,12 @@ impl Session {
     /// another tool's) against this scan ([`job::check_gcode`]): every
     /// straight move along its length, the nozzle `nozzle` (`{inner_diameter_mm,
     /// outer_diameter_mm}`) kept `tol_mm` from the surface. Returns the
-    /// `job::GcodeCheck` with `clear` (no move closer than tol); a file that
-    /// cannot be read (an arc, a bad number, ...) is an `Error` of kind
+    /// `job::GcodeCheck` with `clear` (no move closer than tol) and, for
+    /// the view, up to [`PAGE_MAX_DRAWN_MOVES`] of the moves checked:
+    /// `moves` (xyz from and to, Float32Array) and `kinds` (0 feed, 1 rapid,
+    /// 2 listed as too close; only the check's first
+    /// [`crate::motion::MAX_LISTED`] are known), or null for more. A file
+    /// that cannot be read (an arc, a bad number, ...) is an `Error` of kind
     /// `gcode` naming the file and the line, one past the page's size limit
     /// of kind `limit`.
     #[wasm_bindgen(js_name = checkGcode)]
@@ -1134,11 +1142,32 @@ impl Session {
         })?;
         let check = job::check_gcode(&self.scan, text, name, &nozzle, tol_mm).map_err(core_err)?;
         let out = to_js(&check)?;
-        set(
-            out.unchecked_ref(),
-            "clear",
-            &JsValue::from_bool(check.is_clear()),
-        );
+        let o: &js_sys::Object = out.unchecked_ref();
+        set(o, "clear", &JsValue::from_bool(check.is_clear()));
+        let (mut moves, mut kinds) = (JsValue::NULL, JsValue::NULL);
+        if check.summary.moves <= PAGE_MAX_DRAWN_MOVES {
+            // Read once more for the drawing: the check keeps no moves, and
+            // its touching moves are indices into this same list.
+            let program = crate::gcode::read_gcode(text, name).map_err(|e| core_err(e.into()))?;
+            let mut xyz = Vec::with_capacity(6 * program.moves.len());
+            let mut k: Vec<u8> = program.moves.iter().map(|m| u8::from(m.rapid)).collect();
+            for m in &program.moves {
+                xyz.extend(
+                    [m.from, m.to]
+                        .iter()
+                        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]),
+                );
+            }
+            for t in &check.summary.touching {
+                if let Some(c) = k.get_mut(t.index) {
+                    *c = 2;
+                }
+            }
+            moves = js_sys::Float32Array::from(&xyz[..]).into();
+            kinds = js_sys::Uint8Array::from(&k[..]).into();
+        }
+        set(o, "moves", &moves);
+        set(o, "kinds", &kinds);
         Ok(out)
     }
 
@@ -1210,6 +1239,13 @@ impl Viewer {
                 defects,
             })
             .map_err(|e| JsError::new(&e))
+    }
+
+    /// A checked G-code program's moves in place of the paths (`moves` and
+    /// `kinds` of [`Session::check_gcode`]); a plan's paths replace them.
+    #[wasm_bindgen(js_name = setMoves)]
+    pub fn set_moves(&mut self, moves: &[f32], kinds: &[u8]) -> Result<(), JsError> {
+        self.r.set_moves(moves, kinds).map_err(|e| JsError::new(&e))
     }
 
     /// Draws the paths moved by (dx, dy, dz) mm, printer frame: while the

@@ -878,6 +878,12 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
         "G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n";
     let bad = check(cut.as_bytes(), "cut.gcode").unwrap_or_else(|e| panic!("{e:?}"));
     assert_eq!(get(&bad, "clear"), JsValue::FALSE);
+    // For the view: the moves placed in the frame (the first travel's
+    // start is unknown), feed, too close, rapid.
+    let kinds = js_sys::Uint8Array::new(&get(&bad, "kinds")).to_vec();
+    assert_eq!(kinds, [0, 2, 1]);
+    let moves = js_sys::Float32Array::new(&get(&bad, "moves")).to_vec();
+    assert_eq!(moves[6..12], [15.4, 16.0, 5.603, 16.23, 16.0, 7.603]);
     let c: job::GcodeCheck = serde_wasm_bindgen::from_value(bad).unwrap();
     assert_eq!(c.summary.touching_moves, 1);
     assert_eq!(c.summary.touching[0].line, Some(4));

@@ -63,6 +63,9 @@ const state = {
   lastComparison: null,
   demoParts: new Map(), // demo part name -> its drawing and settings (wasm demoPart)
   checkId: 0, // the G-code check in flight
+  checking: null, // {id, name} of the check in flight
+  checkMoves: null, // the last checked program's {moves, kinds} for the view
+  viewShowsCheck: false, // the view draws those moves instead of the plan
   interacting: false, // a drag or slider in progress: skip the comparison
   info: null, // the scan as the worker read it
   viewer: null,
@@ -1013,6 +1016,7 @@ function showPlan(plan) {
     } catch (e) {
       showError('Could not draw the paths', e.message);
     }
+    setViewShowsCheck(false);
     updateDragOffset();
     requestDraw();
   }
@@ -1278,6 +1282,8 @@ function checkGcodeFile(file) {
   const nozzle = { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) };
   const tol = num(s.process.tol);
   state.checking = { id, name: file.name };
+  state.checkMoves = null;
+  $('check-draw').hidden = true;
   $('check-panel').hidden = false;
   $('check-verdict').textContent = `checking ${file.name}…`;
   $('check-verdict').className = 'verdict';
@@ -1286,6 +1292,9 @@ function checkGcodeFile(file) {
 }
 
 function showCheckError(name, message) {
+  state.checkMoves = null;
+  $('check-draw').hidden = true;
+  if (state.viewShowsCheck) drawCheckedMoves(false);
   $('check-panel').hidden = false;
   $('check-verdict').textContent = `could not check ${name}`;
   $('check-verdict').className = 'verdict bad';
@@ -1366,9 +1375,41 @@ function onCheck(m) {
     details.push(ul);
   }
   $('check-details').replaceChildren(...details);
+  state.checkMoves = c.moves ? { moves: c.moves, kinds: c.kinds } : null;
+  $('check-draw').hidden = !state.checkMoves;
+  if (state.viewShowsCheck) drawCheckedMoves(!!state.checkMoves);
+}
+
+// The view draws the checked program's moves (on) or the plan's paths.
+function drawCheckedMoves(on) {
+  if (!state.viewer) return;
+  try {
+    if (on && state.checkMoves) {
+      state.viewer.setMoves(state.checkMoves.moves, state.checkMoves.kinds);
+    } else if (state.lastPlan) {
+      const v = state.lastPlan.view;
+      state.viewer.setPathArrays(v.pieces, v.ta, v.tool, v.defects);
+      updateDragOffset();
+    } else {
+      state.viewer.setPathArrays(new Uint32Array(0), new Float32Array(0), new Float32Array(0), new Uint8Array(0));
+    }
+  } catch (e) {
+    showError('Could not draw the moves', e.message);
+    return;
+  }
+  setViewShowsCheck(on && !!state.checkMoves);
+  requestDraw();
+}
+
+function setViewShowsCheck(on) {
+  state.viewShowsCheck = on;
+  const b = $('check-draw');
+  b.setAttribute('aria-pressed', on ? 'true' : 'false');
+  b.textContent = on ? 'Back to the plan in the 3-D view' : 'Draw in the 3-D view';
 }
 
 function bindFiles() {
+  $('check-draw').addEventListener('click', () => drawCheckedMoves(!state.viewShowsCheck));
   const gcodeInput = $('gcode-input');
   gcodeInput.addEventListener('change', () => {
     const f = gcodeInput.files && gcodeInput.files[0];

@@ -146,7 +146,8 @@ async function check(m) {
     await planning;
     if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
     const result = session.checkGcode(bytes, name, m.nozzle, m.tol);
-    post({ type: 'check', id, name, scan: session.info().name, result });
+    const transfer = result.moves ? [result.moves.buffer, result.kinds.buffer] : [];
+    post({ type: 'check', id, name, scan: session.info().name, result }, transfer);
   } catch (err) {
     post({ type: 'check', id, name, ...errorOf(err), error: errorOf(err).message });
   }

@@ -192,6 +192,18 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
   assert.match(verdict, /^clear: none of the \d+ moves comes closer than tol; demo-test-part-lines-even\.gcode against demo-test-part\.ply \(nozzle outer diameter 0\.908 mm, tol 0\.1 mm\)$/);
   assert.match(await page.textContent('#check-min'), /^minimum clearance 0\.1\d\d mm at line \d+ \(/);
   assert.equal(await page.$('#check-touching'), null);
+  // Its moves drawn in the 3-D view in place of the plan's paths (feed
+  // moves light, no defect colours), and back.
+  const planPx = await viewPixels(page);
+  await page.click('#check-draw');
+  await page.waitForFunction(() => document.getElementById('check-draw').getAttribute('aria-pressed') === 'true');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const movesPx = await viewPixels(page);
+  assert.ok(movesPx.good < 20 && movesPx.ta > planPx.ta && movesPx.mesh > 1000, `${JSON.stringify(planPx)} / ${JSON.stringify(movesPx)}`);
+  await page.click('#check-draw');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const backPx = await viewPixels(page);
+  assert.ok(backPx.good > 200, JSON.stringify(backPx));
 
   // Down beside a 2 mm wall of the test part, then up across its corner.
   const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
