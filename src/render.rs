@@ -25,6 +25,10 @@ pub const HOLE_MARKER: [f32; 3] = [1.0, 0.85, 0.1];
 pub const PRINTER_MARKER: [f32; 3] = [0.9, 0.2, 0.9];
 /// Points picked on the mesh (scan points Sr chosen by clicking): cyan.
 pub const PICK_MARKER: [f32; 3] = [0.1, 0.9, 0.95];
+/// A checked G-code program's moves: feed moves light, rapid moves dim,
+/// moves that come closer than tol in the contact colour.
+pub const FEED_MOVE: [f32; 3] = SURFACE_PATH;
+pub const RAPID_MOVE: [f32; 3] = [0.45, 0.5, 0.6];
 
 /// Defect colours (the legend): contact red, flattening orange,
 /// floating blue, good green.
@@ -650,6 +654,30 @@ impl Renderer {
             start = hi;
         }
         self.set_lines(&pos, &col)
+    }
+
+    /// A G-code program's straight moves in place of the paths: `moves`
+    /// holds xyz from and to per move (6 floats), `kinds` one code per
+    /// move (0 feed, 1 rapid, 2 too close to the surface).
+    pub fn set_moves(&mut self, moves: &[f32], kinds: &[u8]) -> Result<(), String> {
+        if moves.len() != 6 * kinds.len() {
+            return Err(format!(
+                "move arrays disagree: {} coordinates for {} moves",
+                moves.len(),
+                kinds.len()
+            ));
+        }
+        let mut col: Vec<f32> = Vec::with_capacity(moves.len());
+        for &k in kinds {
+            let c = match k {
+                0 => FEED_MOVE,
+                1 => RAPID_MOVE,
+                _ => defect_rgb(Defect::Contact),
+            };
+            col.extend(c);
+            col.extend(c);
+        }
+        self.set_lines(moves, &col)
     }
 
     fn set_lines(&mut self, pos: &[f32], col: &[f32]) -> Result<(), String> {

@@ -11,9 +11,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use wasm_bindgen::prelude::*;
 
-use crate::demo::{self, antennas, test_part};
+use crate::demo::{self, antennas, parts::DemoPart, test_part};
 use crate::fiducials::{find_fiducials, Fiducial};
-use crate::gcode::MachineProfile;
+use crate::gcode::{MachineProfile, MAX_GCODE_BYTES};
 use crate::job::{self, InputFile, JobSettings, PreparedScan, RegistrationSettings};
 use crate::mesh::{ImportOptions, ImportedMesh, MAX_SCAN_BYTES};
 use crate::params::Nozzle;
@@ -43,6 +43,10 @@ const _: () = assert!(PAGE_MAX_SCAN_BYTES < MAX_SCAN_BYTES);
 /// is 281 MiB), so ten million would not fit a tab's 4 GiB.
 pub const PAGE_MAX_SAMPLES: usize = 1_000_000;
 
+/// Most moves of a checked G-code program the page draws in the 3-D view
+/// (24 bytes each, twice: in wasm memory and in WebGL's buffer).
+pub const PAGE_MAX_DRAWN_MOVES: usize = 1_000_000;
+
 /// A core error as the JS `Error` the page shows: its message names the
 /// file, line or point at fault.
 fn js_err(e: impl std::fmt::Display) -> JsError {
@@ -50,8 +54,12 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 }
 
 /// A core error as a JS `Error` with a `kind` naming the stage that failed
-/// (`mesh`, `svg`, `registration` or `other`): the page drops a file whose
-/// bytes could not be read but keeps one that only failed to register.
+/// (`mesh`, `svg`, `registration`, `gcode` for a G-code file that could not
+/// be read, `touching` for G-code refused by the motion check, or `other`):
+/// the page drops a file whose bytes could not be read but keeps one that
+/// only failed to register. A `touching` error also carries `touching`, the
+/// check's summary (`motion::MotionSummary`: the first touching moves with
+/// their G-code lines).
 fn core_err(e: crate::Error) -> JsValue {
     use crate::Error;
     // `matches!` rather than a `match`, so a variant added to the core later
@@ -62,10 +70,21 @@ fn core_err(e: crate::Error) -> JsValue {
         "svg"
     } else if matches!(e, Error::Registration(_)) {
         "registration"
+    } else if matches!(e, Error::GcodeRead(_)) {
+        "gcode"
+    } else if matches!(e, Error::Touching(_)) {
+        "touching"
     } else {
         "other"
     };
-    kind_err(kind, &e.to_string())
+    let err = kind_err(kind, &e.to_string());
+    if let Error::Touching(t) = &e {
+        // Without it the message alone still names the first moves.
+        if let Ok(summary) = to_js(&t.summary) {
+            let _ = js_sys::Reflect::set(&err, &"touching".into(), &summary);
+        }
+    }
+    err
 }
 
 /// A JS `Error` with `message` and a `kind` the page branches on (`limit`
@@ -86,7 +105,8 @@ fn set(obj: &js_sys::Object, key: &str, value: &JsValue) {
 const MIB: f64 = (1u64 << 20) as f64;
 
 /// The page's limits, for its messages and the README: `{scan_bytes,
-/// svg_bytes, samples, core_scan_bytes, core_samples_per_subpath}`.
+/// svg_bytes, samples, core_scan_bytes, core_samples_per_subpath,
+/// gcode_bytes}` (the last: the largest G-code file the reader checks).
 #[wasm_bindgen(js_name = pageLimits)]
 pub fn page_limits() -> JsValue {
     let o = js_sys::Object::new();
@@ -95,6 +115,7 @@ pub fn page_limits() -> JsValue {
     set(&o, "samples", &(PAGE_MAX_SAMPLES as f64).into());
     set(&o, "core_scan_bytes", &(MAX_SCAN_BYTES as f64).into());
     set(&o, "core_samples_per_subpath", &(MAX_SAMPLES as f64).into());
+    set(&o, "gcode_bytes", &(MAX_GCODE_BYTES as f64).into());
     o.into()
 }
 
@@ -197,40 +218,89 @@ pub fn dialects() -> Vec<String> {
         .collect()
 }
 
-/// The demo scan (the paper's test part) as the binary PLY a user could load.
-#[wasm_bindgen(js_name = demoScan)]
-pub fn demo_scan() -> Vec<u8> {
-    demo::demo_scan_bytes()
+/// The planners' names, the comparison's order ([`PlannerKind::ALL`]).
+#[wasm_bindgen]
+pub fn planners() -> Vec<String> {
+    PlannerKind::ALL
+        .iter()
+        .map(|k| k.name().to_string())
+        .collect()
 }
 
-#[wasm_bindgen(js_name = demoScanName)]
-pub fn demo_scan_name() -> String {
-    demo::DEMO_SCAN_NAME.to_string()
+/// A comparison row's `min_clearance_mm` is `null` when every print move
+/// clears by more than tol plus this (mm,
+/// [`pipeline::CLEARANCE_CAP_ABOVE_TOL_MM`]): the table shows `>` that sum.
+#[wasm_bindgen(js_name = clearanceCapAboveTolMm)]
+pub fn clearance_cap_above_tol_mm() -> f64 {
+    pipeline::CLEARANCE_CAP_ABOVE_TOL_MM
 }
 
-/// The demo's drawn line paths, as SVG text.
-#[wasm_bindgen(js_name = demoPathSvg)]
-pub fn demo_path_svg() -> String {
-    test_part::test_part_svg()
+/// A built-in part by name, or an error listing the names.
+fn demo_part_named(name: &str) -> Result<DemoPart, JsError> {
+    name.parse::<DemoPart>().map_err(|e| JsError::new(&e))
 }
 
-#[wasm_bindgen(js_name = demoPathName)]
-pub fn demo_path_name() -> String {
-    demo::DEMO_PATH_NAME.to_string()
+/// The generated demo parts for the page's menu: `[{name, description}]`,
+/// the test part first.
+#[wasm_bindgen(js_name = demoParts)]
+pub fn demo_parts() -> Result<JsValue, JsError> {
+    #[derive(Serialize)]
+    struct Entry {
+        name: &'static str,
+        description: &'static str,
+    }
+    let list: Vec<Entry> = DemoPart::ALL
+        .iter()
+        .map(|p| Entry {
+            name: p.name(),
+            description: p.description(),
+        })
+        .collect();
+    to_js(&list)
 }
 
-/// The demo's settings: its placement, and auto fiducials against the
-/// part's three holes (already in the printer frame, so G is ~identity).
-#[wasm_bindgen(js_name = demoSettings)]
-pub fn demo_settings() -> Result<JsValue, JsError> {
-    let mut s = JobSettings::default();
-    s.plan.placement = test_part::placement();
-    s.registration = RegistrationSettings {
-        fiducials: job::FiducialSource::Auto,
-        printer_points: test_part::FIDUCIALS_MM.to_vec(),
-        ..RegistrationSettings::default()
-    };
-    to_js(&s)
+/// A demo part's drawing and settings, as `pcpp demo --part NAME` plans
+/// it: `{name, description, scan_name, path_name, svg, settings}`, where
+/// `settings` (JobSettings) has the part's placement and, for the test
+/// part, auto fiducials against its three holes (the other parts have none:
+/// they are generated in the printer frame). Its scan's bytes come from
+/// [`demo_part_scan`] (the worker makes them with [`ScanBuffer::demo_part`]).
+#[wasm_bindgen(js_name = demoPart)]
+pub fn demo_part(name: &str) -> Result<JsValue, JsError> {
+    #[derive(Serialize)]
+    struct PartView {
+        name: &'static str,
+        description: &'static str,
+        scan_name: String,
+        path_name: String,
+        svg: String,
+        settings: JobSettings,
+    }
+    let part = demo_part_named(name)?;
+    let mut settings = JobSettings::default();
+    settings.plan.placement = part.placement();
+    if part == DemoPart::TestPart {
+        settings.registration = RegistrationSettings {
+            fiducials: job::FiducialSource::Auto,
+            printer_points: test_part::FIDUCIALS_MM.to_vec(),
+            ..RegistrationSettings::default()
+        };
+    }
+    to_js(&PartView {
+        name: part.name(),
+        description: part.description(),
+        scan_name: part.scan_name(),
+        path_name: part.path_name(),
+        svg: part.svg(),
+        settings,
+    })
+}
+
+/// A demo part's scan as the binary PLY a user could load (what
+/// `pcpp demo --part NAME` writes).
+#[wasm_bindgen(js_name = demoPartScan)]
+pub fn demo_part_scan(name: &str) -> Result<Vec<u8>, JsError> {
+    Ok(demo::to_binary_ply(&demo_part_named(name)?.mesh()))
 }
 
 /// Points typed as `x,y,z; x,y,z` or one per line (the registration's
@@ -442,15 +512,13 @@ impl ScanBuffer {
 
     /// The demo scan (the paper's test part as binary PLY), already full.
     pub fn demo() -> ScanBuffer {
-        let bytes = demo::demo_scan_bytes();
-        let mut sha256 = Sha256::new();
-        sha256.update(&bytes);
-        ScanBuffer {
-            name: demo::DEMO_SCAN_NAME.to_string(),
-            size: bytes.len(),
-            bytes,
-            sha256,
-        }
+        ScanBuffer::full(DemoPart::TestPart)
+    }
+
+    /// A generated demo part's scan ([`demo_part_scan`]), already full.
+    #[wasm_bindgen(js_name = demoPart)]
+    pub fn demo_part(name: &str) -> Result<ScanBuffer, JsError> {
+        Ok(ScanBuffer::full(demo_part_named(name)?))
     }
 
     /// Appends the next chunk of the file.
@@ -494,6 +562,21 @@ impl ScanBuffer {
             fiducials: None,
             registration: None,
         })
+    }
+}
+
+impl ScanBuffer {
+    /// A demo part's scan as the binary PLY `pcpp demo --part` writes.
+    fn full(part: DemoPart) -> ScanBuffer {
+        let bytes = demo::to_binary_ply(&part.mesh());
+        let mut sha256 = Sha256::new();
+        sha256.update(&bytes);
+        ScanBuffer {
+            name: part.scan_name(),
+            size: bytes.len(),
+            bytes,
+            sha256,
+        }
     }
 }
 
@@ -582,6 +665,12 @@ struct PlanSummary<'a> {
     stats: crate::stats::PathStats,
     warnings: &'a [String],
     registration_rms_mm: f64,
+    /// The report's safe-motion part: the check of every move the G-code
+    /// commands, waypoints, backward moves, sideways offset.
+    motion: &'a job::MotionReport,
+    /// Its line in the G-code header (`safe motion: ...`; it starts with
+    /// `WARNING` when the risk was accepted for touching moves).
+    motion_line: String,
 }
 
 /// The page's code for a defect (the view's and the plot's colour index).
@@ -724,6 +813,29 @@ fn plan_arrays(plan: &Plan) -> js_sys::Object {
     set(&o, "kappa", &js_sys::Float32Array::from(&kappa[..]).into());
     set(&o, "error", &js_sys::Float32Array::from(&error[..]).into());
     o
+}
+
+/// One planner's per-point errors and defect codes for the plot beside the
+/// others: `{planner, error, defects}` in the order of [`plan_arrays`] (the
+/// planners share the surface path, so its slope and curvature arrays hold
+/// for every planner).
+fn plan_series(plan: &Plan) -> Result<js_sys::Object, JsError> {
+    let n: usize = plan.pieces.iter().map(|p| p.quality.len()).sum();
+    let mut defects = Vec::with_capacity(n);
+    let mut error = Vec::with_capacity(n);
+    for q in plan.pieces.iter().flat_map(|p| &p.quality) {
+        defects.push(defect_code(q.defect));
+        error.push(q.error_mm.map_or(f32::NAN, |e| e as f32));
+    }
+    let o = js_sys::Object::new();
+    set(&o, "planner", &to_js(&plan.planner)?);
+    set(&o, "error", &js_sys::Float32Array::from(&error[..]).into());
+    set(
+        &o,
+        "defects",
+        &js_sys::Uint8Array::from(&defects[..]).into(),
+    );
+    Ok(o)
 }
 
 #[wasm_bindgen]
@@ -871,10 +983,19 @@ impl Session {
     /// [`Session::plan`]: the same G-code and report bytes as
     /// [`job::run_on`] and the CLI), projecting the drawing once (reused
     /// while the nozzle and placement stay) and, when `compare`, also
-    /// plans the other three planners on that one surface path. Returns
+    /// plans every other planner on that one surface path. Returns
     /// `{gcode, report}` (UTF-8 bytes, Uint8Array), `summary` (planner,
-    /// settings, quality, stats, warnings, registration RMS), `view` (see
-    /// [`plan_arrays`]) and `comparison` (`[{planner, quality}]` or null).
+    /// settings, quality, stats, warnings, registration RMS, the report's
+    /// `motion` and its header line `motion_line`), `view` (see
+    /// [`plan_arrays`]), `comparison` (`[job::ComparisonRow]`, every
+    /// planner, or null) and `series` (per planner, see [`plan_series`],
+    /// or null).
+    ///
+    /// G-code whose moves come closer to the surface than tol is refused
+    /// unless `accept_risk` (an `Error` of kind `touching`, see
+    /// [`core_err`]); that error also carries the `comparison` and `series`
+    /// when they were asked for, so the page can compare the planners on the
+    /// settings that failed.
     #[wasm_bindgen(js_name = planLive)]
     pub fn plan_live(
         &mut self,
@@ -898,37 +1019,56 @@ impl Session {
             pipeline::plan_surface_path(surface, sp, k, &settings.nozzle, &settings.process)
         };
         let plan = plan_with(settings.planner);
-        let comparison = if compare {
-            let rows: Vec<job::ComparisonRow> = PlannerKind::ALL
-                .iter()
-                .map(|&k| {
-                    if k == settings.planner {
-                        job::ComparisonRow::of(&plan)
-                    } else {
-                        job::ComparisonRow::of(&plan_with(k))
-                    }
-                })
-                .collect();
-            to_js(&rows)?
+        let (comparison, series) = if compare {
+            let rows = js_sys::Array::new();
+            let series = js_sys::Array::new();
+            let mut table = Vec::with_capacity(PlannerKind::ALL.len());
+            for &k in &PlannerKind::ALL {
+                // One planner at a time: its plan is dropped before the next.
+                let other;
+                let p = if k == settings.planner {
+                    &plan
+                } else {
+                    other = plan_with(k);
+                    &other
+                };
+                table.push(job::ComparisonRow::of(p));
+                series.push(&plan_series(p)?.into());
+            }
+            for r in &table {
+                rows.push(&to_js(r)?);
+            }
+            (JsValue::from(rows), JsValue::from(series))
         } else {
-            JsValue::NULL
+            (JsValue::NULL, JsValue::NULL)
         };
         let path = self
             .path
             .as_ref()
             .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
         // The core's own refusal and writer, so the bytes are the CLI's.
-        job::refuse_uncleared(&plan, accept_risk).map_err(core_err)?;
-        let (report, gcode) = job::write_outputs(
-            &self.scan,
-            &path.file,
-            &path.drawn.notes,
-            &plan,
-            &settings,
-            &profile,
-            accept_risk,
-        )
-        .map_err(core_err)?;
+        let written = job::refuse_uncleared(&plan, accept_risk).and_then(|()| {
+            job::write_outputs(
+                &self.scan,
+                &path.file,
+                &path.drawn.notes,
+                &plan,
+                &settings,
+                &profile,
+                accept_risk,
+            )
+        });
+        let (report, gcode) = match written {
+            Ok(w) => w,
+            Err(e) => {
+                let err = core_err(e);
+                if compare {
+                    let _ = js_sys::Reflect::set(&err, &"comparison".into(), &comparison);
+                    let _ = js_sys::Reflect::set(&err, &"series".into(), &series);
+                }
+                return Err(err);
+            }
+        };
         let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
         report_json.push(b'\n');
         let out = js_sys::Object::new();
@@ -949,14 +1089,90 @@ impl Session {
             stats: plan.stats,
             warnings: &report.warnings,
             registration_rms_mm: report.registration.rms_mm,
+            motion: &report.motion,
+            motion_line: report.motion.summary_line(),
         };
         set(&out, "summary", &to_js(&summary)?);
         set(&out, "view", &plan_arrays(&plan).into());
         set(&out, "comparison", &comparison);
+        set(&out, "series", &series);
         Ok(out.into())
     }
 
-    /// The four planners' quality summaries side by side ([`job::compare_on`]).
+    /// Checks a G-code file (`bytes`, UTF-8 text, any program: ours or
+    /// another tool's) against this scan ([`job::check_gcode`]): every
+    /// straight move along its length, the nozzle `nozzle` (`{inner_diameter_mm,
+    /// outer_diameter_mm}`) kept `tol_mm` from the surface. Returns the
+    /// `job::GcodeCheck` with `clear` (no move closer than tol) and, for
+    /// the view, up to [`PAGE_MAX_DRAWN_MOVES`] of the moves checked:
+    /// `moves` (xyz from and to, Float32Array) and `kinds` (0 feed, 1 rapid,
+    /// 2 listed as too close; only the check's first
+    /// [`crate::motion::MAX_LISTED`] are known), or null for more. A file
+    /// that cannot be read (an arc, a bad number, ...) is an `Error` of kind
+    /// `gcode` naming the file and the line, one past the page's size limit
+    /// of kind `limit`.
+    #[wasm_bindgen(js_name = checkGcode)]
+    pub fn check_gcode(
+        &self,
+        bytes: &[u8],
+        name: &str,
+        nozzle: JsValue,
+        tol_mm: f64,
+    ) -> Result<JsValue, JsValue> {
+        let nozzle: Nozzle = from_js("nozzle", nozzle)?;
+        if bytes.len() > MAX_GCODE_BYTES {
+            return Err(kind_err(
+                "limit",
+                &format!(
+                    "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check \
+                     reads; split the program and check each part",
+                    bytes.len() as f64 / MIB,
+                    MAX_GCODE_BYTES >> 20
+                ),
+            ));
+        }
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            kind_err(
+                "gcode",
+                &format!(
+                    "{name}: not UTF-8 text (byte {}); is it a G-code program?",
+                    e.valid_up_to()
+                ),
+            )
+        })?;
+        let check = job::check_gcode(&self.scan, text, name, &nozzle, tol_mm).map_err(core_err)?;
+        let out = to_js(&check)?;
+        let o: &js_sys::Object = out.unchecked_ref();
+        set(o, "clear", &JsValue::from_bool(check.is_clear()));
+        let (mut moves, mut kinds) = (JsValue::NULL, JsValue::NULL);
+        if check.summary.moves <= PAGE_MAX_DRAWN_MOVES {
+            // Read once more for the drawing: the check keeps no moves, and
+            // its touching moves are indices into this same list.
+            let program = crate::gcode::read_gcode(text, name).map_err(|e| core_err(e.into()))?;
+            let mut xyz = Vec::with_capacity(6 * program.moves.len());
+            let mut k: Vec<u8> = program.moves.iter().map(|m| u8::from(m.rapid)).collect();
+            for m in &program.moves {
+                xyz.extend(
+                    [m.from, m.to]
+                        .iter()
+                        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]),
+                );
+            }
+            for t in &check.summary.touching {
+                if let Some(c) = k.get_mut(t.index) {
+                    *c = 2;
+                }
+            }
+            moves = js_sys::Float32Array::from(&xyz[..]).into();
+            kinds = js_sys::Uint8Array::from(&k[..]).into();
+        }
+        set(o, "moves", &moves);
+        set(o, "kinds", &kinds);
+        Ok(out)
+    }
+
+    /// Every planner's quality and motion summaries side by side
+    /// ([`job::compare_on`]).
     pub fn compare(
         &self,
         svg: &[u8],
@@ -1023,6 +1239,13 @@ impl Viewer {
                 defects,
             })
             .map_err(|e| JsError::new(&e))
+    }
+
+    /// A checked G-code program's moves in place of the paths (`moves` and
+    /// `kinds` of [`Session::check_gcode`]); a plan's paths replace them.
+    #[wasm_bindgen(js_name = setMoves)]
+    pub fn set_moves(&mut self, moves: &[f32], kinds: &[u8]) -> Result<(), JsError> {
+        self.r.set_moves(moves, kinds).map_err(|e| JsError::new(&e))
     }
 
     /// Draws the paths moved by (dx, dy, dz) mm, printer frame: while the

@@ -6,7 +6,7 @@
 //! `pcpp::wasm::Session` adapter.
 #![cfg(target_arch = "wasm32")]
 
-use pcpp::demo::{self, antennas, test_part};
+use pcpp::demo::{self, antennas, parts::DemoPart, test_part};
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{self, FiducialSource, JobSettings, RegistrationSettings};
 use pcpp::mesh::{import_mesh, ImportOptions, MeshFormat, ScanUnits};
@@ -557,9 +557,35 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
                 get(&summary, "planner").as_string().unwrap(),
                 plan.planner.name()
             );
-            // The comparison comes in the same call, on the same surface path.
+            // The report's safe-motion part and its G-code header line.
+            let motion: job::MotionReport =
+                serde_wasm_bindgen::from_value(get(&summary, "motion")).unwrap();
+            assert_eq!(motion, want.report.motion);
+            assert_eq!(
+                get(&summary, "motion_line").as_string().unwrap(),
+                want.report.motion.summary_line()
+            );
+            // The comparison comes in the same call, on the same surface path,
+            // with every planner's per-point errors for the plot.
             let comparison = get(&out, "comparison");
+            let series = get(&out, "series");
             if step == 0 {
+                let series = js_sys::Array::from(&series);
+                assert_eq!(series.length() as usize, PlannerKind::ALL.len());
+                let errors = js_sys::Float32Array::new(&get(&view, "error")).to_vec();
+                for (sr, k) in series.iter().zip(PlannerKind::ALL) {
+                    assert_eq!(get(&sr, "planner").as_string().unwrap(), k.name());
+                    let e = js_sys::Float32Array::new(&get(&sr, "error")).to_vec();
+                    let d = js_sys::Uint8Array::new(&get(&sr, "defects")).to_vec();
+                    assert_eq!((e.len(), d.len()), (errors.len(), errors.len()));
+                    if k == plan.planner {
+                        assert_eq!(d, defects);
+                        assert!(e
+                            .iter()
+                            .zip(&errors)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()));
+                    }
+                }
                 let rows: Vec<serde_json::Value> =
                     serde_wasm_bindgen::from_value(comparison).unwrap();
                 let want_rows =
@@ -580,6 +606,7 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
                 }
             } else {
                 assert!(comparison.is_null());
+                assert!(series.is_null());
             }
         }
     }
@@ -699,4 +726,195 @@ fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
         message.contains("samples needed") && message.contains("10000000"),
         "{message}"
     );
+}
+
+// ---- safe motion, the G-code check and the demo parts in the page ----
+
+/// A demo part's session as the worker makes it (ScanBuffer.demoPart, then
+/// the staged import), with the part's drawing set, and its page settings.
+fn demo_part_session(name: &str) -> (pcpp::wasm::Session, JobSettings) {
+    let part = pcpp::wasm::demo_part(name).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let settings: JobSettings = serde_wasm_bindgen::from_value(get(&part, "settings")).unwrap();
+    let buf = pcpp::wasm::ScanBuffer::demo_part(name)
+        .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let mut imp = buf
+        .import_scan(js(&settings.scan))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    imp.register(js(&settings.registration))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = imp.index().unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = get(&part, "svg").as_string().unwrap();
+    let path_name = get(&part, "path_name").as_string().unwrap();
+    session
+        .set_path(svg.as_bytes(), &path_name)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    (session, settings)
+}
+
+#[wasm_bindgen_test]
+fn demo_parts_load_as_the_cli_makes_them() {
+    let list: Vec<serde_json::Value> =
+        serde_wasm_bindgen::from_value(pcpp::wasm::demo_parts().unwrap()).unwrap();
+    let names: Vec<&str> = list.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    let want: Vec<&str> = DemoPart::ALL.iter().map(|p| p.name()).collect();
+    assert_eq!(names, want);
+    for part in DemoPart::ALL {
+        let view =
+            pcpp::wasm::demo_part(part.name()).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        assert_eq!(get(&view, "svg").as_string().unwrap(), part.svg());
+        assert_eq!(
+            get(&view, "scan_name").as_string().unwrap(),
+            part.scan_name()
+        );
+        let settings: JobSettings = serde_wasm_bindgen::from_value(get(&view, "settings")).unwrap();
+        assert_eq!(settings.plan.placement, part.placement());
+        assert_eq!(settings.plan.planner, PlannerKind::Even);
+        let auto = settings.registration.fiducials == FiducialSource::Auto;
+        assert_eq!(auto, part == DemoPart::TestPart, "{part}");
+        let bytes = pcpp::wasm::demo_part_scan(part.name())
+            .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        assert_eq!(bytes, demo::to_binary_ply(&part.mesh()));
+        let buf = pcpp::wasm::ScanBuffer::demo_part(part.name())
+            .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        assert_eq!(buf.received(), bytes.len());
+    }
+    assert_eq!(
+        pcpp::wasm::ScanBuffer::demo().received(),
+        demo::demo_scan_bytes().len()
+    );
+    let err = JsValue::from(pcpp::wasm::demo_part("teapot").err().unwrap());
+    let (message, _) = message_and_kind(&err);
+    assert!(
+        message.contains("unknown demo part 'teapot'") && message.contains("stepped-block"),
+        "{message}"
+    );
+    assert_eq!(
+        pcpp::wasm::planners(),
+        PlannerKind::ALL
+            .iter()
+            .map(|k| k.name().to_string())
+            .collect::<Vec<_>>()
+    );
+}
+
+#[wasm_bindgen_test]
+fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
+    let (mut session, settings) = demo_part_session("stepped-block");
+    let mut plan = settings.plan;
+    plan.planner = PlannerKind::Slope;
+    let err = session
+        .plan_live(js(&plan), "marlin", false, None, true)
+        .expect_err("slope runs into the steps' walls");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "touching");
+    assert!(
+        message.contains("of planner slope") && message.contains("line "),
+        "{message}"
+    );
+    let touching: pcpp::motion::MotionSummary =
+        serde_wasm_bindgen::from_value(get(&err, "touching")).unwrap();
+    assert!(touching.touching_moves > 0);
+    let first = &touching.touching[0];
+    assert!(
+        message.contains(&format!("line {}: the move", first.line.unwrap())),
+        "{message}"
+    );
+    // The planners were compared on the settings that failed.
+    let rows: Vec<job::ComparisonRow> =
+        serde_wasm_bindgen::from_value(get(&err, "comparison")).unwrap();
+    assert_eq!(rows.len(), PlannerKind::ALL.len());
+    let slope = rows
+        .iter()
+        .find(|r| r.planner == PlannerKind::Slope)
+        .unwrap();
+    assert!(slope.motion.touching_moves > 0);
+    for r in rows.iter().filter(|r| r.planner.is_guarded()) {
+        assert_eq!(r.motion.touching_moves, 0, "{:?}", r.planner);
+    }
+    // Without the comparison, none is attached.
+    let err = session
+        .plan_live(js(&plan), "marlin", false, None, false)
+        .err()
+        .unwrap();
+    assert!(get(&err, "comparison").is_undefined());
+
+    // Accepted: written, and said so in the summary and the G-code header.
+    let out = session
+        .plan_live(js(&plan), "marlin", true, None, false)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let summary = get(&out, "summary");
+    let motion: job::MotionReport =
+        serde_wasm_bindgen::from_value(get(&summary, "motion")).unwrap();
+    assert!(motion.risk_accepted);
+    assert_eq!(motion.program.touching_moves, touching.touching_moves);
+    let line = get(&summary, "motion_line").as_string().unwrap();
+    assert!(line.starts_with("WARNING: "), "{line}");
+    assert!(bytes_text(&get(&out, "gcode")).contains(&format!("; safe motion: {line}\n")));
+
+    // The default planner clears the steps.
+    let out = session
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let motion: job::MotionReport =
+        serde_wasm_bindgen::from_value(get(&get(&out, "summary"), "motion")).unwrap();
+    assert!(!motion.risk_accepted);
+    assert_eq!(motion.program.touching_moves, 0);
+}
+
+#[wasm_bindgen_test]
+fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
+    let settings = golden_settings();
+    let session = staged_session(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
+    let nozzle = js(&settings.plan.nozzle);
+    let tol = settings.plan.process.tolerance_mm;
+    let check =
+        |text: &[u8], name: &str| session.check_gcode(text, name, js(&settings.plan.nozzle), tol);
+    // The demo's own G-code clears the part.
+    let ok = check(GOLDEN_MARLIN.as_bytes(), "demo-even.gcode").unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(get(&ok, "clear"), JsValue::TRUE);
+    let c: job::GcodeCheck = serde_wasm_bindgen::from_value(ok).unwrap();
+    assert!(c.is_clear() && c.summary.moves > 1000);
+    assert!(c.summary.min_clearance_mm.unwrap() >= tol);
+
+    // Down beside a 2 mm wall, then up across its corner: line 4.
+    let cut =
+        "G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n";
+    let bad = check(cut.as_bytes(), "cut.gcode").unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(get(&bad, "clear"), JsValue::FALSE);
+    // For the view: the moves placed in the frame (the first travel's
+    // start is unknown), feed, too close, rapid.
+    let kinds = js_sys::Uint8Array::new(&get(&bad, "kinds")).to_vec();
+    assert_eq!(kinds, [0, 2, 1]);
+    let moves = js_sys::Float32Array::new(&get(&bad, "moves")).to_vec();
+    assert_eq!(moves[6..12], [15.4, 16.0, 5.603, 16.23, 16.0, 7.603]);
+    let c: job::GcodeCheck = serde_wasm_bindgen::from_value(bad).unwrap();
+    assert_eq!(c.summary.touching_moves, 1);
+    assert_eq!(c.summary.touching[0].line, Some(4));
+    assert!(c.summary.touching[0].rise_mm > 1.0);
+
+    // What the reader cannot follow is an error naming the file and line.
+    let err = check(b"G21 G90\nG0 X10 Y10 Z30\nG2 X20 Y10 I5 J0\n", "arc.nc").unwrap_err();
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "gcode");
+    assert!(message.starts_with("arc.nc, line 3: arcs"), "{message}");
+    let err = check(b"G1 X1\n; \xff\n", "latin1.gcode").unwrap_err();
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "gcode");
+    assert!(
+        message.contains("latin1.gcode: not UTF-8 text (byte 8)"),
+        "{message}"
+    );
+    // A nozzle the core refuses, and a settings object that is not one.
+    let mut thin = settings.plan.nozzle;
+    thin.outer_diameter_mm = 0.1;
+    let err = session
+        .check_gcode(cut.as_bytes(), "cut.gcode", js(&thin), tol)
+        .unwrap_err();
+    assert!(message_and_kind(&err).0.contains("outer"), "{err:?}");
+    assert!(session
+        .check_gcode(cut.as_bytes(), "cut.gcode", JsValue::from_str("x"), tol)
+        .is_err());
+    assert!(session
+        .check_gcode(cut.as_bytes(), "cut.gcode", nozzle, -1.0)
+        .is_err());
 }

@@ -3,7 +3,7 @@
 // same `job` code as the CLI); this file moves bytes and settings around
 // and shows results. Text from files and errors is set with textContent.
 import { loadWasm, startWorker } from './engine.js';
-import { drawPlot } from './plot.js';
+import { drawPlot, plannerColor } from './plot.js';
 import { keepInput, keptInput } from './store.js';
 import {
   Viewer,
@@ -11,14 +11,14 @@ import {
   checkProfile,
   checkScanSize,
   checkSvgSize,
-  demoPathName,
-  demoPathSvg,
-  demoScanName,
-  demoSettings,
+  clearanceCapAboveTolMm,
+  demoPart,
+  demoParts,
   dialects,
   pageLimits,
   parsePoints,
   pathBounds,
+  planners,
   version,
 } from '../pkg/pcpp.js';
 
@@ -58,6 +58,14 @@ const state = {
   gen: 0,
   planId: 0,
   lastPlan: null,
+  // The last comparison of every planner {rows, series, gen} (series: the
+  // per-point errors of each planner, for the plot; null after a failed plan).
+  lastComparison: null,
+  demoParts: new Map(), // demo part name -> its drawing and settings (wasm demoPart)
+  checkId: 0, // the G-code check in flight
+  checking: null, // {id, name} of the check in flight
+  checkMoves: null, // the last checked program's {moves, kinds} for the view
+  viewShowsCheck: false, // the view draws those moves instead of the plan
   interacting: false, // a drag or slider in progress: skip the comparison
   info: null, // the scan as the worker read it
   viewer: null,
@@ -85,13 +93,25 @@ let settings = null;
 
 const fmtPoints = (pts) => pts.map((p) => p.map((v) => +v.toFixed(4)).join(', ')).join('\n');
 
-function demoUiSettings() {
-  const d = demoSettings();
+// A built-in demo part (wasm demoPart): its drawing, names and settings,
+// made once per part.
+function demoInfo(name) {
+  let info = state.demoParts.get(name);
+  if (!info) {
+    info = demoPart(name);
+    state.demoParts.set(name, info);
+  }
+  return info;
+}
+
+function demoUiSettings(part = 'test-part') {
+  const d = demoInfo(part).settings;
   const pl = d.plan.placement;
   return {
+    demoPart: part,
     scanUnits: '',
     scanUp: '',
-    fidSource: 'auto',
+    fidSource: d.registration.fiducials === 'auto' ? 'auto' : 'none',
     fidMethod: d.registration.method,
     fidScanText: '',
     fidPrinterText: fmtPoints(d.registration.printer_points),
@@ -132,6 +152,8 @@ function loadSettings() {
   const cp = base.customProfile;
   if (!cp || typeof cp.text !== 'string' || typeof cp.name !== 'string') base.customProfile = null;
   if (base.dialect === 'custom' && !base.customProfile) base.dialect = 'marlin';
+  if (!demoParts().some((p) => p.name === base.demoPart)) base.demoPart = 'test-part';
+  if (!planners().includes(base.planner)) base.planner = demoUiSettings().planner;
   return base;
 }
 
@@ -213,15 +235,17 @@ function currentSvg() {
       return made(`antenna-${kind}-${JSON.stringify(params)}`, `antenna-${kind}.svg`,
         () => antennaSvg(kind, params));
     }
-    default:
-      return made('demo', demoPathName(), demoPathSvg);
+    default: {
+      const part = demoInfo(settings.demoPart);
+      return made(`demo-${part.name}`, part.path_name, () => part.svg);
+    }
   }
 }
 
 // ---------- form binding ----------
 
 // [element id, getter, setter, when to re-plan]: 'live' on every input
-// event at once (sliders; the comparison of the four planners waits for the
+// event at once (sliders; the comparison of every planner waits for the
 // release), 'typed' on every keystroke after a short pause, otherwise on
 // change. Re-plans are coalesced: only the newest settings are planned.
 const FIELDS = [
@@ -275,6 +299,10 @@ function syncGauge() {
 }
 
 function syncVisibility() {
+  const part = demoInfo(settings.demoPart);
+  $('path-source').querySelector('option[value="demo"]').textContent = `demo: ${part.name} drawing`;
+  $('demo-part').value = part.name;
+  $('demo-part').title = part.description;
   for (const k of ['spiral', 'hilbert', 'monopole']) $(`antenna-${k}`).hidden = settings.pathSource !== k;
   $('fid-scan-wrap').hidden = settings.fidSource !== 'points' && !state.picking;
   const svg = settings.pathSource === 'file' ? state.pendingSvg || state.svgFile : null;
@@ -346,6 +374,19 @@ function bindForm() {
   });
   const dialect = $('dialect');
   for (const d of dialects()) dialect.add(new Option(d, d));
+  const planner = $('planner');
+  for (const p of planners()) planner.add(new Option(p, p));
+  const plot = $('plot-series');
+  plot.add(new Option('every planner', 'all'));
+  for (const p of planners()) plot.add(new Option(p, p));
+  plot.addEventListener('change', showErrorPlot);
+  const demo = $('demo-part');
+  for (const p of demoParts()) {
+    const o = new Option(p.name, p.name);
+    o.title = p.description;
+    demo.add(o);
+  }
+  demo.addEventListener('change', () => loadDemo(demo.value));
   syncProfileOption();
 }
 
@@ -383,28 +424,66 @@ function setStatus(text, stale) {
   el.classList.toggle('stale', !!stale);
 }
 
+const GCODE_LABEL = 'Download G-code';
+const RISKY_LABEL = 'Download G-code (the nozzle touches the part)…';
+const CONFIRM_LABEL = 'Download anyway (the nozzle touches the part)';
+
 function hideDownloads() {
-  $('dl-gcode').hidden = true;
+  const g = $('dl-gcode');
+  g.hidden = true;
   $('dl-report').hidden = true;
   for (const u of state.urls) URL.revokeObjectURL(u);
   state.urls = [];
-  $('dl-gcode').removeAttribute('href');
+  g.removeAttribute('href');
   $('dl-report').removeAttribute('href');
+  g.textContent = GCODE_LABEL;
+  g.classList.remove('risky', 'armed');
+  g.removeAttribute('tabindex');
+  state.risky = null;
+  $('risk-warning').hidden = true;
+}
+
+function linkBytes(el, bytes, type, name) {
+  const url = URL.createObjectURL(new Blob([bytes], { type }));
+  state.urls.push(url);
+  el.href = url;
+  el.download = name;
+  el.hidden = false;
 }
 
 // The G-code and report as the planner wrote them (bytes, no string copy).
+// G-code whose moves touch the part (written because the risk was accepted)
+// has no link until the user confirms: the first click turns the button
+// into "Download anyway", the second downloads.
 function offerDownloads(plan) {
   hideDownloads();
   const stem = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
-  const link = (el, bytes, type, name) => {
-    const url = URL.createObjectURL(new Blob([bytes], { type }));
-    state.urls.push(url);
-    el.href = url;
-    el.download = name;
-    el.hidden = false;
-  };
-  link($('dl-gcode'), plan.gcodeBytes, 'text/plain', `${stem}-${plan.planner}.gcode`);
-  link($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
+  const gcodeName = `${stem}-${plan.planner}.gcode`;
+  const motion = plan.summary.motion;
+  if (motion.risk_accepted) {
+    const g = $('dl-gcode');
+    state.risky = { plan, name: gcodeName };
+    g.textContent = RISKY_LABEL;
+    g.classList.add('risky');
+    g.tabIndex = 0;
+    g.hidden = false;
+    $('risk-warning-text').textContent = `safe motion: ${plan.summary.motion_line}`;
+    $('risk-warning').hidden = false;
+  } else {
+    linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
+  }
+  linkBytes($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
+}
+
+// The first click on a touching plan's G-code asks for the second.
+function onGcodeClick(e) {
+  const r = state.risky;
+  const g = $('dl-gcode');
+  if (!r || g.classList.contains('armed')) return;
+  e.preventDefault();
+  linkBytes(g, r.plan.gcodeBytes, 'text/plain', r.name);
+  g.textContent = CONFIRM_LABEL;
+  g.classList.add('armed');
 }
 
 function showProgress(stage, label, fraction) {
@@ -470,7 +549,7 @@ function endInteraction() {
   if (!state.interacting) return;
   state.interacting = false;
   saveSettings();
-  // Once more with the comparison of the four planners (the surface path is
+  // Once more with the comparison of every planner (the surface path is
   // kept by the worker, so this only plans).
   requestPlan();
 }
@@ -516,7 +595,7 @@ function runPlan() {
     type: 'plan',
     id,
     // A File is a handle: posting it copies no bytes (the worker reads it).
-    scan: { key: scan.key, name: scan.name, blob: scan.blob },
+    scan: { key: scan.key, name: scan.name, blob: scan.blob, part: scan.part },
     scanSettings: job.scan,
     registration: job.registration,
     svg: msgSvg,
@@ -565,6 +644,10 @@ function onWorkerMessage(e) {
     onPick(m);
     return;
   }
+  if (m.type === 'check') {
+    onCheck(m);
+    return;
+  }
   if (!busy || m.id !== busy.id) {
     if (m.type === 'error' && m.stage === 'init') showError('Could not start the planner', m.message);
     return;
@@ -604,15 +687,20 @@ function onWorkerMessage(e) {
       if (st.planMs.length > 1000) { st.planMs.shift(); st.latencyMs.shift(); }
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
+      if (m.comparison) state.lastComparison = { rows: m.comparison, series: m.series, gen: busy.gen };
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
-        setStatus(`planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}`);
+        const touching = m.summary.motion.program.touching_moves;
+        setStatus(touching > 0
+          ? `planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}: ${touching} move(s) touch the part; `
+            + 'the G-code downloads only after a confirmation'
+          : `planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}`, touching > 0);
       } else {
         // Shown while the user goes on changing things; not offered.
         setStatus('settings changed: re-planning…', true);
       }
-      if (m.comparison) showComparison(m.comparison, busy.planner);
+      if (m.comparison) showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm);
       else $('compare-table').classList.add('stale');
       break;
     }
@@ -674,6 +762,15 @@ function onPlanError(m, busy) {
       : '\nBack to the demo paths.';
   } else if (m.kind === 'limit') {
     title = 'The path is too long for the page';
+  } else if (m.kind === 'touching') {
+    title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
+    message += '\nThe settings, the drawing and the previous plan stay as they were.';
+  }
+  // A plan refused for its motion still compared the planners on the
+  // settings that failed: the table shows why.
+  if (m.comparison) {
+    state.lastComparison = { rows: m.comparison, series: null, gen: busy.gen };
+    showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm);
   }
   showError(title, message);
   // Nothing stale on offer; the previous plan stays on screen, where it was
@@ -716,6 +813,12 @@ function cancelPlan() {
 function restartWorker() {
   state.worker.terminate();
   state.worker = makeWorker();
+  if (state.checking) {
+    // The new worker never got the check in flight.
+    $('check-verdict').textContent = `${state.checking.name} was not checked: the planner was restarted; check it again`;
+    $('check-verdict').className = 'verdict bad';
+    state.checking = null;
+  }
 }
 
 function makeWorker() {
@@ -913,6 +1016,7 @@ function showPlan(plan) {
     } catch (e) {
       showError('Could not draw the paths', e.message);
     }
+    setViewShowsCheck(false);
     updateDragOffset();
     requestDraw();
   }
@@ -945,35 +1049,144 @@ function showPlan(plan) {
     li.textContent = w;
     return li;
   }));
+  showMotion(summary);
   // A long path's plot waits for the end of a drag.
-  if (!state.interacting || view.defects.length < 20000) {
-    drawPlot($('plot'), view, summary.settings.nozzle.inner_diameter_mm);
-  }
+  if (!state.interacting || view.defects.length < 20000) showErrorPlot();
 }
 
-function showComparison(rows, selected) {
+// The plot of the plan on screen: every planner's errors (the last
+// comparison, if it was made for this plan), or one planner's coloured by
+// defect. During a drag only the plan being dragged is drawn.
+function showErrorPlot() {
+  const plan = state.lastPlan;
+  if (!plan) return;
+  const { view, summary } = plan;
+  const c = state.lastComparison;
+  const n = view.defects.length;
+  const series = c && c.gen === plan.gen && c.series && c.series.every((x) => x.error.length === n)
+    ? c.series
+    : [{ planner: plan.planner, error: view.error, defects: view.defects }];
+  const choice = $('plot-series').value;
+  let shown;
+  if (choice === 'all') {
+    // The planner on screen last, on top of the others.
+    shown = [...series.filter((x) => x.planner !== plan.planner), ...series.filter((x) => x.planner === plan.planner)];
+  } else {
+    shown = series.filter((x) => x.planner === choice);
+  }
+  $('plot-legend').replaceChildren(...(choice === 'all' ? series : []).map((x) => {
+    const li = document.createElement('li');
+    const sw = document.createElement('i');
+    sw.className = 'sw';
+    sw.style.background = plannerColor(x.planner);
+    li.append(sw, x.planner);
+    return li;
+  }));
+  $('plot-note').textContent = shown.length === 0
+    ? `${choice}: compared after the drag or change ends`
+    : choice === 'all' ? `${shown.length} planner(s), one colour each` : `${choice}, coloured by predicted defect`;
+  drawPlot($('plot'), view, shown, choice === 'all', summary.settings.nozzle.inner_diameter_mm);
+}
+
+// A clearance as the tables show it: null is "more than tol + the cap"
+// (the planners' check finds the smallest clearance only that far).
+function fmtClearance(c, tol) {
+  return c === null || c === undefined ? `>${fmt(tol + clearanceCapAboveTolMm())}` : fmt(c);
+}
+
+function cell(tr, text, cls, title) {
+  const td = document.createElement('td');
+  td.textContent = text;
+  if (cls) td.className = cls;
+  if (title) td.title = title;
+  tr.append(td);
+  return td;
+}
+
+function showComparison(rows, selected, tol) {
   $('compare-table').classList.remove('stale');
   const body = $('compare-table').tBodies[0];
   body.replaceChildren(...rows.map((r) => {
     const q = r.quality;
+    const mo = r.motion;
     const tr = document.createElement('tr');
+    tr.dataset.planner = r.planner;
     if (r.planner === selected) tr.className = 'selected';
     for (const v of [r.planner, fmt(q.mean_abs_error_mm, 4), fmt(q.mean_negative_error_mm, 4),
       fmt(q.mean_positive_error_mm, 4), `${fmt(q.contact_pct, 1)}%`, `${fmt(q.flattening_pct, 1)}%`,
-      `${fmt(q.floating_pct, 1)}%`]) {
-      const td = document.createElement('td');
-      td.textContent = v;
-      tr.append(td);
+      `${fmt(q.floating_pct, 1)}%`, `${fmt(q.contact_pct + q.flattening_pct + q.floating_pct, 1)}%`]) {
+      cell(tr, v);
     }
+    cell(tr, String(mo.backward_moves), 'backward');
+    const t = mo.tol_mm ?? tol;
+    // Below tol the nozzle touches (or comes too close to) the surface.
+    const touching = mo.touching_moves > 0 || (mo.min_clearance_mm !== null && mo.min_clearance_mm < t);
+    cell(tr, fmtClearance(mo.min_clearance_mm, t), touching ? 'clearance bad' : 'clearance',
+      touching ? `${mo.touching_moves} print move(s) closer than tol = ${t} mm` : `tol = ${t} mm`);
+    cell(tr, String(mo.waypoints), 'waypoints');
     return tr;
   }));
 }
 
+// The plan's quality and safe motion (spec section 6f): the check of every
+// move its G-code commands, next to the predicted quality.
+function showMotion(summary) {
+  const q = summary.quality;
+  const m = summary.motion;
+  const p = m.program;
+  const touching = p.touching_moves > 0;
+  let clear = 'no move passes near the scan';
+  if (p.min_clearance_mm !== null && p.min_clearance_mm !== undefined) {
+    const at = p.min_clearance_at ? ` at (${p.min_clearance_at.map((v) => fmt(v, 2)).join(', ')})` : '';
+    const line = p.min_clearance_line ? `, G-code line ${p.min_clearance_line}` : '';
+    clear = `${fmt(p.min_clearance_mm)} mm${at}${line}`;
+  }
+  const rows = [
+    ['planner', summary.planner],
+    ['predicted quality', `mean |e| ${fmt(q.mean_abs_error_mm, 4)} mm; defects `
+      + `${fmt(q.contact_pct + q.flattening_pct + q.floating_pct, 1)}% (contact ${fmt(q.contact_pct, 1)}%, `
+      + `flattening ${fmt(q.flattening_pct, 1)}%, floating ${fmt(q.floating_pct, 1)}%)`],
+    ['min clearance, all moves', clear, 'motion-min-clear', touching ? 'bad' : ''],
+    ['moves too close (< tol)', `${p.touching_moves} of ${p.moves} (tol ${m.tol_mm} mm)`, 'motion-touching',
+      touching ? 'bad' : ''],
+    ['waypoints added', `${m.waypoints} (+${fmt(m.extra_length_mm)} mm)`, 'motion-waypoints'],
+    ['backward moves', String(m.backward_moves), 'motion-backward'],
+    ['max sideways offset', `${fmt(m.max_sideways_mm)} mm`],
+  ];
+  if (m.risk_accepted) rows.push(['risk', 'accepted: G-code with moves closer than tol', 'motion-risk', 'bad']);
+  const body = $('motion-table').tBodies[0];
+  body.replaceChildren(...rows.map(([k, v, id, cls]) => {
+    const tr = document.createElement('tr');
+    cell(tr, k);
+    const td = cell(tr, v, cls);
+    if (id) td.id = id;
+    return tr;
+  }));
+  $('motion-touches').replaceChildren(...p.touching.slice(0, 5).map((t) => {
+    const li = document.createElement('li');
+    li.textContent = fmtTouch(t);
+    return li;
+  }));
+}
+
+// A touching move in the core's words (motion::Touch's Display).
+function fmtTouch(t) {
+  return `${t.line ? `line ${t.line}: ` : ''}the move ${fmtPoint(t.from)} -> ${fmtPoint(t.to)} comes too close at `
+    + `${fmtPoint(t.at)}: the nozzle would have to be ${fmt(t.rise_mm)} mm higher there`;
+}
+
 // ---------- files ----------
+
+// G-code programs a user may check against the scan (by their extension).
+const GCODE_FILE = /\.(gcode|gco|g|nc|ngc|tap|txt)$/i;
 
 async function openFile(file) {
   if (/\.svg$/i.test(file.name)) {
     await openSvg(file);
+    return;
+  }
+  if (GCODE_FILE.test(file.name)) {
+    checkGcodeFile(file);
     return;
   }
   // Past the page's limit the file is refused before a byte is read, and
@@ -1051,7 +1264,158 @@ async function openProfile(file) {
   schedulePlan(0);
 }
 
+// ---------- checking a G-code file against the scan ----------
+
+// A user's G-code (ours or another tool's) checked by the core against the
+// scan the worker holds, with the nozzle and tol of the settings: the
+// worker reads the File (as it reads a scan), after any plan in flight.
+function checkGcodeFile(file) {
+  const limit = pageLimits().gcode_bytes;
+  if (file.size > limit) {
+    const message = `${file.name}: the file is ${(file.size / (1 << 20)).toFixed(1)} MiB, more than the `
+      + `${limit / (1 << 20)} MiB the G-code check reads; split the program and check each part`;
+    showCheckError(file.name, message);
+    return;
+  }
+  const s = settings;
+  const id = ++state.checkId;
+  const nozzle = { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) };
+  const tol = num(s.process.tol);
+  state.checking = { id, name: file.name };
+  state.checkMoves = null;
+  $('check-draw').hidden = true;
+  $('check-panel').hidden = false;
+  $('check-verdict').textContent = `checking ${file.name}…`;
+  $('check-verdict').className = 'verdict';
+  $('check-details').replaceChildren();
+  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol });
+}
+
+function showCheckError(name, message) {
+  state.checkMoves = null;
+  $('check-draw').hidden = true;
+  if (state.viewShowsCheck) drawCheckedMoves(false);
+  $('check-panel').hidden = false;
+  $('check-verdict').textContent = `could not check ${name}`;
+  $('check-verdict').className = 'verdict bad';
+  $('check-details').replaceChildren();
+  showError(`Could not check ${name}`, message);
+}
+
+// A move that comes too close, as the core's own message words it.
+const fmtPoint = (p) => `(${p.map((v) => fmt(v)).join(', ')})`;
+
+function onCheck(m) {
+  if (m.id !== state.checkId) return;
+  state.checking = null;
+  if (m.error) {
+    showCheckError(m.name, m.error);
+    return;
+  }
+  const c = m.result;
+  const sum = c.summary;
+  const verdict = $('check-verdict');
+  const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
+  verdict.textContent = c.clear
+    ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
+    : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
+  verdict.className = c.clear ? 'verdict good' : 'verdict bad';
+  const details = [];
+  const p = (text, id, cls) => {
+    const el = document.createElement('p');
+    el.textContent = text;
+    if (id) el.id = id;
+    if (cls) el.className = cls;
+    details.push(el);
+    return el;
+  };
+  p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined
+    ? 'minimum clearance: no move passes near the scan'
+    : `minimum clearance ${fmt(sum.min_clearance_mm)} mm`
+      + `${sum.min_clearance_line ? ` at line ${sum.min_clearance_line}` : ''}`
+      + `${sum.min_clearance_at ? ` ${fmtPoint(sum.min_clearance_at)}` : ''}`,
+  'check-min', sum.min_clearance_mm !== null && sum.min_clearance_mm < c.tol_mm ? 'bad' : '');
+  if (sum.touching.length) {
+    const table = document.createElement('table');
+    table.id = 'check-touching';
+    table.className = 'num';
+    const head = table.createTHead().insertRow();
+    for (const h of ['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm']) {
+      const th = document.createElement('th');
+      th.textContent = h;
+      head.append(th);
+    }
+    const body = table.createTBody();
+    for (const t of sum.touching) {
+      const tr = body.insertRow();
+      cell(tr, t.line ? String(t.line) : '—', 'line');
+      cell(tr, `${fmtPoint(t.from)} → ${fmtPoint(t.to)}`);
+      cell(tr, fmtPoint(t.at));
+      cell(tr, fmt(t.clearance_mm));
+      cell(tr, fmt(t.rise_mm), 'bad');
+    }
+    details.push(table);
+    if (sum.touching_moves > sum.touching.length) {
+      p(`… and ${sum.touching_moves - sum.touching.length} more touching move(s)`);
+    }
+  }
+  if (c.unchecked_lines.length) {
+    p(`${c.unchecked_lines.length} move(s) not checked (their position is not in the file): lines `
+      + `${c.unchecked_lines.slice(0, 10).join(', ')}${c.unchecked_lines.length > 10 ? ', …' : ''}`, 'check-unchecked');
+  }
+  if (c.notes.length) {
+    const ul = document.createElement('ul');
+    ul.id = 'check-notes';
+    ul.className = 'warnings small';
+    for (const n of c.notes) {
+      const li = document.createElement('li');
+      li.textContent = n;
+      ul.append(li);
+    }
+    details.push(ul);
+  }
+  $('check-details').replaceChildren(...details);
+  state.checkMoves = c.moves ? { moves: c.moves, kinds: c.kinds } : null;
+  $('check-draw').hidden = !state.checkMoves;
+  if (state.viewShowsCheck) drawCheckedMoves(!!state.checkMoves);
+}
+
+// The view draws the checked program's moves (on) or the plan's paths.
+function drawCheckedMoves(on) {
+  if (!state.viewer) return;
+  try {
+    if (on && state.checkMoves) {
+      state.viewer.setMoves(state.checkMoves.moves, state.checkMoves.kinds);
+    } else if (state.lastPlan) {
+      const v = state.lastPlan.view;
+      state.viewer.setPathArrays(v.pieces, v.ta, v.tool, v.defects);
+      updateDragOffset();
+    } else {
+      state.viewer.setPathArrays(new Uint32Array(0), new Float32Array(0), new Float32Array(0), new Uint8Array(0));
+    }
+  } catch (e) {
+    showError('Could not draw the moves', e.message);
+    return;
+  }
+  setViewShowsCheck(on && !!state.checkMoves);
+  requestDraw();
+}
+
+function setViewShowsCheck(on) {
+  state.viewShowsCheck = on;
+  const b = $('check-draw');
+  b.setAttribute('aria-pressed', on ? 'true' : 'false');
+  b.textContent = on ? 'Back to the plan in the 3-D view' : 'Draw in the 3-D view';
+}
+
 function bindFiles() {
+  $('check-draw').addEventListener('click', () => drawCheckedMoves(!state.viewShowsCheck));
+  const gcodeInput = $('gcode-input');
+  gcodeInput.addEventListener('change', () => {
+    const f = gcodeInput.files && gcodeInput.files[0];
+    if (f) checkGcodeFile(f);
+    gcodeInput.value = '';
+  });
   const profileInput = $('profile-input');
   profileInput.addEventListener('change', () => {
     const f = profileInput.files && profileInput.files[0];
@@ -1086,13 +1450,17 @@ function bindFiles() {
   });
 }
 
-// The demo scan: the worker makes its bytes itself.
-function demoScanEntry() {
-  return { key: 'demo', name: demoScanName(), size: 0, blob: null };
+// A demo part's scan: the worker makes its bytes itself.
+function demoScanEntry(part) {
+  const info = demoInfo(part);
+  return { key: `demo-${info.name}`, name: info.scan_name, size: 0, blob: null, part: info.name };
 }
 
-function loadDemo() {
-  const demo = demoUiSettings();
+// Loads a demo part: its scan, drawing, placement and fiducials (the test
+// part's three holes; the other parts are made in the printer frame).
+function loadDemo(part = settings.demoPart) {
+  const demo = demoUiSettings(part);
+  settings.demoPart = demo.demoPart;
   settings.fidSource = demo.fidSource;
   settings.fidMethod = demo.fidMethod;
   settings.fidPrinterText = demo.fidPrinterText;
@@ -1101,7 +1469,8 @@ function loadDemo() {
   settings.scanUnits = '';
   settings.scanUp = '';
   state.pendingScan = null;
-  state.scan = demoScanEntry();
+  state.scan = demoScanEntry(settings.demoPart);
+  $('scan-name').textContent = state.scan.name;
   state.svgFile = null;
   state.pendingSvg = null;
   keep('scan', null);
@@ -1469,7 +1838,14 @@ async function start() {
   bindView();
   $('plan-btn').addEventListener('click', requestPlan);
   $('cancel-btn').addEventListener('click', cancelPlan);
-  $('demo-btn').addEventListener('click', loadDemo);
+  $('demo-btn').addEventListener('click', () => loadDemo($('demo-part').value));
+  $('dl-gcode').addEventListener('click', onGcodeClick);
+  $('dl-gcode').addEventListener('keydown', (e) => {
+    // A touching plan's button has no link until confirmed: keys click it.
+    if ((e.key === 'Enter' || e.key === ' ') && state.risky && !$('dl-gcode').classList.contains('armed')) {
+      onGcodeClick(e);
+    }
+  });
   $('center-btn').addEventListener('click', () => { centreOnScan(true); schedulePlan(0); });
   $('error-close').addEventListener('click', clearError);
   $('pick-btn').addEventListener('click', () => setPicking(!state.picking));
@@ -1483,7 +1859,7 @@ async function start() {
   });
   window.addEventListener('keydown', (e) => { if (e.key === 'Escape' && state.picking) setPicking(false); });
   state.worker = makeWorker();
-  state.scan = demoScanEntry();
+  state.scan = demoScanEntry(settings.demoPart);
   $('scan-name').textContent = state.scan.name;
   await restoreInputs();
   writeForm();

@@ -1,6 +1,7 @@
 // The error plot (the paper's Figure 3d): predicted filament error against
-// surface slope and against curvature, one dot per point, coloured by the
-// predicted defect. Drawn on a 2-D canvas from the plan's per-point arrays.
+// surface slope and against curvature, one dot per point, for every planner
+// (one colour each) or for one planner (coloured by the predicted defect).
+// Drawn on a 2-D canvas from the plan's per-point arrays.
 
 // The planner's defect codes (src/wasm.rs, defect_code).
 const DEFECT_NAMES = ['good', 'contact', 'flattening', 'floating'];
@@ -30,11 +31,28 @@ function niceRange(lo, hi) {
   return [lo - pad, hi + pad];
 }
 
-function panel(ctx, box, points, xLabel, xOf, d) {
+// Planner colours in the every-planner plot (not the defect colours).
+const PLANNER_COLORS = {
+  constant: '#8a8f99',
+  slope: '#e08a00',
+  pcpp: '#b03fd1',
+  'pcpp-guarded': '#1f6fe0',
+  even: '#14a04a',
+};
+
+export function plannerColor(name) {
+  return PLANNER_COLORS[name] || '#333a48';
+}
+
+// One panel: `xs` the abscissa per point; `series` [{error, defects, color}]
+// (color null: each point in its defect's colour).
+function panel(ctx, box, xs, series, xLabel, d) {
   const { x, y, w, h } = box;
-  const [x0, x1] = niceRange(...extent(points.map(xOf)));
+  const [x0, x1] = niceRange(...extent(xs));
   // Contacts carry no error estimate: they are drawn on the top edge.
-  const [y0, y1] = niceRange(...extent(points.map((p) => p.e), -d, d));
+  let [lo, hi] = [-d, d];
+  for (const sr of series) [lo, hi] = extent(sr.error, lo, hi);
+  const [y0, y1] = niceRange(lo, hi);
   const px = (v) => x + ((v - x0) / (x1 - x0)) * w;
   const py = (v) => y + h - ((v - y0) / (y1 - y0)) * h;
   ctx.strokeStyle = '#c8ccd4';
@@ -59,17 +77,24 @@ function panel(ctx, box, points, xLabel, xOf, d) {
   ctx.lineTo(x + w, py(0));
   ctx.stroke();
   ctx.setLineDash([]);
-  for (const p of points) {
-    ctx.fillStyle = COLORS[p.defect] || COLORS.good;
-    const vy = p.e === null ? y + 3 : py(p.e);
-    ctx.fillRect(px(xOf(p)) - 1.5, vy - 1.5, 3, 3);
+  for (const sr of series) {
+    const one = sr.color;
+    for (let i = 0; i < xs.length; i++) {
+      if (!Number.isFinite(xs[i])) continue;
+      const e = sr.error[i];
+      ctx.fillStyle = one || COLORS[DEFECT_NAMES[sr.defects[i]]] || COLORS.good;
+      const vy = Number.isNaN(e) ? y + 3 : py(e);
+      ctx.fillRect(px(xs[i]) - 1.5, vy - 1.5, 3, 3);
+    }
   }
 }
 
-// Draws both panels from a plan's per-point arrays (`view` of the worker's
-// result: slope, kappa, error with NaN at contacts, defect codes); null
-// clears.
-export function drawPlot(canvas, view, nozzleD) {
+// Draws both panels: `view` (the plan's per-point arrays: slope and kappa,
+// shared by every planner, since they plan on one surface path) and
+// `series` ([{planner, error (NaN at contacts), defects}], each as long as
+// the view's arrays), one colour per planner when `byPlanner`, else by
+// predicted defect. A null view clears.
+export function drawPlot(canvas, view, series, byPlanner, nozzleD) {
   const dpr = window.devicePixelRatio || 1;
   const cw = canvas.clientWidth || 900;
   const ch = canvas.clientHeight || 260;
@@ -78,19 +103,10 @@ export function drawPlot(canvas, view, nozzleD) {
   const ctx = canvas.getContext('2d');
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, cw, ch);
-  if (!view) return;
-  const points = [];
-  for (let i = 0; i < view.defects.length; i++) {
-    const e = view.error[i];
-    points.push({
-      slope: view.slope[i],
-      kappa: view.kappa[i],
-      e: Number.isNaN(e) ? null : e,
-      defect: DEFECT_NAMES[view.defects[i]] || 'good',
-    });
-  }
-  if (points.length === 0) return;
+  if (!view || view.defects.length === 0 || !series.length) return;
+  const shown = series.map((sr) => ({ ...sr, color: byPlanner ? plannerColor(sr.planner) : null }));
   const w = (cw - 130) / 2;
-  panel(ctx, { x: 55, y: 10, w, h: ch - 50 }, points, 'slope (deg)', (p) => p.slope, nozzleD);
-  panel(ctx, { x: 55 + w + 65, y: 10, w, h: ch - 50 }, points, 'curvature κ (1/mm)', (p) => p.kappa, nozzleD);
+  panel(ctx, { x: 55, y: 10, w, h: ch - 50 }, view.slope, shown, 'slope (deg)', nozzleD);
+  panel(ctx, { x: 55 + w + 65, y: 10, w, h: ch - 50 }, view.kappa, shown, 'curvature κ (1/mm)', nozzleD);
 }
+

@@ -4,7 +4,7 @@
 // settings stay the same, and the drawing set on it, so a placement or
 // nozzle change re-plans without re-importing or re-reading the SVG.
 //
-// The scan arrives as a File (or null: the demo). Posting a File copies no
+// The scan arrives as a File (or null: a demo part, named by `part`). Posting a File copies no
 // bytes; this worker reads it in slices straight into wasm memory
 // (ScanBuffer), so the page's main thread never holds the scan and JS never
 // holds it whole. Results go back as typed arrays whose buffers are
@@ -24,6 +24,9 @@ let sessionKey = null;
 // one set on the session.
 let svg = null;
 let pathKey = null;
+// The plan in progress (a promise): a G-code check waits for it, so it runs
+// on the scan that plan reads.
+let planning = Promise.resolve();
 
 const post = (msg, transfer) => self.postMessage(msg, transfer || []);
 const mib = (n) => (n / (1 << 20)).toFixed(1);
@@ -32,10 +35,15 @@ function errorOf(err) {
   // A trap (out of memory, or a bug) leaves the wasm instance unusable:
   // the page restarts this worker.
   const crashed = typeof WebAssembly !== 'undefined' && err instanceof WebAssembly.RuntimeError;
-  return {
+  const out = {
     message: String((err && err.message) || err),
     kind: crashed ? 'crash' : (err && err.kind) || 'other',
   };
+  // G-code refused for its motion: the check's summary, and the planners
+  // compared on the same settings.
+  if (err && err.touching) out.touching = err.touching;
+  if (err && err.comparison) out.comparison = err.comparison;
+  return out;
 }
 
 function progress(id, step, label, fraction, first) {
@@ -69,7 +77,7 @@ async function loadScan(m) {
       throw err;
     }
   } else {
-    buf = ScanBuffer.demo();
+    buf = ScanBuffer.demoPart(m.scan.part || 'test-part');
   }
   progress(id, 'import', `importing ${name}`, undefined, !blob);
   const imp = buf.importScan(m.scanSettings);
@@ -111,19 +119,37 @@ async function plan(m) {
       session.setPath(svg.bytes, svg.name);
       pathKey = svg.key;
     }
-    progress(id, 'plan', m.compare ? 'planning and comparing the four planners' : 'planning');
+    progress(id, 'plan', m.compare ? 'planning and comparing every planner' : 'planning');
     const t0 = performance.now();
     const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare);
     const planMs = performance.now() - t0;
     const v = r.view;
+    const transfer = [r.gcode.buffer, r.report.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
+      v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer];
+    for (const sr of r.series || []) transfer.push(sr.error.buffer, sr.defects.buffer);
     post({
       type: 'result', id, gcode: r.gcode, report: r.report, summary: r.summary, view: v,
-      comparison: r.comparison, planMs, memory: memoryBytes(),
-    }, [r.gcode.buffer, r.report.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
-      v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer]);
+      comparison: r.comparison, series: r.series, planMs, memory: memoryBytes(),
+    }, transfer);
     post({ type: 'done', id });
   } catch (err) {
     post({ type: 'error', id, stage, ...errorOf(err) });
+  }
+}
+
+// Checks a G-code File against the session's scan (read here, like the
+// scan, never on the page's main thread).
+async function check(m) {
+  const { id, name } = m;
+  try {
+    const bytes = new Uint8Array(await m.file.arrayBuffer());
+    await planning;
+    if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
+    const result = session.checkGcode(bytes, name, m.nozzle, m.tol);
+    const transfer = result.moves ? [result.moves.buffer, result.kinds.buffer] : [];
+    post({ type: 'check', id, name, scan: session.info().name, result }, transfer);
+  } catch (err) {
+    post({ type: 'check', id, name, ...errorOf(err), error: errorOf(err).message });
   }
 }
 
@@ -138,7 +164,9 @@ self.onmessage = (e) => {
       post({ type: 'error', id: -1, stage: 'init', ...errorOf(err) });
     }
   } else if (m.type === 'plan') {
-    plan(m);
+    planning = plan(m);
+  } else if (m.type === 'check') {
+    check(m);
   } else if (m.type === 'pick') {
     // The first surface point along the view's ray, on the session's scan.
     if (!session) {

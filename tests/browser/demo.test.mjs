@@ -11,10 +11,10 @@ const env = withPageServer();
 test('the demo plans on load, is drawn, and its G-code downloads', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
-  // The comparison of the four planners arrives after the plan.
-  await page.waitForFunction(() => document.querySelectorAll('#compare-table tbody tr').length === 4);
+  // The comparison of every planner arrives after the plan.
+  await page.waitForFunction(() => document.querySelectorAll('#compare-table tbody tr').length === 5);
   const planners = await page.$$eval('#compare-table tbody tr td:first-child', (tds) => tds.map((t) => t.textContent));
-  assert.deepEqual(planners, ['constant', 'slope', 'pcpp', 'pcpp-guarded']);
+  assert.deepEqual(planners, ['constant', 'slope', 'pcpp', 'pcpp-guarded', 'even']);
 
   // Registration against the demo's three holes: residuals shown, RMS small.
   const rms = await page.textContent('#rms');
@@ -28,13 +28,13 @@ test('the demo plans on load, is drawn, and its G-code downloads', async () => {
   assert.ok(px.ta > 100, `surface-path pixels: ${JSON.stringify(px)}`);
 
   const gcode = await download(page, 'dl-gcode');
-  assert.equal(gcode.name, 'demo-test-part-lines-pcpp-guarded.gcode');
+  assert.equal(gcode.name, 'demo-test-part-lines-even.gcode');
   const text = gcode.bytes.toString('utf8');
   assert.match(text, /G1 /);
   assert.match(text, /demo-test-part\.ply/);
   const report = await download(page, 'dl-report');
   const json = JSON.parse(report.bytes.toString('utf8'));
-  assert.equal(json.planner, 'pcpp-guarded');
+  assert.equal(json.planner, 'even');
   assert.equal(json.toolpath.length, 6);
 
   mkdirSync(join(ROOT, 'target'), { recursive: true });

@@ -158,7 +158,7 @@ test('a failed plan keeps the inputs and settings, also across a reload; fixing 
   await page.setInputFiles('#svg-input', svgPath);
   await page.fill('#pl-x', '20');
   await page.fill('#pl-y', '60'); // SVG y points down: the track spans y 34-40 mm
-  await page.selectOption('#planner', 'slope');
+  await page.selectOption('#planner', 'pcpp-guarded'); // not the default (even)
   await page.selectOption('#dialect', 'grbl');
   await waitSettled(page);
   const good = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);

@@ -1,0 +1,286 @@
+// Safe motion in the page (spec section 6f): every planner compared with its
+// backward moves and clearance; the plan's motion summary; G-code whose
+// moves touch the part refused (the message names the G-code lines) or,
+// with the risk accepted, offered only after a second, explicit click; any
+// G-code file checked against the loaded scan; the demo parts' menu.
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { after, before, test } from 'node:test';
+import {
+  ROOT, download, openPage, viewPixels, waitIdle, waitSettled, withPageServer,
+} from './helpers.mjs';
+
+const env = withPageServer();
+const CLI = join(ROOT, 'target/debug/pcpp');
+
+let dir;
+before(() => {
+  dir = mkdtempSync(join(tmpdir(), 'pcpp-motion-'));
+});
+after(() => {
+  if (dir) rmSync(dir, { recursive: true, force: true });
+});
+
+const PLANNERS = ['constant', 'slope', 'pcpp', 'pcpp-guarded', 'even'];
+const gcodeFile = (name, text) => ({ name, mimeType: 'text/plain', buffer: Buffer.from(text) });
+
+// The comparison table as {planner: {column: text}}, and the classes of
+// the clearance cells.
+const compareTable = (page) => page.evaluate(() => {
+  const heads = [...document.querySelectorAll('#compare-table thead th')].map((th) => th.textContent);
+  const rows = {};
+  for (const tr of document.querySelectorAll('#compare-table tbody tr')) {
+    const cells = [...tr.children];
+    rows[cells[0].textContent] = Object.fromEntries(cells.map((td, i) => [heads[i], td.textContent]));
+    rows[cells[0].textContent].clearanceBad = tr.querySelector('td.clearance').classList.contains('bad');
+  }
+  return { heads, rows };
+});
+
+test('every planner is compared with its defects, backward moves, clearance and waypoints; the plot shows each', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const { heads, rows } = await compareTable(page);
+  assert.deepEqual(heads, ['planner', 'mean |e| mm', 'mean e− mm', 'mean e+ mm', 'contact', 'flattening',
+    'floating', 'defects', 'backward', 'min clear mm', 'waypoints']);
+  assert.deepEqual(Object.keys(rows), PLANNERS);
+  const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  assert.equal(report.planner, 'even');
+  const tol = report.settings.process.tolerance_mm;
+  // even, the default, never falls back along the drawn path and keeps tol.
+  assert.equal(rows.even.backward, '0');
+  assert.ok(Number(rows.even['min clear mm']) >= tol, rows.even['min clear mm']);
+  assert.equal(rows.even.clearanceBad, false);
+  assert.ok(Number(rows.even.waypoints) > 0);
+  for (const p of PLANNERS) {
+    const r = rows[p];
+    // defects = contact + flattening + floating
+    const sum = ['contact', 'flattening', 'floating'].reduce((a, k) => a + Number.parseFloat(r[k]), 0);
+    assert.ok(Math.abs(Number.parseFloat(r.defects) - sum) <= 0.15, `${p}: ${JSON.stringify(r)}`);
+    // A clearance either a number or more than tol + 0.05 mm (not found
+    // below that); below tol it is marked as a problem.
+    const c = r['min clear mm'];
+    if (c.startsWith('>')) {
+      assert.equal(c, `>${(tol + 0.05).toFixed(3)}`);
+    } else {
+      assert.equal(r.clearanceBad, Number(c) < tol, `${p}: ${c}`);
+    }
+  }
+  // The paper's constant stand-off runs into the part's walls.
+  assert.ok(Number(rows.constant['min clear mm']) < 0 && rows.constant.clearanceBad, JSON.stringify(rows.constant));
+
+  // The plan's safe-motion summary, next to its quality: the check of
+  // every move the G-code commands.
+  const motion = report.motion;
+  assert.equal(motion.program.touching_moves, 0);
+  assert.equal(await page.textContent('#motion-min-clear'),
+    `${motion.program.min_clearance_mm.toFixed(3)} mm at (${motion.program.min_clearance_at.map((v) => v.toFixed(2)).join(', ')}), `
+    + `G-code line ${motion.program.min_clearance_line}`);
+  assert.equal(await page.textContent('#motion-waypoints'), `${motion.waypoints} (+${motion.extra_length_mm.toFixed(3)} mm)`);
+  assert.equal(await page.textContent('#motion-backward'), '0');
+  assert.match(await page.textContent('#motion-touching'), /^0 of \d+ \(tol 0\.1 mm\)$/);
+  assert.equal(await page.isHidden('#risk-warning'), true);
+
+  // The plot draws every planner, one colour each, even among them.
+  const legend = await page.$$eval('#plot-legend li', (lis) => lis.map((li) => li.textContent));
+  assert.deepEqual(legend.sort(), [...PLANNERS].sort());
+  const plotColours = () => page.evaluate(() => {
+    const c = document.getElementById('plot');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    const count = (r, g, b) => {
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - r) < 3 && Math.abs(d[i + 1] - g) < 3 && Math.abs(d[i + 2] - b) < 3) n++;
+      }
+      return n;
+    };
+    // even's and constant's colours (web/plot.js), and the defect colours.
+    return { even: count(0x14, 0xa0, 0x4a), constant: count(0x8a, 0x8f, 0x99), good: count(0x28, 0xd2, 0x46) };
+  });
+  const all = await plotColours();
+  assert.ok(all.even > 100 && all.constant > 100, JSON.stringify(all));
+  // One planner alone: coloured by defect.
+  await page.selectOption('#plot-series', 'even');
+  const one = await plotColours();
+  assert.ok(one.even === 0 && one.constant === 0 && one.good > 100, JSON.stringify(one));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a plan whose G-code touches the part names its lines and offers nothing; accepting the risk needs a second click', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.selectOption('#demo-part', 'stepped-block');
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
+  await waitSettled(page);
+  const good = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  assert.match(good, /; planner: even/);
+  assert.match(good, /^; scan file: demo-stepped-block\.ply /m);
+  const before = await page.evaluate(() => [...document.querySelectorAll('.side input, .side select, .side textarea')]
+    .filter((el) => el.id && el.type !== 'file').map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]));
+
+  // The paper's slope planner runs the nozzle into the steps' walls.
+  await page.selectOption('#planner', 'slope');
+  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
+    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'The nozzle would touch the part with slope: no G-code');
+  const message = await page.textContent('#error-message');
+  assert.match(message, /G-code move\(s\) of planner slope would bring the nozzle/);
+  assert.match(message, /line \d+: the move \([-\d., ]+\) -> \([-\d., ]+\) comes too close at \([-\d., ]+\): the nozzle would have to be \d+\.\d{3} mm higher there/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.isHidden('#dl-report'), true);
+  assert.equal(await page.textContent('#plan-status'), 'plan failed: showing the previous plan, no download');
+  // Settings, drawing and previous plan stay.
+  const afterSettings = await page.evaluate(() => [...document.querySelectorAll('.side input, .side select, .side textarea')]
+    .filter((el) => el.id && el.type !== 'file').map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]));
+  assert.deepEqual(afterSettings, before.map(([k, v]) => [k, k === 'planner' ? 'slope' : v]));
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good);
+  assert.equal(await page.textContent('#svg-name'), 'demo: stepped-block drawing');
+  // The planners were still compared on these settings: slope's row says why.
+  const { rows } = await compareTable(page);
+  assert.equal(rows.slope.clearanceBad, true);
+  assert.ok(Number(rows.slope['min clear mm']) < 0);
+  assert.equal(await page.$eval('#compare-table tr.selected td', (td) => td.textContent), 'slope');
+
+  // With the risk accepted the plan is written, with a WARNING line, and
+  // its G-code is downloaded only after a second click.
+  await page.check('#accept-risk');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true);
+  const warning = await page.textContent('#risk-warning-text');
+  assert.match(warning, /^safe motion: WARNING: \d+ of \d+ moves come closer to the surface than tol 0\.1 mm \(min clearance -\d+\.\d{3} mm at line \d+\); written only because the risk was accepted/);
+  assert.equal(await page.isHidden('#risk-warning'), false);
+  assert.match(await page.textContent('#motion-touching'), /^[1-9]\d* of \d+ \(tol 0\.1 mm\)$/);
+  assert.equal(await page.getAttribute('#dl-gcode', 'href'), null);
+  let downloads = 0;
+  page.on('download', () => { downloads++; });
+  await page.click('#dl-gcode');
+  await page.waitForTimeout(500);
+  assert.equal(downloads, 0, 'the first click downloaded the touching G-code');
+  assert.equal(await page.textContent('#dl-gcode'), 'Download anyway (the nozzle touches the part)');
+  const gcode = await download(page, 'dl-gcode');
+  assert.equal(gcode.name, 'demo-stepped-block-path-slope.gcode');
+  const text = gcode.bytes.toString('utf8');
+  const line = text.split('\n').find((l) => l.includes('safe motion:'));
+  assert.equal(line, `; ${warning}`);
+  assert.match(line, /WARNING/);
+  // The report downloads as any other.
+  const report = JSON.parse((await download(page, 'dl-report')).bytes.toString('utf8'));
+  assert.equal(report.motion.risk_accepted, true);
+
+  // Any change takes the confirmation back.
+  await page.selectOption('#planner', 'even');
+  await waitSettled(page);
+  assert.equal(await page.textContent('#dl-gcode'), 'Download G-code');
+  assert.equal(await page.isHidden('#risk-warning'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a G-code file is checked against the scan: the demo\'s own is clear, a cutting move and an arc are named by line', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#check-panel'), true);
+  const own = await download(page, 'dl-gcode');
+  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
+  await page.waitForFunction(() => /^clear/.test(document.getElementById('check-verdict').textContent));
+  const verdict = await page.textContent('#check-verdict');
+  assert.match(verdict, /^clear: none of the \d+ moves comes closer than tol; demo-test-part-lines-even\.gcode against demo-test-part\.ply \(nozzle outer diameter 0\.908 mm, tol 0\.1 mm\)$/);
+  assert.match(await page.textContent('#check-min'), /^minimum clearance 0\.1\d\d mm at line \d+ \(/);
+  assert.equal(await page.$('#check-touching'), null);
+  // Its moves drawn in the 3-D view in place of the plan's paths (feed
+  // moves light, no defect colours), and back.
+  const planPx = await viewPixels(page);
+  await page.click('#check-draw');
+  await page.waitForFunction(() => document.getElementById('check-draw').getAttribute('aria-pressed') === 'true');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const movesPx = await viewPixels(page);
+  assert.ok(movesPx.good < 20 && movesPx.ta > planPx.ta && movesPx.mesh > 1000, `${JSON.stringify(planPx)} / ${JSON.stringify(movesPx)}`);
+  await page.click('#check-draw');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const backPx = await viewPixels(page);
+  assert.ok(backPx.good > 200, JSON.stringify(backPx));
+
+  // Down beside a 2 mm wall of the test part, then up across its corner.
+  const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
+  await page.setInputFiles('#gcode-input', gcodeFile('cut.gcode', cut));
+  await page.waitForFunction(() => /touch/.test(document.getElementById('check-verdict').textContent));
+  assert.match(await page.textContent('#check-verdict'), /^1 of \d+ moves touch: closer than tol; cut\.gcode against demo-test-part\.ply/);
+  assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
+  const touching = await page.$$eval('#check-touching tbody tr', (trs) => trs.map((tr) => [...tr.children].map((td) => td.textContent)));
+  assert.equal(touching.length, 1);
+  assert.equal(touching[0][0], '4');
+  assert.equal(touching[0][1], '(15.400, 16.000, 5.603) → (16.230, 16.000, 7.603)');
+  assert.ok(Number(touching[0][4]) > 1, touching[0].join(' | '));
+  assert.match(await page.textContent('#check-min'), /^minimum clearance -\d\.\d{3} mm at line 4 /);
+  const notes = await page.$$eval('#check-notes li', (lis) => lis.map((li) => li.textContent));
+  assert.ok(notes.some((n) => /^line 2: the program starts by rising above the scan/.test(n)), notes.join('\n'));
+
+  // An arc: the reader's error names the line; the plan stays offered.
+  await page.setInputFiles('#gcode-input', gcodeFile('arc.nc', 'G21 G90\nG0 X10 Y10 Z30\nG2 X20 Y10 I5 J0\n'));
+  await page.waitForFunction(() => /arc\.nc/.test(document.getElementById('error-title').textContent));
+  assert.equal(await page.textContent('#error-title'), 'Could not check arc.nc');
+  assert.match(await page.textContent('#error-message'), /^arc\.nc, line 3: arcs \(`G2` at column 1\) are not supported/);
+  assert.equal(await page.textContent('#check-verdict'), 'could not check arc.nc');
+  assert.equal(await page.isHidden('#dl-gcode'), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('the demo menu loads each generated part with its drawing and placement', async (t) => {
+  const cli = existsSync(CLI);
+  if (!cli) t.diagnostic(`${CLI} not built (cargo build --bin pcpp): the G-code is not compared with the CLI's`);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const parts = await page.$$eval('#demo-part option', (os) => os.map((o) => o.value));
+  assert.deepEqual(parts, ['test-part', 'stepped-block', 'dimpled-hemisphere', 'folded-film', 'wrinkled-film']);
+  for (const part of [...parts.slice(1), parts[0]]) {
+    await page.selectOption('#demo-part', part);
+    const scan = part === 'test-part' ? 'demo-test-part.ply' : `demo-${part}.ply`;
+    const path = part === 'test-part' ? 'demo-test-part-lines.svg' : `demo-${part}-path.svg`;
+    await page.waitForFunction((s) => {
+      const p = window.pcpp.state.lastPlan;
+      return p && p.gcode.includes(`; scan file: ${s}`);
+    }, scan, { timeout: 120_000 });
+    await waitSettled(page);
+    assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+    assert.equal(await page.textContent('#scan-name'), scan);
+    assert.equal(await page.textContent('#svg-name'), `demo: ${part} drawing`);
+    const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+    assert.deepEqual(report.inputs.map((i) => i.name), [scan, path]);
+    // The part's own placement, as `pcpp demo --part` plans it; only the
+    // test part registers on fiducial holes.
+    const placement = await page.evaluate(() => window.pcpp.settings.placement);
+    assert.deepEqual(report.settings.placement,
+      { offset_mm: [placement.x, placement.y], rotation_deg: placement.rot, scale: placement.scale });
+    assert.equal(await page.inputValue('#fid-source'), part === 'test-part' ? 'auto' : 'none');
+    assert.equal(report.motion.program.touching_moves, 0);
+    assert.equal(await page.$$eval('#compare-table tbody tr', (trs) => trs.length), 5);
+    const px = await viewPixels(page);
+    assert.ok(px.mesh > px.total * 0.03 && px.good > 50, `${part}: ${JSON.stringify(px)}`);
+    // The same G-code as `pcpp demo --part` writes for the default planner
+    // (the test part is registered on its holes here, not there: its plan
+    // is compared with the CLI's in live.test.mjs).
+    if (cli && part !== 'test-part') {
+      const out = join(dir, part);
+      execFileSync(CLI, ['demo', '--part', part, '--out', out], { stdio: ['ignore', 'ignore', 'pipe'] });
+      const want = readFileSync(join(out, `demo-${part}-even.gcode`), 'utf8');
+      const got = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+      assert.ok(got === want, `${part}: the page's G-code differs from pcpp demo --part ${part}`);
+    }
+  }
+  // The last part stays across a reload.
+  await page.selectOption('#demo-part', 'folded-film');
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-folded-film.ply');
+  await waitSettled(page);
+  await page.reload();
+  await waitSettled(page);
+  assert.equal(await page.inputValue('#demo-part'), 'folded-film');
+  assert.equal(await page.textContent('#scan-name'), 'demo-folded-film.ply');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
