@@ -12,7 +12,7 @@ use sha2::{Digest, Sha256};
 use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, parts::DemoPart, test_part};
-use crate::fiducials::{find_fiducials, Fiducial};
+use crate::fiducials::{find_fiducials, find_fiducials_sized, Fiducial};
 use crate::gcode::{MachineProfile, MAX_GCODE_BYTES};
 use crate::job::{self, InputFile, JobSettings, PreparedScan, RegistrationSettings};
 use crate::mesh::{ImportOptions, ImportedMesh, MAX_SCAN_BYTES};
@@ -600,10 +600,12 @@ impl ScanImport {
     /// does. A failure (kind `registration`) leaves the import usable.
     pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
         let settings: RegistrationSettings = from_js("registration settings", registration)?;
+        let mesh = &self.imported.mesh;
         let holes = self
             .fiducials
-            .get_or_insert_with(|| find_fiducials(&self.imported.mesh));
-        let reg = job::registration_for(holes, &settings).map_err(core_err)?;
+            .get_or_insert_with(|| find_fiducials_sized(mesh, settings.dot_diameter_mm));
+        // Placement on the bed included, as job::prepare_scan does.
+        let reg = job::registration_for_scan(mesh, holes, &settings).map_err(core_err)?;
         self.registration = Some((reg, settings.method));
         Ok(())
     }

@@ -172,7 +172,11 @@ fn guarded_point(
         t = start;
         clear = false;
     }
-    let lift = if clear { 0.0 } else { c.rise_needed(surface, t) };
+    let lift = if clear {
+        0.0
+    } else {
+        c.rise_needed(surface, t)
+    };
     if lift > 0.0 {
         t.z += lift;
         out.lifted.push((j, lift));
