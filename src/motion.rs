@@ -140,25 +140,21 @@ pub fn insert_waypoints_capped(
         return out;
     };
     out.points.push(first);
-    // The moves' clearances first, with shared index queries; the limit
-    // only matters below the smallest so far and the cap.
-    let pairs: Vec<(DVec3, DVec3)> = planned.windows(2).map(|w| (w[0], w[1])).collect();
-    let mut gaps = Vec::with_capacity(pairs.len());
     let mut min = f64::INFINITY;
     let cap = cap.max(clearance.tol_mm);
-    for &(p, q) in &pairs {
-        let g = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
-        if let Some(g) = g {
+    for (j, pair) in planned.windows(2).enumerate() {
+        let (p, q) = (pair[0], pair[1]);
+        // The move's clearance matters only below the smallest so far and
+        // the cap (and always below tol).
+        let gap = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
+        if let Some(g) = gap {
             min = min.min(g.gap_mm.max(clearance.tol_mm - TIE_MM));
         }
-        gaps.push(g);
-    }
-    for (j, &(p, q)) in pairs.iter().enumerate() {
-        let mut added = Vec::new();
-        if gaps[j].is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
+        if gap.is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
             out.points.push(q);
             continue;
         }
+        let mut added = Vec::new();
         if !resolve(surface, clearance, p, q, &mut added) {
             added = rise_over(surface, clearance, p, q);
             if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
@@ -355,14 +351,11 @@ pub fn check_moves_capped(
     clearance: &Clearance,
     cap: f64,
 ) -> MotionSummary {
-    let moves: Vec<(DVec3, DVec3, Option<usize>)> = moves.into_iter().collect();
-    let mut s = MotionSummary {
-        moves: moves.len(),
-        ..MotionSummary::default()
-    };
+    let mut s = MotionSummary::default();
     let mut min = f64::INFINITY;
     let cap = cap.max(clearance.tol_mm);
-    for (index, &(a, b, line)) in moves.iter().enumerate() {
+    for (index, (a, b, line)) in moves.into_iter().enumerate() {
+        s.moves += 1;
         // Only a clearance below tol, or below the smallest so far and the
         // cap, matters.
         let Some(g) = clearance.gap(surface, a, b, min.min(cap).max(clearance.tol_mm)) else {

@@ -179,34 +179,13 @@ impl Surface {
     }
 
     /// The highest z of the scan over the horizontal disk of `radius` around
-    /// `xy` (the footprint of a vertical nozzle there), `None` if the scan has
-    /// nothing under it. The guarded planner's clearance rests on this.
+    /// `xy` (the footprint of a vertical flat-ended nozzle there), `None` if
+    /// the scan has nothing under it: the point case of the flat cutter of
+    /// [`Self::sweep_gap`].
     pub fn max_height_in_disk(&self, xy: DVec2, radius: f64) -> Option<f64> {
-        self.max_height_in_disk_above(xy, radius, f64::NEG_INFINITY)
-    }
-
-    /// [`Self::max_height_in_disk`] when it exceeds `floor`, else `None`.
-    /// Only triangles reaching above `floor` are visited, so asking "does
-    /// anything under the nozzle come within tol of its tip" is cheap.
-    pub fn max_height_in_disk_above(&self, xy: DVec2, radius: f64, floor: f64) -> Option<f64> {
-        let q = QueryBox {
-            lo: DVec3::new(xy.x - radius, xy.y - radius, floor),
-            hi: DVec3::new(xy.x + radius, xy.y + radius, f64::INFINITY),
-        };
-        let mut best: Option<f64> = None;
-        self.index.visit(&q, |i| {
-            // A triangle whose box misses the query box (in particular one
-            // wholly at or below the floor) cannot raise the answer above
-            // the floor: its height over the disk is a mix of its vertices'.
-            let t = self.mesh.triangle(i);
-            if !meets(&t, &q) || !box_near_disk(&t, xy, radius) {
-                return;
-            }
-            if let Some(z) = triangle_max_z_in_disk(t, xy, radius) {
-                best = Some(best.map_or(z, |b: f64| b.max(z)));
-            }
-        });
-        best.filter(|&h| h > floor)
+        let p = xy.extend(self.top_z() + 1.0);
+        self.sweep_gap(p, p, radius, f64::INFINITY)
+            .map(|g| p.z - g.gap_mm)
     }
 }
 
@@ -349,58 +328,86 @@ fn segment_triangle(o: DVec3, dir: DVec3, t: [DVec3; 3]) -> Option<f64> {
     (-eps..=1.0 + eps).contains(&tt).then(|| tt.clamp(0.0, 1.0))
 }
 
-/// Highest z of the triangle over the XY disk: a linear function on the
-/// convex set triangle ∩ cylinder peaks at a triangle vertex inside the disk,
-/// where an edge crosses the circle, or where the circle meets the plane's
-/// steepest ascent (if that point lies in the triangle).
-fn triangle_max_z_in_disk(t: [DVec3; 3], c: DVec2, r: f64) -> Option<f64> {
-    let r2 = r * r;
-    let mut best: Option<f64> = None;
-    let mut take = |z: f64| best = Some(best.map_or(z, |b: f64| b.max(z)));
-    for k in 0..3 {
-        let (a, b) = (t[k], t[(k + 1) % 3]);
-        if (a.truncate() - c).length_squared() <= r2 {
-            take(a.z);
-        }
-        let d = (b - a).truncate();
-        let f = a.truncate() - c;
-        let qa = d.length_squared();
-        if qa > 0.0 {
-            let qb = 2.0 * f.dot(d);
-            let qc = f.length_squared() - r2;
-            let disc = qb * qb - 4.0 * qa * qc;
-            if disc >= 0.0 {
-                let sq = disc.sqrt();
-                for s in [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] {
-                    if (0.0..=1.0).contains(&s) {
-                        take(a.z + (b.z - a.z) * s);
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// The highest z of the scan over the XY disk, by its own exact
+    /// per-triangle geometry (independent of the sweep's): the reference
+    /// the sweep's tests sample against.
+    pub(crate) fn reference_max_height_in_disk(s: &Surface, c: DVec2, r: f64) -> Option<f64> {
+        let q = QueryBox {
+            lo: DVec3::new(c.x - r, c.y - r, f64::NEG_INFINITY),
+            hi: DVec3::new(c.x + r, c.y + r, f64::INFINITY),
+        };
+        let mut best: Option<f64> = None;
+        s.index.visit(&q, |i| {
+            if let Some(z) = triangle_max_z_in_disk(s.mesh.triangle(i), c, r) {
+                best = Some(best.map_or(z, |b: f64| b.max(z)));
+            }
+        });
+        best
+    }
+
+    /// Highest z of the triangle over the XY disk: a linear function on the
+    /// convex set triangle ∩ cylinder peaks at a triangle vertex inside the disk,
+    /// where an edge crosses the circle, or where the circle meets the plane's
+    /// steepest ascent (if that point lies in the triangle).
+    fn triangle_max_z_in_disk(t: [DVec3; 3], c: DVec2, r: f64) -> Option<f64> {
+        let r2 = r * r;
+        let mut best: Option<f64> = None;
+        let mut take = |z: f64| best = Some(best.map_or(z, |b: f64| b.max(z)));
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if (a.truncate() - c).length_squared() <= r2 {
+                take(a.z);
+            }
+            let d = (b - a).truncate();
+            let f = a.truncate() - c;
+            let qa = d.length_squared();
+            if qa > 0.0 {
+                let qb = 2.0 * f.dot(d);
+                let qc = f.length_squared() - r2;
+                let disc = qb * qb - 4.0 * qa * qc;
+                if disc >= 0.0 {
+                    let sq = disc.sqrt();
+                    for s in [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] {
+                        if (0.0..=1.0).contains(&s) {
+                            take(a.z + (b.z - a.z) * s);
+                        }
                     }
                 }
             }
         }
-    }
-    // Interior candidates need a non-vertical plane z = g . xy + z0.
-    let n = (t[1] - t[0]).cross(t[2] - t[0]);
-    if n.z.abs() > 1e-14 * n.length() {
-        let g = DVec2::new(-n.x / n.z, -n.y / n.z);
-        let z_at = |p: DVec2| t[0].z + g.dot(p - t[0].truncate());
-        if barycentric_xy(t, c).is_some() {
-            take(z_at(c));
-        }
-        let gl = g.length();
-        if gl > 0.0 {
-            let p = c + g / gl * r;
-            if barycentric_xy(t, p).is_some() {
-                take(z_at(p));
+        // Interior candidates need a non-vertical plane z = g . xy + z0.
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if n.z.abs() > 1e-14 * n.length() {
+            let g = DVec2::new(-n.x / n.z, -n.y / n.z);
+            let z_at = |p: DVec2| t[0].z + g.dot(p - t[0].truncate());
+            if barycentric_xy(t, c).is_some() {
+                take(z_at(c));
+            }
+            let gl = g.length();
+            if gl > 0.0 {
+                let p = c + g / gl * r;
+                if barycentric_xy(t, p).is_some() {
+                    take(z_at(p));
+                }
             }
         }
+        best
     }
-    best
-}
 
-#[cfg(test)]
-pub(crate) mod tests {
-    use super::*;
+    #[test]
+    fn the_flat_footprint_query_matches_the_reference() {
+        let s = Surface::new(grid(40, 10.0, |x, y| (x * 1.7).sin() + 0.3 * y)).unwrap();
+        for k in 0..200 {
+            let c = DVec2::new(0.5 + 0.045 * k as f64, 2.0 + 0.03 * k as f64);
+            let a = s.max_height_in_disk(c, 0.45).unwrap();
+            let b = reference_max_height_in_disk(&s, c, 0.45).unwrap();
+            assert!((a - b).abs() < 1e-9, "{c}: {a} vs {b}");
+        }
+    }
 
     /// The plane z = 0 over [-10, 10]^2, for the planners' and quality tests.
     pub(crate) fn flat() -> Surface {

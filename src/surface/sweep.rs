@@ -446,7 +446,7 @@ fn segment_segment_dist2(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::grid;
+    use super::super::tests::{grid, reference_max_height_in_disk};
     use super::*;
     use crate::mesh::TriMesh;
 
@@ -456,8 +456,7 @@ mod tests {
         (0..=n)
             .map(|i| {
                 let p = a.lerp(b, i as f64 / n as f64);
-                s.max_height_in_disk(p.truncate(), r)
-                    .map_or(f64::INFINITY, |h| p.z - h)
+                reference_max_height_in_disk(s, p.truncate(), r).map_or(f64::INFINITY, |h| p.z - h)
             })
             .fold(f64::INFINITY, f64::min)
     }
@@ -589,7 +588,7 @@ mod tests {
         for k in 0..50 {
             let p = DVec3::new(0.5 + 0.04 * k as f64, 1.5, 2.0);
             let g = surf.sweep_gap(p, p, 0.4, f64::INFINITY).unwrap().gap_mm;
-            let h = surf.max_height_in_disk(p.truncate(), 0.4).unwrap();
+            let h = reference_max_height_in_disk(&surf, p.truncate(), 0.4).unwrap();
             assert!((g - (p.z - h)).abs() < 1e-9, "{g} vs {}", p.z - h);
         }
     }
