@@ -733,6 +733,10 @@ pub struct GcodeCheck {
     /// The clearance checked: tol (mm) and the nozzle's outer diameter.
     pub tol_mm: f64,
     pub outer_diameter_mm: f64,
+    /// The straight moves followed, in file order (the touching moves'
+    /// `index` points into them): for drawing; not in the JSON.
+    #[serde(skip)]
+    pub moves: Vec<crate::gcode::GcodeMove>,
 }
 
 impl GcodeCheck {
@@ -832,6 +836,7 @@ pub fn check_gcode(
         notes,
         tol_mm,
         outer_diameter_mm: nozzle.outer_diameter_mm,
+        moves: program.moves,
     })
 }
 

@@ -1148,12 +1148,10 @@ impl Session {
         set(o, "clear", &JsValue::from_bool(check.is_clear()));
         let (mut moves, mut kinds) = (JsValue::NULL, JsValue::NULL);
         if check.summary.moves <= PAGE_MAX_DRAWN_MOVES {
-            // Read once more for the drawing: the check keeps no moves, and
-            // its touching moves are indices into this same list.
-            let program = crate::gcode::read_gcode(text, name).map_err(|e| core_err(e.into()))?;
-            let mut xyz = Vec::with_capacity(6 * program.moves.len());
-            let mut k: Vec<u8> = program.moves.iter().map(|m| u8::from(m.rapid)).collect();
-            for m in &program.moves {
+            // The check's own moves: its touching moves index into them.
+            let mut xyz = Vec::with_capacity(6 * check.moves.len());
+            let mut k: Vec<u8> = check.moves.iter().map(|m| u8::from(m.rapid)).collect();
+            for m in &check.moves {
                 xyz.extend(
                     [m.from, m.to]
                         .iter()
