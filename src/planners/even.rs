@@ -109,36 +109,30 @@ pub(super) fn plan(
         height.push(f.z);
     }
     // Progress: the tip's place along the path, w_j = u_j + shift_j, must
-    // advance by MIN_ADVANCE of each step; closest in least squares.
+    // advance by MIN_ADVANCE of each step (`advance`, summed in `floor`);
+    // the closest such places in least squares are the nondecreasing fit
+    // to w_j - floor_j, plus floor_j.
     let mut u = Vec::with_capacity(n);
-    let mut acc = 0.0;
+    let mut advance = vec![0.0; n];
+    let mut floor = Vec::with_capacity(n);
+    let (mut acc, mut least) = (0.0, 0.0);
     for j in 0..n {
         if j > 0 {
-            acc += (ta[j] - ta[j - 1]).truncate().length();
+            let step = (ta[j] - ta[j - 1]).truncate().length();
+            acc += step;
+            advance[j] = MIN_ADVANCE * step;
+            least += advance[j];
         }
         u.push(acc);
+        floor.push(least);
     }
-    let mut floor = 0.0;
-    let mut lifted: Vec<f64> = Vec::with_capacity(n);
-    for j in 0..n {
-        if j > 0 {
-            floor += MIN_ADVANCE * (u[j] - u[j - 1]);
-        }
-        lifted.push(u[j] + shift[j] - floor);
-    }
-    let fitted = isotonic(&lifted);
+    let lowered: Vec<f64> = (0..n).map(|j| u[j] + shift[j] - floor[j]).collect();
+    let target: Vec<f64> = isotonic(&lowered)
+        .into_iter()
+        .zip(&floor)
+        .map(|(w, f)| w + f)
+        .collect();
     let c = Clearance::new(nozzle, process.tolerance_mm).with_margin(PLANNING_MARGIN_MM);
-    // Targets along the path (absolute w) and the least advance per step.
-    let mut target = Vec::with_capacity(n);
-    let mut advance = vec![0.0; n];
-    let mut floor = 0.0;
-    for j in 0..n {
-        if j > 0 {
-            advance[j] = MIN_ADVANCE * (u[j] - u[j - 1]);
-            floor += advance[j];
-        }
-        target.push(fitted[j] + floor);
-    }
     let at =
         |j: usize, w: f64, z: f64| DVec3::new(ta[j].x, ta[j].y, z) + (w - u[j]) * geometry[j].v;
     // Where a target is too close to the surface, the tip may stay back at
