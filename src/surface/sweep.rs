@@ -183,7 +183,7 @@ impl Sweep {
             return;
         }
         let steps = &self.steps.0[..self.steps.1];
-        self.m.triangle(t, self.low_tip - top, steps, best);
+        self.m.triangle(t, self.low_tip, steps, best);
     }
 
     fn finish(&self, best: Best) -> Option<SweepGap> {
@@ -223,142 +223,140 @@ impl Move {
         }
     }
 
-    /// `headroom` is the lowest tip height less the triangle's top: no
-    /// contact of it can have a value below `headroom - h`.
-    fn triangle(&self, t: [DVec3; 3], headroom: f64, steps: &[(f64, f64)], best: &mut Best) {
-        // The steps that could still beat the best value (their h is what
-        // a contact of this triangle can gain at most).
-        let mut live = [false; 4];
-        let mut any = false;
-        for (k, &(_, h)) in steps.iter().enumerate() {
-            live[k] = headroom - h < best.gap;
-            any |= live[k];
+    /// The value z(s) - q_z - h (s in [0, 1]).
+    #[inline]
+    fn value(&self, s: f64, q: DVec3, h: f64) -> f64 {
+        self.a.z + s.clamp(0.0, 1.0) * self.dz - q.z - h
+    }
+
+    /// The corners, edges and facet of triangle `t` for the move whose
+    /// lowest tip height is `low_tip`.
+    ///
+    /// A corner or edge whose top lies `room` below `low_tip` has no
+    /// contact with a value below `room - h` under a step whose bottom
+    /// lies `h` below the tip: only the steps that could still beat the
+    /// best value are tried ([`live_steps`]), and a corner's or edge's
+    /// distance from the move is found only when a step is left. Skipping
+    /// a candidate that cannot be strictly better leaves the result as it
+    /// was.
+    fn triangle(&self, t: [DVec3; 3], low_tip: f64, steps: &[(f64, f64)], best: &mut Best) {
+        let (a, b) = (self.a.truncate(), self.a.truncate() + self.d);
+        // Squared XY distances of the corners from the move, once found.
+        let mut dv = [f64::NAN; 3];
+        for k in 0..3 {
+            let live = live_steps(low_tip - t[k].z, steps, best.gap);
+            if !live.is_empty() {
+                dv[k] = point_segment_dist2(t[k].truncate(), a, b);
+                self.corner(t[k], dv[k], live, best);
+            }
         }
-        if any {
-            // How far (in XY) each corner and edge lies from the move: a
-            // step narrower than that meets it nowhere.
-            let (dv, de) = self.distances2(t);
-            for (v, d2) in t.iter().zip(dv) {
-                self.corner(*v, d2, steps, &live, best);
+        for k in 0..3 {
+            let (i, j) = (k, (k + 1) % 3);
+            let live = live_steps(low_tip - t[i].z.max(t[j].z), steps, best.gap);
+            if live.is_empty() {
+                continue;
             }
-            for k in 0..3 {
-                self.edge(t[k], t[(k + 1) % 3], de[k], steps, &live, best);
-            }
+            let (p, q) = (t[i].truncate(), t[j].truncate());
+            let d2 = if segments_cross(p, q, a, b) {
+                0.0
+            } else {
+                let mut end = |k: usize, v: DVec2| {
+                    if dv[k].is_nan() {
+                        dv[k] = point_segment_dist2(v, a, b);
+                    }
+                    dv[k]
+                };
+                end(i, p)
+                    .min(end(j, q))
+                    .min(point_segment_dist2(a, p, q))
+                    .min(point_segment_dist2(b, p, q))
+            };
+            self.edge(t[i], t[j], d2, live, best);
         }
         self.facet(t, best);
     }
 
     /// A corner under each live step: the worst s of its interval is its
-    /// lower end when the tip rises, its upper end when it descends.
-    fn corner(&self, v: DVec3, d2: f64, steps: &[(f64, f64)], live: &[bool; 4], best: &mut Best) {
-        let w = v.truncate() - self.a.truncate();
-        let (ww, dd) = (w.length_squared(), self.d.length_squared());
-        let wd = w.dot(self.d);
-        for (k, &(radius, h)) in steps.iter().enumerate() {
-            let r2 = radius * radius * (1.0 + SLACK);
-            if !live[k] || d2 > r2 {
-                continue;
+    /// lower end when the tip rises, its upper end when it descends. With
+    /// more than one step, the widest live step with the largest h first
+    /// bounds them all (its interval holds theirs): nothing under them can
+    /// beat the best value when that bound does not.
+    fn corner(&self, v: DVec3, d2: f64, steps: &[(f64, f64)], best: &mut Best) {
+        if let [(_, h0), .., (wide, _)] = *steps {
+            match self.corner_s(v, d2, wide) {
+                Some(s) if self.value(s, v, h0) < best.gap + BOUND_EPS => {}
+                _ => return,
             }
-            let (s0, s1) = if dd <= 1e-30 {
-                if ww > r2 {
-                    continue;
-                }
-                (0.0, 1.0)
-            } else {
-                let disc = wd * wd - dd * (ww - r2);
-                if disc < 0.0 {
-                    continue;
-                }
-                let sq = disc.sqrt();
-                let (s0, s1) = (((wd - sq) / dd).max(0.0), ((wd + sq) / dd).min(1.0));
-                if s0 > s1 {
-                    continue;
-                }
-                (s0, s1)
-            };
-            self.consider(if self.dz >= 0.0 { s0 } else { s1 }, v, h, best);
+        }
+        for &(radius, h) in steps {
+            if let Some(s) = self.corner_s(v, d2, radius) {
+                self.consider(s, v, h, best);
+            }
         }
     }
 
-    /// Squared XY distances of the corners and edges from the move.
-    fn distances2(&self, t: [DVec3; 3]) -> ([f64; 3], [f64; 3]) {
-        let (a, b) = (self.a.truncate(), self.a.truncate() + self.d);
-        let dv = t.map(|v| point_segment_dist2(v.truncate(), a, b));
-        let de: [f64; 3] = std::array::from_fn(|k| {
-            segment_segment_dist2(t[k].truncate(), t[(k + 1) % 3].truncate(), a, b)
-        });
-        (dv, de)
+    /// The worst s at which corner `v` (squared XY distance `d2` from the
+    /// move) lies under a flat cutter of `radius`, if it ever does.
+    #[inline]
+    fn corner_s(&self, v: DVec3, d2: f64, radius: f64) -> Option<f64> {
+        let r2 = radius * radius * (1.0 + SLACK);
+        if d2 > r2 {
+            return None;
+        }
+        let w = v.truncate() - self.a.truncate();
+        let (ww, dd) = (w.length_squared(), self.d.length_squared());
+        let (s0, s1) = if dd <= 1e-30 {
+            if ww > r2 {
+                return None;
+            }
+            (0.0, 1.0)
+        } else {
+            let wd = w.dot(self.d);
+            let disc = wd * wd - dd * (ww - r2);
+            if disc < 0.0 {
+                return None;
+            }
+            let sq = disc.sqrt();
+            let (s0, s1) = (((wd - sq) / dd).max(0.0), ((wd + sq) / dd).min(1.0));
+            if s0 > s1 {
+                return None;
+            }
+            (s0, s1)
+        };
+        Some(if self.dz >= 0.0 { s0 } else { s1 })
     }
 
     /// Edge crossings under each live step (a flat cutter of its radius
     /// whose bottom lies its h below the tip): the chords at s = 0 and
     /// s = 1, and the point of the (t, s) ellipse where the value is
-    /// smallest. What does not depend on the radius is found once.
-    fn edge(
-        &self,
-        p: DVec3,
-        q: DVec3,
-        d2: f64,
-        steps: &[(f64, f64)],
-        live: &[bool; 4],
-        best: &mut Best,
-    ) {
-        let e = (q - p).truncate();
-        let ee = e.length_squared();
-        if ee <= 1e-30 {
-            return; // a vertical edge: its top corner is a corner above
+    /// smallest. With more than one step, the widest live step with the
+    /// largest h first bounds them all: its region of (t, s) holds theirs,
+    /// so their candidates are no lower than its smallest value over its
+    /// region's boundary (these candidates and the edge's ends, the
+    /// sides t = 0 and t = 1).
+    fn edge(&self, p: DVec3, q: DVec3, d2: f64, steps: &[(f64, f64)], best: &mut Best) {
+        let widest = steps.last().map_or(0.0, |s| s.0);
+        if d2 > widest * widest * (1.0 + SLACK) {
+            return;
         }
-        let a_xy = self.a.truncate();
-        let w0 = p.truncate() - a_xy;
-        let moving = self.d.length_squared() > 1e-30;
-        // The chords' quadratics at s = 0 and s = 1.
-        let ends: [(f64, f64, f64); 2] = [0.0, 1.0].map(|s| {
-            let f = w0 - s * self.d;
-            (s, f.dot(e), f.length_squared())
-        });
-        // y = w0 + M v with v = (t, s), M = [e | -d]: the ellipse is
-        // |y| <= r. The value is c . v + const with c = (-(q_z - p_z), dz);
-        // over |y| = r its minimum is at y = -r g / |g|, g = M^-T c.
-        let d = self.d;
-        let det = d.perp_dot(e);
-        let ellipse = if moving && det.abs() > 1e-12 * d.length() * ee.sqrt() {
-            let c = DVec2::new(-(q.z - p.z), self.dz);
-            let inv = 1.0 / det;
-            let g = DVec2::new(-d.y * c.x - e.y * c.y, d.x * c.x + e.x * c.y) * inv;
-            let gl = g.length();
-            // A constant value on the ellipse: the square's sides suffice.
-            (gl > 1e-300).then_some((g / gl, inv))
-        } else {
-            // e parallel to the move: the square's sides suffice.
-            None
+        let Some(e) = EdgeSweep::new(self, p, q) else {
+            return; // a vertical edge: its top corner is a corner above
         };
-        for (k, &(radius, h)) in steps.iter().enumerate() {
-            let r2 = radius * radius * (1.0 + SLACK);
-            if !live[k] || d2 > r2 {
-                continue;
-            }
-            for &(s, b, ff) in &ends[..if moving { 2 } else { 1 }] {
-                let disc = b * b - ee * (ff - r2);
-                if disc < 0.0 {
-                    continue;
-                }
-                let sq = disc.sqrt();
-                for t in [(-b - sq) / ee, (-b + sq) / ee] {
-                    if (0.0..=1.0).contains(&t) {
-                        self.consider(s, p + (q - p) * t, h, best);
-                    }
+        if let [(_, h0), .., (wide, _)] = *steps {
+            let mut low = f64::INFINITY;
+            e.candidates(self, d2, wide, |s, x| low = low.min(self.value(s, x, h0)));
+            for v in [p, q] {
+                // (0 for the distance: the corner's own interval decides.)
+                if let Some(s) = self.corner_s(v, 0.0, wide) {
+                    low = low.min(self.value(s, v, h0));
                 }
             }
-            if let Some((gn, inv)) = ellipse {
-                let y = -radius * gn - w0;
-                // v = M^-1 y, M^-1 = [[-d.y, d.x], [-e.y, e.x]] / det.
-                let t = (-d.y * y.x + d.x * y.y) * inv;
-                let s = (-e.y * y.x + e.x * y.y) * inv;
-                let eps = 1e-12;
-                if (-eps..=1.0 + eps).contains(&t) && (-eps..=1.0 + eps).contains(&s) {
-                    self.consider(s, p + (q - p) * t.clamp(0.0, 1.0), h, best);
-                }
+            if low >= best.gap + BOUND_EPS {
+                return;
             }
+        }
+        for &(radius, h) in steps {
+            e.candidates(self, d2, radius, |s, x| self.consider(s, x, h, best));
         }
     }
 
@@ -414,6 +412,19 @@ impl Move {
     }
 }
 
+/// The steps whose contacts with a point `room` below the lowest tip could
+/// still beat the value `best`: room - h < best. The steps' h fall from
+/// the first to the last ([`RIM_SIN_COS`]: cos 0, 25, 45, 65 degrees), so
+/// they are the steps from the first to the last one for which it holds.
+#[inline]
+fn live_steps(room: f64, steps: &[(f64, f64)], best: f64) -> &[(f64, f64)] {
+    let mut n = 0;
+    while n < steps.len() && room - steps[n].1 < best {
+        n += 1;
+    }
+    &steps[..n]
+}
+
 /// Squared distance from `p` to the segment [a, b] (2-D).
 fn point_segment_dist2(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
@@ -426,22 +437,110 @@ fn point_segment_dist2(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     (a + ab * t - p).length_squared()
 }
 
-/// Squared distance between the segments [p, q] and [a, b] (2-D): zero
-/// where they cross, else the least of the four end-to-segment distances.
-fn segment_segment_dist2(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let (r, s) = (q - p, b - a);
-    let den = r.perp_dot(s);
-    if den != 0.0 {
-        let t = (a - p).perp_dot(s) / den;
-        let u = (a - p).perp_dot(r) / den;
-        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
-            return 0.0;
+/// What an edge's candidates share across the steps: y = w0 + M v with
+/// v = (t, s), M = [e | -d], the ellipse |y| <= r of a flat cutter of
+/// radius r; the value is c . v + const with c = (-(q_z - p_z), dz), and
+/// over |y| = r its minimum is at y = -r g / |g|, g = M^-T c.
+struct EdgeSweep {
+    p: DVec3,
+    q: DVec3,
+    e: DVec2,
+    ee: f64,
+    w0: DVec2,
+    /// The chords' quadratics at s = 0 and (for a moving tip) s = 1.
+    ends: [(f64, f64, f64); 2],
+    n_ends: usize,
+    /// g / |g| and 1 / det M, unless the value is constant on the ellipse
+    /// or e is parallel to the move (the square's sides suffice then).
+    ellipse: Option<(DVec2, f64)>,
+}
+
+impl EdgeSweep {
+    fn new(m: &Move, p: DVec3, q: DVec3) -> Option<EdgeSweep> {
+        let e = (q - p).truncate();
+        let ee = e.length_squared();
+        if ee <= 1e-30 {
+            return None;
+        }
+        let w0 = p.truncate() - m.a.truncate();
+        let d = m.d;
+        let moving = d.length_squared() > 1e-30;
+        let ends = [0.0, 1.0].map(|s| {
+            let f = w0 - s * d;
+            (s, f.dot(e), f.length_squared())
+        });
+        let det = d.perp_dot(e);
+        let ellipse = if moving && det.abs() > 1e-12 * d.length() * ee.sqrt() {
+            let c = DVec2::new(-(q.z - p.z), m.dz);
+            let inv = 1.0 / det;
+            let g = DVec2::new(-d.y * c.x - e.y * c.y, d.x * c.x + e.x * c.y) * inv;
+            let gl = g.length();
+            (gl > 1e-300).then_some((g / gl, inv))
+        } else {
+            None
+        };
+        Some(EdgeSweep {
+            p,
+            q,
+            e,
+            ee,
+            w0,
+            ends,
+            n_ends: if moving { 2 } else { 1 },
+            ellipse,
+        })
+    }
+
+    /// Calls `f(s, x)` with each candidate under a flat cutter of `radius`
+    /// (none when the edge lies `d2` away, beyond it).
+    #[inline]
+    fn candidates(&self, m: &Move, d2: f64, radius: f64, mut f: impl FnMut(f64, DVec3)) {
+        let r2 = radius * radius * (1.0 + SLACK);
+        if d2 > r2 {
+            return;
+        }
+        let (p, q, ee) = (self.p, self.q, self.ee);
+        for &(s, b, ff) in &self.ends[..self.n_ends] {
+            let disc = b * b - ee * (ff - r2);
+            if disc < 0.0 {
+                continue;
+            }
+            let sq = disc.sqrt();
+            for t in [(-b - sq) / ee, (-b + sq) / ee] {
+                if (0.0..=1.0).contains(&t) {
+                    f(s, p + (q - p) * t);
+                }
+            }
+        }
+        if let Some((gn, inv)) = self.ellipse {
+            let (d, e) = (m.d, self.e);
+            let y = -radius * gn - self.w0;
+            // v = M^-1 y, M^-1 = [[-d.y, d.x], [-e.y, e.x]] / det.
+            let t = (-d.y * y.x + d.x * y.y) * inv;
+            let s = (-e.y * y.x + e.x * y.y) * inv;
+            let eps = 1e-12;
+            if (-eps..=1.0 + eps).contains(&t) && (-eps..=1.0 + eps).contains(&s) {
+                f(s, p + (q - p) * t.clamp(0.0, 1.0));
+            }
         }
     }
-    point_segment_dist2(p, a, b)
-        .min(point_segment_dist2(q, a, b))
-        .min(point_segment_dist2(a, p, q))
-        .min(point_segment_dist2(b, p, q))
+}
+
+/// A bound must clear the best value by this much before the candidates
+/// under it are skipped, so rounding in the bound never hides one.
+const BOUND_EPS: f64 = 1e-12;
+
+/// Whether the segments [p, q] and [a, b] cross (2-D; parallel ones never
+/// do here: their distance is then that of an end to the other segment).
+fn segments_cross(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> bool {
+    let (r, s) = (q - p, b - a);
+    let den = r.perp_dot(s);
+    if den == 0.0 {
+        return false;
+    }
+    let t = (a - p).perp_dot(s) / den;
+    let u = (a - p).perp_dot(r) / den;
+    (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)
 }
 
 #[cfg(test)]
