@@ -17,6 +17,9 @@
 //!   (issue 11: with the check within 1.5x of without; issue 12: `even`
 //!   within 2x of `pcpp-guarded`), and the same on W2.
 //!
+//! - `cloud/W4 ...`: a million raw points (W4) meshed (issue 14: under
+//!   2 s natively), read from XYZ text, and with the holes and index.
+//!
 //! `PCPP_BENCH_N` shrinks the film (grid cells per side, default 1000).
 //! `PCPP_BENCH_CLOCK=cpu` times the bench thread's CPU time instead of wall
 //! time (see [`Clock`]). `scripts/bench.sh` runs these with the wasm timings
@@ -135,6 +138,47 @@ fn motion_benches(c: &mut Criterion<Clock>) {
     g.finish();
 }
 
+/// Issue 14: W4, a million raw points, read and meshed (target: under 2 s
+/// natively).
+fn cloud_benches(c: &mut Criterion<Clock>) {
+    let side = std::env::var("PCPP_BENCH_CLOUD_SIDE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(workloads::CLOUD_SIDE);
+    let points = workloads::film_cloud(side);
+    let xyz = workloads::to_xyz(&points);
+    let mut g = c.benchmark_group("cloud");
+    g.sample_size(10).sampling_mode(SamplingMode::Flat);
+    g.bench_function("W4 1M points: triangulate", |b| {
+        b.iter(|| pcpp::mesh::triangulate(black_box(points.clone()), None, "W4").unwrap())
+    });
+    g.throughput(Throughput::Bytes(xyz.len() as u64));
+    g.bench_function("W4 1M points: XYZ import + mesh", |b| {
+        b.iter(|| {
+            pcpp::mesh::import_mesh(
+                black_box(xyz.as_bytes()),
+                workloads::W4_XYZ,
+                &pcpp::mesh::ImportOptions::DEFAULT,
+            )
+            .unwrap()
+        })
+    });
+    // What the page's Session does with it: also the holes and the index.
+    let (w2,) = (workloads::w2_settings(),);
+    g.bench_function("W4 1M points: XYZ + index", |b| {
+        b.iter(|| {
+            prepare_scan(
+                black_box(xyz.as_bytes()),
+                workloads::W4_XYZ,
+                &w2.scan,
+                &w2.registration,
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
 fn benches(c: &mut Criterion<Clock>) {
     let film = workloads::wrinkled_film(n());
     let ply = to_binary_ply(&film);
@@ -200,6 +244,6 @@ fn benches(c: &mut Criterion<Clock>) {
 criterion_group! {
     name = pipeline_benches;
     config = Criterion::default().with_measurement(Clock::from_env());
-    targets = motion_benches, benches
+    targets = motion_benches, cloud_benches, benches
 }
 criterion_main!(pipeline_benches);

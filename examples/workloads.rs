@@ -109,6 +109,13 @@ fn run() -> Result<(), String> {
     let obj_bytes = obj.len();
     drop(obj);
 
+    // W4: the film as a million raw points (fewer with a smaller film).
+    let side = (cells + 1).min(workloads::CLOUD_SIDE);
+    let cloud = workloads::to_xyz(&workloads::film_cloud(side));
+    write(&dir, workloads::W4_XYZ, cloud.as_bytes())?;
+    let cloud_bytes = cloud.len();
+    drop(cloud);
+
     let (w2, w3) = (workloads::w2_svg(), workloads::w3_svg());
     let (s2, s3) = (workloads::w2_settings(), workloads::w3_settings());
     write(&dir, workloads::W2_SVG, w2.as_bytes())?;
@@ -129,6 +136,7 @@ fn run() -> Result<(), String> {
         },
         "W2": path_summary(&surface, &w2, workloads::W2_SVG, &s2)?,
         "W3": path_summary(&surface, &w3, workloads::W3_SVG, &s3)?,
+        "W4": { "points": side * side, "xyz_bytes": cloud_bytes },
     });
     write(&dir, "workloads.json", json(&manifest)?.as_bytes())?;
     println!(

@@ -69,6 +69,32 @@ def ply_binary(v, t):
     return h + body
 
 
+def cloud_seeds(v):
+    """Point-cloud seeds for import_cloud: the first byte picks the name
+    (0 .xyz, 1 .csv, 2 .pcd, 3 .ply; bit 2 adds an edge limit from the
+    next byte)."""
+    d = SEEDS / "import_cloud"
+    d.mkdir(parents=True)
+    xyz = "".join(f"{x} {y} {z}\n" for x, y, z in v).encode()
+    csv = b"x,y,z,nx,ny,nz\n" + "".join(f"{x},{y},{z},0,0,1\n" for x, y, z in v).encode()
+    n = len(v)
+    head = lambda data: (f"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                         f"COUNT 1 1 1\nWIDTH {n}\nHEIGHT 1\nPOINTS {n}\nDATA {data}\n").encode()
+    binary = head("binary") + b"".join(struct.pack("<3f", *p) for p in v)
+    cols = b"".join(struct.pack("<f", p[k]) for k in range(3) for p in v)
+    lzf = b"".join(bytes([len(cols[i:i + 32]) - 1]) + cols[i:i + 32] for i in range(0, len(cols), 32))
+    compressed = head("binary_compressed") + struct.pack("<II", len(lzf), len(cols)) + lzf
+    ply = (f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+           f"property float y\nproperty float z\nend_header\n").encode()
+    ply += b"".join(struct.pack("<3f", *p) for p in v)
+    for name, data in [("grid.xyz", b"\x00" + xyz), ("grid.csv", b"\x01" + csv),
+                       ("grid_ascii.pcd", b"\x02" + head("ascii") + xyz),
+                       ("grid_binary.pcd", b"\x02" + binary),
+                       ("grid_compressed.pcd", b"\x02" + compressed),
+                       ("grid_points.ply", b"\x03" + ply), ("grid_limit.xyz", b"\x04\x50" + xyz)]:
+        (d / name).write_bytes(data)
+
+
 def normal(a, b, c):
     u = [b[i] - a[i] for i in range(3)]
     w = [c[i] - a[i] for i in range(3)]
@@ -266,6 +292,7 @@ def main():
     data = pipeline_input(1, 3 | 16, ply_ascii(v, t), svg(SVGS["path_all.svg"]), (200, 255, 5, 228, 233, 45, 140))
     (d / "ply_guarded_rotated").write_bytes(data)
     gcode_seeds()
+    cloud_seeds(v)
     total = sum(p.stat().st_size for p in SEEDS.rglob("*") if p.is_file())
     print(f"wrote seeds under {SEEDS} ({total} bytes)")
 

@@ -132,6 +132,22 @@ for (let k = 0; k < runs.obj; k++) {
   log(`Session(W1.obj, ${mb(obj.length)} MB): ${ms.toFixed(0)} ms, ${(obj.length / 1e3 / ms).toFixed(1)} MB/s`);
 }
 
+// 2b. W4, a million raw points as XYZ text -> Session (meshed, holes,
+// index), when the workloads have it.
+const w4Path = join(dir, 'W4.xyz');
+const w4Ms = [];
+let w4Triangles = 0;
+if (existsSync(w4Path)) {
+  const w4 = readFileSync(w4Path);
+  for (let k = 0; k < runs.obj; k++) {
+    const [ms, s] = time(() => session(w4, 'W4.xyz'));
+    w4Ms.push(ms);
+    w4Triangles = s.info().triangles;
+    s.free();
+    log(`Session(W4.xyz, ${mb(w4.length)} MB): ${ms.toFixed(0)} ms, ${w4Triangles} triangles`);
+  }
+}
+
 // 3. Plans on one W1 Session (accept risk: the timing must not depend on
 // whether some raster point could not be cleared).
 const scan = session(ply, 'W1.ply');
@@ -161,6 +177,8 @@ const result = {
   ply_session_first_s: plyMs[0] / 1e3,
   obj_session_s: median(objMs) / 1e3,
   obj_session_mb_s: obj.length / 1e6 / (median(objMs) / 1e3),
+  w4_session_s: w4Ms.length ? median(w4Ms) / 1e3 : null,
+  w4_triangles: w4Triangles,
   w2_plan_ms: median(p2.ms),
   w2_points: p2.points,
   w3_plan_ms: median(p3.ms),

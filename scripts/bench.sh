@@ -48,6 +48,9 @@ fi
 log "native peak memory holding W1 ready (examples/peak_memory.rs)"
 target/release/examples/peak_memory "$WL/W1.ply" </dev/null >"$OUT/native-memory.txt"
 cat "$OUT/native-memory.txt" >&2
+log "native peak memory holding W4 (a million raw points) ready"
+target/release/examples/peak_memory "$WL/W4.xyz" </dev/null >"$OUT/native-memory-w4.txt"
+cat "$OUT/native-memory-w4.txt" >&2
 
 log "criterion benches (cargo bench --bench pipeline)"
 if [ "$QUICK" = 1 ]; then
@@ -117,6 +120,11 @@ const w2S = bench('plan/W2 spiral on W1 (pcpp-guarded + quality)').median_s;
 const w3S = bench('plan/W3 raster on W1 (pcpp-guarded + quality)').median_s;
 const w2JobS = bench('job/W2 plan + report + G-code').median_s;
 const w3JobS = bench('job/W3 plan + report + G-code').median_s;
+const w4MeshS = bench('cloud/W4 1M points: XYZ import + mesh').median_s;
+const w4TriS = bench('cloud/W4 1M points: triangulate').median_s;
+const w4SessionS = bench('cloud/W4 1M points: XYZ + index').median_s;
+const memW4 = readFileSync('target/bench/native-memory-w4.txt', 'utf8');
+const peakW4 = Number(/peak_rss_bytes=(\d+)/.exec(memW4)?.[1] ?? die('no peak_rss_bytes for W4'));
 
 const f = (x, d) => x.toFixed(d);
 const ms = (s) => (s < 0.1 ? f(s * 1e3, 1) : f(s * 1e3, 0)) + ' ms';
@@ -133,6 +141,11 @@ const rows = [
     '<= 250 ms', ms(wasm.w3_plan_ms / 1e3) + ' (b)', wasm.w3_plan_ms <= 250],
   ['peak memory holding W1 ready to plan', '<= 250 MB', f(peakRss / 1e6, 0) + ' MB (c)', peakRss <= 250e6,
     '<= 250 MB', f(wasm.memory_w1_ready_bytes / 1e6, 0) + ' MB (d)', wasm.memory_w1_ready_bytes <= 250e6],
+  ['W4 1 M raw points (XYZ): read + 2.5-D Delaunay mesh', '<= 2 s', f(w4MeshS, 2) + ' s (e)', w4MeshS <= 2,
+    '-', '-', true],
+  ['W4 read + mesh + holes + index (Session)', '-', f(w4SessionS, 2) + ' s', true,
+    '-', wasm.w4_session_s == null ? 'not run' : f(wasm.w4_session_s, 2) + ' s', true],
+  ['peak memory holding W4 ready to plan', '-', f(peakW4 / 1e6, 0) + ' MB (c)', true, '-', '-', true],
 ];
 const e = process.env;
 const out = [];
@@ -165,6 +178,9 @@ out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs: the file's b
 out.push('');
 out.push(`(d) memory.buffer.byteLength holding a Session on W1.ply (wasm memory never shrinks: ` +
   `also the peak while preparing it).`);
+out.push('');
+out.push(`(e) of which the triangulation alone (spade's bulk load, the nearest-neighbour spacing, ` +
+  `the edge-length filter) ${f(w4TriS, 2)} s.`);
 out.push('');
 out.push(`Medians (wasm: W1 imports ${wasm.runs.ply_ms.length}x, plans ${wasm.runs.w2_ms.length}x and ` +
   `${wasm.runs.w3_ms.length}x after a warm-up); the first W1.ply Session in a fresh Node took ` +

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials_sized;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
-use crate::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
+use crate::mesh::{CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::placement::{RegistrationStatus, ScanPlacement};
@@ -253,6 +253,10 @@ pub struct MeshReport {
     pub triangles: usize,
     /// [[minx, miny, minz], [maxx, maxy, maxz]], printer frame.
     pub bbox_mm: [[f64; 3]; 2],
+    /// For a point cloud: points read, merged, triangles made, the point
+    /// spacing and the edge-length limit used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_cloud: Option<CloudInfo>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -369,6 +373,8 @@ pub struct PreparedScan {
     pub units: ScanUnits,
     /// What the importer noticed (degenerate triangles skipped, ...).
     pub warnings: Vec<String>,
+    /// For a point cloud, how it was meshed.
+    pub cloud: Option<CloudInfo>,
     /// Fiducial candidates, scanner frame, smallest/roundest first.
     pub fiducials: Vec<Fiducial>,
     pub registration: Registration,
@@ -420,6 +426,7 @@ impl PreparedScan {
             format: imported.format,
             units: imported.units,
             warnings: imported.warnings,
+            cloud: imported.cloud,
             fiducials,
             registration,
             method,
@@ -453,6 +460,7 @@ pub fn report(
         mesh: MeshReport {
             triangles: scan.triangle_count(),
             bbox_mm: [arr(&lo), arr(&hi)],
+            point_cloud: scan.cloud,
         },
         registration: RegistrationReport {
             status: scan.registration.status,

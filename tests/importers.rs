@@ -16,6 +16,7 @@ use pcpp::{DMat4, DVec3};
 const RAW: ImportOptions = ImportOptions {
     units: Some(ScanUnits::Mm),
     up_axis: Some(UpAxis::Z),
+    max_edge_mm: None,
 };
 
 /// A small bumpy grid of quads; all coordinates are exact in f32 so binary
@@ -484,6 +485,7 @@ fn centimetres_are_ten_times_millimetres() {
         &ImportOptions {
             units: Some(ScanUnits::Cm),
             up_axis: None,
+            max_edge_mm: None,
         },
     );
     assert_eq!(cm.units, ScanUnits::Cm);
@@ -496,6 +498,7 @@ fn centimetres_are_ten_times_millimetres() {
         &ImportOptions {
             units: Some(ScanUnits::In),
             up_axis: None,
+            max_edge_mm: None,
         },
     );
     let (_, hi) = inches.mesh.bbox().unwrap();
@@ -667,7 +670,7 @@ fn empty_and_garbage_files() {
         assert_error(b"", name, &["empty"]);
         assert_error(b" \n\t\n", name, &["empty"]);
     }
-    assert_error(b"\x01\x02garbage", "x.bin", &["not a mesh"]);
+    assert_error(b"\x01\x02garbage", "x.bin", &["not a scan this program reads"]);
     assert_error(b"# only a comment\n", "c.obj", &["no triangles"]);
     assert_error(b"solid x\nendsolid x\n", "c.stl", &["no triangles"]);
     assert_error(

@@ -5,6 +5,7 @@ mod fuzz_regressions;
 mod gcode;
 mod importers;
 mod planning;
+mod pointcloud;
 mod properties;
 mod realworld;
 mod registration;

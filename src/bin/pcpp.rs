@@ -178,6 +178,7 @@ macro_rules! job_flags {
             valued("dwell"),
             valued("scan-units"),
             valued("up-axis"),
+            valued("max-edge"),
             valued("place"),
             valued("fiducials"),
             valued("printer-points"),
@@ -222,6 +223,7 @@ const COMMANDS: &[Command] = &[
             valued("scan"),
             valued("scan-units"),
             valued("up-axis"),
+            valued("max-edge"),
             valued("dot-diameter"),
         ],
         run: cmd_fiducials,
@@ -251,6 +253,7 @@ const COMMANDS: &[Command] = &[
             valued("tol"),
             valued("scan-units"),
             valued("up-axis"),
+            valued("max-edge"),
             valued("fiducials"),
             valued("printer-points"),
             valued("registration"),
@@ -493,6 +496,7 @@ fn job_settings(a: &Args) -> CliResult<JobSettings> {
     let mut s = JobSettings::default();
     s.scan.units = a.parsed::<ScanUnits>("scan-units")?;
     s.scan.up_axis = a.parsed::<UpAxis>("up-axis")?;
+    s.scan.max_edge_mm = a.number("max-edge")?;
     if let Some(v) = a.number("dot-diameter")? {
         s.registration.dot_diameter_mm = v;
     }
@@ -838,6 +842,9 @@ fn load_scan(
         "scan: {} triangles",
         thousands(prepared.triangle_count())
     ));
+    if let Some(cloud) = &prepared.cloud {
+        progress.say(&cloud.to_string());
+    }
     if settings.registration.fiducials != FiducialSource::None {
         progress.say(&registration_line(&prepared.registration, prepared.method));
     }
@@ -1058,6 +1065,7 @@ fn cmd_fiducials(a: &Args) -> CliResult<()> {
     let mut options = pcpp::mesh::ImportOptions::DEFAULT;
     options.units = a.parsed::<ScanUnits>("scan-units")?;
     options.up_axis = a.parsed::<UpAxis>("up-axis")?;
+    options.max_edge_mm = a.number("max-edge")?;
     let path = PathBuf::from(a.required("scan")?);
     let progress = Progress::new();
     progress.say(&format!("reading scan {}...", path.display()));
@@ -1065,6 +1073,9 @@ fn cmd_fiducials(a: &Args) -> CliResult<()> {
     let name = file_name(&path);
     let imported = pcpp::pipeline::load_scan(&bytes, &name, &options)
         .map_err(|e| Failure::Input(in_file(&path, &name, &e.to_string())))?;
+    if let Some(cloud) = &imported.cloud {
+        progress.say(&cloud.to_string());
+    }
     progress.say(&format!(
         "scan: {} triangles; looking for holes...",
         thousands(imported.mesh.triangle_count())
@@ -1347,7 +1358,9 @@ exit status: 0 success, 1 bad input (the message names the file and where),
 ";
 
 const JOB_FLAGS_HELP: &str =
-    "  --scan FILE              the scanned surface: OBJ, PLY, STL, glTF or GLB (required)
+    "  --scan FILE              the scanned surface: a mesh (OBJ, PLY, STL, glTF, GLB)
+                           or a point cloud (XYZ/CSV/TXT, vertex-only PLY, PCD)
+                           (required)
   --path FILE.svg          the drawn path (required)
   --nozzle-id MM           nozzle inner diameter d (default 0.603)
   --nozzle-od MM           nozzle outer diameter do (default 0.908)
@@ -1356,6 +1369,9 @@ const JOB_FLAGS_HELP: &str =
   --dwell S                dwell after dispense on / before off (default 0)
   --scan-units U           mm, cm, m or in (default: the format's, mm; glTF m)
   --up-axis A              z or y (default: the format's, z; glTF y)
+  --max-edge MM            point clouds: the longest edge (in XY) of a triangle
+                           of the meshed cloud; longer gaps stay holes (default
+                           3 x the median point spacing)
   --place X,Y[,ROT[,SCALE]]
                            put the SVG's origin at (X, Y) mm of the printer frame,
                            turned ROT degrees counter-clockwise and scaled
@@ -1418,7 +1434,7 @@ inputs:
 const FIDUCIALS_HELP: &str = "\
 pcpp fiducials: holes of a scan that could be fiducials, as JSON on stdout
 
-usage: pcpp fiducials --scan FILE [--scan-units U] [--up-axis A]
+usage: pcpp fiducials --scan FILE [--scan-units U] [--up-axis A] [--max-edge MM]
 
 Each candidate has its centroid (mm, scan frame after units and up axis),
 equivalent diameter, loop size (vertices), area, perimeter and roundness

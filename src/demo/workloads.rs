@@ -4,6 +4,8 @@
 //! - W2: the paper's spiral antenna (556 mm, 1853 points at d = 0.603 mm)
 //!   placed on W1.
 //! - W3: a dense serpentine raster of about 100,000 points on W1.
+//! - W4: W1's film as a raw point cloud of 1,000,000 points (XYZ text),
+//!   as a laser line scanner gives it: a 0.1 mm grid with jitter in XY.
 
 use glam::DVec2;
 
@@ -40,6 +42,36 @@ pub const W1_PLY: &str = "W1.ply";
 pub const W1_OBJ: &str = "W1.obj";
 pub const W2_SVG: &str = "W2.svg";
 pub const W3_SVG: &str = "W3.svg";
+pub const W4_XYZ: &str = "W4.xyz";
+
+/// Points per side of W4 at full size (1,000,000 points).
+pub const CLOUD_SIDE: usize = 1000;
+
+/// W4: the film's heights at `side` x `side` points over 100 mm, each
+/// moved by up to 0.2 of the spacing in x and y (deterministic).
+pub fn film_cloud(side: usize) -> Vec<glam::DVec3> {
+    let film = wrinkled_film(side.max(2) - 1);
+    let spacing = FILM_MM / (side.max(2) - 1) as f64;
+    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
+    film.vertices
+        .into_iter()
+        .map(|v| {
+            let dx = 0.2 * spacing * (2.0 * rng.next_f64() - 1.0);
+            let dy = 0.2 * spacing * (2.0 * rng.next_f64() - 1.0);
+            glam::DVec3::new(v.x + dx, v.y + dy, v.z)
+        })
+        .collect()
+}
+
+/// Points as XYZ text, one "x y z" line each.
+pub fn to_xyz(points: &[glam::DVec3]) -> String {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(points.len() * 28);
+    for p in points {
+        let _ = writeln!(s, "{:.4} {:.4} {:.4}", p.x, p.y, p.z);
+    }
+    s
+}
 
 /// W2's drawing: the paper's 556 mm spiral antenna.
 pub fn w2_svg() -> String {

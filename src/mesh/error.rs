@@ -4,7 +4,7 @@
 /// A scan that cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
-    #[error("{file}: not a mesh this program reads (expected OBJ, PLY, STL, glTF or GLB)")]
+    #[error("{file}: not a scan this program reads (expected a mesh: OBJ, PLY, STL, glTF, GLB; or a point cloud: XYZ/CSV/TXT, PLY, PCD)")]
     UnknownFormat { file: String },
     /// Text formats: a line that cannot be parsed.
     #[error("{file}:{line}: {message}")]

@@ -6,7 +6,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec3;
 
-use super::{gltf, obj, ply, stl};
+use super::{cloud, gltf, obj, pcd, ply, stl, xyz};
 use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, TriMesh, UpAxis};
 
 /// What a format parser hands to the shared steps: positions in the file's
@@ -33,6 +33,8 @@ fn from_extension(file: &str) -> Option<MeshFormat> {
         "stl" => Some(MeshFormat::Stl),
         "gltf" => Some(MeshFormat::Gltf),
         "glb" => Some(MeshFormat::Glb),
+        "xyz" | "csv" | "txt" | "asc" | "pts" => Some(MeshFormat::Xyz),
+        "pcd" => Some(MeshFormat::Pcd),
         _ => None,
     }
 }
@@ -50,6 +52,9 @@ fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
     if text.starts_with(b"ply\n") || text.starts_with(b"ply\r\n") {
         return Some(MeshFormat::Ply);
     }
+    if pcd::looks_like_pcd(text) {
+        return Some(MeshFormat::Pcd);
+    }
     if text.starts_with(b"solid") {
         return Some(MeshFormat::Stl);
     }
@@ -62,6 +67,9 @@ fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
     }
     if looks_like_obj(text) {
         return Some(MeshFormat::Obj);
+    }
+    if xyz::looks_like_xyz(text) {
+        return Some(MeshFormat::Xyz);
     }
     None
 }
@@ -127,9 +135,27 @@ pub fn import_mesh(
         MeshFormat::Ply => ply::parse(bytes, file)?,
         MeshFormat::Stl => stl::parse(bytes, file)?,
         MeshFormat::Gltf | MeshFormat::Glb => gltf::parse(bytes, file)?,
+        MeshFormat::Xyz => Parsed {
+            vertices: xyz::parse(bytes, file)?,
+            ..Parsed::default()
+        },
+        MeshFormat::Pcd => {
+            let (vertices, warnings) = pcd::parse(bytes, file)?;
+            Parsed {
+                vertices,
+                warnings,
+                ..Parsed::default()
+            }
+        }
     };
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
+    // A PLY with vertices and no faces is a point cloud too.
+    if parsed.triangles.is_empty()
+        && matches!(format, MeshFormat::Xyz | MeshFormat::Pcd | MeshFormat::Ply)
+    {
+        return import_cloud(parsed, file, format, options, units.to_mm(), up_axis);
+    }
     // STL and glTF parsers weld as they read; OBJ and PLY files from
     // exporters often split vertices at UV seams too (a Blender PLY cube has
     // 24 vertices), which would turn every seam into fake holes for the
@@ -142,6 +168,56 @@ pub fn import_mesh(
         units,
         up_axis,
         warnings,
+        cloud: None,
+    })
+}
+
+/// A point cloud into millimetres and printer axes, then meshed as a
+/// height field over the printer's XY ([`cloud::triangulate`]).
+fn import_cloud(
+    parsed: Parsed,
+    file: &str,
+    format: MeshFormat,
+    options: &ImportOptions,
+    scale: f64,
+    up_axis: UpAxis,
+) -> Result<ImportedMesh, MeshError> {
+    let Parsed {
+        mut vertices,
+        mut warnings,
+        ..
+    } = parsed;
+    if let Some((vertex, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        let value = v.to_array().into_iter().find(|c| !c.is_finite());
+        return Err(MeshError::NonFiniteVertex {
+            file: file.into(),
+            vertex,
+            line: None,
+            value: value.unwrap_or(f64::NAN),
+        });
+    }
+    for v in &mut vertices {
+        let p = *v * scale;
+        *v = match up_axis {
+            UpAxis::Z => p,
+            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+        };
+    }
+    let (mesh, info) = cloud::triangulate(vertices, options.max_edge_mm, file)?;
+    check_triangle_count(mesh.triangle_count(), file)?;
+    if info.merged > 0 {
+        warnings.push(format!(
+            "{file}: {} point(s) shared their XY with another; the highest of each was kept",
+            info.merged
+        ));
+    }
+    Ok(ImportedMesh {
+        mesh,
+        format,
+        units: options.units.unwrap_or(format.default_units()),
+        up_axis,
+        warnings,
+        cloud: Some(info),
     })
 }
 

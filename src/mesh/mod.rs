@@ -1,5 +1,7 @@
-//! Scan import: OBJ, PLY, STL and glTF/GLB bytes into one [`TriMesh`] in
-//! millimetres, printer convention +Z up (spec "Inputs").
+//! Scan import: OBJ, PLY, STL and glTF/GLB meshes, and raw point clouds
+//! (XYZ/CSV text, vertex-only PLY, PCD) meshed as a height field, bytes
+//! into one [`TriMesh`] in millimetres, printer convention +Z up (spec
+//! "Inputs").
 //!
 //! Each format has its own parser file that reads the file's own units and
 //! axes; [`import_mesh`] sniffs the format, validates (finite coordinates,
@@ -11,13 +13,17 @@ use std::{fmt, str::FromStr};
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
+mod cloud;
 mod error;
 mod gltf;
 mod import;
 mod obj;
+mod pcd;
 mod ply;
 mod stl;
+mod xyz;
 
+pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use import::{detect_format, import_mesh};
 
@@ -174,6 +180,10 @@ pub enum MeshFormat {
     Stl,
     Gltf,
     Glb,
+    /// A text point cloud: XYZ, CSV, TXT, ASC, PTS.
+    Xyz,
+    /// The Point Cloud Library's PCD.
+    Pcd,
 }
 
 impl MeshFormat {
@@ -199,12 +209,18 @@ impl MeshFormat {
 pub struct ImportOptions {
     pub units: Option<ScanUnits>,
     pub up_axis: Option<UpAxis>,
+    /// Point clouds: the longest edge (in XY, mm after units) a triangle
+    /// of the meshed cloud may have; `None`: [`EDGE_LIMIT_PER_SPACING`]
+    /// times the median point spacing.
+    #[serde(default)]
+    pub max_edge_mm: Option<f64>,
 }
 
 impl ImportOptions {
     pub const DEFAULT: ImportOptions = ImportOptions {
         units: None,
         up_axis: None,
+        max_edge_mm: None,
     };
 }
 
@@ -217,4 +233,6 @@ pub struct ImportedMesh {
     pub up_axis: UpAxis,
     /// Recoverable oddities (degenerate triangles skipped, ...), for the report.
     pub warnings: Vec<String>,
+    /// For a point cloud, how it was meshed.
+    pub cloud: Option<CloudInfo>,
 }

@@ -4,12 +4,13 @@
 ; nozzle: d 0.603 mm, do 0.908 mm
 ; process: tol 0.1 mm, speed 5 mm/s, dwell 0 s
 ; placement: offset (0, 80) mm, rotation 0 deg, scale 1
-; planner: pcpp-guarded
-; registration: lsq [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
+; planner: even
+; registration: unregistered, taken as it is (the scan's frame is the printer's); G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
 ; residuals: [] mm, rms 0.0000 mm
-; path: 6 piece(s), 1362 points, 465.636 mm, height change 4.500 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 93.1 s
-; predicted quality: mean |e| 0.0671 mm, mean e- -0.0858 mm, mean e+ 0.0489 mm, contact 0.00%, flattening 15.57%, floating 4.11%
-; warnings: 0
+; path: 6 piece(s), 1362 points, 457.516 mm, height change 4.504 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 91.5 s
+; predicted quality: mean |e| 0.0136 mm, mean e- -0.0101 mm, mean e+ 0.0193 mm, contact 0.00%, flattening 1.03%, floating 1.76%
+; safe motion: min clearance 0.101 mm (tol 0.1 mm) along all 1444 moves; 70 waypoint(s) added (+3.680 mm)
+; warnings: 1
 ; profile: marlin
 ; print feed: F300 mm/min (5 mm/s)
 ; safe travel height: 13.603 mm
@@ -17,29 +18,28 @@ G21
 G90
 M107
 G0 Z13.603 F3000
-; subpath 0: 227 points
-G0 X6.000 Y16.000 Z13.603 F3000
-G1 X6.000 Y16.000 Z5.603 F3000
+; subpath 0: 247 points
+G0 X6.454 Y16.000 Z13.603 F3000
+G1 X6.454 Y16.000 Z5.603 F3000
 M106 S255
-G1 X6.301 Y16.000 Z5.603 F300
-G1 X6.602 Y16.000 Z5.603
+G1 X6.602 Y16.000 Z5.603 F300
 G1 X6.903 Y16.000 Z5.603
 G1 X7.204 Y16.000 Z5.603
-G1 X7.504 Y16.000 Z5.603
-G1 X7.805 Y16.000 Z5.603
-G1 X8.106 Y16.000 Z5.603
-G1 X8.407 Y16.000 Z5.603
-G1 X8.708 Y16.000 Z5.603
+G1 X7.505 Y16.000 Z5.603
+G1 X7.806 Y16.000 Z5.603
+G1 X8.107 Y16.000 Z5.603
+G1 X8.408 Y16.000 Z5.603
+G1 X8.709 Y16.000 Z5.603
 G1 X9.009 Y16.000 Z5.603
 G1 X9.310 Y16.000 Z5.603
 G1 X9.611 Y16.000 Z5.603
 G1 X9.912 Y16.000 Z5.603
-G1 X10.212 Y16.000 Z5.603
-G1 X10.513 Y16.000 Z5.603
-G1 X10.814 Y16.000 Z5.603
-G1 X11.115 Y16.000 Z5.603
-G1 X73.699 Y66.000 Z5.603
-G1 X74.000 Y66.000 Z5.603
+G1 X10.213 Y16.000 Z5.603
+G1 X10.514 Y16.000 Z5.603
+G1 X10.815 Y16.000 Z5.603
+G1 X11.116 Y16.000 Z5.603
+G1 X74.001 Y66.000 Z5.603
+G1 X74.302 Y66.000 Z5.603
 M107
 G0 Z13.603 F3000
 M107

@@ -1,0 +1,298 @@
+//! Raw point clouds (issue 14): the demo part sampled as a scanner would
+//! (heights on a 0.2 mm grid, none in the fiducial holes, 0.02 mm of
+//! noise), written in every point-cloud format, meshed by the importer,
+//! and compared with the mesh: the same fiducials and the same tool path.
+
+use pcpp::demo::test_part;
+use pcpp::fiducials::find_fiducials;
+use pcpp::mesh::{import_mesh, ImportOptions, ImportedMesh, MeshFormat};
+use pcpp::pipeline::{self, Plan, PlanSettings};
+use pcpp::surface::Surface;
+use pcpp::{DVec2, DVec3};
+
+/// Spacing of the sampled grid, mm.
+const STEP: f64 = 0.2;
+/// Noise added to each height, mm (uniform in +-NOISE).
+const NOISE: f64 = 0.02;
+
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        // xorshift64*
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The demo part as a profilometer sees it: the highest surface point on
+/// each vertical line of a STEP grid, none where the line misses (the
+/// fiducial holes), with noise on the height.
+fn sampled_cloud() -> Vec<DVec3> {
+    let surface = Surface::new(test_part::test_part()).unwrap();
+    let n = (test_part::SIZE_MM / STEP).round() as usize;
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut pts = Vec::with_capacity((n + 1) * (n + 1));
+    for j in 0..=n {
+        for i in 0..=n {
+            let xy = DVec2::new(i as f64 * STEP, j as f64 * STEP);
+            if let Some(z) = surface.highest_hit(xy) {
+                pts.push(xy.extend(z + NOISE * (2.0 * rng.unit() - 1.0)));
+            }
+        }
+    }
+    pts
+}
+
+fn lzf_literal(data: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(data.len() + data.len() / 32 + 1);
+    for chunk in data.chunks(32) {
+        out.push((chunk.len() - 1) as u8);
+        out.extend_from_slice(chunk);
+    }
+    out
+}
+
+/// The cloud in each format, with a file name that names it.
+fn files(pts: &[DVec3]) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut xyz = String::new();
+    let mut csv = String::from("x,y,z,nx,ny,nz\n");
+    for p in pts {
+        xyz += &format!("{:.4} {:.4} {:.4}\n", p.x, p.y, p.z);
+        csv += &format!("{:.4},{:.4},{:.4},0,0,1\n", p.x, p.y, p.z);
+    }
+    out.push(("part.xyz".to_string(), xyz.clone().into_bytes()));
+    out.push(("part.csv".to_string(), csv.into_bytes()));
+    let n = pts.len();
+    let mut ply = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment points only\nelement vertex {n}\n\
+         property float x\nproperty float y\nproperty float z\nproperty uchar red\nend_header\n"
+    )
+    .into_bytes();
+    for p in pts {
+        for v in p.to_array() {
+            ply.extend_from_slice(&(v as f32).to_le_bytes());
+        }
+        ply.push(200);
+    }
+    out.push(("part-binary.ply".to_string(), ply));
+    let mut ply_ascii = format!(
+        "ply\nformat ascii 1.0\nelement vertex {n}\nproperty double x\nproperty double y\n\
+         property double z\nend_header\n"
+    );
+    ply_ascii += &xyz;
+    out.push(("part-ascii.ply".to_string(), ply_ascii.into_bytes()));
+    let head = |data: &str| {
+        format!(
+            "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n\
+             TYPE F F F\nCOUNT 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\n\
+             DATA {data}\n"
+        )
+    };
+    out.push((
+        "part-ascii.pcd".to_string(),
+        (head("ascii") + &xyz).into_bytes(),
+    ));
+    let mut bin = head("binary").into_bytes();
+    let mut columns = Vec::with_capacity(12 * n);
+    for p in pts {
+        for v in p.to_array() {
+            bin.extend_from_slice(&(v as f32).to_le_bytes());
+        }
+    }
+    for k in 0..3 {
+        for p in pts {
+            columns.extend_from_slice(&(p[k] as f32).to_le_bytes());
+        }
+    }
+    out.push(("part-binary.pcd".to_string(), bin));
+    let packed = lzf_literal(&columns);
+    let mut comp = head("binary_compressed").into_bytes();
+    comp.extend_from_slice(&(packed.len() as u32).to_le_bytes());
+    comp.extend_from_slice(&(columns.len() as u32).to_le_bytes());
+    comp.extend_from_slice(&packed);
+    out.push(("part-compressed.pcd".to_string(), comp));
+    out
+}
+
+fn import(bytes: &[u8], name: &str) -> ImportedMesh {
+    import_mesh(bytes, name, &ImportOptions::DEFAULT).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn plan(mesh: pcpp::mesh::TriMesh) -> Plan {
+    let surface = Surface::new(mesh).unwrap();
+    let drawn = pipeline::load_path(test_part::test_part_svg().as_bytes(), "demo.svg").unwrap();
+    let settings = PlanSettings {
+        placement: test_part::placement(),
+        ..Default::default()
+    };
+    pipeline::plan(&surface, &drawn.subpaths, &settings).unwrap()
+}
+
+/// Distance from `p` to the polyline `line` (3-D).
+fn to_polyline(p: DVec3, line: &[DVec3]) -> f64 {
+    line.windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let ab = b - a;
+            let t = if ab.length_squared() > 0.0 {
+                ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a + ab * t).distance(p)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn the_demo_part_as_a_point_cloud_in_every_format_gives_the_meshs_fiducials_and_path() {
+    let pts = sampled_cloud();
+    let mesh = test_part::test_part();
+    let mesh_fids = find_fiducials(&mesh);
+    let mesh_plan = plan(mesh);
+    for (name, bytes) in files(&pts) {
+        let imported = import(&bytes, &name);
+        let want = if name.ends_with(".pcd") {
+            MeshFormat::Pcd
+        } else if name.ends_with(".ply") {
+            MeshFormat::Ply
+        } else {
+            MeshFormat::Xyz
+        };
+        assert_eq!(imported.format, want, "{name}");
+        let info = imported
+            .cloud
+            .unwrap_or_else(|| panic!("{name}: not read as a cloud"));
+        assert_eq!(info.points, pts.len(), "{name}");
+        assert!((info.spacing_mm - STEP).abs() < 1e-3, "{name}: {info:?}");
+        assert!((info.max_edge_mm - 3.0 * info.spacing_mm).abs() < 1e-12);
+        // The three dots are the three best candidates, each within 0.1 mm.
+        let fids = find_fiducials(&imported.mesh);
+        for (k, f) in mesh_fids.iter().take(3).enumerate() {
+            let nearest = fids
+                .iter()
+                .take(3)
+                .map(|g| g.centroid.truncate().distance(f.centroid.truncate()))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest < 0.1,
+                "{name}: fiducial {k} at {} is {nearest:.3} mm from the cloud's best three",
+                f.centroid
+            );
+        }
+        // The tool path: the plan on the meshed cloud against the mesh's.
+        // Text and binary forms of one format mesh the same points, so the
+        // path is planned for one file of each format.
+        if !(name == "part.xyz" || name == "part-binary.ply" || name == "part-compressed.pcd") {
+            continue;
+        }
+        let cloud_plan = plan(imported.mesh);
+        let mut devs = Vec::new();
+        for (a, b) in cloud_plan.pieces.iter().zip(&mesh_plan.pieces) {
+            for p in &a.toolpath {
+                devs.push(to_polyline(*p, &b.toolpath));
+            }
+        }
+        assert_eq!(cloud_plan.pieces.len(), mesh_plan.pieces.len(), "{name}");
+        devs.sort_by(f64::total_cmp);
+        let pct = |q: f64| devs[((devs.len() - 1) as f64 * q).round() as usize];
+        eprintln!(
+            "{name}: tool path vs the mesh's: median {:.4}, 95% {:.4}, 99% {:.4}, max {:.4} mm \
+             over {} points",
+            pct(0.5),
+            pct(0.95),
+            pct(0.99),
+            pct(1.0),
+            devs.len()
+        );
+        assert!(
+            pct(0.95) <= 0.05,
+            "{name}: 95% of the path within {:.4}",
+            pct(0.95)
+        );
+    }
+}
+
+#[test]
+fn hostile_point_clouds_get_clear_errors() {
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "ragged.xyz",
+            b"1 2 3\n4 5\n".to_vec(),
+            "ragged.xyz:2: 2 value(s)",
+        ),
+        (
+            "text.csv",
+            b"1,2,3\n4,five,6\n".to_vec(),
+            "text.csv:2: 'five'",
+        ),
+        ("one.xyz", b"1 2 3\n".to_vec(), "at least 3 points"),
+        (
+            "line.xyz",
+            (0..50)
+                .map(|i| format!("{i} {i} 0\n"))
+                .collect::<String>()
+                .into_bytes(),
+            "one line",
+        ),
+        (
+            "nan.xyz",
+            b"1 2 3\n4 5 nan\n".to_vec(),
+            "nan.xyz:2: z is NaN",
+        ),
+        (
+            "noface.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+              property float z\nend_header\n0 0 0\n1 1 1\n"
+                .to_vec(),
+            "at least 3 points",
+        ),
+    ];
+    for (name, bytes, want) in cases {
+        let e = import_mesh(&bytes, name, &ImportOptions::DEFAULT)
+            .err()
+            .unwrap_or_else(|| panic!("{name} was accepted"))
+            .to_string();
+        assert!(e.contains(want), "{name}: {e}");
+    }
+}
+
+/// 10^6 identical points (the issue asks 10^7 of the importer; a million
+/// keeps the debug test quick and takes the same path): one error, no
+/// panic, no triangulation of a million copies.
+#[test]
+fn a_million_identical_points_are_one_place() {
+    let bytes = "1.5 2.5 3.5\n".repeat(1_000_000).into_bytes();
+    let e = import_mesh(&bytes, "same.xyz", &ImportOptions::DEFAULT)
+        .expect_err("accepted")
+        .to_string();
+    assert!(e.contains("only 1 place"), "{e}");
+}
+
+#[test]
+fn a_larger_edge_limit_closes_the_fiducial_holes() {
+    let pts = sampled_cloud();
+    let text: String = pts
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    let options = ImportOptions {
+        max_edge_mm: Some(2.0),
+        ..ImportOptions::DEFAULT
+    };
+    let m = import_mesh(text.as_bytes(), "part.xyz", &options).unwrap();
+    let info = m.cloud.unwrap();
+    assert!(info.max_edge_given && info.max_edge_mm == 2.0);
+    let fids = find_fiducials(&m.mesh);
+    for f in test_part::FIDUCIALS_MM {
+        assert!(
+            fids.iter()
+                .all(|g| g.centroid.truncate().distance(f.truncate()) > 0.3),
+            "the hole at {f} stayed open with a 2 mm limit"
+        );
+    }
+}
