@@ -670,7 +670,11 @@ fn empty_and_garbage_files() {
         assert_error(b"", name, &["empty"]);
         assert_error(b" \n\t\n", name, &["empty"]);
     }
-    assert_error(b"\x01\x02garbage", "x.bin", &["not a scan this program reads"]);
+    assert_error(
+        b"\x01\x02garbage",
+        "x.bin",
+        &["not a scan this program reads"],
+    );
     assert_error(b"# only a comment\n", "c.obj", &["no triangles"]);
     assert_error(b"solid x\nendsolid x\n", "c.stl", &["no triangles"]);
     assert_error(

@@ -151,9 +151,12 @@ pub fn import_mesh(
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
     // A PLY with vertices and no faces is a point cloud too.
-    if parsed.triangles.is_empty()
-        && matches!(format, MeshFormat::Xyz | MeshFormat::Pcd | MeshFormat::Ply)
-    {
+    let cloud = match format {
+        MeshFormat::Xyz | MeshFormat::Pcd => true,
+        MeshFormat::Ply => parsed.triangles.is_empty() && !parsed.vertices.is_empty(),
+        _ => false,
+    };
+    if cloud {
         return import_cloud(parsed, file, format, options, units.to_mm(), up_axis);
     }
     // STL and glTF parsers weld as they read; OBJ and PLY files from
