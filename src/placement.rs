@@ -298,9 +298,7 @@ pub fn carry_drawing(
     // The turn in degrees as typed, not read back from the matrix: a
     // quarter turn stays 90, not 89.99999999999999.
     Placement {
-        offset_mm: m
-            .transform_point3(drawing.offset_mm.extend(0.0))
-            .truncate(),
+        offset_mm: m.transform_point3(drawing.offset_mm.extend(0.0)).truncate(),
         rotation_deg: drawing.rotation_deg + turn(to) - turn(from),
         scale: drawing.scale,
     }
@@ -410,7 +408,11 @@ mod tests {
         let scan_point = drawing.apply(q).extend(-800.0);
         let g = turned.transform(bbox).unwrap();
         let want = g.transform_point3(scan_point).truncate();
-        assert!((after.apply(q) - want).length() < 1e-9, "{}", after.apply(q));
+        assert!(
+            (after.apply(q) - want).length() < 1e-9,
+            "{}",
+            after.apply(q)
+        );
         // And back to the scanner's frame.
         let back = carry_drawing(&after, bbox, &turned, &ScanPlacement::AsScanned);
         assert!((back.offset_mm - drawing.offset_mm).length() < 1e-9);
