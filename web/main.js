@@ -3,7 +3,7 @@
 // same `job` code as the CLI); this file moves bytes and settings around
 // and shows results. Text from files and errors is set with textContent.
 import { loadWasm, startWorker } from './engine.js';
-import { fmtPoints, initFiducials, pointsEdited, safePoints, showFiducials } from './fiducials.js';
+import { BEST, fmtPoints, initFiducials, pointsEdited, safePoints, showFiducials } from './fiducials.js';
 import {
   SCAN_PLACE_DEFAULT, cancelCentre, centreRequest, initPlacement, moveScan, onCentred, requestCentre,
   sanitizeScanPlace, scanPlacementFor, setNote, showScanPlacement,
@@ -765,6 +765,7 @@ function onPlanError(m, busy) {
         keep('scan', null);
       }
       state.pendingScan = null;
+      dropCentre();
       message += `; still using the previous scan, ${state.scan.name}`;
     }
     message += '.';
@@ -778,6 +779,7 @@ function onPlanError(m, busy) {
       keep('scan', null);
     }
     state.pendingScan = null;
+    dropCentre();
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
   } else if (m.stage === 'scan') {
@@ -790,6 +792,8 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
     title = `Could not read the SVG ${state.pendingSvg.name}`;
     state.pendingSvg = null;
+    // The drawing stays where it was.
+    cancelCentre();
     if (!state.svgFile) settings.pathSource = 'demo';
     writeForm();
     message += state.svgFile
@@ -816,6 +820,12 @@ function onPlanError(m, busy) {
     requestDraw();
   }
   setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+}
+
+// A file that could not be read changes nothing: no centring for it (a
+// new drawing opened with it is still centred).
+function dropCentre() {
+  if (state.centre && !state.centre.fresh) cancelCentre();
 }
 
 // The pending scan was read: it becomes the scan, and the demo's fiducial
@@ -916,7 +926,9 @@ function updateMarkers() {
     const picked = showScan
       ? safePoints(settings.fidScanText).map((p) => applyG(info.registration.matrix, p)) : [];
     try {
-      state.viewer.setMarkers(info.holes.map((h) => h.printer), printer, picked);
+      // The holes listed (the best candidates), not every scanner hole.
+      const holes = info.holes.filter((h) => h.candidate).slice(0, BEST);
+      state.viewer.setMarkers(holes.map((h) => h.printer), printer, picked);
     } catch (e) {
       showError('Could not draw the fiducials', e.message);
     }
