@@ -925,6 +925,13 @@ fn json(v: JsValue) -> serde_json::Value {
     serde_wasm_bindgen::from_value(v).unwrap()
 }
 
+/// JSON as the page sends it: plain objects, not `Map`s.
+fn obj(v: &serde_json::Value) -> JsValue {
+    use serde::Serialize;
+    v.serialize(&serde_wasm_bindgen::Serializer::new().serialize_maps_as_objects(true))
+        .unwrap()
+}
+
 #[wasm_bindgen_test]
 fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
     // The test part as a scanner gives it: turned and 800 mm down.
@@ -979,14 +986,21 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
     let drawing = serde_json::json!({"offset_mm": [b[0] + 10.0, b[1] + 10.0], "rotation_deg": 0.0, "scale": 1.0});
     let carried = json(
         pcpp::wasm::carry_drawing(
-            js(&drawing),
+            obj(&drawing),
             &b,
-            js(&serde_json::json!({"mode": "as-scanned"})),
-            js(&placement),
+            obj(&serde_json::json!({"mode": "as-scanned"})),
+            obj(&placement),
         )
         .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e))),
     );
     assert_eq!(carried["scale"], 1.0);
+    // Placed without a turn, the scan moved by a shift: the drawing too.
+    for k in 0..2 {
+        let shift = pinfo["bbox_mm"][0][k].as_f64().unwrap() - b[k];
+        let moved =
+            carried["offset_mm"][k].as_f64().unwrap() - drawing["offset_mm"][k].as_f64().unwrap();
+        assert!((moved - shift).abs() < 1e-9, "{moved} vs {shift}");
+    }
     let spiral = antennas::paper_spiral_svg();
     placed
         .set_path(spiral.as_bytes(), "spiral.svg")
