@@ -12,7 +12,8 @@
 //!
 //! A new drawing, or a drawing on a new scan, is centred on the scan's
 //! footprint and scaled down (with a note) when it does not fit:
-//! [`centre_drawing`].
+//! [`centre_drawing`]; when the scan is moved on the bed by hand, the
+//! drawing goes with it: [`carry_drawing`].
 
 use glam::{DMat4, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -276,6 +277,33 @@ pub fn centre_drawing(
     Some((placement, note))
 }
 
+/// The drawing's placement after its scan moves from `from` to `to` (both
+/// for a scan whose bounds in the scanner frame are `bbox`): the drawing
+/// moves and turns with the scan, so it stays on the same part of it (the
+/// page moves the scan by hand; re-centring would undo the user's own
+/// placement of the drawing). Both placements are turns about z and moves,
+/// so the result is again a [`Placement`]; its scale is kept.
+pub fn carry_drawing(
+    drawing: &Placement,
+    bbox: (DVec3, DVec3),
+    from: &ScanPlacement,
+    to: &ScanPlacement,
+) -> Placement {
+    let g = |p: &ScanPlacement| p.transform(bbox).unwrap_or(DMat4::IDENTITY);
+    let m = g(to) * g(from).inverse();
+    let turn = |p: &ScanPlacement| match p {
+        ScanPlacement::OnBed { rotation_deg, .. } => *rotation_deg,
+        ScanPlacement::AsScanned => 0.0,
+    };
+    // The turn in degrees as typed, not read back from the matrix: a
+    // quarter turn stays 90, not 89.99999999999999.
+    Placement {
+        offset_mm: m.transform_point3(drawing.offset_mm.extend(0.0)).truncate(),
+        rotation_deg: drawing.rotation_deg + turn(to) - turn(from),
+        scale: drawing.scale,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -344,6 +372,51 @@ mod tests {
             s.to_string(),
             "registered (lsq, 3 fiducials, RMS residual 0.165 mm)"
         );
+    }
+
+    #[test]
+    fn a_drawing_moves_and_turns_with_its_scan() {
+        let bbox = (
+            DVec3::new(-60.0, 30.0, -820.0),
+            DVec3::new(40.0, 90.0, -790.0),
+        );
+        let drawing = Placement {
+            offset_mm: DVec2::new(-10.0, 60.0),
+            rotation_deg: 10.0,
+            scale: 0.5,
+        };
+        let bed = ScanPlacement::OnBed {
+            bed: Bed::of(&volume()),
+            rotation_deg: 0.0,
+            offset_mm: DVec3::ZERO,
+        };
+        // Placed on the bed: the footprint's middle (-10, 60) goes to the
+        // bed's (110, 110), and the drawing with it.
+        let on_bed = carry_drawing(&drawing, bbox, &ScanPlacement::AsScanned, &bed);
+        assert!((on_bed.offset_mm - DVec2::new(110.0, 110.0)).length() < 1e-9);
+        assert_eq!((on_bed.rotation_deg, on_bed.scale), (10.0, 0.5));
+        // Turned a quarter and moved: a point of the drawing lands where
+        // the scan's point under it went.
+        let turned = ScanPlacement::OnBed {
+            bed: Bed::of(&volume()),
+            rotation_deg: 90.0,
+            offset_mm: DVec3::new(5.0, -3.0, 1.0),
+        };
+        let after = carry_drawing(&on_bed, bbox, &bed, &turned);
+        assert_eq!(after.rotation_deg, 100.0);
+        let q = DVec2::new(4.0, 2.0);
+        let scan_point = drawing.apply(q).extend(-800.0);
+        let g = turned.transform(bbox).unwrap();
+        let want = g.transform_point3(scan_point).truncate();
+        assert!(
+            (after.apply(q) - want).length() < 1e-9,
+            "{}",
+            after.apply(q)
+        );
+        // And back to the scanner's frame.
+        let back = carry_drawing(&after, bbox, &turned, &ScanPlacement::AsScanned);
+        assert!((back.offset_mm - drawing.offset_mm).length() < 1e-9);
+        assert_eq!(back.rotation_deg, 10.0);
     }
 
     #[test]

@@ -18,6 +18,7 @@ use crate::job::{self, InputFile, JobSettings, PreparedScan, RegistrationSetting
 use crate::mesh::{ImportOptions, ImportedMesh, MAX_SCAN_BYTES};
 use crate::params::Nozzle;
 use crate::pipeline::{self, DrawnPath, Plan, PlanSettings, SurfacePath};
+use crate::placement::{self, Bed, ScanPlacement};
 use crate::planners::PlannerKind;
 use crate::quality::Defect;
 use crate::registration::{Registration, RegistrationMethod};
@@ -408,6 +409,63 @@ pub fn check_profile(text: &str, file_name: &str) -> Result<String, JsValue> {
     Ok(p.name)
 }
 
+/// Six finite numbers `[min x, min y, min z, max x, max y, max z]` (mm) as
+/// bounds, or an error naming `what`.
+fn bounds(what: &str, v: &[f64]) -> Result<(DVec3, DVec3), JsError> {
+    match v {
+        [a, b, c, d, e, f] if v.iter().all(|x| x.is_finite()) => {
+            Ok((DVec3::new(*a, *b, *c), DVec3::new(*d, *e, *f)))
+        }
+        _ => Err(JsError::new(&format!(
+            "{what} must be six finite numbers (min x, y, z, max x, y, z), got {v:?}"
+        ))),
+    }
+}
+
+/// Where a scan with bounds `bbox` (`[min x, y, z, max x, y, z]`, printer
+/// frame) lies against the build volume of the machine profile `dialect`
+/// (as in [`Session::plan`]): `placement::VolumeFit` with the sentence the
+/// page shows in its banner.
+#[wasm_bindgen(js_name = volumeFit)]
+pub fn volume_fit(
+    bbox: &[f64],
+    dialect: &str,
+    profile_file: Option<String>,
+) -> Result<JsValue, JsValue> {
+    let bbox = bounds("the scan's bounds", bbox)?;
+    let p = profile(dialect, profile_file.as_deref())?;
+    Ok(to_js(&placement::volume_fit(
+        bbox,
+        &p.build_volume,
+        &p.name,
+    ))?)
+}
+
+/// The bed of the machine profile `dialect` (`{centre_mm, z_mm}`), for a
+/// scan placement `{mode: "on-bed", bed, rotation_deg, offset_mm}`.
+#[wasm_bindgen(js_name = bedOf)]
+pub fn bed_of(dialect: &str, profile_file: Option<String>) -> Result<JsValue, JsValue> {
+    let p = profile(dialect, profile_file.as_deref())?;
+    Ok(to_js(&Bed::of_profile(&p))?)
+}
+
+/// The drawing's placement after the scan (scanner-frame bounds `scan_bbox`,
+/// `[min x, y, z, max x, y, z]`) moves from the scan placement `from` to
+/// `to` ([`placement::carry_drawing`]).
+#[wasm_bindgen(js_name = carryDrawing)]
+pub fn carry_drawing(
+    drawing: JsValue,
+    scan_bbox: &[f64],
+    from: JsValue,
+    to: JsValue,
+) -> Result<JsValue, JsError> {
+    let drawing: Placement = from_js("drawing placement", drawing)?;
+    let bbox = bounds("the scan's bounds", scan_bbox)?;
+    let from: ScanPlacement = from_js("scan placement", from)?;
+    let to: ScanPlacement = from_js("scan placement", to)?;
+    to_js(&placement::carry_drawing(&drawing, bbox, &from, &to))
+}
+
 /// Three finite numbers from the page, or an error naming `what`.
 fn vec3(what: &str, v: &[f64]) -> Result<DVec3, JsError> {
     match v {
@@ -436,6 +494,11 @@ struct HoleView {
     printer: [f64; 3],
     diameter_mm: f64,
     roundness: f64,
+    /// How well it matches the expected dot, 0 to 1 ([`Fiducial::score`]).
+    score: f64,
+    /// Whether it could be a dot at all ([`Fiducial::is_candidate`]):
+    /// border notches, slits and tiny dropouts are not.
+    candidate: bool,
 }
 
 #[derive(Serialize)]
@@ -445,7 +508,10 @@ struct ScanView<'a> {
     format: crate::mesh::MeshFormat,
     units: crate::mesh::ScanUnits,
     triangles: usize,
+    /// Printer frame (after the registration or placement on the bed).
     bbox_mm: [[f64; 3]; 2],
+    /// Scanner frame, as imported (what a placement on the bed moves).
+    scan_bbox_mm: [[f64; 3]; 2],
     warnings: &'a [String],
     registration: RegistrationView<'a>,
     holes: Vec<HoleView>,
@@ -453,6 +519,10 @@ struct ScanView<'a> {
 
 #[derive(Serialize)]
 struct RegistrationView<'a> {
+    /// How the scan got into the printer frame, and its sentence
+    /// ([`placement::RegistrationStatus`]'s Display, as in the G-code header).
+    status: placement::RegistrationStatus,
+    status_text: String,
     method: crate::registration::RegistrationMethod,
     matrix: [[f64; 4]; 4],
     residuals_mm: &'a [f64],
@@ -619,10 +689,11 @@ impl ScanImport {
         let fiducials = self
             .fiducials
             .unwrap_or_else(|| find_fiducials(&self.imported.mesh));
+        let scan_bbox = self.imported.mesh.bbox();
         let prepared =
             PreparedScan::assemble(self.file, self.imported, fiducials, registration, method)
                 .map_err(core_err)?;
-        Ok(Session::from_prepared(prepared))
+        Ok(Session::from_prepared(prepared, scan_bbox))
     }
 }
 
@@ -646,6 +717,8 @@ struct PathCache {
 #[wasm_bindgen]
 pub struct Session {
     scan: PreparedScan,
+    /// The scan's bounds in the scanner frame, as imported.
+    scan_bbox: (DVec3, DVec3),
     path: Option<LoadedPath>,
     cache: Option<PathCache>,
 }
@@ -728,9 +801,24 @@ fn check_samples(path: &LoadedPath, settings: &PlanSettings) -> Result<(), JsVal
 }
 
 impl Session {
-    fn from_prepared(scan: PreparedScan) -> Session {
+    /// `scan_bbox`: the import's bounds (scanner frame); without them they
+    /// are found by taking the registered mesh back (G is rigid).
+    fn from_prepared(scan: PreparedScan, scan_bbox: Option<(DVec3, DVec3)>) -> Session {
+        let scan_bbox = scan_bbox.unwrap_or_else(|| {
+            let reg = &scan.registration;
+            let back = scan
+                .surface
+                .mesh()
+                .vertices
+                .iter()
+                .map(|&v| reg.apply_inverse(v));
+            back.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+        });
         Session {
             scan,
+            scan_bbox,
             path: None,
             cache: None,
         }
@@ -854,7 +942,7 @@ impl Session {
         let scan: ImportOptions = from_js("scan settings", scan)?;
         let registration: RegistrationSettings = from_js("registration settings", registration)?;
         let scan = job::prepare_scan(bytes, name, &scan, &registration).map_err(core_err)?;
-        Ok(Session::from_prepared(scan))
+        Ok(Session::from_prepared(scan, None))
     }
 
     /// Vertices of the registered mesh, printer frame, xyz f32 (for drawing).
@@ -895,8 +983,11 @@ impl Session {
                 printer: arr(s.registration.apply(f.centroid)),
                 diameter_mm: f.diameter_mm,
                 roundness: f.roundness,
+                score: f.score,
+                candidate: f.is_candidate(),
             })
             .collect();
+        let (slo, shi) = self.scan_bbox;
         to_js(&ScanView {
             name: &s.file.name,
             bytes: s.file.bytes,
@@ -904,8 +995,11 @@ impl Session {
             units: s.units,
             triangles: s.triangle_count(),
             bbox_mm: [arr(lo), arr(hi)],
+            scan_bbox_mm: [arr(slo), arr(shi)],
             warnings: &s.warnings,
             registration: RegistrationView {
+                status: s.registration.status,
+                status_text: s.registration.status.to_string(),
                 method: s.method,
                 matrix: s.registration.matrix_row_major(),
                 residuals_mm: &s.registration.residuals_mm,
@@ -978,6 +1072,35 @@ impl Session {
             drawn,
         });
         Ok(())
+    }
+
+    /// The drawing of [`Session::set_path`] centred on this scan's footprint
+    /// (printer XY), keeping the rotation and scale of `placement` and
+    /// scaling it down when it does not fit ([`placement::centre_drawing`]):
+    /// `{placement, note}` (`note` says how it was scaled, or is null), or
+    /// null for a drawing without points.
+    #[wasm_bindgen(js_name = centreDrawing)]
+    pub fn centre_drawing(&self, placement: JsValue) -> Result<JsValue, JsValue> {
+        #[derive(Serialize)]
+        struct Centred {
+            placement: Placement,
+            note: Option<String>,
+        }
+        let current: Placement = from_js("drawing placement", placement)?;
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to centre: set a path first"))?;
+        let (lo, hi) = self.scan.surface.bbox();
+        let centred = placement::centre_drawing(
+            &path.drawn.subpaths,
+            (lo.truncate(), hi.truncate()),
+            &current,
+        );
+        Ok(match centred {
+            Some((placement, note)) => to_js(&Centred { placement, note })?,
+            None => JsValue::NULL,
+        })
     }
 
     /// One call for a live re-plan: plans the drawing of [`Session::set_path`]

@@ -918,3 +918,107 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
         .check_gcode(cut.as_bytes(), "cut.gcode", nozzle, -1.0)
         .is_err());
 }
+
+// ---- a scan in its scanner frame, placed on the bed (issue 13) ----
+
+fn json(v: JsValue) -> serde_json::Value {
+    serde_wasm_bindgen::from_value(v).unwrap()
+}
+
+/// JSON as the page sends it: plain objects, not `Map`s.
+fn obj(v: &serde_json::Value) -> JsValue {
+    use serde::Serialize;
+    v.serialize(&serde_wasm_bindgen::Serializer::new().serialize_maps_as_objects(true))
+        .unwrap()
+}
+
+#[wasm_bindgen_test]
+fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
+    // The test part as a scanner gives it: turned and 800 mm down.
+    let mut mesh = test_part::test_part();
+    let g = pcpp::DMat4::from_translation(DVec3::new(-300.0, 150.0, -800.0))
+        * pcpp::DMat4::from_rotation_z(0.5);
+    mesh.transform(&g);
+    let bytes = demo::to_binary_ply(&mesh);
+    let mut settings = JobSettings::default();
+    let as_scanned = staged_session(&bytes, "face.ply", &settings);
+    let info = json(as_scanned.info().unwrap());
+    let reg = &info["registration"];
+    assert_eq!(reg["status"]["kind"], "as-scanned");
+    assert!(reg["status_text"]
+        .as_str()
+        .unwrap()
+        .starts_with("unregistered, taken as it is"));
+    assert_eq!(info["bbox_mm"], info["scan_bbox_mm"]);
+    let b: Vec<f64> = info["bbox_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|p| p.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+        .collect();
+    let fit = json(pcpp::wasm::volume_fit(&b, "marlin", None).unwrap());
+    assert_eq!(fit["inside"], false);
+    let message = fit["message"].as_str().unwrap();
+    assert!(
+        message.contains("outside the build volume of profile marlin")
+            && message.contains("'Place on the bed'"),
+        "{message}"
+    );
+    assert!(pcpp::wasm::volume_fit(&b[..5], "marlin", None).is_err());
+
+    // Placed on the bed of the profile: lowest point at z 0, the scan's
+    // own frame unchanged, the status says so.
+    let bed = pcpp::wasm::bed_of("marlin", None).unwrap();
+    let placement = serde_json::json!({
+        "mode": "on-bed", "bed": json(bed), "rotation_deg": 0.0, "offset_mm": [0.0, 0.0, 0.0]
+    });
+    settings.registration.scan_placement = serde_json::from_value(placement.clone()).unwrap();
+    let mut placed = staged_session(&bytes, "face.ply", &settings);
+    let pinfo = json(placed.info().unwrap());
+    assert_eq!(
+        pinfo["registration"]["status_text"],
+        "unregistered, placed on the bed"
+    );
+    assert_eq!(pinfo["scan_bbox_mm"], info["scan_bbox_mm"]);
+    assert!(pinfo["bbox_mm"][0][2].as_f64().unwrap().abs() < 1e-9);
+
+    // The drawing carried with the scan, and a new drawing centred on it.
+    let drawing = serde_json::json!({"offset_mm": [b[0] + 10.0, b[1] + 10.0], "rotation_deg": 0.0, "scale": 1.0});
+    let carried = json(
+        pcpp::wasm::carry_drawing(
+            obj(&drawing),
+            &b,
+            obj(&serde_json::json!({"mode": "as-scanned"})),
+            obj(&placement),
+        )
+        .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e))),
+    );
+    assert_eq!(carried["scale"], 1.0);
+    // Placed without a turn, the scan moved by a shift: the drawing too.
+    for k in 0..2 {
+        let shift = pinfo["bbox_mm"][0][k].as_f64().unwrap() - b[k];
+        let moved =
+            carried["offset_mm"][k].as_f64().unwrap() - drawing["offset_mm"][k].as_f64().unwrap();
+        assert!((moved - shift).abs() < 1e-9, "{moved} vs {shift}");
+    }
+    let spiral = antennas::paper_spiral_svg();
+    placed
+        .set_path(spiral.as_bytes(), "spiral.svg")
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let centred = json(
+        placed
+            .centre_drawing(js(&settings.plan.placement))
+            .unwrap_or_else(|e| panic!("{e:?}")),
+    );
+    assert!(centred["note"].is_null(), "{centred}");
+    settings.plan.placement = serde_json::from_value(centred["placement"].clone()).unwrap();
+    let out = placed
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let gcode = bytes_text(&get(&out, "gcode"));
+    assert!(
+        gcode.contains("; registration: unregistered, placed on the bed;"),
+        "{}",
+        &gcode[..800]
+    );
+}

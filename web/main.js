@@ -3,6 +3,11 @@
 // same `job` code as the CLI); this file moves bytes and settings around
 // and shows results. Text from files and errors is set with textContent.
 import { loadWasm, startWorker } from './engine.js';
+import { BEST, fmtPoints, initFiducials, pointsEdited, safePoints, showFiducials } from './fiducials.js';
+import {
+  SCAN_PLACE_DEFAULT, cancelCentre, centreRequest, initPlacement, moveScan, onCentred, requestCentre,
+  sanitizeScanPlace, scanPlacementFor, setNote, showScanPlacement,
+} from './placement.js';
 import { drawPlot, plannerColor } from './plot.js';
 import { keepInput, keptInput } from './store.js';
 import {
@@ -67,6 +72,7 @@ const state = {
   checkMoves: null, // the last checked program's {moves, kinds} for the view
   viewShowsCheck: false, // the view draws those moves instead of the plan
   interacting: false, // a drag or slider in progress: skip the comparison
+  centre: null, // {token}: the next plan centres the drawing on the scan (placement.js)
   info: null, // the scan as the worker read it
   viewer: null,
   redraw: 0,
@@ -91,8 +97,6 @@ let settings = null;
 
 // ---------- settings ----------
 
-const fmtPoints = (pts) => pts.map((p) => p.map((v) => +v.toFixed(4)).join(', ')).join('\n');
-
 // A built-in demo part (wasm demoPart): its drawing, names and settings,
 // made once per part.
 function demoInfo(name) {
@@ -113,6 +117,9 @@ function demoUiSettings(part = 'test-part') {
     scanUp: '',
     fidSource: d.registration.fiducials === 'auto' ? 'auto' : 'none',
     fidMethod: d.registration.method,
+    dotDiameter: d.registration.dot_diameter_mm,
+    // An unregistered scan placed on the bed (placement.js).
+    scanPlace: { ...SCAN_PLACE_DEFAULT },
     fidScanText: '',
     fidPrinterText: fmtPoints(d.registration.printer_points),
     pathSource: 'demo',
@@ -154,6 +161,7 @@ function loadSettings() {
   if (base.dialect === 'custom' && !base.customProfile) base.dialect = 'marlin';
   if (!demoParts().some((p) => p.name === base.demoPart)) base.demoPart = 'test-part';
   if (!planners().includes(base.planner)) base.planner = demoUiSettings().planner;
+  base.scanPlace = sanitizeScanPlace(base.scanPlace);
   return base;
 }
 
@@ -176,9 +184,17 @@ function jobSettings(scan) {
     printer = parseField('printer points P', s.fidPrinterText);
     fiducials = s.fidSource === 'auto' ? 'auto' : { points: parseField('scan points Sr', s.fidScanText) };
   }
+  const dot = num(s.dotDiameter);
+  if (!(dot > 0)) throw new Error('fiducial dot diameter: type a diameter in mm, greater than 0 (default 1)');
   return {
     scan: { units: s.scanUnits || null, up_axis: s.scanUp || null },
-    registration: { fiducials, printer_points: printer, method: s.fidMethod },
+    registration: {
+      fiducials,
+      printer_points: printer,
+      method: s.fidMethod,
+      dot_diameter_mm: dot,
+      scan_placement: scanPlacementFor(scan),
+    },
     plan: {
       nozzle: { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) },
       process: {
@@ -253,6 +269,7 @@ const FIELDS = [
   ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
   ['fid-source', () => settings.fidSource, (v) => { settings.fidSource = v; }],
   ['fid-method', () => settings.fidMethod, (v) => { settings.fidMethod = v; }],
+  ['fid-dot', () => settings.dotDiameter, (v) => { settings.dotDiameter = v === '' ? NaN : Number(v); }, 'typed'],
   ['fid-scan', () => settings.fidScanText, (v) => { settings.fidScanText = v; }],
   ['fid-printer', () => settings.fidPrinterText, (v) => { settings.fidPrinterText = v; }],
   ['path-source', () => settings.pathSource, (v) => { settings.pathSource = v; }],
@@ -332,7 +349,17 @@ function bindForm() {
     const antennaField = /^(sp|hb|mp)-/.test(id);
     const handler = () => {
       const before = antennaField ? pathCentre() : null;
-      set(el.type === 'checkbox' ? el.checked : el.value);
+      const value = el.type === 'checkbox' ? el.checked : el.value;
+      // A new profile has its own bed: a scan placed on it moves, and the
+      // drawing with it.
+      if (id === 'dialect') moveScan(() => set(value));
+      else set(value);
+      if (/^pl-/.test(id)) {
+        // The user places the drawing: no centring over it.
+        cancelCentre();
+        setNote('');
+      }
+      if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
       const after = before ? pathCentre() : null;
       if (before && after) {
         const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);
@@ -344,8 +371,9 @@ function bindForm() {
       saveSettings();
       syncGauge();
       syncVisibility();
+      showScanPlacement();
       if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
-        centreOnScan(false);
+        requestCentre(true);
       }
       if (mode === 'live') {
         state.interacting = true;
@@ -578,7 +606,8 @@ function runPlan() {
   if (state.busy) state.stats.overlapped++;
   const id = ++state.planId;
   const compare = !state.interacting;
-  state.busy = { id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, t0: performance.now() };
+  const centre = centreRequest();
+  state.busy = { id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now() };
   state.queued = false;
   laterProgress('starting');
   if (!state.interacting) setStatus('planning…');
@@ -607,6 +636,8 @@ function runPlan() {
       ? settings.customProfile.file : undefined,
     acceptRisk: !!settings.acceptRisk,
     compare,
+    // Centre the drawing on the scan before planning (a new scan or drawing).
+    centre,
   }, transfer);
 }
 
@@ -630,7 +661,8 @@ function keptPlan(m, busy) {
     view: m.view,
     svgName: busy.svg.name,
     planner: busy.planner,
-    placement: busy.job.plan.placement,
+    // What the worker planned (it may have centred the drawing).
+    placement: m.summary.settings.placement,
     gen: busy.gen,
     compared: !!m.comparison,
   };
@@ -671,6 +703,9 @@ function onWorkerMessage(e) {
       }
       state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);
+      break;
+    case 'centred':
+      onCentred(m, busy);
       break;
     case 'result': {
       if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {
@@ -730,6 +765,7 @@ function onPlanError(m, busy) {
         keep('scan', null);
       }
       state.pendingScan = null;
+      dropCentre();
       message += `; still using the previous scan, ${state.scan.name}`;
     }
     message += '.';
@@ -743,6 +779,7 @@ function onPlanError(m, busy) {
       keep('scan', null);
     }
     state.pendingScan = null;
+    dropCentre();
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
   } else if (m.stage === 'scan') {
@@ -755,6 +792,8 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
     title = `Could not read the SVG ${state.pendingSvg.name}`;
     state.pendingSvg = null;
+    // The drawing stays where it was.
+    cancelCentre();
     if (!state.svgFile) settings.pathSource = 'demo';
     writeForm();
     message += state.svgFile
@@ -783,6 +822,12 @@ function onPlanError(m, busy) {
   setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 
+// A file that could not be read changes nothing: no centring for it (a
+// new drawing opened with it is still centred).
+function dropCentre() {
+  if (state.centre && !state.centre.fresh) cancelCentre();
+}
+
 // The pending scan was read: it becomes the scan, and the demo's fiducial
 // settings it was read without are dropped for good.
 function acceptScan() {
@@ -797,6 +842,13 @@ function acceptScan() {
     saveSettings();
     writeForm();
   }
+  if (scan.asScanned) {
+    // A new scan is read as it is; the banner offers to place it.
+    delete scan.asScanned;
+    settings.scanPlace = { ...SCAN_PLACE_DEFAULT };
+    saveSettings();
+  }
+  showScanPlacement();
 }
 
 function cancelPlan() {
@@ -854,127 +906,9 @@ function showScan(info, positions, indices, seconds) {
     }
   }
   showFiducials();
-  requestDraw();
-}
-
-function showFiducials() {
-  const info = state.info;
-  const holes = $('fid-holes');
-  const res = $('fid-residuals');
-  holes.replaceChildren();
-  res.replaceChildren();
-  if (!info) return;
-  const list = info.holes.slice(0, 8);
-  if (list.length) {
-    const p = document.createElement('p');
-    p.textContent = `${info.holes.length} hole(s) found (scan frame):`;
-    holes.append(p);
-    const ol = document.createElement('ol');
-    for (const h of list) {
-      const li = document.createElement('li');
-      li.textContent = `(${h.scan.map((v) => fmt(v)).join(', ')}) Ø ${fmt(h.diameter_mm)} mm`;
-      ol.append(li);
-    }
-    holes.append(ol);
-  } else {
-    holes.textContent = 'No holes found in the scan.';
-  }
-  const r = info.registration;
-  if (r.residuals_mm.length === 0) {
-    res.textContent = 'No registration: the scan is used as it is (printer frame).';
-  } else {
-    const d = Number(settings.nozzle.id);
-    const p = document.createElement('p');
-    p.textContent = `Residuals: ${r.residuals_mm.map((v) => fmt(v, 4)).join(', ')} mm; RMS `;
-    const rms = document.createElement('span');
-    rms.className = 'rms';
-    rms.id = 'rms';
-    rms.textContent = `${fmt(r.rms_mm, 4)} mm`;
-    // Above d/2 the path lands off by more than half a filament width.
-    if (r.rms_mm > d / 2) {
-      rms.classList.add('bad');
-      rms.title = `above d/2 = ${fmt(d / 2)} mm`;
-    }
-    p.append(rms);
-    res.append(p);
-
-    for (const n of r.notes) {
-      const q = document.createElement('p');
-      q.textContent = n;
-      res.append(q);
-    }
-  }
-  showPairs(list);
   updateMarkers();
-}
-
-// Which hole is matched with which printer point P: one select per P row
-// (the holes in the list above), the residual of each pair beside it.
-// Choosing holes here types their centres as the scan points Sr.
-function showPairs(list) {
-  const box = $('fid-pairs');
-  box.replaceChildren();
-  const info = state.info;
-  const printer = safePoints(settings.fidPrinterText);
-  if (!info || !list.length || !printer.length || settings.fidSource === 'none') return;
-  const scanPts = settings.fidSource === 'points' ? safePoints(settings.fidScanText) : [];
-  const r = info.registration;
-  const near = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-  const closest = (p, key, tol) => {
-    let best = -1;
-    let bd = tol;
-    list.forEach((h, i) => {
-      const dd = near(h[key], p);
-      if (dd < bd) { bd = dd; best = i; }
-    });
-    return best;
-  };
-  const head = document.createElement('p');
-  head.textContent = 'Pairs (hole → printer point P), residual:';
-  const table = document.createElement('table');
-  table.className = 'num pairs';
-  const selects = [];
-  printer.forEach((pp, i) => {
-    // Preselected: the hole typed for this row, or (auto) the hole that
-    // lands nearest to P after the registration.
-    let chosen = -1;
-    if (settings.fidSource === 'points') {
-      if (scanPts[i]) chosen = closest(scanPts[i], 'scan', 1e-3);
-    } else if (r.residuals_mm.length) {
-      chosen = closest(pp, 'printer', Infinity);
-    }
-    const tr = document.createElement('tr');
-    const sel = document.createElement('select');
-    sel.id = `fid-pair-${i}`;
-    sel.className = 'pair-select';
-    sel.setAttribute('aria-label', `hole for printer point ${i + 1}`);
-    sel.add(new Option('—', ''));
-    list.forEach((h, k) => sel.add(new Option(`hole ${k + 1}`, String(k))));
-    sel.value = chosen >= 0 ? String(chosen) : '';
-    sel.addEventListener('change', () => choosePairs(list, selects));
-    selects.push(sel);
-    const cells = [sel, `P${i + 1} (${pp.map((v) => fmt(v, 2)).join(', ')})`,
-      r.residuals_mm.length === printer.length ? `${fmt(r.residuals_mm[i], 4)} mm` : ''];
-    for (const c of cells) {
-      const td = document.createElement('td');
-      if (typeof c === 'string') td.textContent = c;
-      else td.append(c);
-      tr.append(td);
-    }
-    table.append(tr);
-  });
-  box.append(head, table);
-}
-
-function choosePairs(list, selects) {
-  const chosen = selects.map((s) => (s.value === '' ? null : list[Number(s.value)]));
-  // Registration needs a hole for every P; wait until each row has one.
-  if (chosen.some((h) => !h)) return;
-  settings.fidScanText = fmtPoints(chosen.map((h) => h.scan));
-  settings.fidSource = 'points';
-  saveSettings();
-  writeForm();
-  schedulePlan(0);
+  showScanPlacement();
+  requestDraw();
 }
 
 // G (the registration, row-major 4 x 4) applied to a scanner-frame point.
@@ -992,19 +926,13 @@ function updateMarkers() {
     const picked = showScan
       ? safePoints(settings.fidScanText).map((p) => applyG(info.registration.matrix, p)) : [];
     try {
-      state.viewer.setMarkers(info.holes.map((h) => h.printer), printer, picked);
+      // The holes listed (the best candidates), not every scanner hole.
+      const holes = info.holes.filter((h) => h.candidate).slice(0, BEST);
+      state.viewer.setMarkers(holes.map((h) => h.printer), printer, picked);
     } catch (e) {
       showError('Could not draw the fiducials', e.message);
     }
     requestDraw();
-  }
-}
-
-function safePoints(text) {
-  try {
-    return parsePoints(text || '');
-  } catch {
-    return [];
   }
 }
 
@@ -1209,6 +1137,10 @@ async function openFile(file) {
   if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
     entry.unregistered = true;
   }
+  // A new scan is read as it is (the banner offers to place it on the bed),
+  // and the drawing is centred on it.
+  if (settings.scanPlace.on) entry.asScanned = true;
+  requestCentre();
   $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
   saveSettings();
   writeForm();
@@ -1232,6 +1164,8 @@ async function openSvg(file) {
   }
   state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes };
   settings.pathSource = 'file';
+  // A new drawing lands on the scan.
+  requestCentre(true);
   saveSettings();
   writeForm();
   schedulePlan(0);
@@ -1256,9 +1190,13 @@ async function openProfile(file) {
     return;
   }
   clearError();
-  settings.customProfile = { name, file: file.name, text };
-  settings.dialect = 'custom';
+  // Its bed may differ: a scan placed on the bed moves with it.
+  moveScan(() => {
+    settings.customProfile = { name, file: file.name, text };
+    settings.dialect = 'custom';
+  });
   syncProfileOption();
+  showScanPlacement();
   saveSettings();
   writeForm();
   schedulePlan(0);
@@ -1468,6 +1406,10 @@ function loadDemo(part = settings.demoPart) {
   settings.placement = demo.placement;
   settings.scanUnits = '';
   settings.scanUp = '';
+  // The demo parts are made in the printer frame, placed where they print.
+  settings.scanPlace = { ...SCAN_PLACE_DEFAULT };
+  cancelCentre();
+  setNote('');
   state.pendingScan = null;
   state.scan = demoScanEntry(settings.demoPart);
   $('scan-name').textContent = state.scan.name;
@@ -1496,27 +1438,6 @@ function placed([x, y]) {
   const s = num(settings.placement.scale);
   const a = (num(settings.placement.rot) * Math.PI) / 180;
   return [s * (Math.cos(a) * x - Math.sin(a) * y), s * (Math.sin(a) * x + Math.cos(a) * y)];
-}
-
-// Places the centre of the path's box over the scan's centre, keeping
-// rotation and scale.
-function centreOnScan(showErrors = true) {
-  if (!state.info) return;
-  let c;
-  try {
-    const svg = currentSvg();
-    const b = pathBounds(svg.bytes, svg.name);
-    c = [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
-  } catch (e) {
-    if (showErrors) showError('Cannot centre the path', e.message);
-    return;
-  }
-  const [lo, hi] = state.info.bbox_mm;
-  const [rx, ry] = placed(c);
-  settings.placement.x = +((lo[0] + hi[0]) / 2 - rx).toFixed(3);
-  settings.placement.y = +((lo[1] + hi[1]) / 2 - ry).toFixed(3);
-  saveSettings();
-  writeForm();
 }
 
 // ---------- picking scan points on the mesh ----------
@@ -1632,6 +1553,8 @@ function movePlacementTo(x, y) {
   if (nx === num(settings.placement.x) && ny === num(settings.placement.y)) return;
   settings.placement.x = nx;
   settings.placement.y = ny;
+  cancelCentre();
+  setNote('');
   writeField('pl-x');
   writeField('pl-y');
   state.interacting = true;
@@ -1832,6 +1755,23 @@ async function start() {
   $('version').textContent = `v${version()}`;
   $('scan-limit').textContent = `${pageLimits().scan_bytes / (1 << 20)} MiB`;
   settings = loadSettings();
+  const page = {
+    state,
+    settings: () => settings,
+    saveSettings,
+    writeForm,
+    schedulePlan,
+    showError,
+    clearError,
+    updateMarkers,
+    // The profile to write with: [dialect or the profile's JSON, its file
+    // name, the name to show].
+    profile: () => (settings.dialect === 'custom' && settings.customProfile
+      ? [settings.customProfile.text, settings.customProfile.file, settings.customProfile.name]
+      : [settings.dialect, undefined, settings.dialect]),
+  };
+  initPlacement(page);
+  initFiducials(page);
   bindForm();
   writeForm();
   bindFiles();
@@ -1846,7 +1786,11 @@ async function start() {
       onGcodeClick(e);
     }
   });
-  $('center-btn').addEventListener('click', () => { centreOnScan(true); schedulePlan(0); });
+  $('center-btn').addEventListener('click', () => {
+    // The core centres it on the scan's footprint, scaled down to fit.
+    requestCentre();
+    schedulePlan(0);
+  });
   $('error-close').addEventListener('click', clearError);
   $('pick-btn').addEventListener('click', () => setPicking(!state.picking));
   $('clear-scan-btn').addEventListener('click', () => {

@@ -119,6 +119,18 @@ async function plan(m) {
       session.setPath(svg.bytes, svg.name);
       pathKey = svg.key;
     }
+    if (m.centre) {
+      // A new scan or drawing: the drawing centred on the scan (the core's
+      // centre_drawing), told to the page before planning, so it keeps the
+      // placement even if this plan fails.
+      // A new drawing starts at its own size.
+      if (m.centre.fresh) m.plan.placement.scale = 1;
+      const c = session.centreDrawing(m.plan.placement);
+      if (c) {
+        m.plan.placement = c.placement;
+        post({ type: 'centred', id, placement: c.placement, note: c.note });
+      }
+    }
     progress(id, 'plan', m.compare ? 'planning and comparing every planner' : 'planning');
     const t0 = performance.now();
     const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare);

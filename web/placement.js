@@ -1,0 +1,285 @@
+// Where the scan and the drawing go in the printer frame, on the page: the
+// banner offering to place an unregistered scan on the bed (shown when the
+// core finds it outside the profile's build volume), the fields that move
+// and turn it there by hand (the drawing goes with it), the registration
+// status in the header, and the centring of a new drawing on the scan. Every
+// number comes from the core (volumeFit, bedOf, carryDrawing and the
+// worker's Session.centreDrawing); this module keeps the settings and the
+// elements in step.
+import { bedOf, carryDrawing, volumeFit } from '../pkg/pcpp.js';
+
+const $ = (id) => document.getElementById(id);
+
+// The scan placement the settings start with (and a new scan is read with).
+export const SCAN_PLACE_DEFAULT = Object.freeze({ on: false, rot: 0, dx: 0, dy: 0, dz: 0 });
+
+// [element id, settings key, name in messages].
+const FIELDS = [
+  ['bed-dx', 'dx', 'move X (mm)'],
+  ['bed-dy', 'dy', 'move Y (mm)'],
+  ['bed-dz', 'dz', 'move Z (mm)'],
+  ['bed-rot', 'rot', 'rotate (°)'],
+];
+
+// Set by initPlacement: {state, settings(), saveSettings, writeForm,
+// schedulePlan, showError, profile() -> [dialect, profileFile]}.
+let ctx = null;
+let centreTokens = 0;
+const beds = new Map(); // profile key -> its bed (wasm bedOf)
+
+const finite = (v) => typeof v === 'number' && Number.isFinite(v);
+
+// The scan placement of the settings, checked: every number typed.
+function scanPlace() {
+  const sp = { ...SCAN_PLACE_DEFAULT, ...(ctx.settings().scanPlace || {}) };
+  for (const [, key, name] of FIELDS) {
+    if (!finite(sp[key])) throw new Error(`scan placement: ${name} must be a number`);
+  }
+  return sp;
+}
+
+function bed() {
+  const [dialect, file] = ctx.profile();
+  const key = `${file || ''}\u0000${dialect}`;
+  let b = beds.get(key);
+  if (!b) {
+    b = bedOf(dialect, file);
+    beds.clear();
+    beds.set(key, b);
+  }
+  return b;
+}
+
+// Whether the scan is placed on the bed: asked for, and no fiducials (a
+// scan is either registered or placed, never both; a new scan is read as
+// it is until the user places it).
+function placed(scan) {
+  const s = ctx.settings();
+  return !!(s.scanPlace && s.scanPlace.on) && s.fidSource === 'none' && !(scan && scan.asScanned);
+}
+
+// The registration's `scan_placement` (job::RegistrationSettings) for
+// planning on `scan`; throws a message naming the field that is not a
+// number.
+export function scanPlacementFor(scan) {
+  if (!placed(scan)) return { mode: 'as-scanned' };
+  const sp = scanPlace();
+  return { mode: 'on-bed', bed: bed(), rotation_deg: sp.rot, offset_mm: [sp.dx, sp.dy, sp.dz] };
+}
+
+// The drawing's placement as the core reads it, or null if a field is not
+// a number.
+function drawingPlacement() {
+  const p = ctx.settings().placement;
+  const v = [p.x, p.y, p.rot, p.scale].map(Number);
+  if (!v.every(Number.isFinite)) return null;
+  return { offset_mm: [v[0], v[1]], rotation_deg: v[2], scale: v[3] };
+}
+
+const round4 = (v) => Math.round(v * 1e4) / 1e4;
+
+// Runs `change` (which edits the settings) and moves the drawing with the
+// scan if that moved it: the drawing stays on the same part of the scan.
+// Before the loaded scan was read (or while its drawing is still to be
+// centred) the drawing is centred on it afterwards instead.
+export function moveScan(change) {
+  const { state } = ctx;
+  let before = null;
+  try {
+    before = scanPlacementFor(state.scan);
+  } catch {
+    // A field was not a number: nothing to carry from.
+  }
+  change();
+  let after = null;
+  try {
+    after = scanPlacementFor(state.scan);
+  } catch {
+    // Shown by the plan request.
+  }
+  if (!before || !after || JSON.stringify(before) === JSON.stringify(after)) return;
+  const info = state.info;
+  const drawing = drawingPlacement();
+  if (state.centre || state.pendingScan || !info || !drawing) {
+    // A centring in flight was for the scan where it was: centre again.
+    if (state.centre) requestCentre(state.centre.fresh);
+    return;
+  }
+  const [lo, hi] = info.scan_bbox_mm;
+  try {
+    const c = carryDrawing(drawing, [...lo, ...hi], before, after);
+    const s = ctx.settings();
+    s.placement.x = round4(c.offset_mm[0]);
+    s.placement.y = round4(c.offset_mm[1]);
+    s.placement.rot = round4(c.rotation_deg);
+  } catch (e) {
+    ctx.showError('Could not move the drawing with the scan', e.message);
+  }
+}
+
+// The next plan centres the drawing on the scan (a new scan or drawing was
+// opened, or "Centre on scan"): a fresh token, so the answer to an older
+// request cannot be taken for it. A new drawing (`drawing`) starts at its
+// own size: the scale set for the previous one does not carry over; the
+// core scales it down if it does not fit.
+export function requestCentre(drawing = false) {
+  const fresh = drawing || !!(ctx.state.centre && ctx.state.centre.fresh);
+  ctx.state.centre = { token: ++centreTokens, fresh };
+}
+
+// The user placed the drawing: nothing is centred over it.
+export function cancelCentre() {
+  ctx.state.centre = null;
+}
+
+// What a plan request carries: {token, fresh}, or null.
+export function centreRequest() {
+  return ctx.state.centre ? { ...ctx.state.centre } : null;
+}
+
+// The worker centred the drawing for the request `busy` (its token): taken
+// into the settings unless the user placed it since, with the core's note
+// when it was scaled to fit.
+export function onCentred(m, busy) {
+  const { state } = ctx;
+  if (!state.centre || !busy || !busy.centre || busy.centre.token !== state.centre.token) return;
+  state.centre = null;
+  const s = ctx.settings();
+  // The core's numbers as they are: what the worker plans.
+  s.placement = {
+    x: m.placement.offset_mm[0],
+    y: m.placement.offset_mm[1],
+    rot: m.placement.rotation_deg,
+    scale: m.placement.scale,
+  };
+  // What was sent is what the worker plans: the request matches again.
+  busy.job.plan.placement = m.placement;
+  setNote(m.note || '');
+  ctx.saveSettings();
+  ctx.writeForm();
+}
+
+// The note under the drawing's placement (the core's, when it scaled the
+// drawing to fit); cleared when the user places it.
+export function setNote(text) {
+  $('pl-note').textContent = text;
+}
+
+// Banner, the placement panel and the header's status, for the scan on
+// screen and the settings now.
+export function showScanPlacement() {
+  const { state } = ctx;
+  const s = ctx.settings();
+  const info = state.info;
+  const status = $('reg-status');
+  const line = status.parentElement;
+  if (info) {
+    status.textContent = info.registration.status_text;
+    const registered = info.registration.status.kind === 'registered';
+    line.classList.toggle('registered', registered);
+    line.classList.toggle('unregistered', !registered);
+  }
+  const on = placed(state.pendingScan || state.scan);
+  let fit = null;
+  if (info) {
+    const [lo, hi] = info.bbox_mm;
+    const [dialect, file] = ctx.profile();
+    try {
+      fit = volumeFit([...lo, ...hi], dialect, file);
+    } catch {
+      fit = null; // a bad profile: its own error is shown when planning
+    }
+  }
+  const outside = !!fit && !fit.inside;
+  $('place-banner').hidden = !(outside && !on && s.fidSource === 'none' && !state.pendingScan);
+  $('place-banner-text').textContent = outside ? capital(fit.message) : '';
+  $('scan-place').hidden = !on;
+  if (on) {
+    $('bed-name').textContent = `profile ${ctx.profile()[2]}`;
+    const note = $('bed-note');
+    const shown = info && info.registration.status.kind === 'placed-on-bed';
+    note.textContent = shown && outside ? capital(fit.message) : '';
+    note.classList.toggle('bad-note', shown && outside);
+  }
+  writeFields(null);
+}
+
+const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
+
+// The fields from the settings (except the one being typed in).
+function writeFields(except) {
+  const sp = { ...SCAN_PLACE_DEFAULT, ...(ctx.settings().scanPlace || {}) };
+  for (const [id, key] of FIELDS) {
+    if (id === except || document.activeElement === $(id)) continue;
+    $(id).value = finite(sp[key]) ? String(sp[key]) : '';
+  }
+}
+
+function placeOnBed() {
+  const s = ctx.settings();
+  moveScan(() => {
+    s.scanPlace = { ...SCAN_PLACE_DEFAULT, on: true };
+    // The registration the page would otherwise read the scan with.
+    s.fidSource = 'none';
+  });
+  ctx.clearError();
+  ctx.saveSettings();
+  ctx.writeForm();
+  showScanPlacement();
+  ctx.schedulePlan(0);
+}
+
+function backToScannerFrame() {
+  const s = ctx.settings();
+  moveScan(() => {
+    s.scanPlace = { ...SCAN_PLACE_DEFAULT };
+  });
+  ctx.saveSettings();
+  ctx.writeForm();
+  showScanPlacement();
+  ctx.schedulePlan(0);
+}
+
+// A typed move or turn: a number moves the scan (and the drawing with it);
+// anything else is named under the fields and changes nothing.
+function onField(id, key, name) {
+  const el = $(id);
+  const v = el.value.trim() === '' ? NaN : Number(el.value);
+  const note = $('bed-note');
+  if (!Number.isFinite(v)) {
+    note.textContent = `${capital(name)}: type a number (the scan stays where it is).`;
+    note.classList.add('bad-note');
+    return;
+  }
+  note.textContent = '';
+  note.classList.remove('bad-note');
+  const s = ctx.settings();
+  if (s.scanPlace[key] === v) return;
+  moveScan(() => {
+    s.scanPlace = { ...s.scanPlace, [key]: v };
+  });
+  ctx.saveSettings();
+  ctx.writeForm();
+  ctx.schedulePlan(250);
+}
+
+// `c`: the page's state and callbacks (see `ctx` above).
+export function initPlacement(c) {
+  ctx = c;
+  $('place-bed-btn').addEventListener('click', placeOnBed);
+  $('bed-undo').addEventListener('click', backToScannerFrame);
+  for (const [id, key, name] of FIELDS) {
+    $(id).addEventListener('input', () => onField(id, key, name));
+  }
+}
+
+// Settings saved before scan placements existed, or edited by hand: a
+// usable scan placement.
+export function sanitizeScanPlace(sp) {
+  const out = { ...SCAN_PLACE_DEFAULT };
+  if (sp && typeof sp === 'object') {
+    out.on = sp.on === true;
+    for (const [, key] of FIELDS) if (finite(sp[key])) out[key] = sp[key];
+  }
+  return out;
+}
