@@ -513,6 +513,9 @@ struct ScanView<'a> {
     /// Scanner frame, as imported (what a placement on the bed moves).
     scan_bbox_mm: [[f64; 3]; 2],
     warnings: &'a [String],
+    /// For a point cloud: how it was meshed, and that as one line.
+    cloud: Option<crate::mesh::CloudInfo>,
+    cloud_text: Option<String>,
     registration: RegistrationView<'a>,
     holes: Vec<HoleView>,
 }
@@ -997,6 +1000,8 @@ impl Session {
             bbox_mm: [arr(lo), arr(hi)],
             scan_bbox_mm: [arr(slo), arr(shi)],
             warnings: &s.warnings,
+            cloud: s.cloud,
+            cloud_text: s.cloud.map(|c| c.to_string()),
             registration: RegistrationView {
                 status: s.registration.status,
                 status_text: s.registration.status.to_string(),

@@ -43,6 +43,7 @@ fn obj_imports_with_units() {
     let cm = ImportOptions {
         units: Some(ScanUnits::Cm),
         up_axis: None,
+        max_edge_mm: None,
     };
     let m = import_mesh(small_obj().as_bytes(), "sheet.obj", &cm).unwrap();
     assert_eq!(m.format, MeshFormat::Obj);

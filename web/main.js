@@ -115,6 +115,7 @@ function demoUiSettings(part = 'test-part') {
     demoPart: part,
     scanUnits: '',
     scanUp: '',
+    scanMaxEdge: '',
     fidSource: d.registration.fiducials === 'auto' ? 'auto' : 'none',
     fidMethod: d.registration.method,
     dotDiameter: d.registration.dot_diameter_mm,
@@ -187,7 +188,11 @@ function jobSettings(scan) {
   const dot = num(s.dotDiameter);
   if (!(dot > 0)) throw new Error('fiducial dot diameter: type a diameter in mm, greater than 0 (default 1)');
   return {
-    scan: { units: s.scanUnits || null, up_axis: s.scanUp || null },
+    scan: {
+      units: s.scanUnits || null,
+      up_axis: s.scanUp || null,
+      max_edge_mm: String(s.scanMaxEdge ?? '').trim() === '' ? null : num(s.scanMaxEdge),
+    },
     registration: {
       fiducials,
       printer_points: printer,
@@ -267,6 +272,7 @@ function currentSvg() {
 const FIELDS = [
   ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; }],
   ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
+  ['scan-max-edge', () => settings.scanMaxEdge, (v) => { settings.scanMaxEdge = v; }],
   ['fid-source', () => settings.fidSource, (v) => { settings.fidSource = v; }],
   ['fid-method', () => settings.fidMethod, (v) => { settings.fidMethod = v; }],
   ['fid-dot', () => settings.dotDiameter, (v) => { settings.dotDiameter = v === '' ? NaN : Number(v); }, 'typed'],
@@ -897,7 +903,8 @@ function showScan(info, positions, indices, seconds) {
   $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
     + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
     + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s; `
-    + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`;
+    + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`
+    + (info.cloud_text ? `; ${info.cloud_text}` : '');
   if (state.viewer) {
     try {
       state.viewer.setMesh(positions, indices);
@@ -1406,6 +1413,7 @@ function loadDemo(part = settings.demoPart) {
   settings.placement = demo.placement;
   settings.scanUnits = '';
   settings.scanUp = '';
+  settings.scanMaxEdge = '';
   // The demo parts are made in the printer frame, placed where they print.
   settings.scanPlace = { ...SCAN_PLACE_DEFAULT };
   cancelCentre();
