@@ -155,7 +155,7 @@ pub fn insert_waypoints_capped(
             continue;
         }
         let mut added = Vec::new();
-        if !resolve(surface, clearance, p, q, &mut added) {
+        if !resolve(surface, clearance, p, q, gap, &mut added) {
             added = rise_over(surface, clearance, p, q);
             if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
                 out.unresolved.push(j);
@@ -192,30 +192,44 @@ fn path_clear(surface: &Surface, c: &Clearance, p: DVec3, mid: &[DVec3], q: DVec
 }
 
 /// Waypoints for p -> q by recursive splitting at the worst place; false
-/// when that did not succeed within the budget.
-fn resolve(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3, out: &mut Vec<DVec3>) -> bool {
-    let Some(worst) = c.touching(surface, p, q) else {
+/// when that did not succeed within the budget. `known` is the move's
+/// clearance when the caller has just found it below tol (the same query
+/// with a larger limit finds the same worst place).
+fn resolve(
+    surface: &Surface,
+    c: &Clearance,
+    p: DVec3,
+    q: DVec3,
+    known: Option<SweepGap>,
+    out: &mut Vec<DVec3>,
+) -> bool {
+    let Some(worst) = known.or_else(|| c.touching(surface, p, q)) else {
         return true;
     };
     if out.len() >= MAX_WAYPOINTS_PER_MOVE {
         return false;
     }
     let x = p.lerp(q, worst.at);
-    // As high as the footprint there needs, and at least tol over the
-    // surface point that sets the worst clearance: that point usually
-    // enters the rounded rim there and then the flat tip as the move goes
-    // on (a step's edge), and clearing it by the full tol at once spares
-    // a waypoint per step of the rim for a few hundredths of a mm.
-    let need = x.z + c.rise_needed(surface, x);
+    // As high as the footprint there needs: the nozzle standing at x has
+    // the move's smallest clearance (the worst place is where the move's
+    // clearance, a minimum over its positions, is reached), so it must
+    // rise by tol less that, and a hair more so that the raised point's
+    // own moves never fail on an exact tie with rounding. And at least tol
+    // over the surface point that sets the worst clearance: that point
+    // usually enters the rounded rim there and then the flat tip as the
+    // move goes on (a step's edge), and clearing it by the full tol at
+    // once spares a waypoint per step of the rim for a few hundredths of a
+    // mm.
+    let need = x.z + (c.tol_mm - worst.gap_mm).max(0.0) + 1e-6;
     let w = DVec3::new(x.x, x.y, need.max(worst.surface_point.z + c.tol_mm + 1e-6));
     // A waypoint that coincides with an end changes nothing: the end
     // itself does not clear.
     if w.distance(p) < 1e-9 || w.distance(q) < 1e-9 {
         return false;
     }
-    resolve(surface, c, p, w, out) && {
+    resolve(surface, c, p, w, None, out) && {
         out.push(w);
-        resolve(surface, c, w, q, out)
+        resolve(surface, c, w, q, None, out)
     }
 }
 

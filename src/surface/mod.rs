@@ -23,6 +23,56 @@ pub struct Surface {
     mesh: TriMesh,
     index: Index,
     bbox: (DVec3, DVec3),
+    /// Per triangle, which of its corners (bits 0-2) and edges (bits 3-5,
+    /// edge k from corner k to k + 1) it owns: the lowest-numbered
+    /// triangle holding a vertex or an edge owns it. The swept query
+    /// tries each corner and edge in its owner only (see `sweep.rs`).
+    owned: Vec<u8>,
+}
+
+/// The ownership bits of [`Surface::owned`], from each vertex's triangles
+/// in order (a counting sort, O(n)): a vertex's owner is the first of its
+/// triangles, an edge's the first of its lower vertex's triangles that
+/// holds its higher vertex too.
+fn ownership(mesh: &TriMesh) -> Vec<u8> {
+    let n = mesh.vertices.len();
+    let mut start = vec![0u32; n + 1];
+    for tri in &mesh.triangles {
+        for &v in tri {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; start[n] as usize];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            around[fill[v as usize] as usize] = t as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    drop(fill);
+    let fan = |v: u32| &around[start[v as usize] as usize..start[v as usize + 1] as usize];
+    let mut owned = vec![0u8; mesh.triangles.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let t = t as u32;
+        for k in 0..3 {
+            if fan(tri[k]).first() == Some(&t) {
+                owned[t as usize] |= 1 << k;
+            }
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let (lo, hi) = (a.min(b), a.max(b));
+            let first = fan(lo)
+                .iter()
+                .find(|&&u| mesh.triangles[u as usize].contains(&hi));
+            if first == Some(&t) {
+                owned[t as usize] |= 8 << k;
+            }
+        }
+    }
+    owned
 }
 
 /// Where the horizontal tip disk C_j cuts the surface (spec section 6c).
@@ -72,8 +122,15 @@ impl Surface {
                 "triangle {i} refers to a vertex past the {n} the scan has"
             )));
         }
+        // First: its transient arrays are freed before the index's grow.
+        let owned = ownership(&mesh);
         let index = Index::build(&mesh, bbox, kind);
-        Ok(Surface { mesh, index, bbox })
+        Ok(Surface {
+            mesh,
+            index,
+            bbox,
+            owned,
+        })
     }
 
     /// Which spatial index the scan got.

@@ -95,8 +95,9 @@ impl Surface {
         let q = QueryBox { lo, hi };
         let sweep = Sweep::new(a, b, radius, tol, limit);
         let mut best = sweep.start();
-        self.index
-            .visit(&q, |i| sweep.visit(self.mesh.triangle(i), &q, &mut best));
+        self.index.visit(&q, |i| {
+            sweep.visit(self.mesh.triangle(i), self.owned[i], &q, &mut best)
+        });
         sweep.finish(best)
     }
 
@@ -172,7 +173,7 @@ impl Sweep {
     }
 
     #[inline]
-    fn visit(&self, t: [DVec3; 3], q: &QueryBox, best: &mut Best) {
+    fn visit(&self, t: [DVec3; 3], owned: u8, q: &QueryBox, best: &mut Best) {
         if !meets(&t, q) {
             return;
         }
@@ -183,7 +184,7 @@ impl Sweep {
             return;
         }
         let steps = &self.steps.0[..self.steps.1];
-        self.m.triangle(t, self.low_tip, steps, best);
+        self.m.triangle(t, owned, self.low_tip, steps, best);
     }
 
     fn finish(&self, best: Best) -> Option<SweepGap> {
@@ -237,13 +238,33 @@ impl Move {
     /// lies `h` below the tip: only the steps that could still beat the
     /// best value are tried ([`live_steps`]), and a corner's or edge's
     /// distance from the move is found only when a step is left. Skipping
-    /// a candidate that cannot be strictly better leaves the result as it
-    /// was.
-    fn triangle(&self, t: [DVec3; 3], low_tip: f64, steps: &[(f64, f64)], best: &mut Best) {
+    /// a candidate that cannot be strictly better leaves the smallest value
+    /// as it was.
+    ///
+    /// A corner or edge is tried only in the triangle that owns it
+    /// (`owned`, see `Surface::owned`): the owner holds it, so while it is
+    /// near enough to the move and high enough to matter, the owner's box
+    /// meets the query box and the owner's top passes the prune in
+    /// [`Sweep::visit`]; the owner is visited, and the candidates are tried
+    /// there once instead of in each of the (about six, or two) triangles
+    /// that share them. The smallest value is the same (to the last bits:
+    /// an edge is tried from its owner's side); where two candidates tie
+    /// exactly, the one reported may be another.
+    fn triangle(
+        &self,
+        t: [DVec3; 3],
+        owned: u8,
+        low_tip: f64,
+        steps: &[(f64, f64)],
+        best: &mut Best,
+    ) {
         let (a, b) = (self.a.truncate(), self.a.truncate() + self.d);
         // Squared XY distances of the corners from the move, once found.
         let mut dv = [f64::NAN; 3];
         for k in 0..3 {
+            if owned & (1 << k) == 0 {
+                continue;
+            }
             let live = live_steps(low_tip - t[k].z, steps, best.gap);
             if !live.is_empty() {
                 dv[k] = point_segment_dist2(t[k].truncate(), a, b);
@@ -251,6 +272,9 @@ impl Move {
             }
         }
         for k in 0..3 {
+            if owned & (8 << k) == 0 {
+                continue;
+            }
             let (i, j) = (k, (k + 1) % 3);
             let live = live_steps(low_tip - t[i].z.max(t[j].z), steps, best.gap);
             if live.is_empty() {
@@ -689,6 +713,61 @@ mod tests {
             let g = surf.sweep_gap(p, p, 0.4, f64::INFINITY).unwrap().gap_mm;
             let h = reference_max_height_in_disk(&surf, p.truncate(), 0.4).unwrap();
             assert!((g - (p.z - h)).abs() < 1e-9, "{g} vs {}", p.z - h);
+        }
+    }
+
+    /// Trying each corner and edge in its owner only gives the same
+    /// smallest clearance (to 1e-12 mm) as trying it in every triangle that
+    /// holds it:
+    /// random moves (rising, level, descending, and standing still) over a
+    /// bumpy field with a step and over the step block.
+    #[test]
+    fn owners_only_give_the_same_clearance_as_every_triangle() {
+        let bumpy = grid(24, 6.0, |x, y| {
+            (x * 1.7).sin() * 0.4 + (y * 2.3).cos() * 0.3 + if x > 3.0 { 1.0 } else { 0.0 }
+        });
+        for surf in [Surface::new(bumpy).unwrap(), step_block()] {
+            let mut all = Surface::new(surf.mesh().clone()).unwrap();
+            all.owned.iter_mut().for_each(|o| *o = 0x3f);
+            assert!(surf.owned.iter().any(|&o| o != 0x3f), "nothing is shared");
+            let (lo, hi) = surf.bbox();
+            let mut seed = 0x2545_F491_4F6C_DD1Du64;
+            let mut unit = || {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                (seed >> 11) as f64 / (1u64 << 53) as f64
+            };
+            for k in 0..400 {
+                let mut at = |z: f64| {
+                    DVec3::new(
+                        lo.x + (hi.x - lo.x) * unit(),
+                        lo.y + (hi.y - lo.y) * unit(),
+                        hi.z - z,
+                    )
+                };
+                let a = at(0.5 * (k % 7) as f64);
+                let b = if k % 5 == 0 {
+                    a
+                } else {
+                    a + (at(0.0) - a) * 0.1
+                };
+                for tol in [0.0, 0.1] {
+                    let g = surf.nozzle_gap(a, b, 0.45, tol, f64::INFINITY);
+                    let h = all.nozzle_gap(a, b, 0.45, tol, f64::INFINITY);
+                    // The same, but for the last bits of an edge tried from
+                    // its other end.
+                    match (g, h) {
+                        (Some(g), Some(h)) => assert!(
+                            (g.gap_mm - h.gap_mm).abs() <= 1e-12,
+                            "move {a} -> {b}, tol {tol}: {} vs {}",
+                            g.gap_mm,
+                            h.gap_mm
+                        ),
+                        (g, h) => assert_eq!(g, h, "move {a} -> {b}, tol {tol}"),
+                    }
+                }
+            }
         }
     }
 }
