@@ -190,15 +190,7 @@ fn import_cloud(
         mut warnings,
         ..
     } = parsed;
-    if let Some((vertex, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        let value = v.to_array().into_iter().find(|c| !c.is_finite());
-        return Err(MeshError::NonFiniteVertex {
-            file: file.into(),
-            vertex,
-            line: None,
-            value: value.unwrap_or(f64::NAN),
-        });
-    }
+    check_finite(&vertices, file)?;
     for v in &mut vertices {
         let p = *v * scale;
         *v = match up_axis {
@@ -222,6 +214,23 @@ fn import_cloud(
         warnings,
         cloud: Some(info),
     })
+}
+
+/// The first vertex with a non-finite coordinate, as an error.
+fn check_finite(vertices: &[DVec3], file: &str) -> Result<(), MeshError> {
+    match vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        Some((vertex, v)) => Err(MeshError::NonFiniteVertex {
+            file: file.into(),
+            vertex,
+            line: None,
+            value: v
+                .to_array()
+                .into_iter()
+                .find(|c| !c.is_finite())
+                .unwrap_or(f64::NAN),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Refuses files past [`super::MAX_SCAN_BYTES`] before reading them.
@@ -269,15 +278,7 @@ fn finish(
         triangles,
         mut warnings,
     } = parsed;
-    if let Some((vertex, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        let value = v.to_array().into_iter().find(|c| !c.is_finite());
-        return Err(MeshError::NonFiniteVertex {
-            file: file.into(),
-            vertex,
-            line: None,
-            value: value.unwrap_or(f64::NAN),
-        });
-    }
+    check_finite(&vertices, file)?;
     let n = vertices.len();
     // remap[i]: the welded index of vertex i (bit-identical positions merge).
     let remap: Option<Vec<u32>> = if weld {

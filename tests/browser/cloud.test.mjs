@@ -9,21 +9,16 @@ import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'no
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { ROOT, download, launch, openPage, startServer, waitForPlan, waitIdle } from './helpers.mjs';
+import { ROOT, download, openPage, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
 
 const CLI = join(ROOT, 'target/debug/pcpp');
 
-let server;
-let chrome;
+const env = withPageServer();
 let dir;
-before(async () => {
-  server = await startServer();
-  chrome = await launch();
+before(() => {
   dir = mkdtempSync(join(tmpdir(), 'pcpp-cloud-'));
 });
-after(async () => {
-  await chrome?.close();
-  server?.stop();
+after(() => {
   if (dir) rmSync(dir, { recursive: true, force: true });
 });
 
@@ -60,7 +55,7 @@ test('a CSV point cloud is meshed in the page as by the CLI, and its edge limit 
   writeFileSync(scanPath, cloudCsv());
   writeFileSync(svgPath, SVG);
 
-  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   await page.setInputFiles('#scan-input', scanPath);
   await page.setInputFiles('#svg-input', svgPath);
