@@ -101,8 +101,9 @@ pub enum GcodeError {
     /// A tool-path point lies outside the machine's build volume: move the
     /// part (registration) or fix the profile's `build_volume`.
     #[error(
-        "subpath {subpath}, point {point} at ({x}, {y}, {z}) mm lies outside the build volume \
-         of profile {profile} ({volume}): check the registration or the profile's build_volume",
+        "subpath {subpath}, point {point} at ({x:.3}, {y:.3}, {z:.3}) mm lies outside the build \
+         volume of profile {profile} ({volume}): check the registration or the profile's \
+         build_volume",
         x = .position.x, y = .position.y, z = .position.z
     )]
     OutOfVolume {
