@@ -533,7 +533,7 @@ M84
         ));
         let m = e.to_string();
         assert!(
-            m.contains("subpath 1, point 1") && m.contains("(-3.5, 10, 1)"),
+            m.contains("subpath 1, point 1") && m.contains("(-3.500, 10.000, 1.000)"),
             "{m}"
         );
         assert!(m.contains("x 0..220, y 0..220, z 0..250"), "{m}");
