@@ -198,9 +198,6 @@ circle) and its score as a dot of --dot-diameter, best candidates first.";
 
 #[derive(Debug, Args)]
 pub struct FiducialsArgs {
-    #[command(flatten)]
-    pub scan: ScanArgs,
-
     /// The fiducial dots' diameter in mm: holes are ranked by how well they
     /// match it
     #[arg(
@@ -211,6 +208,9 @@ pub struct FiducialsArgs {
         allow_hyphen_values = true,
     )]
     pub dot_diameter: f64,
+
+    #[command(flatten)]
+    pub scan: ScanArgs,
 }
 
 const REGISTER_ABOUT: &str = "\
@@ -306,7 +306,7 @@ pub struct JobArgs {
         long,
         value_name = "FILE.svg",
         value_hint = ValueHint::FilePath,
-        help_heading = "Scan and drawing"
+        help_heading = "Drawing"
     )]
     pub path: PathBuf,
 
@@ -318,7 +318,7 @@ pub struct JobArgs {
         value_name = "X,Y[,ROT[,SCALE]]",
         value_parser = place,
         allow_hyphen_values = true,
-        help_heading = "Scan and drawing"
+        help_heading = "Drawing"
     )]
     pub place: Option<PlaceArg>,
 
@@ -334,7 +334,7 @@ pub struct JobArgs {
 
 /// `--scan` and how to read it.
 #[derive(Debug, Args)]
-#[command(next_help_heading = "Scan and drawing")]
+#[command(next_help_heading = "Scan")]
 pub struct ScanArgs {
     /// The scanned surface: a mesh (OBJ, PLY, STL, glTF, GLB) or a point
     /// cloud (XYZ/CSV/TXT, vertex-only PLY, PCD)
