@@ -454,10 +454,13 @@ fn help_and_version() {
         &["fiducials", "--help"],
         &["register", "--help"],
         &["demo", "--help"],
+        &["check", "--help"],
+        &["completions", "--help"],
     ] {
         let o = pcpp(args);
         assert_eq!(code(&o), 0, "{args:?}: {}", stderr(&o));
-        assert!(stdout(&o).contains("usage: pcpp"), "{args:?}");
+        // clap's heading.
+        assert!(stdout(&o).contains("Usage: pcpp"), "{args:?}");
     }
     assert!(stdout(&pcpp(&["plan", "--help"])).contains("--printer-points"));
     let o = pcpp(&["--version"]);
@@ -466,6 +469,33 @@ fn help_and_version() {
         stdout(&o).trim(),
         format!("pcpp {}", env!("CARGO_PKG_VERSION"))
     );
+}
+
+/// `pcpp completions SHELL` prints a script the shell accepts; bash's is
+/// checked with `bash -n` where bash is installed.
+#[test]
+fn completions_print_a_script_bash_accepts() {
+    for shell in ["bash", "zsh", "fish"] {
+        let o = pcpp(&["completions", shell]);
+        assert_eq!(code(&o), 0, "{shell}: {}", stderr(&o));
+        let script = stdout(&o);
+        // fish writes long flags without their dashes (`-l place-scan`).
+        for word in ["plan", "compare", "printer-points", "place-scan"] {
+            assert!(script.contains(word), "{shell}: {word} missing");
+        }
+    }
+    let o = pcpp(&["completions", "tcsh"]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("tcsh"), "{}", stderr(&o));
+
+    let dir = temp_dir("completions");
+    let script = dir.join("pcpp.bash");
+    std::fs::write(&script, pcpp(&["completions", "bash"]).stdout).unwrap();
+    match Command::new("bash").arg("-n").arg(&script).output() {
+        Ok(o) => assert!(o.status.success(), "bash -n: {}", stderr(&o)),
+        Err(e) => eprintln!("bash not run ({e}): skipping bash -n"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -791,6 +821,42 @@ fn no_progress_chatter_when_stderr_is_not_a_terminal() {
         err.lines().all(|l| l.starts_with("warning: ")),
         "only warnings expected on a pipe:\n{err}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// On a terminal (a pseudo-terminal from util-linux `script`, where it is
+/// installed) the finished steps are shown; `--quiet` shows none of them.
+#[test]
+fn quiet_silences_progress_on_a_terminal() {
+    if Command::new("script").arg("--version").output().is_err() {
+        eprintln!("util-linux script missing: skipping");
+        return;
+    }
+    let dir = temp_dir("quiet-tty");
+    let run = |quiet: bool| {
+        let shell = format!(
+            "{BIN} plan {} --scan {} --path {} --place 0,80 -o {}",
+            if quiet { "--quiet" } else { "" },
+            s(&demo_file(demo::DEMO_SCAN_NAME)),
+            s(&demo_file(demo::DEMO_PATH_NAME)),
+            s(&dir.join("t.gcode"))
+        );
+        // -e: script exits with the command's status.
+        let o = Command::new("script")
+            .args(["-qec", &shell, "/dev/null"])
+            .output()
+            .unwrap();
+        assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+        stdout(&o)
+    };
+    let shown = run(false);
+    assert!(
+        shown.contains("scan: ") && shown.contains(" triangles"),
+        "{shown}"
+    );
+    let quiet = run(true);
+    assert!(quiet.contains("wrote "), "{quiet}");
+    assert!(!quiet.contains(" triangles"), "{quiet}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -1,0 +1,80 @@
+//! `pcpp check`: every move of a G-code file, ours or another tool's,
+//! checked against a scan.
+
+use std::fmt::Write as _;
+
+use pcpp::job;
+
+use crate::args::CheckArgs;
+use crate::files::{file_name, in_file, read_text, to_json, write_one};
+use crate::plan::load_scan;
+use crate::progress::Progress;
+use crate::settings::check_settings;
+use crate::{CliResult, Failure};
+
+pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
+    let (settings, _profile) =
+        check_settings("check", &a.scan, &a.nozzle, &a.registration, &a.machine)?;
+    let gcode_path = &a.gcode;
+    let text = read_text(gcode_path, "gcode")?;
+    let prepared = load_scan(&a.scan, &settings, progress)?;
+    progress.step("checking every move...");
+    let name = file_name(gcode_path);
+    let check = job::check_gcode(
+        &prepared,
+        &text,
+        &name,
+        &settings.plan.nozzle,
+        settings.plan.process.tolerance_mm,
+    )
+    .map_err(|e| Failure::Input(in_file(gcode_path, &name, &e.to_string())))?;
+    if let Some(r) = &a.report {
+        write_one(r, to_json(&check)?.as_bytes())?;
+    }
+    progress.finish();
+    progress.warn(&prepared.warnings);
+    progress.warn(&check.notes);
+    let sum = &check.summary;
+    let clear = sum
+        .min_clearance_mm
+        .map_or("no move passes near the scan".to_string(), |c| {
+            format!(
+                "min clearance {c:.3} mm{}",
+                sum.min_clearance_line
+                    .map_or(String::new(), |l| format!(" (line {l})"))
+            )
+        });
+    let head = format!(
+        "{}: {} moves checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
+        gcode_path.display(),
+        sum.moves,
+        a.scan.scan.display(),
+        check.outer_diameter_mm,
+        check.tol_mm
+    );
+    if check.is_clear() {
+        println!("{head}; no move comes closer than tol");
+        if !check.unchecked_lines.is_empty() {
+            println!(
+                "{} move(s) not checked: their position is not in the file (see the warning)",
+                check.unchecked_lines.len()
+            );
+        }
+        return Ok(());
+    }
+    let mut s = format!(
+        "{head}; {} move(s) come closer than tol:",
+        sum.touching_moves
+    );
+    for t in &sum.touching {
+        let _ = write!(s, "\n  {t}");
+    }
+    if sum.touching_moves > sum.touching.len() {
+        let _ = write!(
+            s,
+            "\n  ... and {} more",
+            sum.touching_moves - sum.touching.len()
+        );
+    }
+    Err(Failure::Input(s))
+}

@@ -1,0 +1,238 @@
+//! `pcpp plan` and `pcpp compare`: a drawing planned on a scan, written as
+//! G-code, or planned by every planner and compared.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use pcpp::job::{self, FiducialSource, InputFile, JobSettings, PreparedScan};
+use pcpp::registration::{Registration, RegistrationMethod};
+use pcpp::Error;
+
+use crate::args::{CompareArgs, JobArgs, PlanArgs, ScanArgs};
+use crate::files::{file_name, in_file, read_bytes, to_json, write_one, Staged};
+use crate::progress::{thousands, Progress};
+use crate::settings::job_settings;
+use crate::{CliResult, Failure, VERSION};
+
+/// The two inputs of a job, read and with the scan prepared.
+pub struct Inputs {
+    pub scan_path: PathBuf,
+    pub svg_path: PathBuf,
+    pub svg_name: String,
+    pub svg: Vec<u8>,
+    pub prepared: PreparedScan,
+}
+
+fn load_inputs(a: &JobArgs, settings: &JobSettings, progress: &Progress) -> CliResult<Inputs> {
+    let prepared = load_scan(&a.scan, settings, progress)?;
+    let svg = read_bytes(&a.path, "path")?;
+    Ok(Inputs {
+        svg_name: file_name(&a.path),
+        scan_path: a.scan.scan.clone(),
+        svg_path: a.path.clone(),
+        svg,
+        prepared,
+    })
+}
+
+/// Reads, registers and indexes `--scan`.
+pub fn load_scan(
+    a: &ScanArgs,
+    settings: &JobSettings,
+    progress: &Progress,
+) -> CliResult<PreparedScan> {
+    let scan_path = &a.scan;
+    progress.step(format!("reading scan {}...", scan_path.display()));
+    let scan = read_bytes(scan_path, "scan")?;
+    let scan_name = file_name(scan_path);
+    progress.step(format!("importing and indexing {scan_name}..."));
+    let prepared = job::prepare_scan(&scan, &scan_name, &settings.scan, &settings.registration)
+        .map_err(|e| match e {
+            Error::Registration(r) => {
+                Failure::Input(format!("registration of {}: {r}", scan_path.display()))
+            }
+            other => Failure::Input(in_file(scan_path, &scan_name, &other.to_string())),
+        })?;
+    progress.note(&format!(
+        "scan: {} triangles",
+        thousands(prepared.triangle_count())
+    ));
+    if let Some(cloud) = &prepared.cloud {
+        progress.note(&cloud.to_string());
+    }
+    if settings.registration.fiducials != FiducialSource::None {
+        progress.note(&registration_line(&prepared.registration, prepared.method));
+    }
+    Ok(prepared)
+}
+
+pub fn registration_line(r: &Registration, method: RegistrationMethod) -> String {
+    let res: Vec<String> = r.residuals_mm.iter().map(|v| format!("{v:.4}")).collect();
+    format!(
+        "registration ({}): rotation {:.3} deg, residuals [{}] mm, rms {:.4} mm",
+        method.name(),
+        r.rotation_deg(),
+        res.join(", "),
+        r.rms_mm
+    )
+}
+
+/// With `--place centre`, the drawing centred on the scan's footprint
+/// (scaled down to fit, with a warning, when it is larger).
+fn centre_on_scan(
+    a: &JobArgs,
+    inputs: &Inputs,
+    plan: &mut pcpp::pipeline::PlanSettings,
+    progress: &Progress,
+) -> CliResult<()> {
+    if !a.place.is_some_and(|p| p.centre) {
+        return Ok(());
+    }
+    let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
+        .map_err(|e| Failure::Input(in_file(&inputs.svg_path, &inputs.svg_name, &e.to_string())))?;
+    let (lo, hi) = inputs.prepared.surface.bbox();
+    let Some((place, note)) = pcpp::placement::centre_drawing(
+        &drawn.subpaths,
+        (lo.truncate(), hi.truncate()),
+        &plan.placement,
+    ) else {
+        return Ok(());
+    };
+    if let Some(n) = note {
+        progress.warn(&[n]);
+    }
+    plan.placement = place;
+    Ok(())
+}
+
+/// Errors of planning on a prepared scan: the drawn path's file is named.
+fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
+    match e {
+        Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
+        e @ Error::OutsideVolume { .. } => Failure::Input(format!(
+            "writing G-code for {}: {e}",
+            inputs.scan_path.display()
+        )),
+        Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
+        Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
+            "{}: {m} (--accept-risk writes it anyway)",
+            inputs.svg_path.display()
+        )),
+        Error::Plan(m) if m.contains("misses the scan") => Failure::Input(format!(
+            "{} on {}: {m}",
+            inputs.svg_path.display(),
+            inputs.scan_path.display()
+        )),
+        other => Failure::Input(in_file(
+            &inputs.svg_path,
+            &inputs.svg_name,
+            &other.to_string(),
+        )),
+    }
+}
+
+pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
+    let (mut settings, profile) = job_settings("plan", &a.job, a.planner, &a.machine)?;
+    let out: &Path = &a.output;
+    let inputs = load_inputs(&a.job, &settings, progress)?;
+    centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
+    progress.step(format!("planning ({})...", settings.plan.planner));
+    let output = job::run_on(
+        &inputs.prepared,
+        &inputs.svg,
+        &inputs.svg_name,
+        &settings.plan,
+        &profile,
+        a.accept_risk,
+    )
+    .map_err(|e| plan_failure(&inputs, e))?;
+
+    progress.step("writing...");
+    let mut staged = Staged::default();
+    staged.add(out, output.gcode.as_bytes())?;
+    if let Some(r) = &a.report {
+        staged.add(r, to_json(&output.report)?.as_bytes())?;
+    }
+    staged.commit()?;
+    progress.finish();
+
+    progress.warn(&output.report.warnings);
+    let st = &output.report.stats;
+    let mut s = format!(
+        "wrote {} ({}, {}): {} piece(s), {} points, {:.3} mm, print time {:.1} s\n",
+        out.display(),
+        output.report.planner,
+        profile.name,
+        st.subpaths,
+        st.points,
+        st.length_mm,
+        st.print_time_s
+    );
+    let _ = writeln!(
+        s,
+        "path: height change {:.3} mm, max inclination {:.1} deg, min radius {:.3} mm",
+        st.height_change_mm, st.max_inclination_deg, st.min_radius_mm
+    );
+    if settings.registration.fiducials != FiducialSource::None {
+        let _ = writeln!(
+            s,
+            "{}",
+            registration_line(&inputs.prepared.registration, inputs.prepared.method)
+        );
+    }
+    let _ = writeln!(s, "scan: {}", output.report.registration.status);
+    let _ = writeln!(s, "predicted quality: {}", output.report.quality);
+    let _ = writeln!(s, "safe motion: {}", output.report.motion.summary_line());
+    if let Some(r) = &a.report {
+        let _ = writeln!(s, "report: {}", r.display());
+    }
+    print!("{s}");
+    Ok(())
+}
+
+/// The comparison as JSON (the `--report` of `compare`, the demo's file).
+pub fn comparison_json(
+    inputs: &[InputFile],
+    settings: &pcpp::pipeline::PlanSettings,
+    rows: &[job::ComparisonRow],
+) -> serde_json::Value {
+    serde_json::json!({
+        "program": "pcpp",
+        "version": VERSION,
+        "inputs": inputs,
+        "settings": settings,
+        "planners": rows,
+    })
+}
+
+pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
+    // The planner flag is plan's; compare plans with all of them.
+    let (mut settings, _profile) = job_settings("compare", &a.job, Default::default(), &a.machine)?;
+    let inputs = load_inputs(&a.job, &settings, progress)?;
+    centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
+    progress.step("planning with all five planners...");
+    let comparison = job::compare_on(
+        &inputs.prepared,
+        &inputs.svg,
+        &inputs.svg_name,
+        &settings.plan,
+    )
+    .map_err(|e| plan_failure(&inputs, e))?;
+    let rows = comparison.rows;
+    if let Some(r) = &a.report {
+        let files = [
+            inputs.prepared.file.clone(),
+            InputFile::new(&inputs.svg_name, &inputs.svg),
+        ];
+        write_one(
+            r,
+            to_json(&comparison_json(&files, &settings.plan, &rows))?.as_bytes(),
+        )?;
+    }
+    progress.finish();
+    progress.warn(&inputs.prepared.warnings);
+    progress.warn(&inputs.prepared.registration.notes);
+    progress.warn(&comparison.warnings);
+    print!("{}", job::comparison_table(&rows));
+    Ok(())
+}

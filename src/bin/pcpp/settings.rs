@@ -1,0 +1,142 @@
+//! Settings from parsed flags: the library's [`JobSettings`] and machine
+//! profile, with the checks that need more than one flag (ranges the
+//! library validates, fiducials against a placement on the bed). They are
+//! usage errors, found before any file is read.
+
+use pcpp::gcode::MachineProfile;
+use pcpp::job::{FiducialSource, JobSettings, RegistrationSettings};
+use pcpp::mesh::ImportOptions;
+use pcpp::placement::ScanPlacement;
+use pcpp::planners::PlannerKind;
+
+use crate::args::{JobArgs, MachineArgs, NozzleArgs, RegistrationArgs, ScanArgs};
+use crate::files::read_text;
+use crate::values::{FiducialsArg, PlaceScanArg};
+use crate::{usage, CliResult, Failure};
+
+/// How the scan file is read.
+pub fn import_options(a: &ScanArgs) -> ImportOptions {
+    let mut options = ImportOptions::DEFAULT;
+    options.units = a.scan_units;
+    options.up_axis = a.up_axis;
+    options.max_edge_mm = a.max_edge;
+    options
+}
+
+/// The machine profile: `--profile FILE.json` or `--dialect` (marlin by
+/// default; clap refuses both). A bad profile file is bad input.
+pub fn profile(a: &MachineArgs) -> CliResult<MachineProfile> {
+    match &a.profile {
+        Some(path) => {
+            let text = read_text(path, "machine profile")?;
+            // The profile's name labels its errors: give the whole path.
+            MachineProfile::from_json(&text, &path.display().to_string())
+                .map_err(|e| Failure::Input(e.to_string()))
+        }
+        None => builtin_profile(&a.dialect),
+    }
+}
+
+/// A built-in profile; clap has already checked the name against
+/// [`MachineProfile::builtin_names`].
+pub fn builtin_profile(name: &str) -> CliResult<MachineProfile> {
+    MachineProfile::builtin(name)
+        .ok_or_else(|| Failure::Input(format!("the built-in dialect '{name}' did not load")))
+}
+
+/// Registration settings: the fiducials, or the scan placed on the bed of
+/// `profile`.
+fn registration(
+    command: &'static str,
+    a: &RegistrationArgs,
+    profile: &MachineProfile,
+) -> CliResult<RegistrationSettings> {
+    let mut r = RegistrationSettings {
+        fiducials: match &a.fiducials {
+            None => FiducialSource::None,
+            Some(FiducialsArg::Auto) => FiducialSource::Auto,
+            Some(FiducialsArg::Points(p)) => FiducialSource::Points(p.clone()),
+        },
+        printer_points: a.printer_points.clone().map(|p| p.0).unwrap_or_default(),
+        method: a.registration,
+        dot_diameter_mm: a.dot_diameter,
+        ..Default::default()
+    };
+    if let Some(PlaceScanArg::OnBed {
+        offset_mm: offset,
+        rotation_deg: rotation,
+    }) = a.place_scan
+    {
+        let mut place = ScanPlacement::on_bed(profile);
+        if let ScanPlacement::OnBed {
+            rotation_deg,
+            offset_mm,
+            ..
+        } = &mut place
+        {
+            *offset_mm = offset;
+            *rotation_deg = rotation;
+        }
+        r.scan_placement = place;
+    }
+    r.validate().map_err(|e| {
+        usage(
+            command,
+            format!("--place-scan/--fiducials/--dot-diameter: {e}"),
+        )
+    })?;
+    Ok(r)
+}
+
+/// The settings of `check` and the machine profile: scan, registration and
+/// nozzle (the process keeps its defaults: only tol matters to a check).
+pub fn check_settings(
+    command: &'static str,
+    scan: &ScanArgs,
+    nozzle: &NozzleArgs,
+    reg: &RegistrationArgs,
+    machine: &MachineArgs,
+) -> CliResult<(JobSettings, MachineProfile)> {
+    let mut s = JobSettings {
+        scan: import_options(scan),
+        ..Default::default()
+    };
+    let p = &mut s.plan;
+    p.nozzle.inner_diameter_mm = nozzle.nozzle_id;
+    p.nozzle.outer_diameter_mm = nozzle.nozzle_od;
+    p.process.tolerance_mm = nozzle.tol;
+    // Out-of-range values are usage errors too: checked before reading
+    // files (a profile file only after them).
+    p.nozzle
+        .validate()
+        .map_err(|e| usage(command, format!("--nozzle-id/--nozzle-od: {e}")))?;
+    p.process
+        .validate()
+        .map_err(|e| usage(command, format!("--tol: {e}")))?;
+    let profile = profile(machine)?;
+    s.registration = registration(command, reg, &profile)?;
+    Ok((s, profile))
+}
+
+/// The settings of `plan` and `compare` and the machine profile.
+pub fn job_settings(
+    command: &'static str,
+    a: &JobArgs,
+    planner: PlannerKind,
+    machine: &MachineArgs,
+) -> CliResult<(JobSettings, MachineProfile)> {
+    let p = pcpp::Process {
+        tolerance_mm: a.nozzle.tol,
+        speed_mm_s: a.process.speed,
+        dwell_s: a.process.dwell,
+    };
+    p.validate()
+        .map_err(|e| usage(command, format!("--tol/--speed/--dwell: {e}")))?;
+    let (mut s, profile) = check_settings(command, &a.scan, &a.nozzle, &a.registration, machine)?;
+    s.plan.process = p;
+    s.plan.planner = planner;
+    if let Some(place) = a.place {
+        s.plan.placement = place.placement;
+    }
+    Ok((s, profile))
+}

@@ -1,0 +1,182 @@
+//! The values of flags: typed values and the parsers clap calls on a flag's
+//! text (`value_parser = ...` in `args.rs`). Their messages say what is
+//! wrong and how to write it; clap puts the flag and value in front.
+
+use pcpp::registration::parse_points;
+use pcpp::svg::Placement;
+use pcpp::{DVec2, DVec3};
+
+/// `--place`: where the drawing goes, or centred on the scan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaceArg {
+    /// `centre`: the offset is found once the scan is read.
+    pub centre: bool,
+    pub placement: Placement,
+}
+
+/// `--place-scan`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlaceScanArg {
+    AsScanned,
+    /// On the bed, then moved and turned.
+    OnBed {
+        offset_mm: DVec3,
+        rotation_deg: f64,
+    },
+}
+
+/// `--fiducials`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FiducialsArg {
+    Auto,
+    Points(Vec<DVec3>),
+}
+
+/// A list of points `x,y,z;x,y,z;...` (one value, not a list of values).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Points(pub Vec<DVec3>);
+
+/// A finite number.
+fn parse_number(text: &str) -> Option<f64> {
+    text.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+pub fn number(text: &str) -> Result<f64, String> {
+    parse_number(text).ok_or_else(|| format!("'{text}' is not a number"))
+}
+
+pub fn dot_diameter(text: &str) -> Result<f64, String> {
+    let d = number(text)?;
+    if d > 0.0 && d <= 100.0 {
+        Ok(d)
+    } else {
+        Err("must be above 0 and at most 100 mm".into())
+    }
+}
+
+pub fn points(text: &str) -> Result<Points, String> {
+    parse_points(text).map(Points).map_err(|e| e.to_string())
+}
+
+pub fn fiducials(text: &str) -> Result<FiducialsArg, String> {
+    if text.trim().eq_ignore_ascii_case("auto") {
+        Ok(FiducialsArg::Auto)
+    } else {
+        points(text).map(|p| FiducialsArg::Points(p.0))
+    }
+}
+
+/// `X,Y[,ROT_DEG[,SCALE]]` or `centre[,ROT_DEG[,SCALE]]` (`center` too).
+pub fn place(text: &str) -> Result<PlaceArg, String> {
+    let (centre, fields, expected) = match centre_word(text) {
+        Some(rest) => (true, rest, 0..=2),
+        None => (false, text, 2..=4),
+    };
+    let parts: Vec<&str> = fields
+        .split(',')
+        .map(str::trim)
+        .filter(|p| !(centre && p.is_empty()))
+        .collect();
+    let write = "write X,Y[,ROT_DEG[,SCALE]] or centre[,ROT_DEG[,SCALE]]";
+    if !expected.contains(&parts.len()) {
+        return Err(if centre {
+            format!("centre takes at most a rotation and a scale; {write}")
+        } else {
+            format!("expected 2 to 4 numbers, got {}; {write}", parts.len())
+        });
+    }
+    // Offset x, y, rotation, scale; `centre` gives only the last two.
+    let mut v = [0.0, 0.0, 0.0, 1.0];
+    let first = if centre { 2 } else { 0 };
+    for (slot, p) in v[first..].iter_mut().zip(&parts) {
+        *slot = parse_number(p).ok_or_else(|| format!("'{p}' is not a number; {write}"))?;
+    }
+    let placement = Placement {
+        offset_mm: DVec2::new(v[0], v[1]),
+        rotation_deg: v[2],
+        scale: v[3],
+    };
+    placement.validate().map_err(|e| e.to_string())?;
+    Ok(PlaceArg { centre, placement })
+}
+
+/// `centre` or `center`, and what follows it.
+fn centre_word(text: &str) -> Option<&str> {
+    let t = text.trim();
+    ["centre", "center"].iter().find_map(|w| {
+        t.get(..w.len())
+            .filter(|h| h.eq_ignore_ascii_case(w))
+            .map(|_| t[w.len()..].trim_start_matches(','))
+    })
+}
+
+/// `bed[,DX,DY,DZ[,ROT_DEG]]` or `as-is`.
+pub fn place_scan(text: &str) -> Result<PlaceScanArg, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts[0].to_ascii_lowercase().as_str() {
+        "as-is" | "asis" | "none" if parts.len() == 1 => Ok(PlaceScanArg::AsScanned),
+        "bed" => {
+            let write = "write bed or bed,DX,DY,DZ[,ROT_DEG]";
+            if !matches!(parts.len(), 1 | 4 | 5) {
+                return Err(format!(
+                    "expected 1, 4 or 5 fields, got {}; {write}",
+                    parts.len()
+                ));
+            }
+            let mut v = [0.0; 4];
+            for (slot, p) in v.iter_mut().zip(&parts[1..]) {
+                *slot = parse_number(p).ok_or_else(|| format!("'{p}' is not a number; {write}"))?;
+            }
+            Ok(PlaceScanArg::OnBed {
+                offset_mm: DVec3::new(v[0], v[1], v[2]),
+                rotation_deg: v[3],
+            })
+        }
+        other => Err(format!(
+            "'{other}' is not a placement; write bed, bed,DX,DY,DZ[,ROT_DEG] or as-is"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn place_takes_offsets_and_centre() {
+        let p = place("0,80").unwrap();
+        assert!(!p.centre);
+        assert_eq!(p.placement.offset_mm, DVec2::new(0.0, 80.0));
+        let p = place(" centre,90,0.5").unwrap();
+        assert!(p.centre);
+        assert_eq!((p.placement.rotation_deg, p.placement.scale), (90.0, 0.5));
+        assert!(place("Center").unwrap().centre);
+        assert!(place("1,y").unwrap_err().contains("'y' is not a number"));
+        assert!(place("1").unwrap_err().contains("got 1"));
+        assert!(place("centre,1,2,3").is_err());
+        assert!(place("0,0,0,0").is_err(), "a zero scale");
+    }
+
+    #[test]
+    fn place_scan_takes_bed_and_moves() {
+        assert_eq!(place_scan("as-is"), Ok(PlaceScanArg::AsScanned));
+        assert_eq!(
+            place_scan("bed,1,2,-3,45"),
+            Ok(PlaceScanArg::OnBed {
+                offset_mm: DVec3::new(1.0, 2.0, -3.0),
+                rotation_deg: 45.0
+            })
+        );
+        assert!(place_scan("bed,1").unwrap_err().contains("got 2"));
+        assert!(place_scan("floor").unwrap_err().contains("'floor'"));
+    }
+
+    #[test]
+    fn numbers_are_finite() {
+        assert_eq!(number(" 1.5"), Ok(1.5));
+        assert!(number("inf").is_err());
+        assert!(number("NaN").is_err());
+        assert!(dot_diameter("0").is_err());
+        assert!(dot_diameter("101").is_err());
+    }
+}
