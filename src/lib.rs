@@ -28,7 +28,7 @@
 //! - SVG text is not converted to paths (no fonts are loaded).
 //!
 //! The core takes bytes and `&str`, never file paths, and knows nothing of
-//! the DOM; `src/wasm.rs` and `src/bin/pcpp.rs` are thin adapters over it.
+//! the DOM; `src/wasm.rs` and `src/bin/pcpp/` are thin adapters over it.
 
 pub mod demo;
 mod error;
