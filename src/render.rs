@@ -1,8 +1,11 @@
 //! The page's 3-D view (wasm32 only): WebGL2 through web-sys.
 //!
 //! Draws the registered scan shaded, the surface path Ta and the tool path
-//! T* as lines (T* coloured by predicted defect) and fiducial markers, with
-//! an orbit camera. It only draws what the page hands it: no planning
+//! T* as lines (T* coloured by predicted defect), fiducial markers, and for
+//! the print preview a G-code program's moves (coloured by clearance or by
+//! predicted defect) with the nozzle drawn to scale at the preview's
+//! moment, with an orbit camera. Moving the nozzle changes one transform;
+//! the path is uploaded once per program and colouring. It only draws what the page hands it: no planning
 //! happens here (house style: rendering code holds no planning logic).
 
 use glam::{DMat4, DVec3};
@@ -29,6 +32,39 @@ pub const PICK_MARKER: [f32; 3] = [0.1, 0.9, 0.95];
 /// moves that come closer than tol in the contact colour.
 pub const FEED_MOVE: [f32; 3] = SURFACE_PATH;
 pub const RAPID_MOVE: [f32; 3] = [0.45, 0.5, 0.6];
+/// The nozzle of the print preview: the tip's end bright violet (a colour
+/// no path or marker uses), the body above it a muted violet.
+pub const NOZZLE_TIP: [f32; 3] = [0.72, 0.38, 1.0];
+pub const NOZZLE_BODY: [f32; 3] = [0.52, 0.42, 0.72];
+/// Length of the tip's end drawn in the tip colour, and of the body above
+/// it, mm. The motion check models the body as a cylinder of the tip's
+/// diameter reaching up indefinitely (`motion::Clearance`); 12 mm of it
+/// shows it without hiding the part.
+pub const NOZZLE_TIP_MM: f64 = 1.0;
+pub const NOZZLE_BODY_MM: f64 = 11.0;
+
+/// The preview's colour codes for a move (`Viewer.setPreviewPath`): by
+/// clearance 0 clear (green), 1 near (orange), 2 closer than tol (red); by
+/// predicted defect 10 + the defect code (good, contact, flattening,
+/// floating, as the plan's colours); 255 a move that prints nothing.
+pub fn preview_rgb8(code: u8) -> [u8; 3] {
+    match code {
+        0 => defect_rgb8("good"),
+        1 => defect_rgb8("flattening"),
+        2 => defect_rgb8("contact"),
+        10..=13 => defect_rgb8(defect_name(crate::preview::defect_of_code(code - 10))),
+        _ => RAPID_MOVE.map(|c| (c * 255.0).round() as u8),
+    }
+}
+
+fn defect_name(d: Defect) -> &'static str {
+    match d {
+        Defect::Contact => "contact",
+        Defect::Flattening => "flattening",
+        Defect::Floating => "floating",
+        Defect::Good => "good",
+    }
+}
 
 /// Defect colours (the issue's legend): contact red, flattening orange,
 /// floating blue, good green.
@@ -42,13 +78,7 @@ pub fn defect_rgb8(name: &str) -> [u8; 3] {
 }
 
 fn defect_rgb(d: Defect) -> [f32; 3] {
-    let name = match d {
-        Defect::Contact => "contact",
-        Defect::Flattening => "flattening",
-        Defect::Floating => "floating",
-        Defect::Good => "good",
-    };
-    defect_rgb8(name).map(|c| f32::from(c) / 255.0)
+    defect_rgb8(defect_name(d)).map(|c| f32::from(c) / 255.0)
 }
 
 /// The parts of a report the view draws (other fields are ignored).
@@ -71,14 +101,7 @@ pub struct PathArrays<'a> {
     pub defects: &'a [u8],
 }
 
-fn defect_of_code(code: u8) -> Defect {
-    match code {
-        1 => Defect::Contact,
-        2 => Defect::Flattening,
-        3 => Defect::Floating,
-        _ => Defect::Good,
-    }
-}
+use crate::preview::defect_of_code;
 
 /// Fiducial markers, printer frame.
 #[derive(Debug, Default)]
@@ -111,6 +134,19 @@ void main() {
   vec3 n = normalize(cross(dFdx(v_pos), dFdy(v_pos)));
   float l = abs(dot(n, u_light));
   o_color = vec4(u_color * (0.35 + 0.65 * l), 1.0);
+}
+"#;
+
+// The nozzle: a unit cylinder placed by u_model, shaded as the mesh is
+// (MESH_FS, from the world position's derivatives).
+const NOZZLE_VS: &str = r#"#version 300 es
+uniform mat4 u_mvp;
+uniform mat4 u_model;
+layout(location = 0) in vec3 a_pos;
+out vec3 v_pos;
+void main() {
+  v_pos = (u_model * vec4(a_pos, 1.0)).xyz;
+  gl_Position = u_mvp * vec4(v_pos, 1.0);
 }
 "#;
 
@@ -286,6 +322,7 @@ struct Program {
     color: Option<WebGlUniformLocation>,
     point_size: Option<WebGlUniformLocation>,
     offset: Option<WebGlUniformLocation>,
+    model: Option<WebGlUniformLocation>,
     color_tex: Option<WebGlUniformLocation>,
     depth_tex: Option<WebGlUniformLocation>,
 }
@@ -299,6 +336,7 @@ impl Program {
             color: gl.get_uniform_location(&program, "u_color"),
             point_size: gl.get_uniform_location(&program, "u_point_size"),
             offset: gl.get_uniform_location(&program, "u_offset"),
+            model: gl.get_uniform_location(&program, "u_model"),
             color_tex: gl.get_uniform_location(&program, "u_color_tex"),
             depth_tex: gl.get_uniform_location(&program, "u_depth_tex"),
             program,
@@ -352,6 +390,28 @@ fn colored(gl: &Gl, pos: &[f32], col: &[f32]) -> Result<Drawable, String> {
         buffers,
         count: (pos.len() / 3) as i32,
     })
+}
+
+/// Segments around the nozzle's cylinder.
+const NOZZLE_SEGMENTS: usize = 24;
+
+/// A cylinder of radius 1 from z = 0 to z = 1, closed at both ends, as
+/// plain triangles (positions only).
+fn unit_cylinder() -> Vec<f32> {
+    let ring = |k: usize| {
+        let a = std::f32::consts::TAU * k as f32 / NOZZLE_SEGMENTS as f32;
+        (a.cos(), a.sin())
+    };
+    let mut pos = Vec::with_capacity(NOZZLE_SEGMENTS * 36);
+    for k in 0..NOZZLE_SEGMENTS {
+        let (c0, s0) = ring(k);
+        let (c1, s1) = ring(k + 1);
+        pos.extend([c0, s0, 0.0, c1, s1, 0.0, c1, s1, 1.0]);
+        pos.extend([c0, s0, 0.0, c1, s1, 1.0, c0, s0, 1.0]);
+        pos.extend([0.0, 0.0, 1.0, c0, s0, 1.0, c1, s1, 1.0]);
+        pos.extend([0.0, 0.0, 0.0, c1, s1, 0.0, c0, s0, 0.0]);
+    }
+    pos
 }
 
 /// An orbit camera around a target, +Z up (the printer's).
@@ -438,6 +498,22 @@ impl Camera {
         self.yaw = -std::f64::consts::FRAC_PI_2;
         self.pitch = MAX_PITCH;
     }
+
+    /// The drawing-buffer pixel (from the top-left) where `p` is drawn, or
+    /// `None` when it lies behind the camera.
+    pub fn project(&self, p: DVec3, width: f64, height: f64) -> Option<(f64, f64)> {
+        let clip = self.view_proj() * p.extend(1.0);
+        if clip.w <= 0.0 || !clip.is_finite() {
+            return None;
+        }
+        let ndc = clip.truncate() / clip.w;
+        Some(((ndc.x + 1.0) * 0.5 * width, (1.0 - ndc.y) * 0.5 * height))
+    }
+
+    /// The angle one pixel of the drawing buffer spans at its centre.
+    pub fn pixel_angle(&self) -> f64 {
+        FOV / self.height_px.max(1.0)
+    }
 }
 
 /// The WebGL2 state of one canvas.
@@ -459,6 +535,13 @@ pub struct Renderer {
     holes: Option<Drawable>,
     printer: Option<Drawable>,
     picked: Option<Drawable>,
+    /// The preview's nozzle: a unit cylinder, and one point at the origin
+    /// (moved by u_offset) marking the tip over everything.
+    nozzle_prog: Program,
+    cylinder: Drawable,
+    tip_point: Drawable,
+    /// Where the nozzle's tip is and its outer diameter; None: not drawn.
+    nozzle: Option<(DVec3, f64)>,
     bounds: (DVec3, DVec3),
     /// Where the paths are drawn relative to where they were planned.
     pub path_offset: DVec3,
@@ -484,6 +567,10 @@ impl Renderer {
         let mesh_prog = Program::new(&gl, MESH_VS, MESH_FS)?;
         let line_prog = Program::new(&gl, LINE_VS, LINE_FS)?;
         let blit_prog = Program::new(&gl, BLIT_VS, BLIT_FS)?;
+        let nozzle_prog = Program::new(&gl, NOZZLE_VS, MESH_FS)?;
+        let cylinder = unit_cylinder();
+        let cylinder = colored(&gl, &cylinder, &vec![0.0; cylinder.len()])?;
+        let tip_point = colored(&gl, &[0.0; 3], &NOZZLE_TIP)?;
         let blit_vao = gl
             .create_vertex_array()
             .ok_or("WebGL could not create a vertex array")?;
@@ -503,6 +590,10 @@ impl Renderer {
             holes: None,
             printer: None,
             picked: None,
+            nozzle_prog,
+            cylinder,
+            tip_point,
+            nozzle: None,
             bounds,
             path_offset: DVec3::ZERO,
             width,
@@ -680,6 +771,69 @@ impl Renderer {
         self.set_lines(moves, &col)
     }
 
+    /// A program's moves for the print preview, in place of the paths:
+    /// `moves` holds xyz from and to per move (6 floats), `codes` one
+    /// colour code per move ([`preview_rgb8`]). Uploaded once per program
+    /// and colouring; the nozzle moves without touching it.
+    pub fn set_preview_path(&mut self, moves: &[f32], codes: &[u8]) -> Result<(), String> {
+        if moves.len() != 6 * codes.len() {
+            return Err(format!(
+                "preview arrays disagree: {} coordinates for {} moves",
+                moves.len(),
+                codes.len()
+            ));
+        }
+        let mut col: Vec<f32> = Vec::with_capacity(moves.len());
+        for &k in codes {
+            let c = preview_rgb8(k).map(|c| f32::from(c) / 255.0);
+            col.extend(c);
+            col.extend(c);
+        }
+        self.set_lines(moves, &col)
+    }
+
+    /// Puts the preview's nozzle with its tip at `tip` (outer diameter
+    /// `outer_diameter_mm`), or takes it away (`None`).
+    pub fn set_nozzle(&mut self, nozzle: Option<(DVec3, f64)>) {
+        self.nozzle = nozzle.filter(|(p, d)| p.is_finite() && d.is_finite() && *d > 0.0);
+    }
+
+    /// The drawing-buffer pixel where `p` is drawn (see [`Camera::project`]).
+    pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        self.camera
+            .project(p, f64::from(self.width), f64::from(self.height))
+    }
+
+    /// The nozzle at its place: the tip's end and the body above it.
+    fn draw_nozzle(&self, mvp: &[f32; 16]) {
+        let Some((tip, diameter)) = self.nozzle else {
+            return;
+        };
+        let gl = &self.gl;
+        let p = &self.nozzle_prog;
+        gl.use_program(Some(&p.program));
+        gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
+        let eye = self.camera.eye() - self.camera.target;
+        let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
+        gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+        let r = 0.5 * diameter;
+        gl.bind_vertex_array(Some(&self.cylinder.vao));
+        for (z0, height, [cr, cg, cb]) in [
+            (0.0, NOZZLE_TIP_MM, NOZZLE_TIP),
+            (NOZZLE_TIP_MM, NOZZLE_BODY_MM, NOZZLE_BODY),
+        ] {
+            let model = DMat4::from_translation(tip + DVec3::new(0.0, 0.0, z0))
+                * DMat4::from_scale(DVec3::new(r, r, height));
+            gl.uniform_matrix4fv_with_f32_array(
+                p.model.as_ref(),
+                false,
+                &model.as_mat4().to_cols_array(),
+            );
+            gl.uniform3f(p.color.as_ref(), cr, cg, cb);
+            gl.draw_arrays(Gl::TRIANGLES, 0, self.cylinder.count);
+        }
+    }
+
     fn set_lines(&mut self, pos: &[f32], col: &[f32]) -> Result<(), String> {
         if let Some(d) = self.lines.take() {
             d.delete(&self.gl);
@@ -836,8 +990,21 @@ impl Renderer {
             gl.draw_arrays(Gl::LINES, 0, lines.count);
         }
         gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
+        self.draw_nozzle(&mvp);
+        let gl = &self.gl;
+        let p = &self.line_prog;
+        gl.use_program(Some(&p.program));
         // Markers sit in holes: draw them over the surface.
         gl.disable(Gl::DEPTH_TEST);
+        if let Some((tip, _)) = self.nozzle {
+            // The tip's place, seen even where the part hides the nozzle.
+            let o = tip.as_vec3();
+            gl.uniform3f(p.offset.as_ref(), o.x, o.y, o.z);
+            gl.uniform1f(p.point_size.as_ref(), 7.0);
+            gl.bind_vertex_array(Some(&self.tip_point.vao));
+            gl.draw_arrays(Gl::POINTS, 0, 1);
+            gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
+        }
         for (m, size) in [
             (&self.holes, 13.0),
             (&self.printer, 6.0),
