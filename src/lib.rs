@@ -41,6 +41,7 @@ pub mod params;
 pub mod pipeline;
 pub mod placement;
 pub mod planners;
+pub mod preview;
 pub mod projection;
 pub mod quality;
 pub mod registration;

@@ -920,6 +920,68 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
         .is_err());
 }
 
+// ---- the print preview (src/preview.rs through the bindings) ----
+
+#[wasm_bindgen_test]
+fn gcode_previews_as_timed_moves_with_their_clearance() {
+    let settings = golden_settings();
+    let session = staged_session(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
+    let tol = settings.plan.process.tolerance_mm;
+    let nozzle = || js(&settings.plan.nozzle);
+    let speed = settings.plan.process.speed_mm_s;
+    let p = session
+        .preview_gcode(
+            GOLDEN_MARLIN.as_bytes(),
+            "demo.gcode",
+            nozzle(),
+            tol,
+            "marlin",
+            None,
+            speed,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let lines = js_sys::Uint32Array::new(&get(&p, "lines")).to_vec();
+    let classes = js_sys::Uint8Array::new(&get(&p, "classes")).to_vec();
+    let starts = js_sys::Float64Array::new(&get(&p, "starts")).to_vec();
+    let durations = js_sys::Float64Array::new(&get(&p, "durations")).to_vec();
+    let moves = js_sys::Float64Array::new(&get(&p, "moves")).to_vec();
+    let rapid = js_sys::Uint8Array::new(&get(&p, "rapid")).to_vec();
+    // The moves the G-code check follows, none closer than tol.
+    let program = pcpp::gcode::read_gcode(GOLDEN_MARLIN, "demo.gcode").unwrap();
+    assert_eq!(lines.len(), program.moves.len());
+    assert!(classes.iter().all(|&c| c < 2) && classes.contains(&1));
+    let total = get(&p, "total_s").as_f64().unwrap();
+    assert!((starts[starts.len() - 1] + durations[durations.len() - 1] - total).abs() < 1e-9);
+    // The page's timeline at a print move's middle: its line and position.
+    let t = pcpp::wasm::PreviewTimeline::new(&moves, &starts, &durations, &lines, &rapid)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let i = rapid.iter().position(|&r| r == 0).unwrap() + 1;
+    let c = json(t.at(starts[i] + 0.5 * durations[i]).unwrap());
+    assert_eq!(c["line"], lines[i]);
+    let mid: Vec<f64> = (0..3)
+        .map(|k| 0.5 * (moves[6 * i + k] + moves[6 * i + 3 + k]))
+        .collect();
+    for k in 0..3 {
+        assert!((c["position"][k].as_f64().unwrap() - mid[k]).abs() < 1e-9);
+    }
+    // Mismatched arrays and unreadable files are errors, not panics.
+    assert!(
+        pcpp::wasm::PreviewTimeline::new(&moves, &starts, &durations, &lines[1..], &rapid).is_err()
+    );
+    let err = session
+        .preview_gcode(
+            b"G2 X1 Y1 I1 J0\n",
+            "arc.nc",
+            nozzle(),
+            tol,
+            "marlin",
+            None,
+            speed,
+        )
+        .unwrap_err();
+    assert_eq!(message_and_kind(&err).1, "gcode");
+}
+
 // ---- a scan in its scanner frame, placed on the bed (issue 13) ----
 
 fn json(v: JsValue) -> serde_json::Value {

@@ -165,6 +165,24 @@ async function check(m) {
   }
 }
 
+// The print preview of a G-code program (the plan's bytes, or a File being
+// checked, read here): its moves timed at its feeds and each move's
+// clearance, by the core (Session.previewGcode), after any plan in flight.
+async function preview(m) {
+  const { id, name } = m;
+  try {
+    const bytes = m.bytes || new Uint8Array(await m.file.arrayBuffer());
+    await planning;
+    if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
+    const r = session.previewGcode(bytes, name, m.nozzle, m.tol, m.dialect, m.profileFile, m.speed);
+    post({ type: 'preview', id, name, result: r },
+      [r.moves.buffer, r.lines.buffer, r.rapid.buffer, r.starts.buffer, r.durations.buffer,
+        r.clearance.buffer, r.classes.buffer]);
+  } catch (err) {
+    post({ type: 'preview', id, name, ...errorOf(err), error: errorOf(err).message });
+  }
+}
+
 self.onmessage = (e) => {
   const m = e.data;
   if (m.type === 'init') {
@@ -179,6 +197,8 @@ self.onmessage = (e) => {
     planning = plan(m);
   } else if (m.type === 'check') {
     check(m);
+  } else if (m.type === 'preview') {
+    preview(m);
   } else if (m.type === 'pick') {
     // The first surface point along the view's ray, on the session's scan.
     if (!session) {

@@ -1,0 +1,811 @@
+//! The page's scan and planning bindings: [`ScanBuffer`] (a file's bytes
+//! written into wasm memory by the worker), [`ScanImport`] (the staged
+//! import and registration) and [`Session`] (a prepared scan that plans,
+//! checks G-code and previews it). Part of [`crate::wasm`]: they only
+//! convert types; every decision is made by [`crate::job`] and the core.
+
+use glam::DVec3;
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+use wasm_bindgen::prelude::*;
+
+use super::{
+    arr, check_samples, check_scan_size, core_err, demo_part_named, from_js, gcode_text, js_err,
+    kind_err, profile, set, to_js, vec3, HoleView, PickView, RegistrationView, ScanView, MIB,
+    PAGE_MAX_DRAWN_MOVES,
+};
+use crate::demo::{self, parts::DemoPart};
+use crate::fiducials::{find_fiducials, find_fiducials_sized, Fiducial};
+use crate::job::{self, InputFile, PreparedScan, RegistrationSettings};
+use crate::mesh::{ImportOptions, ImportedMesh};
+use crate::params::Nozzle;
+use crate::pipeline::{self, DrawnPath, Plan, PlanSettings, SurfacePath};
+use crate::placement;
+use crate::planners::PlannerKind;
+use crate::preview::{self, FeedRules, PlanArrays, Timeline};
+use crate::registration::{Registration, RegistrationMethod};
+use crate::svg::Placement;
+
+/// A scan file's bytes, written into wasm memory chunk by chunk as the
+/// worker reads the file (`Blob.slice().arrayBuffer()`), so a large scan is
+/// never held whole by JS nor passed through a string. The first of the
+/// staged steps that [`job::prepare_scan`] runs in one call; the page shows
+/// progress between them: [`ScanBuffer::import_scan`], [`ScanImport::register`],
+/// [`ScanImport::index`].
+#[wasm_bindgen]
+pub struct ScanBuffer {
+    name: String,
+    size: usize,
+    bytes: Vec<u8>,
+    /// The report's sha256, chunk by chunk as the bytes arrive: V8 runs a
+    /// long single call in its baseline tier (no on-stack replacement for
+    /// wasm), where hashing a large file at once took 16 times longer.
+    sha256: Sha256,
+}
+
+#[wasm_bindgen]
+impl ScanBuffer {
+    /// Room for a file of `size` bytes; refuses sizes past the page's limit
+    /// ([`check_scan_size`]) and, without aborting, sizes the tab's memory
+    /// cannot hold.
+    #[wasm_bindgen(constructor)]
+    pub fn new(name: &str, size: f64) -> Result<ScanBuffer, JsValue> {
+        check_scan_size(name, size)?;
+        let size = size as usize;
+        let mut bytes = Vec::new();
+        bytes.try_reserve_exact(size).map_err(|_| {
+            kind_err(
+                "limit",
+                &format!(
+                    "{name}: this tab has no room for the file's {:.1} MiB; close other tabs \
+                     or reload the page (its memory only grows), decimate the scan, or plan it \
+                     with the command line",
+                    size as f64 / MIB
+                ),
+            )
+        })?;
+        Ok(ScanBuffer {
+            name: name.to_string(),
+            size,
+            bytes,
+            sha256: Sha256::new(),
+        })
+    }
+
+    /// The demo scan (the paper's test part as binary PLY), already full.
+    pub fn demo() -> ScanBuffer {
+        ScanBuffer::full(DemoPart::TestPart)
+    }
+
+    /// A generated demo part's scan ([`demo_part_scan`]), already full.
+    #[wasm_bindgen(js_name = demoPart)]
+    pub fn demo_part(name: &str) -> Result<ScanBuffer, JsError> {
+        Ok(ScanBuffer::full(demo_part_named(name)?))
+    }
+
+    /// Appends the next chunk of the file.
+    pub fn write(&mut self, chunk: &[u8]) -> Result<(), JsError> {
+        if self.bytes.len() + chunk.len() > self.size {
+            return Err(JsError::new(&format!(
+                "{}: the file grew while it was read (more than its {} bytes); open it again",
+                self.name, self.size
+            )));
+        }
+        self.bytes.extend_from_slice(chunk);
+        self.sha256.update(chunk);
+        Ok(())
+    }
+
+    /// Bytes written so far.
+    pub fn received(&self) -> usize {
+        self.bytes.len()
+    }
+
+    /// Imports the bytes ([`pipeline::load_scan`]) with `scan`
+    /// (ImportOptions); the bytes are freed once read, before the next step
+    /// allocates the search structure.
+    #[wasm_bindgen(js_name = importScan)]
+    pub fn import_scan(self, scan: JsValue) -> Result<ScanImport, JsValue> {
+        if self.bytes.len() != self.size {
+            return Err(JsError::new(&format!(
+                "{}: only {} of {} bytes were read; open the file again",
+                self.name,
+                self.bytes.len(),
+                self.size
+            ))
+            .into());
+        }
+        let options: ImportOptions = from_js("scan settings", scan)?;
+        let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
+        let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize());
+        Ok(ScanImport {
+            file,
+            imported,
+            fiducials: None,
+            registration: None,
+        })
+    }
+}
+
+impl ScanBuffer {
+    /// A demo part's scan as the binary PLY `pcpp demo --part` writes.
+    fn full(part: DemoPart) -> ScanBuffer {
+        let bytes = demo::to_binary_ply(&part.mesh());
+        let mut sha256 = Sha256::new();
+        sha256.update(&bytes);
+        ScanBuffer {
+            name: part.scan_name(),
+            size: bytes.len(),
+            bytes,
+            sha256,
+        }
+    }
+}
+
+/// A scan imported (scanner frame), not yet registered or indexed.
+#[wasm_bindgen]
+pub struct ScanImport {
+    file: InputFile,
+    imported: ImportedMesh,
+    fiducials: Option<Vec<Fiducial>>,
+    registration: Option<(Registration, RegistrationMethod)>,
+}
+
+#[wasm_bindgen]
+impl ScanImport {
+    pub fn triangles(&self) -> usize {
+        self.imported.mesh.triangle_count()
+    }
+
+    /// Finds the fiducial holes (once, in the scanner frame) and registers
+    /// with `registration` (RegistrationSettings), as [`job::prepare_scan`]
+    /// does. A failure (kind `registration`) leaves the import usable.
+    pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
+        let settings: RegistrationSettings = from_js("registration settings", registration)?;
+        let mesh = &self.imported.mesh;
+        let holes = self
+            .fiducials
+            .get_or_insert_with(|| find_fiducials_sized(mesh, settings.dot_diameter_mm));
+        // Placement on the bed included, as job::prepare_scan does.
+        let reg = job::registration_for_scan(mesh, holes, &settings).map_err(core_err)?;
+        self.registration = Some((reg, settings.method));
+        Ok(())
+    }
+
+    /// Builds the registered surface and its spatial index: the [`Session`]
+    /// that plans. Call [`ScanImport::register`] first.
+    pub fn index(self) -> Result<Session, JsValue> {
+        let Some((registration, method)) = self.registration else {
+            return Err(JsError::new("the scan must be registered before it is indexed").into());
+        };
+        let fiducials = self
+            .fiducials
+            .unwrap_or_else(|| find_fiducials(&self.imported.mesh));
+        let scan_bbox = self.imported.mesh.bbox();
+        let prepared =
+            PreparedScan::assemble(self.file, self.imported, fiducials, registration, method)
+                .map_err(core_err)?;
+        Ok(Session::from_prepared(prepared, scan_bbox))
+    }
+}
+
+/// The drawing the session plans, read once per file.
+pub(super) struct LoadedPath {
+    pub(super) file: InputFile,
+    pub(super) drawn: DrawnPath,
+}
+
+/// The planner-independent surface path of the last placement and nozzle:
+/// a change of planner, tolerance, speed or dwell, or the comparison after
+/// a drag, re-plans without projecting again.
+struct PathCache {
+    nozzle: Nozzle,
+    placement: Placement,
+    surface_path: SurfacePath,
+}
+
+/// A scan loaded, registered and indexed, kept while only the path or the
+/// plan settings change (re-planning then skips import and BVH build).
+#[wasm_bindgen]
+pub struct Session {
+    scan: PreparedScan,
+    /// The scan's bounds in the scanner frame, as imported.
+    scan_bbox: (DVec3, DVec3),
+    path: Option<LoadedPath>,
+    cache: Option<PathCache>,
+}
+
+#[derive(Serialize)]
+struct PlanResult {
+    gcode: String,
+    /// Pretty JSON, exactly what the CLI's `--report` writes.
+    report_json: String,
+    warnings: Vec<String>,
+}
+
+/// What the page shows of a plan besides the per-point arrays.
+#[derive(Serialize)]
+struct PlanSummary<'a> {
+    planner: PlannerKind,
+    settings: &'a PlanSettings,
+    quality: crate::quality::QualitySummary,
+    stats: crate::stats::PathStats,
+    warnings: &'a [String],
+    registration_rms_mm: f64,
+    /// The report's safe-motion part: the check of every move the G-code
+    /// commands, waypoints, backward moves, sideways offset.
+    motion: &'a job::MotionReport,
+    /// Its line in the G-code header (`safe motion: ...`; it starts with
+    /// `WARNING` when the risk was accepted for touching moves).
+    motion_line: String,
+}
+
+impl Session {
+    /// `scan_bbox`: the import's bounds (scanner frame); without them they
+    /// are found by taking the registered mesh back (G is rigid).
+    fn from_prepared(scan: PreparedScan, scan_bbox: Option<(DVec3, DVec3)>) -> Session {
+        let scan_bbox = scan_bbox.unwrap_or_else(|| {
+            let reg = &scan.registration;
+            let back = scan
+                .surface
+                .mesh()
+                .vertices
+                .iter()
+                .map(|&v| reg.apply_inverse(v));
+            back.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+        });
+        Session {
+            scan,
+            scan_bbox,
+            path: None,
+            cache: None,
+        }
+    }
+
+    /// Projects the drawing for the nozzle and placement of `settings`
+    /// unless the cache already holds that surface path.
+    fn ensure_surface_path(&mut self, settings: &PlanSettings) -> Result<(), JsValue> {
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
+        let hit = self
+            .cache
+            .as_ref()
+            .is_some_and(|c| c.nozzle == settings.nozzle && c.placement == settings.placement);
+        if !hit {
+            // The old surface path goes first: memory for one, not two.
+            self.cache = None;
+            check_samples(path, settings)?;
+            let surface_path = pipeline::surface_path(
+                &self.scan.surface,
+                &path.drawn.subpaths,
+                &settings.nozzle,
+                &settings.placement,
+            )
+            .map_err(core_err)?;
+            self.cache = Some(PathCache {
+                nozzle: settings.nozzle,
+                placement: settings.placement,
+                surface_path,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The per-point arrays of a plan as typed arrays ([`PlanArrays`]):
+/// `pieces`, `ta`, `tool`, `defects`, `slope` (deg), `kappa` (1/mm) and
+/// `error` (mm, NaN at a contact), for the view and the plot without
+/// parsing the JSON report.
+fn plan_arrays(plan: &Plan) -> js_sys::Object {
+    let a = PlanArrays::of(plan);
+    let o = js_sys::Object::new();
+    set(
+        &o,
+        "pieces",
+        &js_sys::Uint32Array::from(&a.pieces[..]).into(),
+    );
+    set(&o, "ta", &js_sys::Float32Array::from(&a.ta[..]).into());
+    set(&o, "tool", &js_sys::Float32Array::from(&a.tool[..]).into());
+    set(
+        &o,
+        "defects",
+        &js_sys::Uint8Array::from(&a.defects[..]).into(),
+    );
+    set(
+        &o,
+        "slope",
+        &js_sys::Float32Array::from(&a.slope_deg[..]).into(),
+    );
+    set(
+        &o,
+        "kappa",
+        &js_sys::Float32Array::from(&a.kappa[..]).into(),
+    );
+    set(
+        &o,
+        "error",
+        &js_sys::Float32Array::from(&a.error_mm[..]).into(),
+    );
+    o
+}
+
+/// One planner's per-point errors and defect codes for the plot beside the
+/// others: `{planner, error, defects}` ([`preview::plan_errors`]).
+fn plan_series(plan: &Plan) -> Result<js_sys::Object, JsError> {
+    let (error, defects) = preview::plan_errors(plan);
+    let o = js_sys::Object::new();
+    set(&o, "planner", &to_js(&plan.planner)?);
+    set(&o, "error", &js_sys::Float32Array::from(&error[..]).into());
+    set(
+        &o,
+        "defects",
+        &js_sys::Uint8Array::from(&defects[..]).into(),
+    );
+    Ok(o)
+}
+
+#[wasm_bindgen]
+impl Session {
+    /// Imports the scan (`bytes` from the file, never through a JS string),
+    /// applies `scan` (ImportOptions) and registers it (RegistrationSettings).
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        bytes: &[u8],
+        name: &str,
+        scan: JsValue,
+        registration: JsValue,
+    ) -> Result<Session, JsValue> {
+        let scan: ImportOptions = from_js("scan settings", scan)?;
+        let registration: RegistrationSettings = from_js("registration settings", registration)?;
+        let scan = job::prepare_scan(bytes, name, &scan, &registration).map_err(core_err)?;
+        Ok(Session::from_prepared(scan, None))
+    }
+
+    /// Vertices of the registered mesh, printer frame, xyz f32 (for drawing).
+    #[wasm_bindgen(js_name = meshPositions)]
+    pub fn mesh_positions(&self) -> Vec<f32> {
+        self.scan
+            .surface
+            .mesh()
+            .vertices
+            .iter()
+            .flat_map(|v| [v.x as f32, v.y as f32, v.z as f32])
+            .collect()
+    }
+
+    /// Triangle vertex indices (three per triangle).
+    #[wasm_bindgen(js_name = meshIndices)]
+    pub fn mesh_indices(&self) -> Vec<u32> {
+        self.scan
+            .surface
+            .mesh()
+            .triangles
+            .iter()
+            .flatten()
+            .copied()
+            .collect()
+    }
+
+    /// What the page shows about the scan: size, format, registration
+    /// (residuals, RMS) and the fiducial holes found in it.
+    pub fn info(&self) -> Result<JsValue, JsError> {
+        let s = &self.scan;
+        let (lo, hi) = s.surface.bbox();
+        let holes = s
+            .fiducials
+            .iter()
+            .map(|f| HoleView {
+                scan: arr(f.centroid),
+                printer: arr(s.registration.apply(f.centroid)),
+                diameter_mm: f.diameter_mm,
+                roundness: f.roundness,
+                score: f.score,
+                candidate: f.is_candidate(),
+            })
+            .collect();
+        let (slo, shi) = self.scan_bbox;
+        to_js(&ScanView {
+            name: &s.file.name,
+            bytes: s.file.bytes,
+            format: s.format,
+            units: s.units,
+            triangles: s.triangle_count(),
+            bbox_mm: [arr(lo), arr(hi)],
+            scan_bbox_mm: [arr(slo), arr(shi)],
+            warnings: &s.warnings,
+            cloud: s.cloud,
+            cloud_text: s.cloud.map(|c| c.to_string()),
+            registration: RegistrationView {
+                status: s.registration.status,
+                status_text: s.registration.status.to_string(),
+                method: s.method,
+                matrix: s.registration.matrix_row_major(),
+                residuals_mm: &s.registration.residuals_mm,
+                rms_mm: s.registration.rms_mm,
+                notes: &s.registration.notes,
+            },
+            holes,
+        })
+    }
+
+    /// The surface point the view shows first along the ray from `origin`
+    /// in `direction` (printer frame, as [`Viewer::pick_ray`] gives it), as
+    /// `{printer, scan}`, or `null` when the ray misses the scan. The view
+    /// draws the registered mesh, so the hit is found on the registered
+    /// surface and taken back to the scanner frame by the inverse of G.
+    pub fn pick(&self, origin: &[f64], direction: &[f64]) -> Result<JsValue, JsError> {
+        let a = vec3("the ray origin", origin)?;
+        let dir = vec3("the ray direction", direction)?.normalize_or_zero();
+        if dir == DVec3::ZERO {
+            return Err(JsError::new("the ray direction must not be zero"));
+        }
+        let (lo, hi) = self.scan.surface.bbox();
+        // Long enough to pass the whole scan from wherever the ray starts.
+        let reach = (a - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
+        let Some(hit) = self.scan.surface.segment_first_hit(a, a + reach * dir) else {
+            return Ok(JsValue::NULL);
+        };
+        let scan = self.scan.registration.apply_inverse(hit);
+        to_js(&PickView {
+            printer: arr(hit),
+            scan: arr(scan),
+        })
+    }
+
+    /// Plans `svg` on this scan ([`job::run_on`]) and writes G-code with the
+    /// machine profile `dialect`: a built-in name or a profile's JSON text
+    /// (`profile_file` then names the file in errors); returns
+    /// `{gcode, report_json, warnings}`.
+    pub fn plan(
+        &self,
+        svg: &[u8],
+        svg_name: &str,
+        settings: JsValue,
+        dialect: &str,
+        accept_risk: bool,
+        profile_file: Option<String>,
+    ) -> Result<JsValue, JsValue> {
+        let settings: PlanSettings = from_js("plan settings", settings)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
+        let out = job::run_on(&self.scan, svg, svg_name, &settings, &profile, accept_risk)
+            .map_err(core_err)?;
+        // Pretty JSON and a final newline: what the CLI's `--report` writes.
+        let mut report_json = serde_json::to_string_pretty(&out.report).map_err(js_err)?;
+        report_json.push('\n');
+        Ok(to_js(&PlanResult {
+            gcode: out.gcode,
+            report_json,
+            warnings: out.report.warnings,
+        })?)
+    }
+
+    /// Reads the drawing the next plans use (an error, kind `svg`, names
+    /// the file and keeps the previous drawing).
+    #[wasm_bindgen(js_name = setPath)]
+    pub fn set_path(&mut self, svg: &[u8], svg_name: &str) -> Result<(), JsValue> {
+        let drawn = pipeline::load_path(svg, svg_name).map_err(core_err)?;
+        self.cache = None;
+        self.path = Some(LoadedPath {
+            file: InputFile::new(svg_name, svg),
+            drawn,
+        });
+        Ok(())
+    }
+
+    /// The drawing of [`Session::set_path`] centred on this scan's footprint
+    /// (printer XY), keeping the rotation and scale of `placement` and
+    /// scaling it down when it does not fit ([`placement::centre_drawing`]):
+    /// `{placement, note}` (`note` says how it was scaled, or is null), or
+    /// null for a drawing without points.
+    #[wasm_bindgen(js_name = centreDrawing)]
+    pub fn centre_drawing(&self, placement: JsValue) -> Result<JsValue, JsValue> {
+        #[derive(Serialize)]
+        struct Centred {
+            placement: Placement,
+            note: Option<String>,
+        }
+        let current: Placement = from_js("drawing placement", placement)?;
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to centre: set a path first"))?;
+        let (lo, hi) = self.scan.surface.bbox();
+        let centred = placement::centre_drawing(
+            &path.drawn.subpaths,
+            (lo.truncate(), hi.truncate()),
+            &current,
+        );
+        Ok(match centred {
+            Some((placement, note)) => to_js(&Centred { placement, note })?,
+            None => JsValue::NULL,
+        })
+    }
+
+    /// One call for a live re-plan: plans the drawing of [`Session::set_path`]
+    /// with `settings` and writes G-code with `dialect` (as
+    /// [`Session::plan`]: the same G-code and report bytes as
+    /// [`job::run_on`] and the CLI), projecting the drawing once (reused
+    /// while the nozzle and placement stay) and, when `compare`, also
+    /// plans every other planner on that one surface path. Returns
+    /// `{gcode, report}` (UTF-8 bytes, Uint8Array), `summary` (planner,
+    /// settings, quality, stats, warnings, registration RMS, the report's
+    /// `motion` and its header line `motion_line`), `view` (see
+    /// [`plan_arrays`]), `comparison` (`[job::ComparisonRow]`, every
+    /// planner, or null) and `series` (per planner, see [`plan_series`],
+    /// or null).
+    ///
+    /// G-code whose moves come closer to the surface than tol is refused
+    /// unless `accept_risk` (an `Error` of kind `touching`, see
+    /// [`core_err`]); that error also carries the `comparison` and `series`
+    /// when they were asked for, so the page can compare the planners on the
+    /// settings that failed.
+    #[wasm_bindgen(js_name = planLive)]
+    pub fn plan_live(
+        &mut self,
+        settings: JsValue,
+        dialect: &str,
+        accept_risk: bool,
+        profile_file: Option<String>,
+        compare: bool,
+    ) -> Result<JsValue, JsValue> {
+        let settings: PlanSettings = from_js("plan settings", settings)?;
+        // As job::run_on: bad settings and profiles fail before any work.
+        settings.validate().map_err(core_err)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
+        self.ensure_surface_path(&settings)?;
+        let Some(cache) = &self.cache else {
+            return Err(JsError::new("the surface path was not kept").into());
+        };
+        let sp = &cache.surface_path;
+        let surface = &self.scan.surface;
+        let plan_with = |k: PlannerKind| {
+            pipeline::plan_surface_path(surface, sp, k, &settings.nozzle, &settings.process)
+        };
+        let plan = plan_with(settings.planner);
+        let (comparison, series) = if compare {
+            let rows = js_sys::Array::new();
+            let series = js_sys::Array::new();
+            let mut table = Vec::with_capacity(PlannerKind::ALL.len());
+            for &k in &PlannerKind::ALL {
+                // One planner at a time: its plan is dropped before the next.
+                let other;
+                let p = if k == settings.planner {
+                    &plan
+                } else {
+                    other = plan_with(k);
+                    &other
+                };
+                table.push(job::ComparisonRow::of(p));
+                series.push(&plan_series(p)?.into());
+            }
+            for r in &table {
+                rows.push(&to_js(r)?);
+            }
+            (JsValue::from(rows), JsValue::from(series))
+        } else {
+            (JsValue::NULL, JsValue::NULL)
+        };
+        let path = self
+            .path
+            .as_ref()
+            .ok_or_else(|| JsError::new("no drawing to plan: set a path first"))?;
+        // The core's own refusal and writer, so the bytes are the CLI's.
+        let written = job::refuse_uncleared(&plan, accept_risk).and_then(|()| {
+            job::write_outputs(
+                &self.scan,
+                &path.file,
+                &path.drawn.notes,
+                &plan,
+                &settings,
+                &profile,
+                accept_risk,
+            )
+        });
+        let (report, gcode) = match written {
+            Ok(w) => w,
+            Err(e) => {
+                let err = core_err(e);
+                if compare {
+                    let _ = js_sys::Reflect::set(&err, &"comparison".into(), &comparison);
+                    let _ = js_sys::Reflect::set(&err, &"series".into(), &series);
+                }
+                return Err(err);
+            }
+        };
+        let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
+        report_json.push(b'\n');
+        let out = js_sys::Object::new();
+        set(
+            &out,
+            "gcode",
+            &js_sys::Uint8Array::from(gcode.as_bytes()).into(),
+        );
+        set(
+            &out,
+            "report",
+            &js_sys::Uint8Array::from(&report_json[..]).into(),
+        );
+        let summary = PlanSummary {
+            planner: plan.planner,
+            settings: &settings,
+            quality: plan.quality,
+            stats: plan.stats,
+            warnings: &report.warnings,
+            registration_rms_mm: report.registration.rms_mm,
+            motion: &report.motion,
+            motion_line: report.motion.summary_line(),
+        };
+        set(&out, "summary", &to_js(&summary)?);
+        set(&out, "view", &plan_arrays(&plan).into());
+        set(&out, "comparison", &comparison);
+        set(&out, "series", &series);
+        Ok(out.into())
+    }
+
+    /// Checks a G-code file (`bytes`, UTF-8 text, any program: ours or
+    /// another tool's) against this scan ([`job::check_gcode`]): every
+    /// straight move along its length, the nozzle `nozzle` (`{inner_diameter_mm,
+    /// outer_diameter_mm}`) kept `tol_mm` from the surface. Returns the
+    /// `job::GcodeCheck` with `clear` (no move closer than tol) and, for
+    /// the view, up to [`PAGE_MAX_DRAWN_MOVES`] of the moves checked:
+    /// `moves` (xyz from and to, Float32Array) and `kinds` (0 feed, 1 rapid,
+    /// 2 listed as too close; only the check's first
+    /// [`crate::motion::MAX_LISTED`] are known), or null for more. A file
+    /// that cannot be read (an arc, a bad number, ...) is an `Error` of kind
+    /// `gcode` naming the file and the line, one past the page's size limit
+    /// of kind `limit`.
+    #[wasm_bindgen(js_name = checkGcode)]
+    pub fn check_gcode(
+        &self,
+        bytes: &[u8],
+        name: &str,
+        nozzle: JsValue,
+        tol_mm: f64,
+    ) -> Result<JsValue, JsValue> {
+        let nozzle: Nozzle = from_js("nozzle", nozzle)?;
+        let text = gcode_text(bytes, name)?;
+        let check = job::check_gcode(&self.scan, text, name, &nozzle, tol_mm).map_err(core_err)?;
+        let out = to_js(&check)?;
+        let o: &js_sys::Object = out.unchecked_ref();
+        set(o, "clear", &JsValue::from_bool(check.is_clear()));
+        let (mut moves, mut kinds) = (JsValue::NULL, JsValue::NULL);
+        if check.summary.moves <= PAGE_MAX_DRAWN_MOVES {
+            // The check's own moves: its touching moves index into them.
+            let mut xyz = Vec::with_capacity(6 * check.moves.len());
+            let mut k: Vec<u8> = check.moves.iter().map(|m| u8::from(m.rapid)).collect();
+            for m in &check.moves {
+                xyz.extend(
+                    [m.from, m.to]
+                        .iter()
+                        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]),
+                );
+            }
+            for t in &check.summary.touching {
+                if let Some(c) = k.get_mut(t.index) {
+                    *c = 2;
+                }
+            }
+            moves = js_sys::Float32Array::from(&xyz[..]).into();
+            kinds = js_sys::Uint8Array::from(&k[..]).into();
+        }
+        set(o, "moves", &moves);
+        set(o, "kinds", &kinds);
+        Ok(out)
+    }
+
+    /// The print preview of a G-code file (`bytes`; the plan's own or one
+    /// being checked) on this scan: its straight moves timed at the file's
+    /// feeds with the machine profile `dialect` (as [`Session::plan_live`];
+    /// `print_speed_mm_s` until the file sets a feed,
+    /// [`preview::time_moves`]) and each move's clearance along its length
+    /// for `nozzle` and `tol_mm` (the motion check's, found up to tol +
+    /// [`preview::PREVIEW_CLEARANCE_CAP_ABOVE_TOL_MM`]). Returns `moves`
+    /// (xyz from and to, Float64Array), `lines` (Uint32Array), `rapid`,
+    /// `starts` and `durations` (s), `clearance` (Float32Array, NaN above
+    /// the cap), `classes` (0 clear, 1 near, 2 closer than tol),
+    /// `total_s`, `tol_mm`, `near_mm`, `cap_mm`. Errors as
+    /// [`Session::check_gcode`]'s; more than [`PAGE_MAX_DRAWN_MOVES`]
+    /// moves is an error of kind `limit`.
+    #[wasm_bindgen(js_name = previewGcode)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn preview_gcode(
+        &self,
+        bytes: &[u8],
+        name: &str,
+        nozzle: JsValue,
+        tol_mm: f64,
+        dialect: &str,
+        profile_file: Option<String>,
+        print_speed_mm_s: f64,
+    ) -> Result<JsValue, JsValue> {
+        let nozzle: Nozzle = from_js("nozzle", nozzle)?;
+        nozzle.validate().map_err(core_err)?;
+        crate::params::Process::DEFAULT
+            .with_tolerance_mm(tol_mm)
+            .validate()
+            .map_err(core_err)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
+        let text = gcode_text(bytes, name)?;
+        let program = crate::gcode::read_gcode(text, name).map_err(|e| core_err(e.into()))?;
+        if program.moves.len() > PAGE_MAX_DRAWN_MOVES {
+            return Err(kind_err(
+                "limit",
+                &format!(
+                    "{name}: {} moves, more than the {} the page previews; check it, or \
+                     preview a part of it",
+                    program.moves.len(),
+                    PAGE_MAX_DRAWN_MOVES
+                ),
+            ));
+        }
+        let rules = FeedRules::of_profile(&profile, print_speed_mm_s);
+        let timeline = Timeline::new(preview::time_moves(text, &program.moves, &rules));
+        let moves = timeline.moves();
+        let cap = tol_mm + preview::PREVIEW_CLEARANCE_CAP_ABOVE_TOL_MM;
+        let clearance = crate::motion::Clearance::new(&nozzle, tol_mm);
+        let gaps = preview::move_clearances(&self.scan.surface, moves, &clearance, cap);
+        let near = preview::DEFAULT_NEAR_MM;
+        let classes: Vec<u8> = gaps
+            .iter()
+            .map(|&g| preview::ClearanceClass::of(g, tol_mm, near).code())
+            .collect();
+        let gaps: Vec<f32> = gaps
+            .iter()
+            .map(|g| g.map_or(f32::NAN, |g| g as f32))
+            .collect();
+        let xyz: Vec<f64> = moves
+            .iter()
+            .flat_map(|m| [m.from.x, m.from.y, m.from.z, m.to.x, m.to.y, m.to.z])
+            .collect();
+        let lines: Vec<u32> = moves.iter().map(|m| m.line as u32).collect();
+        let rapid: Vec<u8> = moves.iter().map(|m| u8::from(m.rapid)).collect();
+        let starts: Vec<f64> = moves.iter().map(|m| m.start_s).collect();
+        let durations: Vec<f64> = moves.iter().map(|m| m.duration_s).collect();
+        let o = js_sys::Object::new();
+        set(&o, "moves", &js_sys::Float64Array::from(&xyz[..]).into());
+        set(&o, "lines", &js_sys::Uint32Array::from(&lines[..]).into());
+        set(&o, "rapid", &js_sys::Uint8Array::from(&rapid[..]).into());
+        set(
+            &o,
+            "starts",
+            &js_sys::Float64Array::from(&starts[..]).into(),
+        );
+        set(
+            &o,
+            "durations",
+            &js_sys::Float64Array::from(&durations[..]).into(),
+        );
+        set(
+            &o,
+            "clearance",
+            &js_sys::Float32Array::from(&gaps[..]).into(),
+        );
+        set(
+            &o,
+            "classes",
+            &js_sys::Uint8Array::from(&classes[..]).into(),
+        );
+        set(&o, "total_s", &timeline.total_s().into());
+        set(&o, "tol_mm", &tol_mm.into());
+        set(&o, "near_mm", &near.into());
+        set(&o, "cap_mm", &cap.into());
+        Ok(o.into())
+    }
+
+    /// Every planner's quality and motion summaries side by side
+    /// ([`job::compare_on`]).
+    pub fn compare(
+        &self,
+        svg: &[u8],
+        svg_name: &str,
+        settings: JsValue,
+    ) -> Result<JsValue, JsValue> {
+        let settings: PlanSettings = from_js("plan settings", settings)?;
+        let comparison = job::compare_on(&self.scan, svg, svg_name, &settings).map_err(core_err)?;
+        to_js(&comparison.rows).map_err(JsValue::from)
+    }
+}

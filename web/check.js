@@ -1,0 +1,149 @@
+// "Check a G-code file": any program, ours or another tool's, checked by
+// the core against the scan the worker holds (every straight move along
+// its length), the verdict and the touching moves listed by line, and the
+// program's moves drawn in the 3-D view on request.
+import { pageLimits } from '../pkg/pcpp.js';
+import { $, fmt, fmtPoint, hooks, num, settings, state } from './page.js';
+import { cell } from './report.js';
+import { showError } from './status.js';
+import { drawPlanPaths, setViewShows } from './view.js';
+
+// A user's G-code (ours or another tool's) checked by the core against the
+// scan the worker holds, with the nozzle and tol of the settings: the
+// worker reads the File (as it reads a scan), after any plan in flight.
+export function checkGcodeFile(file) {
+  const limit = pageLimits().gcode_bytes;
+  if (file.size > limit) {
+    const message = `${file.name}: the file is ${(file.size / (1 << 20)).toFixed(1)} MiB, more than the `
+      + `${limit / (1 << 20)} MiB the G-code check reads; split the program and check each part`;
+    showCheckError(file.name, message);
+    return;
+  }
+  const s = settings;
+  const id = ++state.checkId;
+  const nozzle = { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) };
+  const tol = num(s.process.tol);
+  state.checking = { id, name: file.name, file, nozzle, tol };
+  state.checkMoves = null;
+  $('check-draw').hidden = true;
+  $('check-panel').hidden = false;
+  $('check-verdict').textContent = `checking ${file.name}…`;
+  $('check-verdict').className = 'verdict';
+  $('check-details').replaceChildren();
+  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol });
+}
+
+function showCheckError(name, message) {
+  state.checkMoves = null;
+  state.checked = null;
+  if (hooks.checkShown) hooks.checkShown();
+  $('check-draw').hidden = true;
+  if (state.viewShows === 'check') drawCheckedMoves(false);
+  $('check-panel').hidden = false;
+  $('check-verdict').textContent = `could not check ${name}`;
+  $('check-verdict').className = 'verdict bad';
+  $('check-details').replaceChildren();
+  showError(`Could not check ${name}`, message);
+}
+
+export function onCheck(m) {
+  if (m.id !== state.checkId) return;
+  const req = state.checking;
+  state.checking = null;
+  if (m.error) {
+    showCheckError(m.name, m.error);
+    return;
+  }
+  // The file checked, for the preview.
+  state.checked = req ? { file: req.file, name: m.name, nozzle: req.nozzle, tol: req.tol } : null;
+  if (hooks.checkShown) hooks.checkShown();
+  const c = m.result;
+  const sum = c.summary;
+  const verdict = $('check-verdict');
+  const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
+  verdict.textContent = c.clear
+    ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
+    : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
+  verdict.className = c.clear ? 'verdict good' : 'verdict bad';
+  const details = [];
+  const p = (text, id, cls) => {
+    const el = document.createElement('p');
+    el.textContent = text;
+    if (id) el.id = id;
+    if (cls) el.className = cls;
+    details.push(el);
+    return el;
+  };
+  p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined
+    ? 'minimum clearance: no move passes near the scan'
+    : `minimum clearance ${fmt(sum.min_clearance_mm)} mm`
+      + `${sum.min_clearance_line ? ` at line ${sum.min_clearance_line}` : ''}`
+      + `${sum.min_clearance_at ? ` ${fmtPoint(sum.min_clearance_at)}` : ''}`,
+  'check-min', sum.min_clearance_mm !== null && sum.min_clearance_mm < c.tol_mm ? 'bad' : '');
+  if (sum.touching.length) {
+    const table = document.createElement('table');
+    table.id = 'check-touching';
+    table.className = 'num';
+    const head = table.createTHead().insertRow();
+    for (const h of ['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm']) {
+      const th = document.createElement('th');
+      th.textContent = h;
+      head.append(th);
+    }
+    const body = table.createTBody();
+    for (const t of sum.touching) {
+      const tr = body.insertRow();
+      cell(tr, t.line ? String(t.line) : '—', 'line');
+      cell(tr, `${fmtPoint(t.from)} → ${fmtPoint(t.to)}`);
+      cell(tr, fmtPoint(t.at));
+      cell(tr, fmt(t.clearance_mm));
+      cell(tr, fmt(t.rise_mm), 'bad');
+    }
+    details.push(table);
+    if (sum.touching_moves > sum.touching.length) {
+      p(`… and ${sum.touching_moves - sum.touching.length} more touching move(s)`);
+    }
+  }
+  if (c.unchecked_lines.length) {
+    p(`${c.unchecked_lines.length} move(s) not checked (their position is not in the file): lines `
+      + `${c.unchecked_lines.slice(0, 10).join(', ')}${c.unchecked_lines.length > 10 ? ', …' : ''}`, 'check-unchecked');
+  }
+  if (c.notes.length) {
+    const ul = document.createElement('ul');
+    ul.id = 'check-notes';
+    ul.className = 'warnings small';
+    for (const n of c.notes) {
+      const li = document.createElement('li');
+      li.textContent = n;
+      ul.append(li);
+    }
+    details.push(ul);
+  }
+  $('check-details').replaceChildren(...details);
+  state.checkMoves = c.moves ? { moves: c.moves, kinds: c.kinds } : null;
+  $('check-draw').hidden = !state.checkMoves;
+  if (state.viewShows === 'check') drawCheckedMoves(!!state.checkMoves);
+}
+
+// The view draws the checked program's moves (on) or the plan's paths.
+export function drawCheckedMoves(on) {
+  if (!state.viewer) return;
+  try {
+    if (on && state.checkMoves) {
+      state.viewer.setMoves(state.checkMoves.moves, state.checkMoves.kinds);
+      setViewShows('check');
+    } else {
+      drawPlanPaths();
+    }
+  } catch (e) {
+    showError('Could not draw the moves', e.message);
+  }
+}
+
+// The button follows what the view shows.
+export function syncCheckButton() {
+  const on = state.viewShows === 'check';
+  const b = $('check-draw');
+  b.setAttribute('aria-pressed', on ? 'true' : 'false');
+  b.textContent = on ? 'Back to the plan in the 3-D view' : 'Draw in the 3-D view';
+}

@@ -1,0 +1,76 @@
+// The downloads: the G-code and the report as the planner wrote them, and
+// the two clicks a G-code that touches the part needs.
+import { $, state } from './page.js';
+
+const GCODE_LABEL = 'Download G-code';
+const RISKY_LABEL = 'Download G-code (the nozzle touches the part)…';
+const CONFIRM_LABEL = 'Download anyway (the nozzle touches the part)';
+
+export function hideDownloads() {
+  const g = $('dl-gcode');
+  g.hidden = true;
+  $('dl-report').hidden = true;
+  for (const u of state.urls) URL.revokeObjectURL(u);
+  state.urls = [];
+  g.removeAttribute('href');
+  $('dl-report').removeAttribute('href');
+  g.textContent = GCODE_LABEL;
+  g.classList.remove('risky', 'armed');
+  g.removeAttribute('tabindex');
+  state.risky = null;
+  $('risk-warning').hidden = true;
+}
+
+function linkBytes(el, bytes, type, name) {
+  const url = URL.createObjectURL(new Blob([bytes], { type }));
+  state.urls.push(url);
+  el.href = url;
+  el.download = name;
+  el.hidden = false;
+}
+
+// The G-code and report as the planner wrote them (bytes, no string copy).
+// G-code whose moves touch the part (written because the risk was accepted)
+// has no link until the user confirms: the first click turns the button
+// into "Download anyway", the second downloads.
+export function offerDownloads(plan) {
+  hideDownloads();
+  const stem = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
+  const gcodeName = `${stem}-${plan.planner}.gcode`;
+  const motion = plan.summary.motion;
+  if (motion.risk_accepted) {
+    const g = $('dl-gcode');
+    state.risky = { plan, name: gcodeName };
+    g.textContent = RISKY_LABEL;
+    g.classList.add('risky');
+    g.tabIndex = 0;
+    g.hidden = false;
+    $('risk-warning-text').textContent = `safe motion: ${plan.summary.motion_line}`;
+    $('risk-warning').hidden = false;
+  } else {
+    linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
+  }
+  linkBytes($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
+}
+
+// The first click on a touching plan's G-code asks for the second.
+export function onGcodeClick(e) {
+  const r = state.risky;
+  const g = $('dl-gcode');
+  if (!r || g.classList.contains('armed')) return;
+  e.preventDefault();
+  linkBytes(g, r.plan.gcodeBytes, 'text/plain', r.name);
+  g.textContent = CONFIRM_LABEL;
+  g.classList.add('armed');
+}
+
+
+export function bindDownloads() {
+  $('dl-gcode').addEventListener('click', onGcodeClick);
+  $('dl-gcode').addEventListener('keydown', (e) => {
+    // A touching plan's button has no link until confirmed: keys click it.
+    if ((e.key === 'Enter' || e.key === ' ') && state.risky && !$('dl-gcode').classList.contains('armed')) {
+      onGcodeClick(e);
+    }
+  });
+}

@@ -1,0 +1,278 @@
+// Inputs and uploads: a scan, an SVG, a machine profile or a G-code file
+// opened or dropped on the page, the demo parts, and the last scan and SVG
+// kept in this browser (store.js) and reopened on the next visit.
+import { checkProfile, checkScanSize, checkSvgSize } from '../pkg/pcpp.js';
+import { checkGcodeFile, drawCheckedMoves } from './check.js';
+import { $, hooks, settings, state } from './page.js';
+import {
+  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, setNote, showScanPlacement,
+} from './placement.js';
+import {
+  demoInfo, demoUiSettings, saveSettings, syncProfileOption, writeForm,
+} from './settings.js';
+import { clearError, showError } from './status.js';
+import { keepInput, keptInput } from './store.js';
+
+// Set while a kept scan is reopened: still set at the next start means the
+// page closed or crashed reading it, and it is not reopened again.
+const RESTORING_KEY = 'pcpp.restoring.v1';
+
+// G-code programs a user may check against the scan (by their extension).
+const GCODE_FILE = /\.(gcode|gco|g|nc|ngc|tap|txt)$/i;
+
+async function openFile(file) {
+  if (/\.svg$/i.test(file.name)) {
+    await openSvg(file);
+    return;
+  }
+  if (GCODE_FILE.test(file.name)) {
+    checkGcodeFile(file);
+    return;
+  }
+  // Past the page's limit the file is refused before a byte is read, and
+  // the loaded scan stays.
+  try {
+    checkScanSize(file.name, file.size);
+  } catch (e) {
+    showError(`Could not open the scan ${file.name}`,
+      `${e.message}\nStill using ${state.scan ? state.scan.name : 'no scan'}.`);
+    return;
+  }
+  // The File itself goes to the worker, which reads it into wasm memory:
+  // the scan's bytes never pass through this thread or a JS string.
+  const entry = { key: `file-${state.nextKey++}`, name: file.name, size: file.size, blob: file };
+  state.pendingScan = entry;
+  // The demo's fiducials belong to the demo part: a new scan is read
+  // unregistered until the user sets its fiducials (the settings change
+  // only once the scan is read, so a bad file changes nothing).
+  const demo = demoUiSettings();
+  if (settings.fidSource === 'auto' && settings.fidPrinterText === demo.fidPrinterText) {
+    entry.unregistered = true;
+  }
+  // A new scan is read as it is (the banner offers to place it on the bed),
+  // and the drawing is centred on it.
+  if (settings.scanPlace.on) entry.asScanned = true;
+  requestCentre();
+  $('scan-name').textContent = `${state.scan ? state.scan.name : '—'} (reading ${file.name}…)`;
+  saveSettings();
+  writeForm();
+  hooks.schedulePlan(0);
+}
+
+async function openSvg(file) {
+  try {
+    checkSvgSize(file.name, file.size);
+  } catch (e) {
+    showError(`Could not open the SVG ${file.name}`, e.message);
+    return;
+  }
+  let bytes;
+  try {
+    // Bytes go to wasm as a Uint8Array, never through a JS string.
+    bytes = new Uint8Array(await file.arrayBuffer());
+  } catch (e) {
+    showError(`Could not read ${file.name}`, e.message);
+    return;
+  }
+  state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes };
+  settings.pathSource = 'file';
+  // A new drawing lands on the scan.
+  requestCentre(true);
+  saveSettings();
+  writeForm();
+  hooks.schedulePlan(0);
+}
+
+// A user's machine profile: checked by the core (the error names the file
+// and the field); a bad file changes nothing, the previous dialect stays.
+async function openProfile(file) {
+  let text;
+  try {
+    text = await file.text();
+  } catch (e) {
+    showError(`Could not read ${file.name}`, e.message);
+    return;
+  }
+  let name;
+  try {
+    name = checkProfile(text, file.name);
+  } catch (e) {
+    showError(`Could not use the machine profile ${file.name}`,
+      `${e.message}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`);
+    return;
+  }
+  clearError();
+  // Its bed may differ: a scan placed on the bed moves with it.
+  moveScan(() => {
+    settings.customProfile = { name, file: file.name, text };
+    settings.dialect = 'custom';
+  });
+  syncProfileOption();
+  showScanPlacement();
+  saveSettings();
+  writeForm();
+  hooks.schedulePlan(0);
+}
+
+export function bindFiles() {
+  $('check-draw').addEventListener('click', () => drawCheckedMoves(state.viewShows !== 'check'));
+  const gcodeInput = $('gcode-input');
+  gcodeInput.addEventListener('change', () => {
+    const f = gcodeInput.files && gcodeInput.files[0];
+    if (f) checkGcodeFile(f);
+    gcodeInput.value = '';
+  });
+  const profileInput = $('profile-input');
+  profileInput.addEventListener('change', () => {
+    const f = profileInput.files && profileInput.files[0];
+    if (f) openProfile(f);
+    profileInput.value = '';
+  });
+  for (const id of ['scan-input', 'svg-input']) {
+    const input = $(id);
+    input.addEventListener('change', () => {
+      const f = input.files && input.files[0];
+      if (f) openFile(f);
+      input.value = '';
+    });
+  }
+  const overlay = $('drop-overlay');
+  let depth = 0;
+  window.addEventListener('dragenter', (e) => {
+    e.preventDefault();
+    depth++;
+    overlay.hidden = false;
+  });
+  window.addEventListener('dragleave', () => {
+    depth = Math.max(0, depth - 1);
+    if (depth === 0) overlay.hidden = true;
+  });
+  window.addEventListener('dragover', (e) => e.preventDefault());
+  window.addEventListener('drop', (e) => {
+    e.preventDefault();
+    depth = 0;
+    overlay.hidden = true;
+    for (const f of e.dataTransfer.files) openFile(f);
+  });
+}
+
+// A demo part's scan: the worker makes its bytes itself.
+export function demoScanEntry(part) {
+  const info = demoInfo(part);
+  return { key: `demo-${info.name}`, name: info.scan_name, size: 0, blob: null, part: info.name };
+}
+
+// Loads a demo part: its scan, drawing, placement and fiducials (the test
+// part's three holes; the other parts are made in the printer frame).
+export function loadDemo(part = settings.demoPart) {
+  const demo = demoUiSettings(part);
+  settings.demoPart = demo.demoPart;
+  settings.fidSource = demo.fidSource;
+  settings.fidMethod = demo.fidMethod;
+  settings.fidPrinterText = demo.fidPrinterText;
+  settings.pathSource = 'demo';
+  settings.placement = demo.placement;
+  settings.scanUnits = '';
+  settings.scanUp = '';
+  settings.scanMaxEdge = '';
+  // The demo parts are made in the printer frame, placed where they print.
+  settings.scanPlace = { ...SCAN_PLACE_DEFAULT };
+  cancelCentre();
+  setNote('');
+  state.pendingScan = null;
+  state.scan = demoScanEntry(settings.demoPart);
+  $('scan-name').textContent = state.scan.name;
+  state.svgFile = null;
+  state.pendingSvg = null;
+  keep('scan', null);
+  keep('svg', null);
+  saveSettings();
+  writeForm();
+  hooks.schedulePlan(0);
+}
+
+// A file that could not be read changes nothing: no centring for it (a
+// new drawing opened with it is still centred).
+export function dropCentre() {
+  if (state.centre && !state.centre.fresh) cancelCentre();
+}
+
+// The pending scan was read: it becomes the scan, and the demo's fiducial
+// settings it was read without are dropped for good.
+export function acceptScan() {
+  const scan = state.pendingScan;
+  state.scan = scan;
+  state.pendingScan = null;
+  if (scan.restored) endRestoring();
+  else keep('scan', scan.blob ? { name: scan.name, file: scan.blob } : null);
+  if (scan.unregistered) {
+    delete scan.unregistered;
+    settings.fidSource = 'none';
+    saveSettings();
+    writeForm();
+  }
+  if (scan.asScanned) {
+    // A new scan is read as it is; the banner offers to place it.
+    delete scan.asScanned;
+    settings.scanPlace = { ...SCAN_PLACE_DEFAULT };
+    saveSettings();
+  }
+  showScanPlacement();
+}
+
+// ---------- the last inputs, kept for the next visit ----------
+
+// Writes to the browser's store in the background; `state.keeping` counts
+// the writes not finished (tests wait for 0 before reloading).
+export function keep(kind, value) {
+  state.keeping++;
+  keepInput(kind, value)
+    .catch(() => {
+      // Not kept (quota, private mode): the next visit starts without it.
+    })
+    .finally(() => { state.keeping--; });
+}
+
+export function endRestoring() {
+  try {
+    localStorage.removeItem(RESTORING_KEY);
+  } catch {
+    // Nothing to clear.
+  }
+}
+
+// Reopens the scan and SVG of the last visit, if the browser kept them.
+export async function restoreInputs() {
+  let svg;
+  let scan;
+  try {
+    [svg, scan] = await Promise.all([keptInput('svg'), keptInput('scan')]);
+  } catch {
+    svg = null;
+    scan = null;
+  }
+  if (svg && svg.bytes instanceof Uint8Array && typeof svg.name === 'string') {
+    state.svgFile = { key: `file-${state.nextKey++}`, name: svg.name, bytes: svg.bytes };
+  } else if (settings.pathSource === 'file') {
+    settings.pathSource = 'demo';
+  }
+  if (!scan || !(scan.file instanceof Blob) || typeof scan.name !== 'string') return;
+  let crashed = null;
+  try {
+    crashed = localStorage.getItem(RESTORING_KEY);
+    localStorage.setItem(RESTORING_KEY, scan.name);
+  } catch {
+    // Without localStorage there is no crash guard; reopen anyway.
+  }
+  if (crashed !== null) {
+    endRestoring();
+    keep('scan', null);
+    showError(`The last scan, ${crashed}, was not reopened`,
+      'The page closed or stopped while reading it last time. Open it again if you need it.');
+    return;
+  }
+  state.pendingScan = {
+    key: `file-${state.nextKey++}`, name: scan.name, size: scan.file.size, blob: scan.file, restored: true,
+  };
+  $('scan-name').textContent = `${state.scan.name} (reopening ${scan.name}…)`;
+}

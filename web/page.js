@@ -1,0 +1,77 @@
+// What the page's modules share: the element lookup, the page's state and
+// settings, number formats, and the hooks main.js fills in. Modules import
+// this one and each other only in one direction (the single-file build,
+// scripts/single-file.mjs, joins them in dependency order and allows no
+// cycle); a call back up (to plan again, say) goes through `hooks`.
+
+export const $ = (id) => document.getElementById(id);
+
+// The settings the user edits (persisted in localStorage by settings.js):
+// one object for the page's life, filled by loadSettings.
+export const settings = {};
+
+// Calls into modules that import this one's users: schedulePlan(delay),
+// planNow(), requestPlan(), endInteraction(), loadDemo(part),
+// showErrorPlot(), viewShowsChanged(), viewClick(px, py) -> handled,
+// planShown(plan).
+export const hooks = {};
+
+export const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
+
+export const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '∞' : v.toFixed(d));
+
+// A point as the core's messages write it.
+export const fmtPoint = (p) => `(${p.map((v) => fmt(v)).join(', ')})`;
+
+export const state = {
+  // The accepted scan {key, name, size, blob}: blob is the user's File
+  // (handed to the worker, which reads it) or null for the demo.
+  scan: null,
+  pendingScan: null, // a scan loaded but not yet read by the worker
+  svgFile: null, // the accepted SVG file {key, name, bytes}
+  pendingSvg: null,
+  svgMade: null, // the last generated path {key, name, bytes} (antennas, demo)
+  nextKey: 1,
+  module: null,
+  worker: null,
+  sentSvgKey: null, // the drawing whose bytes the current worker holds
+  busy: null, // the plan request in flight
+  queued: false, // a newer request waits for it: only the newest is planned
+  // Every change of an input or setting counts up; a plan is offered for
+  // download only if nothing changed since it was requested.
+  gen: 0,
+  planId: 0,
+  lastPlan: null,
+  // The last comparison of every planner {rows, series, gen} (series: the
+  // per-point errors of each planner, for the plot; null after a failed plan).
+  lastComparison: null,
+  demoParts: new Map(), // demo part name -> its drawing and settings (wasm demoPart)
+  checkId: 0, // the G-code check in flight
+  checking: null, // {id, name} of the check in flight
+  checkMoves: null, // the last checked program's {moves, kinds} for the view
+  checked: null, // the last file checked clear or not {file, name, nozzle, tol} (the preview reads it)
+  // What the view draws as its lines: 'plan' (Ta and T*), 'check' (a
+  // checked program's moves) or 'preview' (the previewed program, with
+  // the nozzle).
+  viewShows: 'plan',
+  interacting: false, // a drag or slider in progress: skip the comparison
+  centre: null, // {token}: the next plan centres the drawing on the scan (placement.js)
+  info: null, // the scan as the worker read it
+  viewer: null,
+  redraw: 0,
+  frames: 0, // frames the view has drawn (tests read the rate)
+  debounce: 0,
+  memory: 0, // the worker's wasm memory after the last scan read (bytes)
+  keeping: 0, // writes of the last inputs to the browser's store under way
+  progressTimer: 0,
+  progressLabel: '',
+  urls: [],
+  picking: false, // "pick on mesh" mode: a click on the view adds a scan point
+  moving: false, // "move path" mode: a drag in the view moves the placement
+  pickId: 0,
+  // Re-planning figures: plans finished, the last planner time and the
+  // last time from request to plan on screen (ms), requests sent while
+  // another was in flight (always 0: never a backlog).
+  stats: { plans: 0, planMs: [], latencyMs: [], overlapped: 0 },
+  progressLog: [], // progress labels of the last scan read (tests read it)
+};

@@ -1,0 +1,201 @@
+// The report: the scan's line, the plan's statistics and warnings, its
+// quality and safe motion, the planners compared in a table and the plot
+// of every planner's error against slope and curvature.
+import { clearanceCapAboveTolMm } from '../pkg/pcpp.js';
+import { showFiducials } from './fiducials.js';
+import { $, fmt, fmtPoint, state } from './page.js';
+import { showScanPlacement } from './placement.js';
+import { drawPlot, plannerColor } from './plot.js';
+import { showError } from './status.js';
+import {
+  requestDraw, setViewShows, updateDragOffset, updateMarkers,
+} from './view.js';
+
+export function showScan(info, positions, indices, seconds) {
+  state.info = info;
+  $('scan-name').textContent = info.name;
+  const [lo, hi] = info.bbox_mm;
+  $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
+    + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
+    + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s; `
+    + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`
+    + (info.cloud_text ? `; ${info.cloud_text}` : '');
+  if (state.viewer) {
+    try {
+      state.viewer.setMesh(positions, indices);
+    } catch (e) {
+      showError('Could not draw the scan', e.message);
+    }
+  }
+  showFiducials();
+  updateMarkers();
+  showScanPlacement();
+  requestDraw();
+}
+
+export function showPlan(plan) {
+  const { summary, view } = plan;
+  if (state.viewer) {
+    try {
+      state.viewer.setPathArrays(view.pieces, view.ta, view.tool, view.defects);
+    } catch (e) {
+      showError('Could not draw the paths', e.message);
+    }
+    setViewShows('plan');
+    updateDragOffset();
+    requestDraw();
+  }
+  const st = summary.stats;
+  const pl = summary.settings.placement;
+  const rows = [
+    ['placement', `(${pl.offset_mm[0]}, ${pl.offset_mm[1]}) mm, ${pl.rotation_deg}°, × ${pl.scale}`, 'shown-placement'],
+    ['pieces', st.subpaths],
+    ['points', st.points],
+    ['tool-path length', `${fmt(st.length_mm, 2)} mm`],
+    ['height change', `${fmt(st.height_change_mm)} mm`],
+    ['max inclination', `${fmt(st.max_inclination_deg, 1)}°`],
+    ['min radius of curvature', `${fmt(st.min_radius_mm)} mm`],
+    ['print time', `${fmt(st.print_time_s, 1)} s`],
+    ['registration RMS', `${fmt(summary.registration_rms_mm, 4)} mm`],
+  ];
+  const body = $('stats-table').tBodies[0];
+  body.replaceChildren(...rows.map(([k, v, id]) => {
+    const tr = document.createElement('tr');
+    const a = document.createElement('td');
+    const b = document.createElement('td');
+    a.textContent = k;
+    b.textContent = String(v);
+    if (id) b.id = id;
+    tr.append(a, b);
+    return tr;
+  }));
+  $('warnings').replaceChildren(...summary.warnings.map((w) => {
+    const li = document.createElement('li');
+    li.textContent = w;
+    return li;
+  }));
+  showMotion(summary);
+  // A long path's plot waits for the end of a drag.
+  if (!state.interacting || view.defects.length < 20000) showErrorPlot();
+}
+
+// The plot of the plan on screen: every planner's errors (the last
+// comparison, if it was made for this plan), or one planner's coloured by
+// defect. During a drag only the plan being dragged is drawn.
+export function showErrorPlot() {
+  const plan = state.lastPlan;
+  if (!plan) return;
+  const { view, summary } = plan;
+  const c = state.lastComparison;
+  const n = view.defects.length;
+  const series = c && c.gen === plan.gen && c.series && c.series.every((x) => x.error.length === n)
+    ? c.series
+    : [{ planner: plan.planner, error: view.error, defects: view.defects }];
+  const choice = $('plot-series').value;
+  let shown;
+  if (choice === 'all') {
+    // The planner on screen last, on top of the others.
+    shown = [...series.filter((x) => x.planner !== plan.planner), ...series.filter((x) => x.planner === plan.planner)];
+  } else {
+    shown = series.filter((x) => x.planner === choice);
+  }
+  $('plot-legend').replaceChildren(...(choice === 'all' ? series : []).map((x) => {
+    const li = document.createElement('li');
+    const sw = document.createElement('i');
+    sw.className = 'sw';
+    sw.style.background = plannerColor(x.planner);
+    li.append(sw, x.planner);
+    return li;
+  }));
+  $('plot-note').textContent = shown.length === 0
+    ? `${choice}: compared after the drag or change ends`
+    : choice === 'all' ? `${shown.length} planner(s), one colour each` : `${choice}, coloured by predicted defect`;
+  drawPlot($('plot'), view, shown, choice === 'all', summary.settings.nozzle.inner_diameter_mm);
+}
+
+// A clearance as the tables show it: null is "more than tol + the cap"
+// (the planners' check finds the smallest clearance only that far).
+function fmtClearance(c, tol) {
+  return c === null || c === undefined ? `>${fmt(tol + clearanceCapAboveTolMm())}` : fmt(c);
+}
+
+export function cell(tr, text, cls, title) {
+  const td = document.createElement('td');
+  td.textContent = text;
+  if (cls) td.className = cls;
+  if (title) td.title = title;
+  tr.append(td);
+  return td;
+}
+
+export function showComparison(rows, selected, tol) {
+  $('compare-table').classList.remove('stale');
+  const body = $('compare-table').tBodies[0];
+  body.replaceChildren(...rows.map((r) => {
+    const q = r.quality;
+    const mo = r.motion;
+    const tr = document.createElement('tr');
+    tr.dataset.planner = r.planner;
+    if (r.planner === selected) tr.className = 'selected';
+    for (const v of [r.planner, fmt(q.mean_abs_error_mm, 4), fmt(q.mean_negative_error_mm, 4),
+      fmt(q.mean_positive_error_mm, 4), `${fmt(q.contact_pct, 1)}%`, `${fmt(q.flattening_pct, 1)}%`,
+      `${fmt(q.floating_pct, 1)}%`, `${fmt(q.contact_pct + q.flattening_pct + q.floating_pct, 1)}%`]) {
+      cell(tr, v);
+    }
+    cell(tr, String(mo.backward_moves), 'backward');
+    const t = mo.tol_mm ?? tol;
+    // Below tol the nozzle touches (or comes too close to) the surface.
+    const touching = mo.touching_moves > 0 || (mo.min_clearance_mm !== null && mo.min_clearance_mm < t);
+    cell(tr, fmtClearance(mo.min_clearance_mm, t), touching ? 'clearance bad' : 'clearance',
+      touching ? `${mo.touching_moves} print move(s) closer than tol = ${t} mm` : `tol = ${t} mm`);
+    cell(tr, String(mo.waypoints), 'waypoints');
+    return tr;
+  }));
+}
+
+// The plan's quality and safe motion (spec section 6f): the check of every
+// move its G-code commands, next to the predicted quality.
+function showMotion(summary) {
+  const q = summary.quality;
+  const m = summary.motion;
+  const p = m.program;
+  const touching = p.touching_moves > 0;
+  let clear = 'no move passes near the scan';
+  if (p.min_clearance_mm !== null && p.min_clearance_mm !== undefined) {
+    const at = p.min_clearance_at ? ` at (${p.min_clearance_at.map((v) => fmt(v, 2)).join(', ')})` : '';
+    const line = p.min_clearance_line ? `, G-code line ${p.min_clearance_line}` : '';
+    clear = `${fmt(p.min_clearance_mm)} mm${at}${line}`;
+  }
+  const rows = [
+    ['planner', summary.planner],
+    ['predicted quality', `mean |e| ${fmt(q.mean_abs_error_mm, 4)} mm; defects `
+      + `${fmt(q.contact_pct + q.flattening_pct + q.floating_pct, 1)}% (contact ${fmt(q.contact_pct, 1)}%, `
+      + `flattening ${fmt(q.flattening_pct, 1)}%, floating ${fmt(q.floating_pct, 1)}%)`],
+    ['min clearance, all moves', clear, 'motion-min-clear', touching ? 'bad' : ''],
+    ['moves too close (< tol)', `${p.touching_moves} of ${p.moves} (tol ${m.tol_mm} mm)`, 'motion-touching',
+      touching ? 'bad' : ''],
+    ['waypoints added', `${m.waypoints} (+${fmt(m.extra_length_mm)} mm)`, 'motion-waypoints'],
+    ['backward moves', String(m.backward_moves), 'motion-backward'],
+    ['max sideways offset', `${fmt(m.max_sideways_mm)} mm`],
+  ];
+  if (m.risk_accepted) rows.push(['risk', 'accepted: G-code with moves closer than tol', 'motion-risk', 'bad']);
+  const body = $('motion-table').tBodies[0];
+  body.replaceChildren(...rows.map(([k, v, id, cls]) => {
+    const tr = document.createElement('tr');
+    cell(tr, k);
+    const td = cell(tr, v, cls);
+    if (id) td.id = id;
+    return tr;
+  }));
+  $('motion-touches').replaceChildren(...p.touching.slice(0, 5).map((t) => {
+    const li = document.createElement('li');
+    li.textContent = fmtTouch(t);
+    return li;
+  }));
+}
+
+// A touching move in the core's words (motion::Touch's Display).
+function fmtTouch(t) {
+  return `${t.line ? `line ${t.line}: ` : ''}the move ${fmtPoint(t.from)} -> ${fmtPoint(t.to)} comes too close at `
+    + `${fmtPoint(t.at)}: the nozzle would have to be ${fmt(t.rise_mm)} mm higher there`;
+}

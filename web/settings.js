@@ -1,0 +1,383 @@
+// The settings and their form: defaults (the demo part's), storage in
+// localStorage, the settings object the core reads (job::JobSettings), the
+// path to plan (a file, an antenna or a demo drawing) and the binding of
+// every field, which re-plans as it changes.
+import {
+  antennaSvg, demoPart, demoParts, dialects, parsePoints, pathBounds, planners,
+} from '../pkg/pcpp.js';
+import { fmtPoints, pointsEdited } from './fiducials.js';
+import { $, hooks, num, settings, state } from './page.js';
+import {
+  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, sanitizeScanPlace, scanPlacementFor, setNote,
+  showScanPlacement,
+} from './placement.js';
+
+const STORE_KEY = 'pcpp.settings.v1';
+// Common dispensing-tip gauges: inner / outer diameter, mm.
+const GAUGES = [
+  ['20 G', 0.603, 0.908],
+  ['22 G', 0.413, 0.718],
+  ['25 G', 0.26, 0.515],
+  ['27 G', 0.21, 0.413],
+  ['30 G', 0.159, 0.312],
+];
+const encoder = new TextEncoder();
+
+// A built-in demo part (wasm demoPart): its drawing, names and settings,
+// made once per part.
+export function demoInfo(name) {
+  let info = state.demoParts.get(name);
+  if (!info) {
+    info = demoPart(name);
+    state.demoParts.set(name, info);
+  }
+  return info;
+}
+
+export function demoUiSettings(part = 'test-part') {
+  const d = demoInfo(part).settings;
+  const pl = d.plan.placement;
+  return {
+    demoPart: part,
+    scanUnits: '',
+    scanUp: '',
+    scanMaxEdge: '',
+    fidSource: d.registration.fiducials === 'auto' ? 'auto' : 'none',
+    fidMethod: d.registration.method,
+    dotDiameter: d.registration.dot_diameter_mm,
+    // An unregistered scan placed on the bed (placement.js).
+    scanPlace: { ...SCAN_PLACE_DEFAULT },
+    fidScanText: '',
+    fidPrinterText: fmtPoints(d.registration.printer_points),
+    pathSource: 'demo',
+    spiral: { turns: null, pitch_mm: 1.5, inner_radius_mm: 1 },
+    hilbert: { order: 3, size_mm: 20 },
+    monopole: { height_mm: 20, base_mm: 15, feed_mm: 5 },
+    placement: { x: pl.offset_mm[0], y: pl.offset_mm[1], rot: pl.rotation_deg, scale: pl.scale },
+    nozzle: { id: d.plan.nozzle.inner_diameter_mm, od: d.plan.nozzle.outer_diameter_mm },
+    process: {
+      tol: d.plan.process.tolerance_mm,
+      speed: d.plan.process.speed_mm_s,
+      dwell: d.plan.process.dwell_s,
+    },
+    planner: d.plan.planner,
+    dialect: 'marlin',
+    // A user's machine profile {name, file, text}; dialect 'custom' uses it.
+    customProfile: null,
+    acceptRisk: false,
+  };
+}
+
+export function loadSettings() {
+  const base = demoUiSettings();
+  try {
+    const saved = JSON.parse(localStorage.getItem(STORE_KEY) || 'null');
+    if (saved && typeof saved === 'object') {
+      for (const k of Object.keys(base)) {
+        if (!(k in saved)) continue;
+        const b = base[k];
+        base[k] = b && typeof b === 'object' ? { ...b, ...saved[k] } : saved[k];
+      }
+    }
+  } catch {
+    // Unreadable saved settings: start from the demo's.
+  }
+  // A saved "SVG file" source needs the kept SVG (restoreInputs).
+  const cp = base.customProfile;
+  if (!cp || typeof cp.text !== 'string' || typeof cp.name !== 'string') base.customProfile = null;
+  if (base.dialect === 'custom' && !base.customProfile) base.dialect = 'marlin';
+  if (!demoParts().some((p) => p.name === base.demoPart)) base.demoPart = 'test-part';
+  if (!planners().includes(base.planner)) base.planner = demoUiSettings().planner;
+  base.scanPlace = sanitizeScanPlace(base.scanPlace);
+  return base;
+}
+
+export function saveSettings() {
+  try {
+    localStorage.setItem(STORE_KEY, JSON.stringify(settings));
+  } catch {
+    // Private mode or a full quota: settings just do not persist.
+  }
+}
+
+// What the library reads: a `job::JobSettings` for planning on `scan`.
+export function jobSettings(scan) {
+  const s = settings;
+  let fiducials = 'none';
+  let printer = [];
+  if (s.fidSource !== 'none' && !(scan && scan.unregistered)) {
+    printer = parseField('printer points P', s.fidPrinterText);
+    fiducials = s.fidSource === 'auto' ? 'auto' : { points: parseField('scan points Sr', s.fidScanText) };
+  }
+  const dot = num(s.dotDiameter);
+  if (!(dot > 0)) throw new Error('fiducial dot diameter: type a diameter in mm, greater than 0 (default 1)');
+  return {
+    scan: {
+      units: s.scanUnits || null,
+      up_axis: s.scanUp || null,
+      max_edge_mm: String(s.scanMaxEdge ?? '').trim() === '' ? null : num(s.scanMaxEdge),
+    },
+    registration: {
+      fiducials,
+      printer_points: printer,
+      method: s.fidMethod,
+      dot_diameter_mm: dot,
+      scan_placement: scanPlacementFor(scan),
+    },
+    plan: {
+      nozzle: { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) },
+      process: {
+        tolerance_mm: num(s.process.tol),
+        speed_mm_s: num(s.process.speed),
+        dwell_s: num(s.process.dwell),
+      },
+      planner: s.planner,
+      placement: {
+        offset_mm: [num(s.placement.x), num(s.placement.y)],
+        rotation_deg: num(s.placement.rot),
+        scale: num(s.placement.scale),
+      },
+    },
+  };
+}
+
+function parseField(label, text) {
+  try {
+    return parsePoints(text || '');
+  } catch (e) {
+    throw new Error(`${label}: ${e.message}`);
+  }
+}
+
+function antennaParams(kind) {
+  const p = { ...settings[kind] };
+  if (kind === 'spiral' && (p.turns === null || p.turns === '' || Number.isNaN(p.turns))) delete p.turns;
+  for (const k of Object.keys(p)) p[k] = num(p[k]);
+  if (kind === 'hilbert') p.order = Math.round(p.order);
+  return p;
+}
+
+// The path to plan: {key, name, bytes}. Generated paths are keyed by their
+// parameters and made once per key (a drag re-plans many times a second).
+export function currentSvg() {
+  const made = (key, name, text) => {
+    if (!state.svgMade || state.svgMade.key !== key) {
+      state.svgMade = { key, name, bytes: encoder.encode(text()) };
+    }
+    return state.svgMade;
+  };
+  switch (settings.pathSource) {
+    case 'file': {
+      const f = state.pendingSvg || state.svgFile;
+      if (!f) throw new Error('no SVG file loaded: open one, or choose another path source');
+      return f;
+    }
+    case 'spiral':
+    case 'hilbert':
+    case 'monopole': {
+      const kind = settings.pathSource;
+      const params = antennaParams(kind);
+      return made(`antenna-${kind}-${JSON.stringify(params)}`, `antenna-${kind}.svg`,
+        () => antennaSvg(kind, params));
+    }
+    default: {
+      const part = demoInfo(settings.demoPart);
+      return made(`demo-${part.name}`, part.path_name, () => part.svg);
+    }
+  }
+}
+
+// ---------- form binding ----------
+
+// [element id, getter, setter, when to re-plan]: 'live' on every input
+// event at once (sliders; the comparison of every planner waits for the
+// release), 'typed' on every keystroke after a short pause, otherwise on
+// change. Re-plans are coalesced: only the newest settings are planned.
+const FIELDS = [
+  ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; }],
+  ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
+  ['scan-max-edge', () => settings.scanMaxEdge, (v) => { settings.scanMaxEdge = v; }],
+  ['fid-source', () => settings.fidSource, (v) => { settings.fidSource = v; }],
+  ['fid-method', () => settings.fidMethod, (v) => { settings.fidMethod = v; }],
+  ['fid-dot', () => settings.dotDiameter, (v) => { settings.dotDiameter = v === '' ? NaN : Number(v); }, 'typed'],
+  ['fid-scan', () => settings.fidScanText, (v) => { settings.fidScanText = v; }],
+  ['fid-printer', () => settings.fidPrinterText, (v) => { settings.fidPrinterText = v; }],
+  ['path-source', () => settings.pathSource, (v) => { settings.pathSource = v; }],
+  ['sp-turns', () => settings.spiral.turns, (v) => { settings.spiral.turns = v === '' ? null : Number(v); }],
+  ['sp-pitch', () => settings.spiral.pitch_mm, (v) => { settings.spiral.pitch_mm = Number(v); }],
+  ['sp-inner', () => settings.spiral.inner_radius_mm, (v) => { settings.spiral.inner_radius_mm = Number(v); }],
+  ['hb-order', () => settings.hilbert.order, (v) => { settings.hilbert.order = Number(v); }],
+  ['hb-size', () => settings.hilbert.size_mm, (v) => { settings.hilbert.size_mm = Number(v); }],
+  ['mp-height', () => settings.monopole.height_mm, (v) => { settings.monopole.height_mm = Number(v); }],
+  ['mp-base', () => settings.monopole.base_mm, (v) => { settings.monopole.base_mm = Number(v); }],
+  ['mp-feed', () => settings.monopole.feed_mm, (v) => { settings.monopole.feed_mm = Number(v); }],
+  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, 'typed'],
+  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, 'typed'],
+  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'typed'],
+  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'typed'],
+  ['pl-rot-range', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'live'],
+  ['pl-scale-range', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'live'],
+  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }, 'typed'],
+  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }, 'typed'],
+  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }, 'typed'],
+  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = Number(v); }, 'typed'],
+  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = Number(v); }, 'typed'],
+  ['planner', () => settings.planner, (v) => { settings.planner = v; }],
+  ['dialect', () => settings.dialect, (v) => { settings.dialect = v; }],
+  ['accept-risk', () => settings.acceptRisk, (v) => { settings.acceptRisk = v; }],
+];
+
+export function writeForm() {
+  for (const [id, get] of FIELDS) {
+    const el = $(id);
+    const v = get();
+    if (el.type === 'checkbox') el.checked = !!v;
+    else el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+  }
+  syncGauge();
+  syncVisibility();
+}
+
+export function syncGauge() {
+  const id = Number(settings.nozzle.id);
+  const od = Number(settings.nozzle.od);
+  const i = GAUGES.findIndex(([, a, b]) => a === id && b === od);
+  $('gauge').value = i >= 0 ? String(i) : 'custom';
+}
+
+export function syncVisibility() {
+  const part = demoInfo(settings.demoPart);
+  $('path-source').querySelector('option[value="demo"]').textContent = `demo: ${part.name} drawing`;
+  $('demo-part').value = part.name;
+  $('demo-part').title = part.description;
+  for (const k of ['spiral', 'hilbert', 'monopole']) $(`antenna-${k}`).hidden = settings.pathSource !== k;
+  $('fid-scan-wrap').hidden = settings.fidSource !== 'points' && !state.picking;
+  const svg = settings.pathSource === 'file' ? state.pendingSvg || state.svgFile : null;
+  $('svg-name').textContent = settings.pathSource === 'file'
+    ? (svg ? svg.name : 'no SVG file loaded')
+    : $('path-source').selectedOptions[0].textContent;
+}
+
+// Number fields and their sliders show the same setting.
+const PAIRS = { 'pl-rot': 'pl-rot-range', 'pl-rot-range': 'pl-rot', 'pl-scale': 'pl-scale-range', 'pl-scale-range': 'pl-scale' };
+
+// Writes one field from the settings (not the one being typed in: that
+// would rewrite "1." as "1" under the user's cursor).
+export function writeField(id) {
+  const f = FIELDS.find((x) => x[0] === id);
+  if (!f) return;
+  const el = $(id);
+  const v = f[1]();
+  el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+}
+
+export function bindForm() {
+  for (const [id, , set, mode] of FIELDS) {
+    const el = $(id);
+    // Antenna SVGs measure from their page's corner, so a new size moves
+    // the antenna; keep its centre where the user placed it.
+    const antennaField = /^(sp|hb|mp)-/.test(id);
+    const handler = () => {
+      const before = antennaField ? pathCentre() : null;
+      const value = el.type === 'checkbox' ? el.checked : el.value;
+      // A new profile has its own bed: a scan placed on it moves, and the
+      // drawing with it.
+      if (id === 'dialect') moveScan(() => set(value));
+      else set(value);
+      if (/^pl-/.test(id)) {
+        // The user places the drawing: no centring over it.
+        cancelCentre();
+        setNote('');
+      }
+      if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
+      const after = before ? pathCentre() : null;
+      if (before && after) {
+        const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);
+        settings.placement.x = +(num(settings.placement.x) + dx).toFixed(3);
+        settings.placement.y = +(num(settings.placement.y) + dy).toFixed(3);
+        writeForm();
+      }
+      if (PAIRS[id]) writeField(PAIRS[id]);
+      saveSettings();
+      syncGauge();
+      syncVisibility();
+      showScanPlacement();
+      if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
+        requestCentre(true);
+      }
+      if (mode === 'live') {
+        state.interacting = true;
+        hooks.planNow();
+      } else {
+        hooks.schedulePlan(mode === 'typed' ? 120 : 350);
+      }
+    };
+    el.addEventListener(mode || el.tagName === 'TEXTAREA' ? 'input' : 'change', handler);
+    if (mode === 'live') {
+      // The slider is let go: plan once more with the comparison.
+      el.addEventListener('change', () => hooks.endInteraction());
+    }
+  }
+  const gauge = $('gauge');
+  GAUGES.forEach(([name, id, od], i) => gauge.add(new Option(`${name}  (${id} / ${od} mm)`, String(i))));
+  gauge.add(new Option('custom', 'custom'));
+  gauge.addEventListener('change', () => {
+    const g = GAUGES[Number(gauge.value)];
+    if (!g) return;
+    settings.nozzle.id = g[1];
+    settings.nozzle.od = g[2];
+    saveSettings();
+    writeForm();
+    hooks.schedulePlan(0);
+  });
+  const dialect = $('dialect');
+  for (const d of dialects()) dialect.add(new Option(d, d));
+  const planner = $('planner');
+  for (const p of planners()) planner.add(new Option(p, p));
+  const plot = $('plot-series');
+  plot.add(new Option('every planner', 'all'));
+  for (const p of planners()) plot.add(new Option(p, p));
+  plot.addEventListener('change', () => hooks.showErrorPlot());
+  const demo = $('demo-part');
+  for (const p of demoParts()) {
+    const o = new Option(p.name, p.name);
+    o.title = p.description;
+    demo.add(o);
+  }
+  demo.addEventListener('change', () => hooks.loadDemo(demo.value));
+  syncProfileOption();
+}
+
+// The dialect list's entry for the user's own profile, if one is loaded.
+export function syncProfileOption() {
+  const dialect = $('dialect');
+  let opt = dialect.querySelector('option[value="custom"]');
+  const cp = settings.customProfile;
+  if (!cp) {
+    if (opt) opt.remove();
+    return;
+  }
+  if (!opt) {
+    opt = new Option('', 'custom');
+    dialect.add(opt);
+  }
+  opt.textContent = `custom: ${cp.name} (${cp.file})`;
+}
+
+// The centre of the path's box as imported (before placement), or null.
+function pathCentre() {
+  try {
+    const svg = currentSvg();
+    const b = pathBounds(svg.bytes, svg.name);
+    return [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
+  } catch {
+    return null;
+  }
+}
+
+// A drawing-frame vector after the placement's rotation and scale.
+function placed([x, y]) {
+  const s = num(settings.placement.scale);
+  const a = (num(settings.placement.rot) * Math.PI) / 180;
+  return [s * (Math.cos(a) * x - Math.sin(a) * y), s * (Math.sin(a) * x + Math.cos(a) * y)];
+}

@@ -1,0 +1,57 @@
+// The page's error panel, status line and progress of a plan: what every
+// other module reports through.
+import { $, state } from './page.js';
+
+export function showError(title, message) {
+  $('error-title').textContent = title;
+  $('error-message').textContent = message;
+  $('error-panel').hidden = false;
+}
+
+export function clearError() {
+  $('error-panel').hidden = true;
+}
+
+export function setStatus(text, stale) {
+  const el = $('plan-status');
+  el.textContent = text;
+  el.classList.toggle('stale', !!stale);
+}
+
+const STAGES = ['read', 'import', 'register', 'index', 'plan'];
+
+export function showProgress(stage, label, fraction) {
+  $('progress').hidden = false;
+  const at = STAGES.indexOf(stage);
+  for (const li of $('stages').children) {
+    const i = STAGES.indexOf(li.dataset.stage);
+    li.classList.toggle('active', i === at);
+    li.classList.toggle('done', at >= 0 && i < at);
+  }
+  $('progress-label').textContent = label || '';
+  const bar = $('progress-bar');
+  bar.hidden = stage !== 'read' || !(fraction >= 0);
+  if (!bar.hidden) bar.value = fraction;
+}
+
+// A plan's progress and Cancel appear only once it has taken a moment:
+// during a drag, plans of a few milliseconds would make the toolbar flicker.
+const PROGRESS_DELAY_MS = 250;
+
+export function laterProgress(label) {
+  state.progressLabel = label;
+  if (state.progressTimer || !$('progress').hidden) return;
+  state.progressTimer = setTimeout(() => {
+    state.progressTimer = 0;
+    if (!state.busy) return;
+    $('cancel-btn').hidden = false;
+    showProgress('plan', state.progressLabel);
+  }, PROGRESS_DELAY_MS);
+}
+
+export function endProgress() {
+  clearTimeout(state.progressTimer);
+  state.progressTimer = 0;
+  $('progress').hidden = true;
+  $('cancel-btn').hidden = true;
+}
