@@ -1,6 +1,10 @@
 //! A whole planning job, bytes in, G-code and a JSON report out: the one
 //! entry the CLI and the page both call, so that for the same inputs and
 //! settings they write identical bytes.
+//!
+//! Length: about 970 lines before its tests: the job's settings, the
+//! prepared scan, the report and the checked write of the outputs belong
+//! together, as the one contract the two adapters share.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

@@ -5,6 +5,8 @@
 //! clearance (the motion check's [`Clearance::gap`], spec section 6f) or by
 //! the predicted defect of the planned point it prints (spec section 7).
 //!
+//! Length: just over 800 lines, a third of them tests.
+//!
 //! It also holds what the page draws of a plan ([`PlanArrays`]): the
 //! per-point arrays, built here so that the wasm bindings only convert them.
 //!

@@ -3,6 +3,8 @@
 //! import and registration) and [`Session`] (a prepared scan that plans,
 //! checks G-code and previews it). Part of [`crate::wasm`]: they only
 //! convert types; every decision is made by [`crate::job`] and the core.
+//!
+//! Length: about 800 lines of bindings, each a few lines of conversion.
 
 use glam::DVec3;
 use serde::Serialize;
