@@ -438,12 +438,13 @@ pub struct TouchingMoves {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::mesh::TriMesh;
 
-    /// A block 2 mm high from x = 5 on, true vertical wall.
-    fn step() -> Surface {
+    /// A block 2 mm high from x = 5 on, true vertical wall (also the
+    /// preview's tests' step).
+    pub(crate) fn step() -> Surface {
         let xs = [0.0, 5.0, 5.0, 10.0];
         let ys = [0.0, 10.0];
         let mut m = TriMesh::default();

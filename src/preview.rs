@@ -5,7 +5,7 @@
 //! clearance (the motion check's [`Clearance::gap`], spec section 6f) or by
 //! the predicted defect of the planned point it prints (spec section 7).
 //!
-//! Length: just over 800 lines, a third of them tests.
+//! Length: about 800 lines, a third of them tests.
 //!
 //! It also holds what the page draws of a plan ([`PlanArrays`]): the
 //! per-point arrays, built here so that the wasm bindings only convert them.
@@ -582,7 +582,7 @@ pub fn plan_errors(plan: &Plan) -> (Vec<f32>, Vec<u8>) {
 mod tests {
     use super::*;
     use crate::gcode::read_gcode;
-    use crate::mesh::TriMesh;
+    use crate::motion::tests::step;
     use crate::params::Nozzle;
 
     fn marlin_rules() -> FeedRules {
@@ -690,23 +690,6 @@ mod tests {
             .nearest_to_ray(DVec3::new(7.0, 0.0, 50.0), DVec3::Z, 0.5)
             .is_none());
         assert!(t.nearest_to_ray(DVec3::ZERO, DVec3::ZERO, 1.0).is_none());
-    }
-
-    /// A block 2 mm high from x = 5 on (the motion tests' step).
-    fn step() -> Surface {
-        let xs = [0.0, 5.0, 5.0, 10.0];
-        let mut m = TriMesh::default();
-        for y in [0.0, 10.0] {
-            for (i, &x) in xs.iter().enumerate() {
-                m.vertices
-                    .push(DVec3::new(x, y, if i >= 2 { 2.0 } else { 0.0 }));
-            }
-        }
-        for i in 0..3u32 {
-            m.triangles.push([i, i + 1, i + 5]);
-            m.triangles.push([i, i + 5, i + 4]);
-        }
-        Surface::new(m).unwrap()
     }
 
     #[test]
