@@ -219,7 +219,7 @@ fn the_demo_part_as_a_point_cloud_in_every_format_gives_the_meshs_fiducials_and_
 
 #[test]
 fn hostile_point_clouds_get_clear_errors() {
-    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+    let mut cases: Vec<(&str, Vec<u8>, &str)> = vec![
         (
             "ragged.xyz",
             b"1 2 3\n4 5\n".to_vec(),
@@ -252,6 +252,18 @@ fn hostile_point_clouds_get_clear_errors() {
             "at least 3 points",
         ),
     ];
+    // A binary PCD point at infinity: the import's check names the point.
+    let mut inf = b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA binary\n".to_vec();
+    for p in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, f32::INFINITY, 0.0],
+    ] {
+        for v in p {
+            inf.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    cases.push(("inf.pcd", inf, "vertex 2 has a non-finite coordinate (inf)"));
     for (name, bytes, want) in cases {
         let e = import_mesh(&bytes, name, &ImportOptions::DEFAULT)
             .err()

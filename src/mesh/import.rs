@@ -7,7 +7,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use glam::DVec3;
 
 use super::{cloud, gltf, obj, pcd, ply, stl, xyz};
-use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, TriMesh, UpAxis};
+use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, ScanUnits, TriMesh, UpAxis};
 
 /// What a format parser hands to the shared steps: positions in the file's
 /// own units and axes, indices already resolved to 0-based.
@@ -157,7 +157,7 @@ pub fn import_mesh(
         _ => false,
     };
     if cloud {
-        return import_cloud(parsed, file, format, options, units.to_mm(), up_axis);
+        return import_cloud(parsed, file, format, options.max_edge_mm, units, up_axis);
     }
     // STL and glTF parsers weld as they read; OBJ and PLY files from
     // exporters often split vertices at UV seams too (a Blender PLY cube has
@@ -181,8 +181,8 @@ fn import_cloud(
     parsed: Parsed,
     file: &str,
     format: MeshFormat,
-    options: &ImportOptions,
-    scale: f64,
+    max_edge_mm: Option<f64>,
+    units: ScanUnits,
     up_axis: UpAxis,
 ) -> Result<ImportedMesh, MeshError> {
     let Parsed {
@@ -191,14 +191,8 @@ fn import_cloud(
         ..
     } = parsed;
     check_finite(&vertices, file)?;
-    for v in &mut vertices {
-        let p = *v * scale;
-        *v = match up_axis {
-            UpAxis::Z => p,
-            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
-        };
-    }
-    let (mesh, info) = cloud::triangulate(vertices, options.max_edge_mm, file)?;
+    to_printer_frame(&mut vertices, units.to_mm(), up_axis);
+    let (mesh, info) = cloud::triangulate(vertices, max_edge_mm, file)?;
     check_triangle_count(mesh.triangle_count(), file)?;
     if info.merged > 0 {
         warnings.push(format!(
@@ -209,11 +203,23 @@ fn import_cloud(
     Ok(ImportedMesh {
         mesh,
         format,
-        units: options.units.unwrap_or(format.default_units()),
+        units,
         up_axis,
         warnings,
         cloud: Some(info),
     })
+}
+
+/// The file's units to mm and its up axis to the printer's +Z.
+fn to_printer_frame(vertices: &mut [DVec3], scale: f64, up_axis: UpAxis) {
+    for v in vertices {
+        let p = *v * scale;
+        *v = match up_axis {
+            UpAxis::Z => p,
+            // +90 deg about X takes the file's +Y to the printer's +Z.
+            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+        };
+    }
 }
 
 /// The first vertex with a non-finite coordinate, as an error.
@@ -329,14 +335,7 @@ fn finish(
         return Err(MeshError::Empty { file: file.into() });
     }
     check_triangle_count(kept.len(), file)?;
-    for v in &mut vertices {
-        let p = *v * scale;
-        *v = match up_axis {
-            UpAxis::Z => p,
-            // +90 deg about X takes the file's +Y to the printer's +Z.
-            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
-        };
-    }
+    to_printer_frame(&mut vertices, scale, up_axis);
     Ok((
         TriMesh {
             vertices,
