@@ -149,23 +149,15 @@ impl FromStr for DemoPart {
 }
 
 /// The placement that puts the centre of the drawing's bounding box at
-/// `centre`.
+/// `centre` (the page's and `--place centre`'s centring, on a footprint of
+/// one point: nothing to scale to).
 fn centred(svg: &str, centre: DVec2) -> Placement {
-    let Ok(drawn) = crate::svg::import_svg(svg.as_bytes(), "demo.svg") else {
-        return Placement::IDENTITY;
-    };
-    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    for p in drawn.iter().flat_map(|s| &s.points) {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Placement::IDENTITY;
-    }
-    Placement {
-        offset_mm: centre - 0.5 * (lo + hi),
-        ..Placement::IDENTITY
-    }
+    crate::svg::import_svg(svg.as_bytes(), "demo.svg")
+        .ok()
+        .and_then(|drawn| {
+            crate::placement::centre_drawing(&drawn, (centre, centre), &Placement::IDENTITY)
+        })
+        .map_or(Placement::IDENTITY, |(placement, _)| placement)
 }
 
 /// A grid over `xs` x `ys` whose x coordinates may repeat at a vertical
