@@ -234,16 +234,6 @@ impl Surface {
         });
         best.map(|t| a + dir * t)
     }
-
-    /// The highest z of the scan over the horizontal disk of `radius` around
-    /// `xy` (the footprint of a vertical flat-ended nozzle there), `None` if
-    /// the scan has nothing under it: the point case of the flat cutter of
-    /// [`Self::sweep_gap`].
-    pub fn max_height_in_disk(&self, xy: DVec2, radius: f64) -> Option<f64> {
-        let p = xy.extend(self.top_z() + 1.0);
-        self.sweep_gap(p, p, radius, f64::INFINITY)
-            .map(|g| p.z - g.gap_mm)
-    }
 }
 
 /// Whether the triangle's box meets the query box (exact, in f64): the index
@@ -455,12 +445,21 @@ pub(crate) mod tests {
         best
     }
 
+    /// The highest z over the disk by the sweep's point case (a flat
+    /// cutter standing above the scan): what the planners' point queries
+    /// rest on.
+    fn max_height_in_disk(s: &Surface, xy: DVec2, radius: f64) -> Option<f64> {
+        let p = xy.extend(s.top_z() + 1.0);
+        s.sweep_gap(p, p, radius, f64::INFINITY)
+            .map(|g| p.z - g.gap_mm)
+    }
+
     #[test]
     fn the_flat_footprint_query_matches_the_reference() {
         let s = Surface::new(grid(40, 10.0, |x, y| (x * 1.7).sin() + 0.3 * y)).unwrap();
         for k in 0..200 {
             let c = DVec2::new(0.5 + 0.045 * k as f64, 2.0 + 0.03 * k as f64);
-            let a = s.max_height_in_disk(c, 0.45).unwrap();
+            let a = max_height_in_disk(&s, c, 0.45).unwrap();
             let b = reference_max_height_in_disk(&s, c, 0.45).unwrap();
             assert!((a - b).abs() < 1e-9, "{c}: {a} vs {b}");
         }
@@ -536,14 +535,14 @@ pub(crate) mod tests {
     #[test]
     fn max_height_over_a_footprint() {
         let s = Surface::new(grid(20, 10.0, |x, y| 0.5 * x + 0.0 * y)).unwrap();
-        let z = s.max_height_in_disk(DVec2::new(5.0, 5.0), 1.0).unwrap();
+        let z = max_height_in_disk(&s, DVec2::new(5.0, 5.0), 1.0).unwrap();
         assert!((z - 3.0).abs() < 1e-9, "{z}");
         // A cone-ish bump: peak inside the disk dominates.
         let s = Surface::new(grid(40, 10.0, |x, y| {
             2.0 - ((x - 5.0).powi(2) + (y - 5.0).powi(2)).sqrt()
         }))
         .unwrap();
-        let z = s.max_height_in_disk(DVec2::new(5.2, 5.0), 0.5).unwrap();
+        let z = max_height_in_disk(&s, DVec2::new(5.2, 5.0), 0.5).unwrap();
         assert!((z - 2.0).abs() < 1e-9, "{z}");
     }
 

@@ -217,7 +217,7 @@ impl Move {
     #[inline]
     fn consider(&self, s: f64, q: DVec3, h: f64, best: &mut Best) {
         let s = s.clamp(0.0, 1.0);
-        let gap = self.a.z + s * self.dz - q.z - h;
+        let gap = self.value(s, q, h);
         if gap < best.gap {
             best.gap = gap;
             best.found = Some((s, q));
