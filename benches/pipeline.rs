@@ -7,7 +7,7 @@
 //! - `import/W1 OBJ + index`: the OBJ's `prepare_scan`, what the wasm script
 //!   can time (its API imports only through a Session);
 //! - `plan/W2 ...`, `plan/W3 ...`: the planning stages (project, spline,
-//!   pcpp-guarded, quality: `pipeline::plan`) of the paper's spiral and a
+//!   the default planner with its safe-motion stage, quality: `pipeline::plan`) of the paper's spiral and a
 //!   100k-point raster on the 2 M triangle film;
 //! - `job/W2 ...`, `job/W3 ...`: the whole `job::run_on` (SVG read, plan,
 //!   report, G-code), what the wasm `Session.plan` runs;
@@ -20,7 +20,8 @@
 //! - `cloud/W4 ...`: a million raw points (W4) meshed (issue 14: under
 //!   2 s natively), read from XYZ text, and with the holes and index.
 //!
-//! `PCPP_BENCH_N` shrinks the film (grid cells per side, default 1000).
+//! `PCPP_BENCH_N` shrinks the film (grid cells per side, default 1000), and
+//! W4 with it.
 //! `PCPP_BENCH_CLOCK=cpu` times the bench thread's CPU time instead of wall
 //! time (see [`Clock`]). `scripts/bench.sh` runs these with the wasm timings
 //! and prints the table.
@@ -29,7 +30,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
-use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, SamplingMode, Throughput};
 use pcpp::demo::{to_binary_ply, workloads};
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{self, prepare_scan, JobSettings};
@@ -142,19 +143,22 @@ fn motion_benches(c: &mut Criterion<Clock>) {
 /// Issue 14: W4, a million raw points, read and meshed (target: under 2 s
 /// natively).
 fn cloud_benches(c: &mut Criterion<Clock>) {
-    let side = std::env::var("PCPP_BENCH_CLOUD_SIDE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(workloads::CLOUD_SIDE);
+    // As examples/workloads.rs writes W4: the film's grid, at most
+    // CLOUD_SIDE points a side.
+    let side = (n() + 1).min(workloads::CLOUD_SIDE);
     let points = workloads::film_cloud(side);
     let xyz = workloads::to_xyz(&points);
     let mut g = c.benchmark_group("cloud");
     g.sample_size(10).sampling_mode(SamplingMode::Flat);
-    g.bench_function("W4 1M points: triangulate", |b| {
-        b.iter(|| pcpp::mesh::triangulate(black_box(points.clone()), None, "W4").unwrap())
+    g.bench_function("W4 points: triangulate", |b| {
+        b.iter_batched(
+            || points.clone(),
+            |p| pcpp::mesh::triangulate(p, None, "W4").unwrap(),
+            BatchSize::LargeInput,
+        )
     });
     g.throughput(Throughput::Bytes(xyz.len() as u64));
-    g.bench_function("W4 1M points: XYZ import + mesh", |b| {
+    g.bench_function("W4 points: XYZ import + mesh", |b| {
         b.iter(|| {
             pcpp::mesh::import_mesh(
                 black_box(xyz.as_bytes()),
@@ -165,8 +169,8 @@ fn cloud_benches(c: &mut Criterion<Clock>) {
         })
     });
     // What the page's Session does with it: also the holes and the index.
-    let (w2,) = (workloads::w2_settings(),);
-    g.bench_function("W4 1M points: XYZ + index", |b| {
+    let w2 = workloads::w2_settings();
+    g.bench_function("W4 points: XYZ + index", |b| {
         b.iter(|| {
             prepare_scan(
                 black_box(xyz.as_bytes()),
@@ -215,11 +219,11 @@ fn benches(c: &mut Criterion<Clock>) {
 
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);
-    g.bench_function("W2 spiral on W1 (pcpp-guarded + quality)", |b| {
+    g.bench_function("W2 spiral on W1 (default planner + quality)", |b| {
         b.iter(|| pipeline::plan(&scan.surface, black_box(&spiral.subpaths), &w2.plan).unwrap())
     });
     g.sampling_mode(SamplingMode::Flat);
-    g.bench_function("W3 raster on W1 (pcpp-guarded + quality)", |b| {
+    g.bench_function("W3 raster on W1 (default planner + quality)", |b| {
         b.iter(|| pipeline::plan(&scan.surface, black_box(&raster.subpaths), &w3.plan).unwrap())
     });
     g.finish();

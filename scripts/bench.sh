@@ -116,13 +116,13 @@ const plyS = bench('import/W1 binary PLY + index').median_s;
 const obj = bench('import/W1 OBJ text');
 const objMbS = obj.bytes / 1e6 / obj.median_s;
 const objSessionS = bench('import/W1 OBJ + index').median_s;
-const w2S = bench('plan/W2 spiral on W1 (pcpp-guarded + quality)').median_s;
-const w3S = bench('plan/W3 raster on W1 (pcpp-guarded + quality)').median_s;
+const w2S = bench('plan/W2 spiral on W1 (default planner + quality)').median_s;
+const w3S = bench('plan/W3 raster on W1 (default planner + quality)').median_s;
 const w2JobS = bench('job/W2 plan + report + G-code').median_s;
 const w3JobS = bench('job/W3 plan + report + G-code').median_s;
-const w4MeshS = bench('cloud/W4 1M points: XYZ import + mesh').median_s;
-const w4TriS = bench('cloud/W4 1M points: triangulate').median_s;
-const w4SessionS = bench('cloud/W4 1M points: XYZ + index').median_s;
+const w4MeshS = bench('cloud/W4 points: XYZ import + mesh').median_s;
+const w4TriS = bench('cloud/W4 points: triangulate').median_s;
+const w4SessionS = bench('cloud/W4 points: XYZ + index').median_s;
 const memW4 = readFileSync('target/bench/native-memory-w4.txt', 'utf8');
 const peakW4 = Number(/peak_rss_bytes=(\d+)/.exec(memW4)?.[1] ?? die('no peak_rss_bytes for W4'));
 
@@ -135,7 +135,7 @@ const rows = [
     '<= 1.2 s', f(wasm.ply_session_s, 2) + ' s', wasm.ply_session_s <= 1.2],
   ['W1 OBJ import', '>= 200 MB/s', f(objMbS, 0) + ' MB/s', objMbS >= 200,
     '>= 120 MB/s', f(wasm.obj_session_mb_s, 0) + ' MB/s (a)', wasm.obj_session_mb_s >= 120],
-  ['plan W2 on W1 (project, spline, pcpp-guarded, quality)', '<= 5 ms', ms(w2S), w2S <= 0.005,
+  ['plan W2 on W1 (project, spline, the default planner with its safe-motion stage, quality)', '<= 5 ms', ms(w2S), w2S <= 0.005,
     '<= 10 ms', ms(wasm.w2_plan_ms / 1e3) + ' (b)', wasm.w2_plan_ms <= 10],
   ['plan W3 on W1', '<= 150 ms', ms(w3S), w3S <= 0.15,
     '<= 250 ms', ms(wasm.w3_plan_ms / 1e3) + ' (b)', wasm.w3_plan_ms <= 250],
