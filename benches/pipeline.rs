@@ -7,8 +7,9 @@
 //! - `import/W1 OBJ + index`: the OBJ's `prepare_scan`, what the wasm script
 //!   can time (its API imports only through a Session);
 //! - `plan/W2 ...`, `plan/W3 ...`: the planning stages (project, spline,
-//!   the default planner with its safe-motion stage, quality: `pipeline::plan`) of the paper's spiral and a
-//!   100k-point raster on the 2 M triangle film;
+//!   the default planner with its safe-motion stage, quality:
+//!   `pipeline::plan`) of the paper's spiral and a 100k-point raster on the
+//!   2 M triangle film;
 //! - `job/W2 ...`, `job/W3 ...`: the whole `job::run_on` (SVG read, plan,
 //!   report, G-code), what the wasm `Session.plan` runs;
 //! - `motion/demo ...`: the demo test part's lines planned by `even` (the
