@@ -952,11 +952,12 @@ fn assert_distance(sample: &Sample, truth: f64) {
     );
 }
 
-/// xorshift64*: reproducible random numbers without a dependency.
-struct Rng(u64);
+/// xorshift64*: reproducible random numbers without a dependency (also
+/// the point-cloud tests' noise).
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn unit(&mut self) -> f64 {
+    pub(crate) fn unit(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;

@@ -10,22 +10,12 @@ use pcpp::pipeline::{self, Plan, PlanSettings};
 use pcpp::surface::Surface;
 use pcpp::{DVec2, DVec3};
 
+use crate::bruteforce::Rng;
+
 /// Spacing of the sampled grid, mm.
 const STEP: f64 = 0.2;
 /// Noise added to each height, mm (uniform in +-NOISE).
 const NOISE: f64 = 0.02;
-
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        // xorshift64*
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// The demo part as a profilometer sees it: the highest surface point on
 /// each vertical line of a STEP grid, none where the line misses (the
