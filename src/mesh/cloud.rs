@@ -66,16 +66,14 @@ impl std::fmt::Display for CloudInfo {
     }
 }
 
-/// A point for the triangulation: its XY, with its height alongside.
-struct Vertex {
-    xy: Point2<f64>,
-    z: f64,
-}
+/// A point for the triangulation: positioned by its XY, its height
+/// carried along.
+struct Vertex(DVec3);
 
 impl HasPosition for Vertex {
     type Scalar = f64;
     fn position(&self) -> Point2<f64> {
-        self.xy
+        Point2::new(self.0.x, self.0.y)
     }
 }
 
@@ -131,14 +129,8 @@ pub fn triangulate(
             ),
         ));
     }
-    let vertices: Vec<Vertex> = points
-        .iter()
-        .map(|p| Vertex {
-            xy: Point2::new(p.x, p.y),
-            z: p.z,
-        })
-        .collect();
-    drop(points);
+    // (Collected in place: the same memory as the points.)
+    let vertices: Vec<Vertex> = points.into_iter().map(Vertex).collect();
     let t: DelaunayTriangulation<Vertex> =
         DelaunayTriangulation::bulk_load(vertices).map_err(|e| {
             MeshError::invalid(
@@ -154,13 +146,7 @@ pub fn triangulate(
     }
     let n = t.num_vertices();
     // In the triangulation's vertex order (its handles' indices).
-    let pos: Vec<DVec3> = t
-        .vertices()
-        .map(|v| {
-            let d = v.data();
-            DVec3::new(d.xy.x, d.xy.y, d.z)
-        })
-        .collect();
+    let pos: Vec<DVec3> = t.vertices().map(|v| v.data().0).collect();
     let len2 = |a: usize, b: usize| (pos[a] - pos[b]).truncate().length_squared();
     // The nearest neighbour of a point is joined to it by a Delaunay edge.
     let mut nearest = vec![f64::INFINITY; n];
