@@ -6,7 +6,7 @@
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{FiducialSource, JobSettings, RegistrationSettings};
 use pcpp::mesh::ImportOptions;
-use pcpp::placement::ScanPlacement;
+use pcpp::placement::{Bed, ScanPlacement};
 use pcpp::planners::PlannerKind;
 
 use crate::args::{JobArgs, MachineArgs, NozzleArgs, RegistrationArgs, ScanArgs};
@@ -63,21 +63,15 @@ fn registration(
         ..Default::default()
     };
     if let Some(PlaceScanArg::OnBed {
-        offset_mm: offset,
-        rotation_deg: rotation,
+        offset_mm,
+        rotation_deg,
     }) = a.place_scan
     {
-        let mut place = ScanPlacement::on_bed(profile);
-        if let ScanPlacement::OnBed {
+        r.scan_placement = ScanPlacement::OnBed {
+            bed: Bed::of_profile(profile),
             rotation_deg,
             offset_mm,
-            ..
-        } = &mut place
-        {
-            *offset_mm = offset;
-            *rotation_deg = rotation;
-        }
-        r.scan_placement = place;
+        };
     }
     r.validate().map_err(|e| {
         usage(
