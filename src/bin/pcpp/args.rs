@@ -19,14 +19,14 @@ use clap_complete::Shell;
 use pcpp::demo::parts::DemoPart;
 use pcpp::fiducials::DEFAULT_DOT_DIAMETER_MM;
 use pcpp::gcode::MachineProfile;
+use pcpp::job::FiducialSource;
 use pcpp::mesh::{ScanUnits, UpAxis};
 use pcpp::params::{Nozzle, Process};
 use pcpp::planners::PlannerKind;
 use pcpp::registration::RegistrationMethod;
 
 use crate::values::{
-    dot_diameter, fiducials, number, place, place_scan, points, FiducialsArg, PlaceArg,
-    PlaceScanArg, Points,
+    dot_diameter, fiducials, number, place, place_scan, points, PlaceArg, PlaceScanArg, Points,
 };
 
 const EXIT_STATUS: &str = "\
@@ -432,7 +432,7 @@ pub struct RegistrationArgs {
         allow_hyphen_values = true,
         requires = "printer_points"
     )]
-    pub fiducials: Option<FiducialsArg>,
+    pub fiducials: Option<FiducialSource>,
 
     /// The same fiducials in the printer frame
     #[arg(
