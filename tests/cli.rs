@@ -68,6 +68,13 @@ fn pcpp(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().unwrap()
 }
 
+/// `pcpp plan --scan SCAN --path SVG` and `flags`.
+fn plan_on(scan: &Path, svg: &Path, flags: &[&str]) -> Output {
+    let mut args = vec!["plan", "--scan", s(scan), "--path", s(svg)];
+    args.extend(flags);
+    pcpp(&args)
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -230,17 +237,11 @@ fn demo_prints_the_table_and_takes_a_dialect() {
 fn plan_on_the_demo_files_writes_the_golden_gcode() {
     let dir = temp_dir("plan-golden");
     let out = dir.join("out.gcode");
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--path",
-        s(&demo_file(demo::DEMO_PATH_NAME)),
-        "--place",
-        "0,80,0,1",
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &["--place", "0,80,0,1", "-o", s(&out)],
+    );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let summary = stdout(&o);
     assert!(summary.contains("points"), "{summary}");
@@ -261,27 +262,26 @@ fn plan_on_the_demo_files_writes_the_golden_gcode() {
 fn plan_report_has_every_field() {
     let dir = temp_dir("plan-report");
     let (out, report) = (dir.join("p.gcode"), dir.join("p.json"));
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--path",
-        s(&demo_file(demo::DEMO_PATH_NAME)),
-        "--place=0,80",
-        "--output",
-        s(&out),
-        "--report",
-        s(&report),
-        "--planner",
-        "slope",
-        "--accept-risk",
-        "--dialect",
-        "grbl",
-        "--fiducials",
-        "auto",
-        "--printer-points",
-        "4,4,5; 76,4,5; 4,76,5",
-    ]);
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &[
+            "--place=0,80",
+            "--output",
+            s(&out),
+            "--report",
+            s(&report),
+            "--planner",
+            "slope",
+            "--accept-risk",
+            "--dialect",
+            "grbl",
+            "--fiducials",
+            "auto",
+            "--printer-points",
+            "4,4,5; 76,4,5; 4,76,5",
+        ],
+    );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stdout(&o).contains("registration"), "{}", stdout(&o));
     let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
@@ -681,15 +681,7 @@ fn bad_input_exits_1_naming_the_file_and_line() {
     let svg = demo_file(demo::DEMO_PATH_NAME);
     let scan = demo_file(demo::DEMO_SCAN_NAME);
 
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&bad_obj),
-        "--path",
-        s(&svg),
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(&bad_obj, &svg, &["-o", s(&out)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -701,42 +693,16 @@ fn bad_input_exits_1_naming_the_file_and_line() {
     assert_eq!(code(&o), 1);
     assert!(stderr(&o).contains("bad-scan.obj"), "{}", stderr(&o));
 
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&scan),
-        "--path",
-        s(&bad_svg),
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(&scan, &bad_svg, &["-o", s(&out)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(stderr(&o).contains("bad-path.svg"), "{}", stderr(&o));
 
     let missing = dir.join("missing.ply");
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&missing),
-        "--path",
-        s(&svg),
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(&missing, &svg, &["-o", s(&out)]);
     assert_eq!(code(&o), 1);
     assert!(stderr(&o).contains("missing.ply"), "{}", stderr(&o));
 
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&scan),
-        "--path",
-        s(&svg),
-        "-o",
-        s(&out),
-        "--profile",
-        s(&bad_profile),
-    ]);
+    let o = plan_on(&scan, &svg, &["-o", s(&out), "--profile", s(&bad_profile)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(stderr(&o).contains("my-profile.json"), "{}", stderr(&o));
 
@@ -763,17 +729,11 @@ fn a_path_that_misses_the_scan_writes_nothing() {
     let dir = temp_dir("misses");
     let (out, report) = (dir.join("out.gcode"), dir.join("out.json"));
     // Without the placement the SVG lies at y < 0, off the 80 x 80 mm part.
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--path",
-        s(&demo_file(demo::DEMO_PATH_NAME)),
-        "-o",
-        s(&out),
-        "--report",
-        s(&report),
-    ]);
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &["-o", s(&out), "--report", s(&report)],
+    );
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -784,17 +744,16 @@ fn a_path_that_misses_the_scan_writes_nothing() {
     assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
 
     // An output folder that does not exist: bad input, nothing written.
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--path",
-        s(&demo_file(demo::DEMO_PATH_NAME)),
-        "--place",
-        "0,80",
-        "-o",
-        s(&dir.join("no-such-dir").join("out.gcode")),
-    ]);
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &[
+            "--place",
+            "0,80",
+            "-o",
+            s(&dir.join("no-such-dir").join("out.gcode")),
+        ],
+    );
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(stderr(&o).contains("no-such-dir"), "{}", stderr(&o));
     assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
@@ -804,17 +763,11 @@ fn a_path_that_misses_the_scan_writes_nothing() {
 #[test]
 fn no_progress_chatter_when_stderr_is_not_a_terminal() {
     let dir = temp_dir("quiet");
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--path",
-        s(&demo_file(demo::DEMO_PATH_NAME)),
-        "--place",
-        "0,80",
-        "-o",
-        s(&dir.join("q.gcode")),
-    ]);
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &["--place", "0,80", "-o", s(&dir.join("q.gcode"))],
+    );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -1003,28 +956,12 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     let scan = dir.join("demo-stepped-block.ply");
     let path = dir.join("demo-stepped-block-path.svg");
     let out = dir.join("slope.gcode");
-    let args = |extra: &[&'static str]| {
-        let mut v: Vec<String> = [
-            "plan",
-            "--scan",
-            s(&scan),
-            "--path",
-            s(&path),
-            "--place",
-            "0,40",
-            "--planner",
-            "slope",
-            "-o",
-            s(&out),
-        ]
-        .iter()
-        .map(|a| a.to_string())
-        .collect();
-        v.extend(extra.iter().map(|a| a.to_string()));
-        v
+    let plan_slope = |extra: &[&str]| {
+        let mut flags = vec!["--place", "0,40", "--planner", "slope", "-o", s(&out)];
+        flags.extend(extra);
+        plan_on(&scan, &path, &flags)
     };
-    let a = args(&[]);
-    let o = pcpp(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = plan_slope(&[]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -1033,8 +970,7 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
     );
     assert!(err.contains("--accept-risk"), "{err}");
     assert!(!out.exists(), "no G-code may be written");
-    let a = args(&["--accept-risk"]);
-    let o = pcpp(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = plan_slope(&["--accept-risk"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&out).unwrap();
     let header = text.lines().find(|l| l.contains("safe motion:")).unwrap();
@@ -1069,20 +1005,10 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
     let report = dir.join("report.json");
     // Where the drawing lands off the scan, the message says how to put
     // it on.
-    let o = pcpp(&["plan", "--scan", s(&scan), "--path", s(&svg), "-o", s(&out)]);
+    let o = plan_on(&scan, &svg, &["-o", s(&out)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(stderr(&o).contains("--place centre"), "{}", stderr(&o));
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&scan),
-        "--path",
-        s(&svg),
-        "--place",
-        "centre",
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(&scan, &svg, &["--place", "centre", "-o", s(&out)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -1090,21 +1016,20 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
         "{err}"
     );
     assert!(!out.exists());
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&scan),
-        "--path",
-        s(&svg),
-        "--place-scan",
-        "bed",
-        "--place",
-        "centre",
-        "-o",
-        s(&out),
-        "--report",
-        s(&report),
-    ]);
+    let o = plan_on(
+        &scan,
+        &svg,
+        &[
+            "--place-scan",
+            "bed",
+            "--place",
+            "centre",
+            "-o",
+            s(&out),
+            "--report",
+            s(&report),
+        ],
+    );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(
         stdout(&o).contains("scan: unregistered, placed on the bed"),
@@ -1138,21 +1063,20 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
         }
     }
     // Fiducials and a placement exclude each other.
-    let o = pcpp(&[
-        "plan",
-        "--scan",
-        s(&scan),
-        "--path",
-        s(&svg),
-        "--place-scan",
-        "bed",
-        "--fiducials",
-        "auto",
-        "--printer-points",
-        "4,4,5;76,4,5;4,76,5",
-        "-o",
-        s(&out),
-    ]);
+    let o = plan_on(
+        &scan,
+        &svg,
+        &[
+            "--place-scan",
+            "bed",
+            "--fiducials",
+            "auto",
+            "--printer-points",
+            "4,4,5;76,4,5;4,76,5",
+            "-o",
+            s(&out),
+        ],
+    );
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("not both"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);

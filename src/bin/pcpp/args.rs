@@ -19,14 +19,14 @@ use clap_complete::Shell;
 use pcpp::demo::parts::DemoPart;
 use pcpp::fiducials::DEFAULT_DOT_DIAMETER_MM;
 use pcpp::gcode::MachineProfile;
+use pcpp::job::FiducialSource;
 use pcpp::mesh::{ScanUnits, UpAxis};
 use pcpp::params::{Nozzle, Process};
 use pcpp::planners::PlannerKind;
 use pcpp::registration::RegistrationMethod;
 
 use crate::values::{
-    dot_diameter, fiducials, number, place, place_scan, points, FiducialsArg, PlaceArg,
-    PlaceScanArg, Points,
+    dot_diameter, fiducials, number, place, place_scan, points, PlaceArg, PlaceScanArg, Points,
 };
 
 const EXIT_STATUS: &str = "\
@@ -86,17 +86,23 @@ pub enum Command {
 // ---------------------------------------------------------------------------
 // Commands
 
-const JOB_AFTER_HELP: &str = "\
+/// The note after the flags of `compare`, and of `plan` after its own (a
+/// macro, not a `const`, so that `concat!` can join it).
+macro_rules! job_after_help {
+    () => {
+        "\
 Without --fiducials and --printer-points, or --place-scan, the scan is taken as
 already in the printer frame. --place centre[,ROT[,SCALE]] centres the drawing on
-the scan's footprint (and scales it down to fit, with a warning).";
+the scan's footprint (and scales it down to fit, with a warning)."
+    };
+}
 
-const PLAN_AFTER_HELP: &str = "\
-The summary goes to stdout, warnings to stderr.
+const JOB_AFTER_HELP: &str = job_after_help!();
 
-Without --fiducials and --printer-points, or --place-scan, the scan is taken as
-already in the printer frame. --place centre[,ROT[,SCALE]] centres the drawing on
-the scan's footprint (and scales it down to fit, with a warning).";
+const PLAN_AFTER_HELP: &str = concat!(
+    "The summary goes to stdout, warnings to stderr.\n\n",
+    job_after_help!()
+);
 
 #[derive(Debug, Args)]
 pub struct PlanArgs {
@@ -432,7 +438,7 @@ pub struct RegistrationArgs {
         allow_hyphen_values = true,
         requires = "printer_points"
     )]
-    pub fiducials: Option<FiducialsArg>,
+    pub fiducials: Option<FiducialSource>,
 
     /// The same fiducials in the printer frame
     #[arg(

@@ -107,13 +107,13 @@ pub fn cmd_demo(a: &DemoArgs, progress: &Progress) -> CliResult<()> {
     }
     let prefix = demo_prefix(part);
     let mut files: Vec<(String, Vec<u8>)> = vec![
-        (scan_name.clone(), scan.clone()),
+        (scan_name, scan),
         (path_name.clone(), svg.clone().into_bytes()),
         (
             format!("{prefix}-comparison.json"),
             to_json(&comparison_json(
                 &[
-                    InputFile::new(&scan_name, &scan),
+                    prepared.file.clone(),
                     InputFile::new(&path_name, svg.as_bytes()),
                 ],
                 &settings.plan,

@@ -4,14 +4,14 @@
 //! usage errors, found before any file is read.
 
 use pcpp::gcode::MachineProfile;
-use pcpp::job::{FiducialSource, JobSettings, RegistrationSettings};
+use pcpp::job::{JobSettings, RegistrationSettings};
 use pcpp::mesh::ImportOptions;
-use pcpp::placement::ScanPlacement;
+use pcpp::placement::{Bed, ScanPlacement};
 use pcpp::planners::PlannerKind;
 
 use crate::args::{JobArgs, MachineArgs, NozzleArgs, RegistrationArgs, ScanArgs};
 use crate::files::read_text;
-use crate::values::{FiducialsArg, PlaceScanArg};
+use crate::values::PlaceScanArg;
 use crate::{usage, CliResult, Failure};
 
 /// How the scan file is read.
@@ -52,32 +52,22 @@ fn registration(
     profile: &MachineProfile,
 ) -> CliResult<RegistrationSettings> {
     let mut r = RegistrationSettings {
-        fiducials: match &a.fiducials {
-            None => FiducialSource::None,
-            Some(FiducialsArg::Auto) => FiducialSource::Auto,
-            Some(FiducialsArg::Points(p)) => FiducialSource::Points(p.clone()),
-        },
+        fiducials: a.fiducials.clone().unwrap_or_default(),
         printer_points: a.printer_points.clone().map(|p| p.0).unwrap_or_default(),
         method: a.registration,
         dot_diameter_mm: a.dot_diameter,
         ..Default::default()
     };
     if let Some(PlaceScanArg::OnBed {
-        offset_mm: offset,
-        rotation_deg: rotation,
+        offset_mm,
+        rotation_deg,
     }) = a.place_scan
     {
-        let mut place = ScanPlacement::on_bed(profile);
-        if let ScanPlacement::OnBed {
+        r.scan_placement = ScanPlacement::OnBed {
+            bed: Bed::of_profile(profile),
             rotation_deg,
             offset_mm,
-            ..
-        } = &mut place
-        {
-            *offset_mm = offset;
-            *rotation_deg = rotation;
-        }
-        r.scan_placement = place;
+        };
     }
     r.validate().map_err(|e| {
         usage(

@@ -2,6 +2,7 @@
 //! text (`value_parser = ...` in `args.rs`). Their messages say what is
 //! wrong and how to write it; clap puts the flag and value in front.
 
+use pcpp::job::FiducialSource;
 use pcpp::registration::parse_points;
 use pcpp::svg::Placement;
 use pcpp::{DVec2, DVec3};
@@ -23,13 +24,6 @@ pub enum PlaceScanArg {
         offset_mm: DVec3,
         rotation_deg: f64,
     },
-}
-
-/// `--fiducials`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum FiducialsArg {
-    Auto,
-    Points(Vec<DVec3>),
 }
 
 /// A list of points `x,y,z;x,y,z;...` (one value, not a list of values).
@@ -58,11 +52,13 @@ pub fn points(text: &str) -> Result<Points, String> {
     parse_points(text).map(Points).map_err(|e| e.to_string())
 }
 
-pub fn fiducials(text: &str) -> Result<FiducialsArg, String> {
+/// `--fiducials`: `auto` or points (never [`FiducialSource::None`]: that is
+/// the flag left out).
+pub fn fiducials(text: &str) -> Result<FiducialSource, String> {
     if text.trim().eq_ignore_ascii_case("auto") {
-        Ok(FiducialsArg::Auto)
+        Ok(FiducialSource::Auto)
     } else {
-        points(text).map(|p| FiducialsArg::Points(p.0))
+        points(text).map(|p| FiducialSource::Points(p.0))
     }
 }
 
