@@ -416,11 +416,7 @@ impl Renderer {
         };
         let gl = &self.gl;
         let p = &self.nozzle_prog;
-        gl.use_program(Some(&p.program));
-        gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
-        let eye = self.camera.eye() - self.camera.target;
-        let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
-        gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+        self.use_shaded(p, mvp);
         let r = 0.5 * diameter;
         gl.bind_vertex_array(Some(&self.cylinder.vao));
         for (z0, height, [cr, cg, cb]) in [
@@ -474,10 +470,10 @@ impl Renderer {
         Ok(())
     }
 
-    /// Draws the mesh with the camera's `mvp` into the bound framebuffer.
-    fn draw_mesh(&self, mesh: &Drawable, mvp: &[f32; 16]) {
+    /// Uses a program of `MESH_FS` (the mesh's or the nozzle's) with the
+    /// camera's `mvp` and its light.
+    fn use_shaded(&self, p: &Program, mvp: &[f32; 16]) {
         let gl = &self.gl;
-        let p = &self.mesh_prog;
         gl.use_program(Some(&p.program));
         gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
         // A headlight, a little above and left of the eye, so faces
@@ -485,6 +481,13 @@ impl Renderer {
         let eye = self.camera.eye() - self.camera.target;
         let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
         gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+    }
+
+    /// Draws the mesh with the camera's `mvp` into the bound framebuffer.
+    fn draw_mesh(&self, mesh: &Drawable, mvp: &[f32; 16]) {
+        let gl = &self.gl;
+        let p = &self.mesh_prog;
+        self.use_shaded(p, mvp);
         let [r, g, b] = MESH;
         gl.uniform3f(p.color.as_ref(), r, g, b);
         // Push the surface back in depth so Ta, which lies on it, wins.
