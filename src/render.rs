@@ -356,24 +356,11 @@ impl Renderer {
     /// holds xyz from and to per move (6 floats), `kinds` one code per
     /// move (0 feed, 1 rapid, 2 too close to the surface).
     pub fn set_moves(&mut self, moves: &[f32], kinds: &[u8]) -> Result<(), String> {
-        if moves.len() != 6 * kinds.len() {
-            return Err(format!(
-                "move arrays disagree: {} coordinates for {} moves",
-                moves.len(),
-                kinds.len()
-            ));
-        }
-        let mut col: Vec<f32> = Vec::with_capacity(moves.len());
-        for &k in kinds {
-            let c = match k {
-                0 => FEED_MOVE,
-                1 => RAPID_MOVE,
-                _ => defect_rgb(Defect::Contact),
-            };
-            col.extend(c);
-            col.extend(c);
-        }
-        self.set_lines(moves, &col)
+        self.set_move_lines("move", moves, kinds, |k| match k {
+            0 => FEED_MOVE,
+            1 => RAPID_MOVE,
+            _ => defect_rgb(Defect::Contact),
+        })
     }
 
     /// A program's moves for the print preview, in place of the paths:
@@ -381,16 +368,30 @@ impl Renderer {
     /// colour code per move ([`preview_rgb8`]). Uploaded once per program
     /// and colouring; the nozzle moves without touching it.
     pub fn set_preview_path(&mut self, moves: &[f32], codes: &[u8]) -> Result<(), String> {
+        self.set_move_lines("preview", moves, codes, |k| {
+            preview_rgb8(k).map(|c| f32::from(c) / 255.0)
+        })
+    }
+
+    /// Moves (6 floats each) as lines in the colour of their code; `what`
+    /// names the arrays when their lengths disagree.
+    fn set_move_lines(
+        &mut self,
+        what: &str,
+        moves: &[f32],
+        codes: &[u8],
+        colour: impl Fn(u8) -> [f32; 3],
+    ) -> Result<(), String> {
         if moves.len() != 6 * codes.len() {
             return Err(format!(
-                "preview arrays disagree: {} coordinates for {} moves",
+                "{what} arrays disagree: {} coordinates for {} moves",
                 moves.len(),
                 codes.len()
             ));
         }
         let mut col: Vec<f32> = Vec::with_capacity(moves.len());
         for &k in codes {
-            let c = preview_rgb8(k).map(|c| f32::from(c) / 255.0);
+            let c = colour(k);
             col.extend(c);
             col.extend(c);
         }
