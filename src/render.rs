@@ -54,7 +54,7 @@ pub fn preview_rgb8(code: u8) -> [u8; 3] {
         0 => defect_rgb8("good"),
         1 => defect_rgb8("flattening"),
         2 => defect_rgb8("contact"),
-        10..=13 => defect_rgb8(defect_name(crate::preview::defect_of_code(code - 10))),
+        10..=13 => defect_rgb8(defect_name(defect_of_code(code - 10))),
         _ => RAPID_MOVE.map(|c| (c * 255.0).round() as u8),
     }
 }
