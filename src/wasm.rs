@@ -110,6 +110,34 @@ fn set(obj: &js_sys::Object, key: &str, value: &JsValue) {
     let _ = js_sys::Reflect::set(obj, &key.into(), value);
 }
 
+/// Numbers the page receives as a typed array of their own type (copied
+/// out of wasm memory, so the worker can transfer its buffer).
+trait TypedArray: Sized {
+    fn typed_array(data: &[Self]) -> JsValue;
+}
+
+macro_rules! typed_array {
+    ($($t:ty => $array:ty),*) => {$(
+        impl TypedArray for $t {
+            fn typed_array(data: &[$t]) -> JsValue {
+                <$array>::from(data).into()
+            }
+        }
+    )*};
+}
+
+typed_array!(
+    u8 => js_sys::Uint8Array,
+    u32 => js_sys::Uint32Array,
+    f32 => js_sys::Float32Array,
+    f64 => js_sys::Float64Array
+);
+
+/// Sets `key` on a JS object to a typed array of `data`.
+fn set_array<T: TypedArray>(obj: &js_sys::Object, key: &str, data: &[T]) {
+    set(obj, key, &T::typed_array(data));
+}
+
 const MIB: f64 = (1u64 << 20) as f64;
 
 /// The page's limits, for its messages and the README: `{scan_bytes,
