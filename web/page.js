@@ -1,5 +1,6 @@
 // What the page's modules share: the element lookup, the page's state and
-// settings, number formats, and the hooks main.js fills in. Modules import
+// settings (and the machine profile they choose), number formats, and the
+// hooks main.js fills in. Modules import
 // this one and each other only in one direction (the single-file build,
 // scripts/single-file.mjs, joins them in dependency order and allows no
 // cycle); a call back up (to plan again, say) goes through `hooks`.
@@ -15,6 +16,16 @@ export const settings = {};
 // showErrorPlot(), viewShowsChanged(), viewClick(px, py) -> handled,
 // planShown(plan).
 export const hooks = {};
+
+// The machine profile a plan or preview is written with: `dialect` a
+// built-in name or the user's profile as JSON text, `file` that profile's
+// file name (for its errors), `name` the name the page shows.
+export function profile() {
+  const cp = settings.dialect === 'custom' && settings.customProfile;
+  return cp
+    ? { dialect: cp.text, file: cp.file, name: cp.name }
+    : { dialect: settings.dialect, file: undefined, name: settings.dialect };
+}
 
 export const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
 

@@ -7,6 +7,7 @@
 // worker's Session.centreDrawing); this module keeps the settings and the
 // elements in step.
 import { bedOf, carryDrawing, volumeFit } from '../pkg/pcpp.js';
+import { profile } from './page.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -22,7 +23,7 @@ const FIELDS = [
 ];
 
 // Set by initPlacement: {state, settings(), saveSettings, writeForm,
-// schedulePlan, showError, profile() -> [dialect, profileFile]}.
+// schedulePlan, showError, clearError}.
 let ctx = null;
 let centreTokens = 0;
 const beds = new Map(); // profile key -> its bed (wasm bedOf)
@@ -39,7 +40,7 @@ function scanPlace() {
 }
 
 function bed() {
-  const [dialect, file] = ctx.profile();
+  const { dialect, file } = profile();
   const key = `${file || ''}\u0000${dialect}`;
   let b = beds.get(key);
   if (!b) {
@@ -183,7 +184,7 @@ export function showScanPlacement() {
   let fit = null;
   if (info) {
     const [lo, hi] = info.bbox_mm;
-    const [dialect, file] = ctx.profile();
+    const { dialect, file } = profile();
     try {
       fit = volumeFit([...lo, ...hi], dialect, file);
     } catch {
@@ -195,7 +196,7 @@ export function showScanPlacement() {
   $('place-banner-text').textContent = outside ? capital(fit.message) : '';
   $('scan-place').hidden = !on;
   if (on) {
-    $('bed-name').textContent = `profile ${ctx.profile()[2]}`;
+    $('bed-name').textContent = `profile ${profile().name}`;
     const note = $('bed-note');
     const shown = info && info.registration.status.kind === 'placed-on-bed';
     note.textContent = shown && outside ? capital(fit.message) : '';

@@ -9,7 +9,7 @@
 // thread (PreviewTimeline) places the nozzle; the view moves only its
 // transform per frame.
 import { PreviewTimeline, Viewer } from '../pkg/pcpp.js';
-import { $, fmt, num, settings, state } from './page.js';
+import { $, fmt, num, profile, settings, state } from './page.js';
 import { drawPlanPaths, requestDraw, setViewShows } from './view.js';
 
 // Speed-ups offered (real print speed first).
@@ -69,13 +69,8 @@ function syncControls() {
 // Asks the worker for the program of the chosen source.
 function request() {
   const id = ++pv.id;
-  const profile = settings.dialect === 'custom' && settings.customProfile;
-  const msg = {
-    type: 'preview',
-    id,
-    dialect: profile ? profile.text : settings.dialect,
-    profileFile: profile ? profile.file : undefined,
-  };
+  const { dialect, file: profileFile } = profile();
+  const msg = { type: 'preview', id, dialect, profileFile };
   const transfer = [];
   let job;
   if (pv.source === 'check') {
