@@ -362,15 +362,9 @@ async function start() {
     viewClick: previewClick,
     checkShown: previewCheckShown,
   });
+  // Calls into modules that import placement.js and fiducials.js.
   const page = {
-    state,
-    settings: () => settings,
-    saveSettings,
-    writeForm,
-    schedulePlan,
-    showError,
-    clearError,
-    updateMarkers,
+    saveSettings, writeForm, schedulePlan, updateMarkers,
   };
   initPlacement(page);
   initFiducials(page);
