@@ -3,8 +3,9 @@
 // its length), the verdict and the touching moves listed by line, and the
 // program's moves drawn in the 3-D view on request.
 import { pageLimits } from '../pkg/pcpp.js';
-import { $, fmt, fmtPoint, hooks, num, settings, state } from './page.js';
-import { cell } from './report.js';
+import {
+  $, cell, el, fmt, fmtPoint, hooks, num, settings, state,
+} from './page.js';
 import { showError } from './status.js';
 import { drawPlanPaths, setViewShows } from './view.js';
 
@@ -66,14 +67,7 @@ export function onCheck(m) {
     : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];
-  const p = (text, id, cls) => {
-    const el = document.createElement('p');
-    el.textContent = text;
-    if (id) el.id = id;
-    if (cls) el.className = cls;
-    details.push(el);
-    return el;
-  };
+  const p = (text, id, cls) => details.push(el('p', text, cls, id));
   p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined
     ? 'minimum clearance: no move passes near the scan'
     : `minimum clearance ${fmt(sum.min_clearance_mm)} mm`
@@ -85,11 +79,7 @@ export function onCheck(m) {
     table.id = 'check-touching';
     table.className = 'num';
     const head = table.createTHead().insertRow();
-    for (const h of ['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm']) {
-      const th = document.createElement('th');
-      th.textContent = h;
-      head.append(th);
-    }
+    head.append(...['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm'].map((h) => el('th', h)));
     const body = table.createTBody();
     for (const t of sum.touching) {
       const tr = body.insertRow();
@@ -109,14 +99,8 @@ export function onCheck(m) {
       + `${c.unchecked_lines.slice(0, 10).join(', ')}${c.unchecked_lines.length > 10 ? ', …' : ''}`, 'check-unchecked');
   }
   if (c.notes.length) {
-    const ul = document.createElement('ul');
-    ul.id = 'check-notes';
-    ul.className = 'warnings small';
-    for (const n of c.notes) {
-      const li = document.createElement('li');
-      li.textContent = n;
-      ul.append(li);
-    }
+    const ul = el('ul', undefined, 'warnings small', 'check-notes');
+    ul.append(...c.notes.map((n) => el('li', n)));
     details.push(ul);
   }
   $('check-details').replaceChildren(...details);

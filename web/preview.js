@@ -9,7 +9,9 @@
 // thread (PreviewTimeline) places the nozzle; the view moves only its
 // transform per frame.
 import { PreviewTimeline, Viewer } from '../pkg/pcpp.js';
-import { $, fmt, num, profile, settings, state } from './page.js';
+import {
+  $, fmt, num, profile, settings, state, swatch,
+} from './page.js';
 import { drawPlanPaths, requestDraw, setViewShows } from './view.js';
 
 // Speed-ups offered (real print speed first).
@@ -303,14 +305,7 @@ export function bindPreview() {
   for (const s of SPEEDS) sp.add(new Option(`${s}×`, String(s)));
   const legend = $('preview-legend');
   legend.replaceChildren(...[[0, 'clear'], [1, 'near: within 0.1 mm over tol'], [2, 'closer than tol'], [NO_DEFECT, 'travel']]
-    .map(([code, label]) => {
-      const li = document.createElement('li');
-      const sw = document.createElement('i');
-      sw.className = 'sw';
-      sw.style.background = `rgb(${Viewer.previewColor(code).join(',')})`;
-      li.append(sw, label);
-      return li;
-    }));
+    .map(([code, label]) => swatch(`rgb(${Viewer.previewColor(code).join(',')})`, label)));
   $('preview-btn').addEventListener('click', () => setOn(!pv.on));
   $('preview-play').addEventListener('click', () => (pv.playing ? stop() : play()));
   $('preview-time').addEventListener('input', (e) => {
