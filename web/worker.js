@@ -175,9 +175,11 @@ async function preview(m) {
     await planning;
     if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
     const r = session.previewGcode(bytes, name, m.nozzle, m.tol, m.dialect, m.profileFile, m.speed);
-    post({ type: 'preview', id, name, result: r },
+    // The bytes go back for the page's line readout: it never reads the
+    // file itself.
+    post({ type: 'preview', id, name, result: r, bytes },
       [r.moves.buffer, r.lines.buffer, r.rapid.buffer, r.starts.buffer, r.durations.buffer,
-        r.clearance.buffer, r.classes.buffer]);
+        r.clearance.buffer, r.classes.buffer, bytes.buffer]);
   } catch (err) {
     post({ type: 'preview', id, name, ...errorOf(err), error: errorOf(err).message });
   }
