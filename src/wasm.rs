@@ -515,20 +515,30 @@ fn arr(p: DVec3) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
-/// A G-code file's text, or an `Error` of kind `limit` past the size the
-/// reader checks, of kind `gcode` when it is not UTF-8.
-fn gcode_text<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, JsValue> {
-    if bytes.len() > MAX_GCODE_BYTES {
-        return Err(kind_err(
-            "limit",
-            &format!(
-                "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check \
-                 reads; split the program and check each part",
-                bytes.len() as f64 / MIB,
-                MAX_GCODE_BYTES >> 20
-            ),
-        ));
+/// Refuses a G-code file of `size` bytes past the size the reader checks
+/// ([`MAX_GCODE_BYTES`]) with an `Error` of kind `limit`; the page calls
+/// this with `File.size` before the worker reads the file.
+#[wasm_bindgen(js_name = checkGcodeSize)]
+pub fn check_gcode_size(name: &str, size: f64) -> Result<(), JsValue> {
+    if size.is_finite() && (0.0..=MAX_GCODE_BYTES as f64).contains(&size) {
+        return Ok(());
     }
+    Err(kind_err(
+        "limit",
+        &format!(
+            "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check reads; \
+             split the program and check each part",
+            size / MIB,
+            MAX_GCODE_BYTES >> 20
+        ),
+    ))
+}
+
+/// A G-code file's text, or an `Error` of kind `limit` past the size the
+/// reader checks ([`check_gcode_size`]), of kind `gcode` when it is not
+/// UTF-8.
+fn gcode_text<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, JsValue> {
+    check_gcode_size(name, bytes.len() as f64)?;
     std::str::from_utf8(bytes).map_err(|e| {
         kind_err(
             "gcode",

@@ -2,7 +2,7 @@
 // the core against the scan the worker holds (every straight move along
 // its length), the verdict and the touching moves listed by line, and the
 // program's moves drawn in the 3-D view on request.
-import { pageLimits } from '../pkg/pcpp.js';
+import { checkGcodeSize } from '../pkg/pcpp.js';
 import {
   $, cell, el, fmt, fmtPoint, hooks, num, settings, state,
 } from './page.js';
@@ -13,11 +13,10 @@ import { drawPlanPaths, setViewShows } from './view.js';
 // scan the worker holds, with the nozzle and tol of the settings: the
 // worker reads the File (as it reads a scan), after any plan in flight.
 export function checkGcodeFile(file) {
-  const limit = pageLimits().gcode_bytes;
-  if (file.size > limit) {
-    const message = `${file.name}: the file is ${(file.size / (1 << 20)).toFixed(1)} MiB, more than the `
-      + `${limit / (1 << 20)} MiB the G-code check reads; split the program and check each part`;
-    showCheckError(file.name, message);
+  try {
+    checkGcodeSize(file.name, file.size);
+  } catch (e) {
+    showCheckError(file.name, e.message);
     return;
   }
   const s = settings;
