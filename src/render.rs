@@ -54,7 +54,7 @@ pub fn preview_rgb8(code: u8) -> [u8; 3] {
         0 => defect_rgb8("good"),
         1 => defect_rgb8("flattening"),
         2 => defect_rgb8("contact"),
-        10..=13 => defect_rgb8(defect_name(crate::preview::defect_of_code(code - 10))),
+        10..=13 => defect_rgb8(defect_name(defect_of_code(code - 10))),
         _ => RAPID_MOVE.map(|c| (c * 255.0).round() as u8),
     }
 }
@@ -356,24 +356,11 @@ impl Renderer {
     /// holds xyz from and to per move (6 floats), `kinds` one code per
     /// move (0 feed, 1 rapid, 2 too close to the surface).
     pub fn set_moves(&mut self, moves: &[f32], kinds: &[u8]) -> Result<(), String> {
-        if moves.len() != 6 * kinds.len() {
-            return Err(format!(
-                "move arrays disagree: {} coordinates for {} moves",
-                moves.len(),
-                kinds.len()
-            ));
-        }
-        let mut col: Vec<f32> = Vec::with_capacity(moves.len());
-        for &k in kinds {
-            let c = match k {
-                0 => FEED_MOVE,
-                1 => RAPID_MOVE,
-                _ => defect_rgb(Defect::Contact),
-            };
-            col.extend(c);
-            col.extend(c);
-        }
-        self.set_lines(moves, &col)
+        self.set_move_lines("move", moves, kinds, |k| match k {
+            0 => FEED_MOVE,
+            1 => RAPID_MOVE,
+            _ => defect_rgb(Defect::Contact),
+        })
     }
 
     /// A program's moves for the print preview, in place of the paths:
@@ -381,16 +368,30 @@ impl Renderer {
     /// colour code per move ([`preview_rgb8`]). Uploaded once per program
     /// and colouring; the nozzle moves without touching it.
     pub fn set_preview_path(&mut self, moves: &[f32], codes: &[u8]) -> Result<(), String> {
+        self.set_move_lines("preview", moves, codes, |k| {
+            preview_rgb8(k).map(|c| f32::from(c) / 255.0)
+        })
+    }
+
+    /// Moves (6 floats each) as lines in the colour of their code; `what`
+    /// names the arrays when their lengths disagree.
+    fn set_move_lines(
+        &mut self,
+        what: &str,
+        moves: &[f32],
+        codes: &[u8],
+        colour: impl Fn(u8) -> [f32; 3],
+    ) -> Result<(), String> {
         if moves.len() != 6 * codes.len() {
             return Err(format!(
-                "preview arrays disagree: {} coordinates for {} moves",
+                "{what} arrays disagree: {} coordinates for {} moves",
                 moves.len(),
                 codes.len()
             ));
         }
         let mut col: Vec<f32> = Vec::with_capacity(moves.len());
         for &k in codes {
-            let c = preview_rgb8(k).map(|c| f32::from(c) / 255.0);
+            let c = colour(k);
             col.extend(c);
             col.extend(c);
         }
@@ -416,11 +417,7 @@ impl Renderer {
         };
         let gl = &self.gl;
         let p = &self.nozzle_prog;
-        gl.use_program(Some(&p.program));
-        gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
-        let eye = self.camera.eye() - self.camera.target;
-        let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
-        gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+        self.use_shaded(p, mvp);
         let r = 0.5 * diameter;
         gl.bind_vertex_array(Some(&self.cylinder.vao));
         for (z0, height, [cr, cg, cb]) in [
@@ -474,10 +471,10 @@ impl Renderer {
         Ok(())
     }
 
-    /// Draws the mesh with the camera's `mvp` into the bound framebuffer.
-    fn draw_mesh(&self, mesh: &Drawable, mvp: &[f32; 16]) {
+    /// Uses a program of `MESH_FS` (the mesh's or the nozzle's) with the
+    /// camera's `mvp` and its light.
+    fn use_shaded(&self, p: &Program, mvp: &[f32; 16]) {
         let gl = &self.gl;
-        let p = &self.mesh_prog;
         gl.use_program(Some(&p.program));
         gl.uniform_matrix4fv_with_f32_array(p.mvp.as_ref(), false, mvp);
         // A headlight, a little above and left of the eye, so faces
@@ -485,6 +482,13 @@ impl Renderer {
         let eye = self.camera.eye() - self.camera.target;
         let l = (eye.normalize_or_zero() + 0.3 * DVec3::Z).normalize_or_zero();
         gl.uniform3f(p.light.as_ref(), l.x as f32, l.y as f32, l.z as f32);
+    }
+
+    /// Draws the mesh with the camera's `mvp` into the bound framebuffer.
+    fn draw_mesh(&self, mesh: &Drawable, mvp: &[f32; 16]) {
+        let gl = &self.gl;
+        let p = &self.mesh_prog;
+        self.use_shaded(p, mvp);
         let [r, g, b] = MESH;
         gl.uniform3f(p.color.as_ref(), r, g, b);
         // Push the surface back in depth so Ta, which lies on it, wins.

@@ -110,6 +110,34 @@ fn set(obj: &js_sys::Object, key: &str, value: &JsValue) {
     let _ = js_sys::Reflect::set(obj, &key.into(), value);
 }
 
+/// Numbers the page receives as a typed array of their own type (copied
+/// out of wasm memory, so the worker can transfer its buffer).
+trait TypedArray: Sized {
+    fn typed_array(data: &[Self]) -> JsValue;
+}
+
+macro_rules! typed_array {
+    ($($t:ty => $array:ty),*) => {$(
+        impl TypedArray for $t {
+            fn typed_array(data: &[$t]) -> JsValue {
+                <$array>::from(data).into()
+            }
+        }
+    )*};
+}
+
+typed_array!(
+    u8 => js_sys::Uint8Array,
+    u32 => js_sys::Uint32Array,
+    f32 => js_sys::Float32Array,
+    f64 => js_sys::Float64Array
+);
+
+/// Sets `key` on a JS object to a typed array of `data`.
+fn set_array<T: TypedArray>(obj: &js_sys::Object, key: &str, data: &[T]) {
+    set(obj, key, &T::typed_array(data));
+}
+
 const MIB: f64 = (1u64 << 20) as f64;
 
 /// The page's limits, for its messages and the README: `{scan_bytes,
@@ -487,20 +515,30 @@ fn arr(p: DVec3) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
-/// A G-code file's text, or an `Error` of kind `limit` past the size the
-/// reader checks, of kind `gcode` when it is not UTF-8.
-fn gcode_text<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, JsValue> {
-    if bytes.len() > MAX_GCODE_BYTES {
-        return Err(kind_err(
-            "limit",
-            &format!(
-                "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check \
-                 reads; split the program and check each part",
-                bytes.len() as f64 / MIB,
-                MAX_GCODE_BYTES >> 20
-            ),
-        ));
+/// Refuses a G-code file of `size` bytes past the size the reader checks
+/// ([`MAX_GCODE_BYTES`]) with an `Error` of kind `limit`; the page calls
+/// this with `File.size` before the worker reads the file.
+#[wasm_bindgen(js_name = checkGcodeSize)]
+pub fn check_gcode_size(name: &str, size: f64) -> Result<(), JsValue> {
+    if size.is_finite() && (0.0..=MAX_GCODE_BYTES as f64).contains(&size) {
+        return Ok(());
     }
+    Err(kind_err(
+        "limit",
+        &format!(
+            "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check reads; \
+             split the program and check each part",
+            size / MIB,
+            MAX_GCODE_BYTES >> 20
+        ),
+    ))
+}
+
+/// A G-code file's text, or an `Error` of kind `limit` past the size the
+/// reader checks ([`check_gcode_size`]), of kind `gcode` when it is not
+/// UTF-8.
+fn gcode_text<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, JsValue> {
+    check_gcode_size(name, bytes.len() as f64)?;
     std::str::from_utf8(bytes).map_err(|e| {
         kind_err(
             "gcode",

@@ -2,9 +2,10 @@
 // the core against the scan the worker holds (every straight move along
 // its length), the verdict and the touching moves listed by line, and the
 // program's moves drawn in the 3-D view on request.
-import { pageLimits } from '../pkg/pcpp.js';
-import { $, fmt, fmtPoint, hooks, num, settings, state } from './page.js';
-import { cell } from './report.js';
+import { checkGcodeSize } from '../pkg/pcpp.js';
+import {
+  $, cell, el, fmt, fmtPoint, hooks, num, settings, state,
+} from './page.js';
 import { showError } from './status.js';
 import { drawPlanPaths, setViewShows } from './view.js';
 
@@ -12,11 +13,10 @@ import { drawPlanPaths, setViewShows } from './view.js';
 // scan the worker holds, with the nozzle and tol of the settings: the
 // worker reads the File (as it reads a scan), after any plan in flight.
 export function checkGcodeFile(file) {
-  const limit = pageLimits().gcode_bytes;
-  if (file.size > limit) {
-    const message = `${file.name}: the file is ${(file.size / (1 << 20)).toFixed(1)} MiB, more than the `
-      + `${limit / (1 << 20)} MiB the G-code check reads; split the program and check each part`;
-    showCheckError(file.name, message);
+  try {
+    checkGcodeSize(file.name, file.size);
+  } catch (e) {
+    showCheckError(file.name, e.message);
     return;
   }
   const s = settings;
@@ -66,14 +66,7 @@ export function onCheck(m) {
     : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];
-  const p = (text, id, cls) => {
-    const el = document.createElement('p');
-    el.textContent = text;
-    if (id) el.id = id;
-    if (cls) el.className = cls;
-    details.push(el);
-    return el;
-  };
+  const p = (text, id, cls) => details.push(el('p', text, cls, id));
   p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined
     ? 'minimum clearance: no move passes near the scan'
     : `minimum clearance ${fmt(sum.min_clearance_mm)} mm`
@@ -85,11 +78,7 @@ export function onCheck(m) {
     table.id = 'check-touching';
     table.className = 'num';
     const head = table.createTHead().insertRow();
-    for (const h of ['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm']) {
-      const th = document.createElement('th');
-      th.textContent = h;
-      head.append(th);
-    }
+    head.append(...['line', 'move from → to', 'worst at', 'clearance mm', 'higher by mm'].map((h) => el('th', h)));
     const body = table.createTBody();
     for (const t of sum.touching) {
       const tr = body.insertRow();
@@ -109,14 +98,8 @@ export function onCheck(m) {
       + `${c.unchecked_lines.slice(0, 10).join(', ')}${c.unchecked_lines.length > 10 ? ', …' : ''}`, 'check-unchecked');
   }
   if (c.notes.length) {
-    const ul = document.createElement('ul');
-    ul.id = 'check-notes';
-    ul.className = 'warnings small';
-    for (const n of c.notes) {
-      const li = document.createElement('li');
-      li.textContent = n;
-      ul.append(li);
-    }
+    const ul = el('ul', undefined, 'warnings small', 'check-notes');
+    ul.append(...c.notes.map((n) => el('li', n)));
     details.push(ul);
   }
   $('check-details').replaceChildren(...details);

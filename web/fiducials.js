@@ -5,23 +5,20 @@
 // printer points P; the registration's residual per fiducial and its RMS.
 // The registration itself runs in the core (the worker's Session).
 import { parsePoints } from '../pkg/pcpp.js';
-
-const $ = (id) => document.getElementById(id);
+import { $, fmt, settings, state } from './page.js';
 
 // How many of the best candidates are listed.
 export const BEST = 8;
 // Two points closer than this (mm) are the same hole's centre.
 const SAME_MM = 1e-3;
 
-// Set by initFiducials: {state, settings(), saveSettings, writeForm,
-// schedulePlan, updateMarkers}.
+// Set by initFiducials: {saveSettings, writeForm, schedulePlan,
+// updateMarkers} (modules that import this one).
 let ctx = null;
 
 export function initFiducials(c) {
   ctx = c;
 }
-
-const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '∞' : v.toFixed(d));
 
 export const fmtPoints = (pts) => pts.map((p) => p.map((v) => +v.toFixed(4)).join(', ')).join('\n');
 
@@ -44,13 +41,13 @@ function candidates(info) {
 }
 
 export function showFiducials() {
-  const info = ctx.state.info;
+  const info = state.info;
   const holes = $('fid-holes');
   const res = $('fid-residuals');
   holes.replaceChildren();
   res.replaceChildren();
   if (!info) return;
-  const s = ctx.settings();
+  const s = settings;
   const cands = candidates(info);
   const list = cands.slice(0, BEST);
   if (list.length) {
@@ -97,7 +94,7 @@ export function showFiducials() {
 // chooses one as the next scan point Sr or drops it. A chosen hole shows
 // its Sr number and, once registered by these points, its residual.
 function holeList(list, info) {
-  const s = ctx.settings();
+  const s = settings;
   const scanPts = safePoints(s.fidScanText);
   const r = info.registration;
   const byPoints = s.fidSource === 'points' && r.residuals_mm.length === scanPts.length;
@@ -134,7 +131,7 @@ function holeList(list, info) {
 
 // Adds the hole as the last scan point Sr, or drops it.
 function toggleHole(h) {
-  const s = ctx.settings();
+  const s = settings;
   const pts = safePoints(s.fidScanText);
   const at = pts.findIndex((p) => near(p, h.scan) < SAME_MM);
   if (at >= 0) pts.splice(at, 1);
@@ -152,7 +149,7 @@ function toggleHole(h) {
 // scan already registered by typed points, the change re-plans (a count
 // that does not match is the core's message).
 export function pointsEdited() {
-  const s = ctx.settings();
+  const s = settings;
   const nScan = safePoints(s.fidScanText).length;
   const nPrinter = safePoints(s.fidPrinterText).length;
   if (s.fidSource !== 'points' && nScan >= 3 && nScan === nPrinter) {
@@ -168,7 +165,7 @@ export function pointsEdited() {
 
 // What the chosen holes still need.
 function chooseNote() {
-  const s = ctx.settings();
+  const s = settings;
   const nScan = safePoints(s.fidScanText).length;
   const nPrinter = safePoints(s.fidPrinterText).length;
   let text = '';
@@ -188,8 +185,8 @@ function chooseNote() {
 function showPairs(list) {
   const box = $('fid-pairs');
   box.replaceChildren();
-  const { info } = ctx.state;
-  const s = ctx.settings();
+  const { info } = state;
+  const s = settings;
   const printer = safePoints(s.fidPrinterText);
   if (!info || !list.length || !printer.length || s.fidSource === 'none') return;
   const scanPts = s.fidSource === 'points' ? safePoints(s.fidScanText) : [];
@@ -244,7 +241,7 @@ function choosePairs(list, selects) {
   const chosen = selects.map((sel) => (sel.value === '' ? null : list[Number(sel.value)]));
   // Registration needs a hole for every P; wait until each row has one.
   if (chosen.some((h) => !h)) return;
-  const s = ctx.settings();
+  const s = settings;
   s.fidScanText = fmtPoints(chosen.map((h) => h.scan));
   s.fidSource = 'points';
   ctx.saveSettings();

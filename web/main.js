@@ -16,7 +16,7 @@ import { loadWasm, startWorker } from './engine.js';
 import {
   acceptScan, bindFiles, demoScanEntry, dropCentre, endRestoring, keep, loadDemo, restoreInputs,
 } from './inputs.js';
-import { $, hooks, settings, state } from './page.js';
+import { $, hooks, profile, settings, state } from './page.js';
 import { cancelCentre, centreRequest, initPlacement, onCentred, requestCentre } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanShown, syncPreviewButton,
@@ -102,6 +102,7 @@ function runPlan() {
     transfer.push(msgSvg.bytes.buffer);
     state.sentSvgKey = svg.key;
   }
+  const { dialect, file: profileFile } = profile();
   state.worker.postMessage({
     type: 'plan',
     id,
@@ -112,10 +113,8 @@ function runPlan() {
     svg: msgSvg,
     plan: job.plan,
     // A built-in name, or the user's profile as JSON text (named by its file).
-    dialect: settings.dialect === 'custom' && settings.customProfile
-      ? settings.customProfile.text : settings.dialect,
-    profileFile: settings.dialect === 'custom' && settings.customProfile
-      ? settings.customProfile.file : undefined,
+    dialect,
+    profileFile,
     acceptRisk: !!settings.acceptRisk,
     compare,
     // Centre the drawing on the scan before planning (a new scan or drawing).
@@ -363,20 +362,9 @@ async function start() {
     viewClick: previewClick,
     checkShown: previewCheckShown,
   });
+  // Calls into modules that import placement.js and fiducials.js.
   const page = {
-    state,
-    settings: () => settings,
-    saveSettings,
-    writeForm,
-    schedulePlan,
-    showError,
-    clearError,
-    updateMarkers,
-    // The profile to write with: [dialect or the profile's JSON, its file
-    // name, the name to show].
-    profile: () => (settings.dialect === 'custom' && settings.customProfile
-      ? [settings.customProfile.text, settings.customProfile.file, settings.customProfile.name]
-      : [settings.dialect, undefined, settings.dialect]),
+    saveSettings, writeForm, schedulePlan, updateMarkers,
   };
   initPlacement(page);
   initFiducials(page);

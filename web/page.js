@@ -1,10 +1,38 @@
-// What the page's modules share: the element lookup, the page's state and
-// settings, number formats, and the hooks main.js fills in. Modules import
-// this one and each other only in one direction (the single-file build,
-// scripts/single-file.mjs, joins them in dependency order and allows no
-// cycle); a call back up (to plan again, say) goes through `hooks`.
+// What the page's modules share: finding and making elements, the page's
+// state and settings (and the machine profile they choose), number formats,
+// and the hooks main.js fills in. Modules import this one and each other
+// only in one direction (the single-file build, scripts/single-file.mjs,
+// joins them in dependency order and allows no cycle); a call back up (to
+// plan again, say) goes through `hooks`.
 
 export const $ = (id) => document.getElementById(id);
+
+// A new element with its text, and its class and id when given (text from
+// files and errors is set as text, never as HTML).
+export function el(tag, text, cls, id) {
+  const e = document.createElement(tag);
+  if (text !== undefined) e.textContent = text;
+  if (cls) e.className = cls;
+  if (id) e.id = id;
+  return e;
+}
+
+// A table cell appended to the row `tr`.
+export function cell(tr, text, cls, title) {
+  const td = el('td', text, cls);
+  if (title) td.title = title;
+  tr.append(td);
+  return td;
+}
+
+// A legend entry: a swatch of the CSS colour `background` and its label.
+export function swatch(background, label) {
+  const sw = el('i', undefined, 'sw');
+  sw.style.background = background;
+  const li = el('li');
+  li.append(sw, label);
+  return li;
+}
 
 // The settings the user edits (persisted in localStorage by settings.js):
 // one object for the page's life, filled by loadSettings.
@@ -15,6 +43,16 @@ export const settings = {};
 // showErrorPlot(), viewShowsChanged(), viewClick(px, py) -> handled,
 // planShown(plan).
 export const hooks = {};
+
+// The machine profile a plan or preview is written with: `dialect` a
+// built-in name or the user's profile as JSON text, `file` that profile's
+// file name (for its errors), `name` the name the page shows.
+export function profile() {
+  const cp = settings.dialect === 'custom' && settings.customProfile;
+  return cp
+    ? { dialect: cp.text, file: cp.file, name: cp.name }
+    : { dialect: settings.dialect, file: undefined, name: settings.dialect };
+}
 
 export const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
 

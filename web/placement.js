@@ -7,8 +7,8 @@
 // worker's Session.centreDrawing); this module keeps the settings and the
 // elements in step.
 import { bedOf, carryDrawing, volumeFit } from '../pkg/pcpp.js';
-
-const $ = (id) => document.getElementById(id);
+import { $, profile, settings, state } from './page.js';
+import { clearError, showError } from './status.js';
 
 // The scan placement the settings start with (and a new scan is read with).
 export const SCAN_PLACE_DEFAULT = Object.freeze({ on: false, rot: 0, dx: 0, dy: 0, dz: 0 });
@@ -21,8 +21,8 @@ const FIELDS = [
   ['bed-rot', 'rot', 'rotate (°)'],
 ];
 
-// Set by initPlacement: {state, settings(), saveSettings, writeForm,
-// schedulePlan, showError, profile() -> [dialect, profileFile]}.
+// Set by initPlacement: {saveSettings, writeForm, schedulePlan} (modules
+// that import this one).
 let ctx = null;
 let centreTokens = 0;
 const beds = new Map(); // profile key -> its bed (wasm bedOf)
@@ -31,7 +31,7 @@ const finite = (v) => typeof v === 'number' && Number.isFinite(v);
 
 // The scan placement of the settings, checked: every number typed.
 function scanPlace() {
-  const sp = { ...SCAN_PLACE_DEFAULT, ...(ctx.settings().scanPlace || {}) };
+  const sp = { ...SCAN_PLACE_DEFAULT, ...(settings.scanPlace || {}) };
   for (const [, key, name] of FIELDS) {
     if (!finite(sp[key])) throw new Error(`scan placement: ${name} must be a number`);
   }
@@ -39,7 +39,7 @@ function scanPlace() {
 }
 
 function bed() {
-  const [dialect, file] = ctx.profile();
+  const { dialect, file } = profile();
   const key = `${file || ''}\u0000${dialect}`;
   let b = beds.get(key);
   if (!b) {
@@ -54,7 +54,7 @@ function bed() {
 // scan is either registered or placed, never both; a new scan is read as
 // it is until the user places it).
 function placed(scan) {
-  const s = ctx.settings();
+  const s = settings;
   return !!(s.scanPlace && s.scanPlace.on) && s.fidSource === 'none' && !(scan && scan.asScanned);
 }
 
@@ -70,7 +70,7 @@ export function scanPlacementFor(scan) {
 // The drawing's placement as the core reads it, or null if a field is not
 // a number.
 function drawingPlacement() {
-  const p = ctx.settings().placement;
+  const p = settings.placement;
   const v = [p.x, p.y, p.rot, p.scale].map(Number);
   if (!v.every(Number.isFinite)) return null;
   return { offset_mm: [v[0], v[1]], rotation_deg: v[2], scale: v[3] };
@@ -83,7 +83,6 @@ const round4 = (v) => Math.round(v * 1e4) / 1e4;
 // Before the loaded scan was read (or while its drawing is still to be
 // centred) the drawing is centred on it afterwards instead.
 export function moveScan(change) {
-  const { state } = ctx;
   let before = null;
   try {
     before = scanPlacementFor(state.scan);
@@ -108,12 +107,12 @@ export function moveScan(change) {
   const [lo, hi] = info.scan_bbox_mm;
   try {
     const c = carryDrawing(drawing, [...lo, ...hi], before, after);
-    const s = ctx.settings();
+    const s = settings;
     s.placement.x = round4(c.offset_mm[0]);
     s.placement.y = round4(c.offset_mm[1]);
     s.placement.rot = round4(c.rotation_deg);
   } catch (e) {
-    ctx.showError('Could not move the drawing with the scan', e.message);
+    showError('Could not move the drawing with the scan', e.message);
   }
 }
 
@@ -123,28 +122,27 @@ export function moveScan(change) {
 // own size: the scale set for the previous one does not carry over; the
 // core scales it down if it does not fit.
 export function requestCentre(drawing = false) {
-  const fresh = drawing || !!(ctx.state.centre && ctx.state.centre.fresh);
-  ctx.state.centre = { token: ++centreTokens, fresh };
+  const fresh = drawing || !!(state.centre && state.centre.fresh);
+  state.centre = { token: ++centreTokens, fresh };
 }
 
 // The user placed the drawing: nothing is centred over it.
 export function cancelCentre() {
-  ctx.state.centre = null;
+  state.centre = null;
 }
 
 // What a plan request carries: {token, fresh}, or null.
 export function centreRequest() {
-  return ctx.state.centre ? { ...ctx.state.centre } : null;
+  return state.centre ? { ...state.centre } : null;
 }
 
 // The worker centred the drawing for the request `busy` (its token): taken
 // into the settings unless the user placed it since, with the core's note
 // when it was scaled to fit.
 export function onCentred(m, busy) {
-  const { state } = ctx;
   if (!state.centre || !busy || !busy.centre || busy.centre.token !== state.centre.token) return;
   state.centre = null;
-  const s = ctx.settings();
+  const s = settings;
   // The core's numbers as they are: what the worker plans.
   s.placement = {
     x: m.placement.offset_mm[0],
@@ -168,8 +166,7 @@ export function setNote(text) {
 // Banner, the placement panel and the header's status, for the scan on
 // screen and the settings now.
 export function showScanPlacement() {
-  const { state } = ctx;
-  const s = ctx.settings();
+  const s = settings;
   const info = state.info;
   const status = $('reg-status');
   const line = status.parentElement;
@@ -183,7 +180,7 @@ export function showScanPlacement() {
   let fit = null;
   if (info) {
     const [lo, hi] = info.bbox_mm;
-    const [dialect, file] = ctx.profile();
+    const { dialect, file } = profile();
     try {
       fit = volumeFit([...lo, ...hi], dialect, file);
     } catch {
@@ -195,7 +192,7 @@ export function showScanPlacement() {
   $('place-banner-text').textContent = outside ? capital(fit.message) : '';
   $('scan-place').hidden = !on;
   if (on) {
-    $('bed-name').textContent = `profile ${ctx.profile()[2]}`;
+    $('bed-name').textContent = `profile ${profile().name}`;
     const note = $('bed-note');
     const shown = info && info.registration.status.kind === 'placed-on-bed';
     note.textContent = shown && outside ? capital(fit.message) : '';
@@ -208,7 +205,7 @@ const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
 
 // The fields from the settings (except the one being typed in).
 function writeFields(except) {
-  const sp = { ...SCAN_PLACE_DEFAULT, ...(ctx.settings().scanPlace || {}) };
+  const sp = { ...SCAN_PLACE_DEFAULT, ...(settings.scanPlace || {}) };
   for (const [id, key] of FIELDS) {
     if (id === except || document.activeElement === $(id)) continue;
     $(id).value = finite(sp[key]) ? String(sp[key]) : '';
@@ -216,13 +213,13 @@ function writeFields(except) {
 }
 
 function placeOnBed() {
-  const s = ctx.settings();
+  const s = settings;
   moveScan(() => {
     s.scanPlace = { ...SCAN_PLACE_DEFAULT, on: true };
     // The registration the page would otherwise read the scan with.
     s.fidSource = 'none';
   });
-  ctx.clearError();
+  clearError();
   ctx.saveSettings();
   ctx.writeForm();
   showScanPlacement();
@@ -230,7 +227,7 @@ function placeOnBed() {
 }
 
 function backToScannerFrame() {
-  const s = ctx.settings();
+  const s = settings;
   moveScan(() => {
     s.scanPlace = { ...SCAN_PLACE_DEFAULT };
   });
@@ -253,7 +250,7 @@ function onField(id, key, name) {
   }
   note.textContent = '';
   note.classList.remove('bad-note');
-  const s = ctx.settings();
+  const s = settings;
   if (s.scanPlace[key] === v) return;
   moveScan(() => {
     s.scanPlace = { ...s.scanPlace, [key]: v };
@@ -263,7 +260,7 @@ function onField(id, key, name) {
   ctx.schedulePlan(250);
 }
 
-// `c`: the page's state and callbacks (see `ctx` above).
+// `c`: the page's callbacks (see `ctx` above).
 export function initPlacement(c) {
   ctx = c;
   $('place-bed-btn').addEventListener('click', placeOnBed);

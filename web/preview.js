@@ -9,7 +9,9 @@
 // thread (PreviewTimeline) places the nozzle; the view moves only its
 // transform per frame.
 import { PreviewTimeline, Viewer } from '../pkg/pcpp.js';
-import { $, fmt, num, settings, state } from './page.js';
+import {
+  $, fmt, num, profile, settings, state, swatch,
+} from './page.js';
 import { drawPlanPaths, requestDraw, setViewShows } from './view.js';
 
 // Speed-ups offered (real print speed first).
@@ -25,8 +27,10 @@ const pv = {
   on: false, // the user wants the preview in the view
   source: 'plan', // 'plan' or 'check' (the last checked file)
   id: 0, // the request in flight (stale answers are dropped)
+  pending: null, // what that request previews: {id, source, name, ...}
   data: null, // the previewed program: see onPreview
   t: 0, // the moment shown, s
+  index: 0, // the move shown at that moment
   playing: false,
   raf: 0,
   last: 0, // the frame time play last advanced from
@@ -69,13 +73,8 @@ function syncControls() {
 // Asks the worker for the program of the chosen source.
 function request() {
   const id = ++pv.id;
-  const profile = settings.dialect === 'custom' && settings.customProfile;
-  const msg = {
-    type: 'preview',
-    id,
-    dialect: profile ? profile.text : settings.dialect,
-    profileFile: profile ? profile.file : undefined,
-  };
+  const { dialect, file: profileFile } = profile();
+  const msg = { type: 'preview', id, dialect, profileFile };
   const transfer = [];
   let job;
   if (pv.source === 'check') {
@@ -106,8 +105,11 @@ function request() {
   state.worker.postMessage(msg, transfer);
 }
 
-// The worker's answer: the moves, their times and clearances.
-export async function onPreview(m) {
+const decoder = new TextDecoder();
+
+// The worker's answer: the moves, their times and clearances, and the
+// program's bytes it read (for the line readout).
+export function onPreview(m) {
   const job = pv.pending;
   if (!job || m.id !== pv.id) return;
   pv.pending = null;
@@ -119,14 +121,7 @@ export async function onPreview(m) {
     return;
   }
   const r = m.result;
-  let text;
-  try {
-    text = job.source === 'plan' ? job.plan.gcode : await job.file.text();
-  } catch (e) {
-    setStatus(`Could not read ${job.name}: ${e.message}`, true);
-    return;
-  }
-  if (m.id !== pv.id) return;
+  const text = job.source === 'plan' ? job.plan.gcode : decoder.decode(m.bytes);
   const timeline = new PreviewTimeline(r.moves, r.starts, r.durations, r.lines, r.rapid);
   let defectCodes = null;
   if (job.source === 'plan') {
@@ -207,7 +202,6 @@ function setTime(t) {
     + `(${CLASS_NAMES[cls]}; tol ${fmt(d.r.tol_mm)} mm)`;
   clear.className = cls === 2 ? 'bad' : cls === 1 ? 'near' : '';
   pv.index = c.index;
-  pv.line = c.line;
   if (state.viewer && state.viewShows === 'preview') {
     state.viewer.setNozzle(x, y, z, d.od);
     requestDraw();
@@ -308,14 +302,7 @@ export function bindPreview() {
   for (const s of SPEEDS) sp.add(new Option(`${s}×`, String(s)));
   const legend = $('preview-legend');
   legend.replaceChildren(...[[0, 'clear'], [1, 'near: within 0.1 mm over tol'], [2, 'closer than tol'], [NO_DEFECT, 'travel']]
-    .map(([code, label]) => {
-      const li = document.createElement('li');
-      const sw = document.createElement('i');
-      sw.className = 'sw';
-      sw.style.background = `rgb(${Viewer.previewColor(code).join(',')})`;
-      li.append(sw, label);
-      return li;
-    }));
+    .map(([code, label]) => swatch(`rgb(${Viewer.previewColor(code).join(',')})`, label)));
   $('preview-btn').addEventListener('click', () => setOn(!pv.on));
   $('preview-play').addEventListener('click', () => (pv.playing ? stop() : play()));
   $('preview-time').addEventListener('input', (e) => {

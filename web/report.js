@@ -3,7 +3,9 @@
 // of every planner's error against slope and curvature.
 import { clearanceCapAboveTolMm } from '../pkg/pcpp.js';
 import { showFiducials } from './fiducials.js';
-import { $, fmt, fmtPoint, state } from './page.js';
+import {
+  $, cell, el, fmt, fmtPoint, state, swatch,
+} from './page.js';
 import { showScanPlacement } from './placement.js';
 import { drawPlot, plannerColor } from './plot.js';
 import { showError } from './status.js';
@@ -60,20 +62,11 @@ export function showPlan(plan) {
   ];
   const body = $('stats-table').tBodies[0];
   body.replaceChildren(...rows.map(([k, v, id]) => {
-    const tr = document.createElement('tr');
-    const a = document.createElement('td');
-    const b = document.createElement('td');
-    a.textContent = k;
-    b.textContent = String(v);
-    if (id) b.id = id;
-    tr.append(a, b);
+    const tr = el('tr');
+    tr.append(el('td', k), el('td', String(v), '', id));
     return tr;
   }));
-  $('warnings').replaceChildren(...summary.warnings.map((w) => {
-    const li = document.createElement('li');
-    li.textContent = w;
-    return li;
-  }));
+  $('warnings').replaceChildren(...summary.warnings.map((w) => el('li', w)));
   showMotion(summary);
   // A long path's plot waits for the end of a drag.
   if (!state.interacting || view.defects.length < 20000) showErrorPlot();
@@ -99,14 +92,8 @@ export function showErrorPlot() {
   } else {
     shown = series.filter((x) => x.planner === choice);
   }
-  $('plot-legend').replaceChildren(...(choice === 'all' ? series : []).map((x) => {
-    const li = document.createElement('li');
-    const sw = document.createElement('i');
-    sw.className = 'sw';
-    sw.style.background = plannerColor(x.planner);
-    li.append(sw, x.planner);
-    return li;
-  }));
+  $('plot-legend').replaceChildren(...(choice === 'all' ? series : [])
+    .map((x) => swatch(plannerColor(x.planner), x.planner)));
   $('plot-note').textContent = shown.length === 0
     ? `${choice}: compared after the drag or change ends`
     : choice === 'all' ? `${shown.length} planner(s), one colour each` : `${choice}, coloured by predicted defect`;
@@ -119,22 +106,13 @@ function fmtClearance(c, tol) {
   return c === null || c === undefined ? `>${fmt(tol + clearanceCapAboveTolMm())}` : fmt(c);
 }
 
-export function cell(tr, text, cls, title) {
-  const td = document.createElement('td');
-  td.textContent = text;
-  if (cls) td.className = cls;
-  if (title) td.title = title;
-  tr.append(td);
-  return td;
-}
-
 export function showComparison(rows, selected, tol) {
   $('compare-table').classList.remove('stale');
   const body = $('compare-table').tBodies[0];
   body.replaceChildren(...rows.map((r) => {
     const q = r.quality;
     const mo = r.motion;
-    const tr = document.createElement('tr');
+    const tr = el('tr');
     tr.dataset.planner = r.planner;
     if (r.planner === selected) tr.className = 'selected';
     for (const v of [r.planner, fmt(q.mean_abs_error_mm, 4), fmt(q.mean_negative_error_mm, 4),
@@ -181,17 +159,11 @@ function showMotion(summary) {
   if (m.risk_accepted) rows.push(['risk', 'accepted: G-code with moves closer than tol', 'motion-risk', 'bad']);
   const body = $('motion-table').tBodies[0];
   body.replaceChildren(...rows.map(([k, v, id, cls]) => {
-    const tr = document.createElement('tr');
-    cell(tr, k);
-    const td = cell(tr, v, cls);
-    if (id) td.id = id;
+    const tr = el('tr');
+    tr.append(el('td', k), el('td', v, cls, id));
     return tr;
   }));
-  $('motion-touches').replaceChildren(...p.touching.slice(0, 5).map((t) => {
-    const li = document.createElement('li');
-    li.textContent = fmtTouch(t);
-    return li;
-  }));
+  $('motion-touches').replaceChildren(...p.touching.slice(0, 5).map((t) => el('li', fmtTouch(t))));
 }
 
 // A touching move in the core's words (motion::Touch's Display).

@@ -149,38 +149,44 @@ async function plan(m) {
   }
 }
 
-// Checks a G-code File against the session's scan (read here, like the
-// scan, never on the page's main thread).
-async function check(m) {
-  const { id, name } = m;
-  try {
-    const bytes = new Uint8Array(await m.file.arrayBuffer());
-    await planning;
-    if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
-    const result = session.checkGcode(bytes, name, m.nozzle, m.tol);
-    const transfer = result.moves ? [result.moves.buffer, result.kinds.buffer] : [];
-    post({ type: 'check', id, name, scan: session.info().name, result }, transfer);
-  } catch (err) {
-    post({ type: 'check', id, name, ...errorOf(err), error: errorOf(err).message });
-  }
-}
-
-// The print preview of a G-code program (the plan's bytes, or a File being
-// checked, read here): its moves timed at its feeds and each move's
-// clearance, by the core (Session.previewGcode), after any plan in flight.
-async function preview(m) {
+// A G-code program (a File, read here like the scan, never on the page's
+// main thread; or bytes the page sent) given to `run` on the session's
+// scan after any plan in flight; `run` returns the answer's fields and
+// the buffers to transfer. Answered as `type`, an error included.
+async function onProgram(m, type, run) {
   const { id, name } = m;
   try {
     const bytes = m.bytes || new Uint8Array(await m.file.arrayBuffer());
     await planning;
     if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
-    const r = session.previewGcode(bytes, name, m.nozzle, m.tol, m.dialect, m.profileFile, m.speed);
-    post({ type: 'preview', id, name, result: r },
-      [r.moves.buffer, r.lines.buffer, r.rapid.buffer, r.starts.buffer, r.durations.buffer,
-        r.clearance.buffer, r.classes.buffer]);
+    const [fields, transfer] = run(bytes);
+    post({ type, id, name, ...fields }, transfer);
   } catch (err) {
-    post({ type: 'preview', id, name, ...errorOf(err), error: errorOf(err).message });
+    const e = errorOf(err);
+    post({ type, id, name, ...e, error: e.message });
   }
+}
+
+// Checks a G-code File against the session's scan.
+function check(m) {
+  return onProgram(m, 'check', (bytes) => {
+    const result = session.checkGcode(bytes, m.name, m.nozzle, m.tol);
+    const transfer = result.moves ? [result.moves.buffer, result.kinds.buffer] : [];
+    return [{ scan: session.info().name, result }, transfer];
+  });
+}
+
+// The print preview of a G-code program (the plan's bytes, or a File being
+// checked): its moves timed at its feeds and each move's clearance, by the
+// core (Session.previewGcode).
+function preview(m) {
+  return onProgram(m, 'preview', (bytes) => {
+    const r = session.previewGcode(bytes, m.name, m.nozzle, m.tol, m.dialect, m.profileFile, m.speed);
+    // The bytes go back for the page's line readout: it never reads the
+    // file itself.
+    return [{ result: r, bytes }, [r.moves.buffer, r.lines.buffer, r.rapid.buffer, r.starts.buffer,
+      r.durations.buffer, r.clearance.buffer, r.classes.buffer, bytes.buffer]];
+  });
 }
 
 self.onmessage = (e) => {

@@ -13,8 +13,8 @@ use wasm_bindgen::prelude::*;
 
 use super::{
     arr, check_samples, check_scan_size, core_err, demo_part_named, from_js, gcode_text, js_err,
-    kind_err, profile, set, to_js, vec3, HoleView, PickView, RegistrationView, ScanView, MIB,
-    PAGE_MAX_DRAWN_MOVES,
+    kind_err, profile, set, set_array, to_js, vec3, HoleView, PickView, RegistrationView, ScanView,
+    TypedArray, MIB, PAGE_MAX_DRAWN_MOVES,
 };
 use crate::demo::{self, parts::DemoPart};
 use crate::fiducials::{find_fiducials, find_fiducials_sized, Fiducial};
@@ -305,33 +305,13 @@ impl Session {
 fn plan_arrays(plan: &Plan) -> js_sys::Object {
     let a = PlanArrays::of(plan);
     let o = js_sys::Object::new();
-    set(
-        &o,
-        "pieces",
-        &js_sys::Uint32Array::from(&a.pieces[..]).into(),
-    );
-    set(&o, "ta", &js_sys::Float32Array::from(&a.ta[..]).into());
-    set(&o, "tool", &js_sys::Float32Array::from(&a.tool[..]).into());
-    set(
-        &o,
-        "defects",
-        &js_sys::Uint8Array::from(&a.defects[..]).into(),
-    );
-    set(
-        &o,
-        "slope",
-        &js_sys::Float32Array::from(&a.slope_deg[..]).into(),
-    );
-    set(
-        &o,
-        "kappa",
-        &js_sys::Float32Array::from(&a.kappa[..]).into(),
-    );
-    set(
-        &o,
-        "error",
-        &js_sys::Float32Array::from(&a.error_mm[..]).into(),
-    );
+    set_array(&o, "pieces", &a.pieces);
+    set_array(&o, "ta", &a.ta);
+    set_array(&o, "tool", &a.tool);
+    set_array(&o, "defects", &a.defects);
+    set_array(&o, "slope", &a.slope_deg);
+    set_array(&o, "kappa", &a.kappa);
+    set_array(&o, "error", &a.error_mm);
     o
 }
 
@@ -341,12 +321,8 @@ fn plan_series(plan: &Plan) -> Result<js_sys::Object, JsError> {
     let (error, defects) = preview::plan_errors(plan);
     let o = js_sys::Object::new();
     set(&o, "planner", &to_js(&plan.planner)?);
-    set(&o, "error", &js_sys::Float32Array::from(&error[..]).into());
-    set(
-        &o,
-        "defects",
-        &js_sys::Uint8Array::from(&defects[..]).into(),
-    );
+    set_array(&o, "error", &error);
+    set_array(&o, "defects", &defects);
     Ok(o)
 }
 
@@ -621,16 +597,8 @@ impl Session {
         let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
         report_json.push(b'\n');
         let out = js_sys::Object::new();
-        set(
-            &out,
-            "gcode",
-            &js_sys::Uint8Array::from(gcode.as_bytes()).into(),
-        );
-        set(
-            &out,
-            "report",
-            &js_sys::Uint8Array::from(&report_json[..]).into(),
-        );
+        set_array(&out, "gcode", gcode.as_bytes());
+        set_array(&out, "report", &report_json);
         let summary = PlanSummary {
             planner: plan.planner,
             settings: &settings,
@@ -691,8 +659,8 @@ impl Session {
                     *c = 2;
                 }
             }
-            moves = js_sys::Float32Array::from(&xyz[..]).into();
-            kinds = js_sys::Uint8Array::from(&k[..]).into();
+            moves = f32::typed_array(&xyz);
+            kinds = u8::typed_array(&k);
         }
         set(o, "moves", &moves);
         set(o, "kinds", &kinds);
@@ -768,29 +736,13 @@ impl Session {
         let starts: Vec<f64> = moves.iter().map(|m| m.start_s).collect();
         let durations: Vec<f64> = moves.iter().map(|m| m.duration_s).collect();
         let o = js_sys::Object::new();
-        set(&o, "moves", &js_sys::Float64Array::from(&xyz[..]).into());
-        set(&o, "lines", &js_sys::Uint32Array::from(&lines[..]).into());
-        set(&o, "rapid", &js_sys::Uint8Array::from(&rapid[..]).into());
-        set(
-            &o,
-            "starts",
-            &js_sys::Float64Array::from(&starts[..]).into(),
-        );
-        set(
-            &o,
-            "durations",
-            &js_sys::Float64Array::from(&durations[..]).into(),
-        );
-        set(
-            &o,
-            "clearance",
-            &js_sys::Float32Array::from(&gaps[..]).into(),
-        );
-        set(
-            &o,
-            "classes",
-            &js_sys::Uint8Array::from(&classes[..]).into(),
-        );
+        set_array(&o, "moves", &xyz);
+        set_array(&o, "lines", &lines);
+        set_array(&o, "rapid", &rapid);
+        set_array(&o, "starts", &starts);
+        set_array(&o, "durations", &durations);
+        set_array(&o, "clearance", &gaps);
+        set_array(&o, "classes", &classes);
         set(&o, "total_s", &timeline.total_s().into());
         set(&o, "tol_mm", &tol_mm.into());
         set(&o, "near_mm", &near.into());

@@ -135,27 +135,41 @@ export async function download(page, linkId) {
   return { name: dl.suggestedFilename(), bytes: readFileSync(path) };
 }
 
+// Runs in the page (sent as source by countViewPixels): the 3-D view's
+// pixels, read from a 2-D copy of its WebGL canvas, counted into `out`.
+function countInPage(out, classify) {
+  const gl = document.getElementById('view');
+  const c = document.createElement('canvas');
+  c.width = gl.width;
+  c.height = gl.height;
+  const ctx = c.getContext('2d');
+  ctx.drawImage(gl, 0, 0);
+  const d = ctx.getImageData(0, 0, c.width, c.height).data;
+  for (let i = 0; i < d.length; i += 4) {
+    const p = i / 4;
+    classify(out, d[i], d[i + 1], d[i + 2], p % c.width, Math.floor(p / c.width));
+  }
+  return out;
+}
+
+// Counts the 3-D view's pixels: `out` holds the counters' starting values,
+// `classify(out, r, g, b, x, y)` adds each pixel (x, y from the top-left).
+// Both go to the page as source: `classify` may use only its arguments.
+export async function countViewPixels(page, out, classify) {
+  return page.evaluate(`(${countInPage})(${JSON.stringify(out)}, ${classify})`);
+}
+
 // Counts view pixels by class: background, mesh (blue-grey), path (the
 // saturated defect colours and the white Ta).
 export async function viewPixels(page) {
-  return page.evaluate(() => {
-    const gl = document.getElementById('view');
-    const c = document.createElement('canvas');
-    c.width = gl.width;
-    c.height = gl.height;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(gl, 0, 0);
-    const d = ctx.getImageData(0, 0, c.width, c.height).data;
-    const out = { total: c.width * c.height, background: 0, mesh: 0, good: 0, defect: 0, ta: 0 };
-    for (let i = 0; i < d.length; i += 4) {
-      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
-      if (Math.abs(r - 23) < 6 && Math.abs(g - 26) < 6 && Math.abs(b - 33) < 6) out.background++;
-      else if (g > r + 90 && g > b + 60) out.good++;
-      else if ((r > g + 100 && r > b + 100) || (b > r + 120 && b > g + 50) || (r > 200 && g > 100 && g < 190 && b < 60)) out.defect++;
-      else if (r > 225 && g > 225 && b > 225) out.ta++;
-      else if (b > r + 4 && b >= g && b - r < 70 && r > 30) out.mesh++;
-    }
-    return out;
+  const start = { total: 0, background: 0, mesh: 0, good: 0, defect: 0, ta: 0 };
+  return countViewPixels(page, start, (out, r, g, b) => {
+    out.total++;
+    if (Math.abs(r - 23) < 6 && Math.abs(g - 26) < 6 && Math.abs(b - 33) < 6) out.background++;
+    else if (g > r + 90 && g > b + 60) out.good++;
+    else if ((r > g + 100 && r > b + 100) || (b > r + 120 && b > g + 50) || (r > 200 && g > 100 && g < 190 && b < 60)) out.defect++;
+    else if (r > 225 && g > 225 && b > 225) out.ta++;
+    else if (b > r + 4 && b >= g && b - r < 70 && r > 30) out.mesh++;
   });
 }
 

@@ -10,7 +10,7 @@ import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { test } from 'node:test';
 import {
-  DIST, download, openPage, waitSettled, withPageServer,
+  DIST, countViewPixels, download, openPage, waitSettled, withPageServer,
 } from './helpers.mjs';
 
 const env = withPageServer();
@@ -51,33 +51,25 @@ const readouts = (page) => page.evaluate(() => ({
 
 // The view's pixels: the nozzle's violet (its centroid), and the path's
 // colours by clearance class and defect (src/render.rs).
-const pixels = (page) => page.evaluate(() => {
-  const gl = document.getElementById('view');
-  const c = document.createElement('canvas');
-  c.width = gl.width;
-  c.height = gl.height;
-  const ctx = c.getContext('2d');
-  ctx.drawImage(gl, 0, 0);
-  const d = ctx.getImageData(0, 0, c.width, c.height).data;
-  const near = (i, [r, g, b]) => Math.abs(d[i] - r) < 8 && Math.abs(d[i + 1] - g) < 8 && Math.abs(d[i + 2] - b) < 8;
-  const out = { nozzle: 0, nx: 0, ny: 0, green: 0, orange: 0, red: 0, blue: 0 };
-  for (let i = 0; i < d.length; i += 4) {
-    const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
+const pixels = async (page) => {
+  const start = { nozzle: 0, nx: 0, ny: 0, green: 0, orange: 0, red: 0, blue: 0 };
+  const out = await countViewPixels(page, start, (o, r, g, b, x, y) => {
+    const near = ([R, G, B]) => Math.abs(r - R) < 8 && Math.abs(g - G) < 8 && Math.abs(b - B) < 8;
     if (b > 120 && b > r + 20 && r > g + 30) {
-      out.nozzle++;
-      out.nx += (i / 4) % c.width;
-      out.ny += Math.floor(i / 4 / c.width);
-    } else if (near(i, [40, 210, 70])) out.green++;
-    else if (near(i, [255, 150, 20])) out.orange++;
-    else if (r > 170 && g < 100 && b < 100) out.red++;
-    else if (near(i, [40, 120, 255])) out.blue++;
-  }
+      o.nozzle++;
+      o.nx += x;
+      o.ny += y;
+    } else if (near([40, 210, 70])) o.green++;
+    else if (near([255, 150, 20])) o.orange++;
+    else if (r > 170 && g < 100 && b < 100) o.red++;
+    else if (near([40, 120, 255])) o.blue++;
+  });
   if (out.nozzle) {
     out.nx /= out.nozzle;
     out.ny /= out.nozzle;
   }
   return out;
-});
+};
 
 // The middle of the first move that matches `pred(i, r)` in the preview's
 // arrays: {i, t, mid}.
