@@ -1,9 +1,6 @@
 //! Format detection and the import steps every format shares: validation,
 //! degenerate-triangle removal, units and up axis (spec "Inputs").
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use glam::DVec3;
 
 use super::{cloud, gltf, obj, pcd, ply, stl, xyz};
@@ -287,19 +284,8 @@ fn finish(
     check_finite(&vertices, file)?;
     let n = vertices.len();
     // remap[i]: the welded index of vertex i (bit-identical positions merge).
-    let remap: Option<Vec<u32>> = if weld {
-        let mut welder = Welder::with_capacity(n);
-        let mut remap = Vec::with_capacity(n);
-        for &v in &vertices {
-            // At most n <= u32::MAX + 1 vertices were indexable, so this holds.
-            remap.push(welder.index(v).unwrap_or(u32::MAX));
-        }
-        if welder.vertices.len() < n {
-            vertices = welder.vertices;
-            Some(remap)
-        } else {
-            None
-        }
+    let remap = if weld {
+        weld_in_place(&mut vertices)
     } else {
         None
     };
@@ -356,66 +342,155 @@ fn zero_area(a: DVec3, b: DVec3, c: DVec3) -> bool {
     ab.cross(ac).length() <= 1e-12 * longest
 }
 
-/// FxHash (rustc's hasher) with a final mix: welding hashes millions of
-/// positions, and the keys are not attacker-chosen collisions we need
-/// SipHash against. The mix matters: coordinates read as f32 have 29 zero
-/// low bits as f64, and Fx's multiply leaves its low bits (the hash map's
-/// bucket index) a function of the input's low bits only, so without it a
-/// real scan's vertices pile into a few buckets (a 10 M triangle PLY took
-/// 19.7 s to weld instead of 1.8 s).
-#[derive(Default)]
-struct FxHasher(u64);
+/// The hash of a position's key: FxHash's (rustc's hasher) multiply per
+/// word with a final mix. Welding hashes millions of positions, and the
+/// keys are not attacker-chosen collisions we need SipHash against. The mix
+/// matters: coordinates read as f32 have 29 zero low bits as f64, and Fx's
+/// multiply leaves its low bits (the table's slot) a function of the
+/// input's low bits only, so without it a real scan's vertices pile into a
+/// few slots (a 10 M triangle PLY took 19.7 s to weld instead of 1.8 s).
+#[inline]
+fn key_hash(key: [u64; 3]) -> u64 {
+    let mut h = 0u64;
+    for w in key {
+        h = (h.rotate_left(5) ^ w).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    // Fold the high bits, which depend on every input bit, into the low.
+    let h = h ^ (h >> 32);
+    h.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (h >> 29)
+}
 
-impl Hasher for FxHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(word));
+/// A position's key: its bits, with +0.0 making -0.0 and 0.0 the same
+/// (the same point in space).
+#[inline]
+fn key(p: DVec3) -> [u64; 3] {
+    (p + DVec3::ZERO).to_array().map(f64::to_bits)
+}
+
+/// No vertex in this slot.
+const EMPTY: u32 = u32::MAX;
+
+/// The welding table: open addressing with linear probing over vertex
+/// indices, at most half full. A slot holds the index of a vertex already
+/// kept, whose position is the key, so the table costs 8 bytes a vertex
+/// where a map holding the keys cost about 70 (for a 2 M triangle PLY, the
+/// difference was 65 MB of the import's peak, and the map's scattered
+/// 32-byte entries made welding the largest step of the import).
+struct WeldTable {
+    slots: Vec<u32>,
+    len: usize,
+}
+
+impl WeldTable {
+    fn with_capacity(n: usize) -> Self {
+        WeldTable {
+            slots: vec![EMPTY; (2 * n).next_power_of_two().max(16)],
+            len: 0,
         }
     }
-    fn write_u64(&mut self, n: u64) {
-        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+
+    /// The index among `kept` (the vertices kept so far, in order) of the
+    /// position `p`, or `None` after making it the next one (`kept.len()`,
+    /// which must be below [`EMPTY`]).
+    #[inline]
+    fn find_or_add(&mut self, p: DVec3, kept: &[DVec3]) -> Option<u32> {
+        if 2 * (self.len + 1) > self.slots.len() {
+            self.grow(kept);
+        }
+        let k = key(p);
+        let mask = self.slots.len() - 1;
+        let mut at = key_hash(k) as usize & mask;
+        loop {
+            match self.slots[at] {
+                EMPTY => {
+                    self.slots[at] = kept.len() as u32;
+                    self.len += 1;
+                    return None;
+                }
+                i if key(kept[i as usize]) == k => return Some(i),
+                _ => at = (at + 1) & mask,
+            }
+        }
     }
-    fn write_usize(&mut self, n: usize) {
-        self.write_u64(n as u64);
-    }
-    fn finish(&self) -> u64 {
-        // Fold the high bits, which depend on every input bit, into the low.
-        let h = self.0 ^ (self.0 >> 32);
-        h.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (h >> 29)
+
+    /// Twice the slots, every kept vertex placed again.
+    fn grow(&mut self, kept: &[DVec3]) {
+        self.slots = vec![EMPTY; 2 * self.slots.len()];
+        let mask = self.slots.len() - 1;
+        for (i, &p) in kept.iter().enumerate() {
+            let mut at = key_hash(key(p)) as usize & mask;
+            while self.slots[at] != EMPTY {
+                at = (at + 1) & mask;
+            }
+            self.slots[at] = i as u32;
+        }
     }
 }
 
 /// Merges bit-identical positions into one vertex. STL stores each facet's
 /// corners separately and glTF exporters split vertices at normal/UV seams;
 /// unwelded, every edge would look like a boundary to the fiducial detector.
-#[derive(Default)]
 pub(super) struct Welder {
-    map: HashMap<[u64; 3], u32, BuildHasherDefault<FxHasher>>,
+    table: WeldTable,
     pub vertices: Vec<DVec3>,
+}
+
+impl Default for Welder {
+    fn default() -> Self {
+        Welder::with_capacity(0)
+    }
 }
 
 impl Welder {
     pub fn with_capacity(n: usize) -> Self {
         Welder {
-            map: HashMap::with_capacity_and_hasher(n, Default::default()),
+            table: WeldTable::with_capacity(n),
             vertices: Vec::with_capacity(n),
         }
     }
 
-    /// The index of `p`, `None` once more than `u32::MAX` vertices exist.
+    /// The index of `p`, `None` once more than `u32::MAX - 1` vertices exist.
     pub fn index(&mut self, p: DVec3) -> Option<u32> {
-        // +0.0 makes -0.0 and 0.0 the same key: the same point in space.
-        let key = (p + DVec3::ZERO).to_array().map(f64::to_bits);
-        if let Some(&i) = self.map.get(&key) {
-            return Some(i);
+        let next = u32::try_from(self.vertices.len())
+            .ok()
+            .filter(|&i| i != EMPTY)?;
+        match self.table.find_or_add(p, &self.vertices) {
+            Some(i) => Some(i),
+            None => {
+                self.vertices.push(p);
+                Some(next)
+            }
         }
-        let i = u32::try_from(self.vertices.len()).ok()?;
-        self.vertices.push(p);
-        self.map.insert(key, i);
-        Some(i)
     }
+}
+
+/// Welds `vertices` in place (the kept ones move to the front, in order of
+/// first appearance): the welded index of each vertex, or `None` when all
+/// are distinct (and `vertices` is as it was).
+fn weld_in_place(vertices: &mut Vec<DVec3>) -> Option<Vec<u32>> {
+    let n = vertices.len();
+    if n >= EMPTY as usize {
+        return None;
+    }
+    let mut table = WeldTable::with_capacity(n);
+    let mut remap = Vec::with_capacity(n);
+    let mut kept = 0usize;
+    for i in 0..n {
+        let p = vertices[i];
+        match table.find_or_add(p, &vertices[..kept]) {
+            Some(j) => remap.push(j),
+            None => {
+                vertices[kept] = p;
+                remap.push(kept as u32);
+                kept += 1;
+            }
+        }
+    }
+    if kept == n {
+        return None;
+    }
+    vertices.truncate(kept);
+    Some(remap)
 }
 
 #[cfg(test)]
@@ -424,8 +499,6 @@ mod tests {
 
     #[test]
     fn weld_hash_spreads_f32_coordinates_over_the_low_bits() {
-        use std::hash::{BuildHasher, BuildHasherDefault};
-        let build = BuildHasherDefault::<super::FxHasher>::default();
         // A scan read as f32: 4096 positions on a 0.1 mm grid with noise.
         let mut low = std::collections::HashSet::new();
         for i in 0..64 {
@@ -436,7 +509,7 @@ mod tests {
                     2.5 + 0.01 * i as f32,
                 ];
                 let key = p.map(|c| (c as f64).to_bits());
-                low.insert(build.hash_one(key) & 0xfff);
+                low.insert(super::key_hash(key) & 0xfff);
             }
         }
         // 4096 keys into 4096 buckets: a good hash fills about 63%.
@@ -528,5 +601,49 @@ mod tests {
         assert_eq!(w.index(DVec3::new(0.0, 1.0, 2.0)), Some(0));
         assert_eq!(w.index(DVec3::new(-0.0, 1.0, 2.0)), Some(0));
         assert_eq!(w.index(DVec3::new(0.0, 1.0, 3.0)), Some(1));
+    }
+
+    /// Positions drawn from a small set, so that most repeat.
+    fn repeating(n: usize, distinct: u64) -> Vec<DVec3> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        (0..n)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let k = (state % distinct) as f64;
+                DVec3::new(k * 0.1, (k * 0.37).sin(), 2.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn welder_grows_past_its_capacity_and_keeps_every_index() {
+        let points = repeating(20_000, 3_000);
+        let mut w = Welder::default();
+        let ids: Vec<u32> = points.iter().map(|&p| w.index(p).unwrap()).collect();
+        // Every position maps to one kept vertex holding it, and the kept
+        // ones are distinct.
+        for (p, &i) in points.iter().zip(&ids) {
+            assert_eq!(w.vertices[i as usize], *p);
+        }
+        let distinct: std::collections::HashSet<[u64; 3]> =
+            points.iter().map(|&p| super::key(p)).collect();
+        assert_eq!(w.vertices.len(), distinct.len());
+    }
+
+    #[test]
+    fn welding_in_place_keeps_first_appearances_in_order() {
+        let original = repeating(5_000, 700);
+        let mut v = original.clone();
+        let remap = weld_in_place(&mut v).expect("repeats were merged");
+        let mut w = Welder::default();
+        let expected: Vec<u32> = original.iter().map(|&p| w.index(p).unwrap()).collect();
+        assert_eq!(remap, expected);
+        assert_eq!(v, w.vertices);
+        // All distinct: nothing to remap, the vertices untouched.
+        let mut distinct = vec![DVec3::ZERO, DVec3::X, DVec3::new(-0.5, 0.0, 1.0)];
+        assert_eq!(weld_in_place(&mut distinct), None);
+        assert_eq!(distinct.len(), 3);
     }
 }
