@@ -400,16 +400,19 @@ pub fn prepare_scan(
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
     registration.validate()?;
-    let imported = pipeline::load_scan(bytes, name, scan)?;
-    let fiducials = find_fiducials_sized(&imported.mesh, registration.dot_diameter_mm);
-    let reg = registration_for_scan(&imported.mesh, &fiducials, registration)?;
-    PreparedScan::assemble(
-        InputFile::new(name, bytes),
-        imported,
-        fiducials,
-        reg,
-        registration.method,
-    )
+    // The provenance hash off the critical path (issue 15): natively on
+    // a second thread while the scan is read, indexed and registered.
+    let (prepared, file) = crate::parallel::join(
+        || -> Result<_> {
+            let imported = pipeline::load_scan(bytes, name, scan)?;
+            let fiducials = find_fiducials_sized(&imported.mesh, registration.dot_diameter_mm);
+            let reg = registration_for_scan(&imported.mesh, &fiducials, registration)?;
+            Ok((imported, fiducials, reg))
+        },
+        || InputFile::new(name, bytes),
+    );
+    let (imported, fiducials, reg) = prepared?;
+    PreparedScan::assemble(file, imported, fiducials, reg, registration.method)
 }
 
 impl PreparedScan {

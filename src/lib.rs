@@ -37,6 +37,7 @@ pub mod gcode;
 pub mod job;
 pub mod mesh;
 pub mod motion;
+mod parallel;
 pub mod params;
 pub mod pipeline;
 pub mod placement;
