@@ -374,18 +374,17 @@ const EMPTY: u32 = u32::MAX;
 /// indices, at most half full. A slot holds the index of a vertex already
 /// kept, whose position is the key, so the table costs 8 bytes a vertex
 /// where a map holding the keys cost about 70 (for a 2 M triangle PLY, the
-/// difference was 65 MB of the import's peak, and the map's scattered
-/// 32-byte entries made welding the largest step of the import).
+/// difference was 65 MB of the import's peak).
+///
+/// The table holds exactly the kept vertices, so their count is its load.
 struct WeldTable {
     slots: Vec<u32>,
-    len: usize,
 }
 
 impl WeldTable {
     fn with_capacity(n: usize) -> Self {
         WeldTable {
             slots: vec![EMPTY; (2 * n).next_power_of_two().max(16)],
-            len: 0,
         }
     }
 
@@ -394,7 +393,7 @@ impl WeldTable {
     /// which must be below [`EMPTY`]).
     #[inline]
     fn find_or_add(&mut self, p: DVec3, kept: &[DVec3]) -> Option<u32> {
-        if 2 * (self.len + 1) > self.slots.len() {
+        if 2 * (kept.len() + 1) > self.slots.len() {
             self.grow(kept);
         }
         let k = key(p);
@@ -404,7 +403,6 @@ impl WeldTable {
             match self.slots[at] {
                 EMPTY => {
                     self.slots[at] = kept.len() as u32;
-                    self.len += 1;
                     return None;
                 }
                 i if key(kept[i as usize]) == k => return Some(i),
