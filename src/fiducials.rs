@@ -14,6 +14,7 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::mesh::buckets::Buckets;
 use crate::mesh::TriMesh;
 
 /// A loop is taken as a boundary of the scan (not a hole) when its area is at
@@ -204,39 +205,25 @@ fn mesh_extent(mesh: &TriMesh) -> Option<f64> {
 
 /// Every closed loop of boundary edges, in no particular order.
 ///
-/// Edges are collected as packed `min << 32 | max` keys and sorted, so a 2M
-/// triangle scan costs one sort of 6M integers and no per-edge allocation.
+/// Edges are bucketed by their lower vertex ([`Buckets`]) and each bucket
+/// sorted, so a 2M triangle scan costs O(n) and no per-edge allocation.
 pub fn boundary_loops(mesh: &TriMesh) -> Vec<BoundaryLoop> {
     let n = mesh.vertices.len();
     // Each undirected edge (lo, hi) bucketed by lo (a counting sort, O(n)),
     // then each bucket (a vertex's few higher neighbours) sorted by hi.
-    let mut start = vec![0u32; n + 1];
-    let valid = || mesh.triangles.iter().filter(|t| valid_triangle(t, n));
-    let edge = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
-    for t in valid() {
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            start[edge(a, b).0 as usize + 1] += 1;
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut his = vec![0u32; start[n] as usize];
-    for t in valid() {
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            let (lo, hi) = edge(a, b);
-            his[fill[lo as usize] as usize] = hi;
-            fill[lo as usize] += 1;
-        }
-    }
-    drop(fill);
+    let mut his = Buckets::new(n, || {
+        mesh.triangles
+            .iter()
+            .filter(|t| valid_triangle(t, n))
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| (a.min(b), a.max(b)))
+    });
 
     // Used exactly once: boundary. Twice: interior. Three or more times:
     // non-manifold, neither a hole's rim nor interior; left out (spec 2).
     let mut edges: Vec<[u32; 2]> = Vec::new();
-    for lo in 0..n {
-        let bucket = &mut his[start[lo] as usize..start[lo + 1] as usize];
+    for lo in 0..n as u32 {
+        let bucket = his.get_mut(lo);
         bucket.sort_unstable();
         let mut i = 0;
         while i < bucket.len() {
@@ -245,13 +232,12 @@ pub fn boundary_loops(mesh: &TriMesh) -> Vec<BoundaryLoop> {
                 j += 1;
             }
             if j - i == 1 {
-                edges.push([lo as u32, bucket[i]]);
+                edges.push([lo, bucket[i]]);
             }
             i = j;
         }
     }
     drop(his);
-    drop(start);
     if edges.is_empty() {
         return Vec::new();
     }
@@ -272,23 +258,14 @@ struct Graph {
 
 impl Graph {
     fn new(n: usize, edges: &[[u32; 2]]) -> Graph {
-        let mut offsets = vec![0u32; n + 1];
-        for e in edges {
-            offsets[e[0] as usize + 1] += 1;
-            offsets[e[1] as usize + 1] += 1;
-        }
-        for k in 0..n {
-            offsets[k + 1] += offsets[k];
-        }
-        let mut fill = offsets.clone();
-        let mut incident = vec![0u32; edges.len() * 2];
-        for (ei, e) in edges.iter().enumerate() {
-            for v in e {
-                let slot = &mut fill[*v as usize];
-                incident[*slot as usize] = ei as u32;
-                *slot += 1;
-            }
-        }
+        let Buckets {
+            start: offsets,
+            items: incident,
+        } = Buckets::new(n, || {
+            (0u32..)
+                .zip(edges)
+                .flat_map(|(ei, e)| [(e[0], ei), (e[1], ei)])
+        });
         Graph { offsets, incident }
     }
 

@@ -13,6 +13,7 @@ use std::{fmt, str::FromStr};
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
+pub(crate) mod buckets;
 mod cloud;
 mod error;
 mod gltf;

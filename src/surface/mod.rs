@@ -13,6 +13,7 @@ mod sweep;
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
+use crate::mesh::buckets::Buckets;
 use crate::mesh::TriMesh;
 pub use index::SpatialIndex;
 use index::{Index, QueryBox};
@@ -35,36 +36,22 @@ pub struct Surface {
 /// triangles, an edge's the first of its lower vertex's triangles that
 /// holds its higher vertex too.
 fn ownership(mesh: &TriMesh) -> Vec<u8> {
-    let n = mesh.vertices.len();
-    let mut start = vec![0u32; n + 1];
-    for tri in &mesh.triangles {
-        for &v in tri {
-            start[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut around = vec![0u32; start[n] as usize];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        for &v in tri {
-            around[fill[v as usize] as usize] = t as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    drop(fill);
-    let fan = |v: u32| &around[start[v as usize] as usize..start[v as usize + 1] as usize];
+    let fans = Buckets::new(mesh.vertices.len(), || {
+        (0u32..)
+            .zip(&mesh.triangles)
+            .flat_map(|(t, tri)| tri.map(|v| (v, t)))
+    });
     let mut owned = vec![0u8; mesh.triangles.len()];
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let t = t as u32;
         for k in 0..3 {
-            if fan(tri[k]).first() == Some(&t) {
+            if fans.get(tri[k]).first() == Some(&t) {
                 owned[t as usize] |= 1 << k;
             }
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             let (lo, hi) = (a.min(b), a.max(b));
-            let first = fan(lo)
+            let first = fans
+                .get(lo)
                 .iter()
                 .find(|&&u| mesh.triangles[u as usize].contains(&hi));
             if first == Some(&t) {
