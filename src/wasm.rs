@@ -165,19 +165,14 @@ pub const PAGE_MAX_SVG_BYTES: usize = 64 << 20;
 /// `limit`), before the page reads it.
 #[wasm_bindgen(js_name = checkSvgSize)]
 pub fn check_svg_size(name: &str, size: f64) -> Result<(), JsValue> {
-    if size.is_finite() && (0.0..=PAGE_MAX_SVG_BYTES as f64).contains(&size) {
-        return Ok(());
-    }
-    Err(kind_err(
-        "limit",
-        &format!(
-            "{name}: the file is {:.1} MiB, more than the {} MiB this page reads for a \
-             drawing; is it the right file? Simplify the drawing (fewer nodes, no embedded \
-             images), or plan it with the command line",
-            size / MIB,
-            PAGE_MAX_SVG_BYTES >> 20
-        ),
-    ))
+    within_limit(
+        name,
+        size,
+        PAGE_MAX_SVG_BYTES,
+        "this page reads for a drawing",
+        "is it the right file? Simplify the drawing (fewer nodes, no embedded images), or plan \
+         it with the command line",
+    )
 }
 
 /// Refuses a scan file of `size` bytes past [`PAGE_MAX_SCAN_BYTES`] with an
@@ -185,19 +180,39 @@ pub fn check_svg_size(name: &str, size: f64) -> Result<(), JsValue> {
 /// calls this with `File.size`, before reading anything.
 #[wasm_bindgen(js_name = checkScanSize)]
 pub fn check_scan_size(name: &str, size: f64) -> Result<(), JsValue> {
-    if size.is_finite() && (0.0..=PAGE_MAX_SCAN_BYTES as f64).contains(&size) {
+    within_limit(
+        name,
+        size,
+        PAGE_MAX_SCAN_BYTES,
+        "this page reads (a browser tab's memory must also hold the mesh and its search \
+         structure)",
+        &format!(
+            "decimate the scan (e.g. MeshLab's quadric edge collapse) or crop it to the printed \
+             area, or plan it with the command line (pcpp plan reads up to {} MiB)",
+            MAX_SCAN_BYTES >> 20
+        ),
+    )
+}
+
+/// Ok for a file of `size` bytes up to `limit`; past it (or a size that is
+/// not one) an `Error` of kind `limit`: "NAME: the file is X MiB, more
+/// than the N MiB `reads`; `advice`", before the page reads the file.
+fn within_limit(
+    name: &str,
+    size: f64,
+    limit: usize,
+    reads: &str,
+    advice: &str,
+) -> Result<(), JsValue> {
+    if size.is_finite() && (0.0..=limit as f64).contains(&size) {
         return Ok(());
     }
     Err(kind_err(
         "limit",
         &format!(
-            "{name}: the file is {:.1} MiB, more than the {} MiB this page reads (a browser \
-             tab's memory must also hold the mesh and its search structure); decimate the scan \
-             (e.g. MeshLab's quadric edge collapse) or crop it to the printed area, or plan it \
-             with the command line (pcpp plan reads up to {} MiB)",
+            "{name}: the file is {:.1} MiB, more than the {} MiB {reads}; {advice}",
             size / MIB,
-            PAGE_MAX_SCAN_BYTES >> 20,
-            MAX_SCAN_BYTES >> 20
+            limit >> 20
         ),
     ))
 }
@@ -520,18 +535,13 @@ fn arr(p: DVec3) -> [f64; 3] {
 /// this with `File.size` before the worker reads the file.
 #[wasm_bindgen(js_name = checkGcodeSize)]
 pub fn check_gcode_size(name: &str, size: f64) -> Result<(), JsValue> {
-    if size.is_finite() && (0.0..=MAX_GCODE_BYTES as f64).contains(&size) {
-        return Ok(());
-    }
-    Err(kind_err(
-        "limit",
-        &format!(
-            "{name}: the file is {:.1} MiB, more than the {} MiB the G-code check reads; \
-             split the program and check each part",
-            size / MIB,
-            MAX_GCODE_BYTES >> 20
-        ),
-    ))
+    within_limit(
+        name,
+        size,
+        MAX_GCODE_BYTES,
+        "the G-code check reads",
+        "split the program and check each part",
+    )
 }
 
 /// A G-code file's text, or an `Error` of kind `limit` past the size the
