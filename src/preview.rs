@@ -18,7 +18,7 @@
 
 use glam::DVec3;
 
-use crate::gcode::{FeedUnits, GcodeMove, MachineProfile};
+use crate::gcode::{numbered_lines, FeedUnits, GcodeMove, MachineProfile};
 use crate::motion::Clearance;
 use crate::pipeline::Plan;
 use crate::quality::Defect;
@@ -124,50 +124,6 @@ fn strip_comment(line: &str) -> &str {
     &line[..end]
 }
 
-/// The last `F` word of a line's code (its comments left out), if any.
-fn feed_word(line: &str) -> Option<f64> {
-    let code = strip_comment(line);
-    let mut feed = None;
-    let mut rest = code;
-    while let Some(i) = rest.find(['F', 'f']) {
-        let after = rest[i + 1..].trim_start();
-        let end = after
-            .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+'))
-            .unwrap_or(after.len());
-        if let Ok(v) = after[..end].parse::<f64>() {
-            if v.is_finite() && v > 0.0 {
-                feed = Some(v);
-            }
-        }
-        rest = &rest[i + 1..];
-    }
-    feed
-}
-
-/// Lines ended by `\n`, `\r\n` or a lone `\r`, numbered as the G-code
-/// reader numbers them (from 1, after a byte-order mark).
-fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut n = 0;
-    std::iter::from_fn(move || {
-        if rest.is_empty() {
-            return None;
-        }
-        n += 1;
-        let Some(end) = rest.find(['\n', '\r']) else {
-            return Some((n, std::mem::take(&mut rest)));
-        };
-        let line = &rest[..end];
-        let skip = if rest[end..].starts_with("\r\n") {
-            2
-        } else {
-            1
-        };
-        rest = &rest[end + skip..];
-        Some((n, line))
-    })
-}
-
 /// One move on the timeline.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimedMove {
@@ -190,30 +146,34 @@ impl TimedMove {
 }
 
 /// Times the `moves` of a program (from [`crate::gcode::read_gcode`] of
-/// `text`, in file order): each at the modal feed of its line (an `F` on
-/// the move's own line applies to it), `G0` at the travel feed, after the
-/// dwells written since the previous move.
+/// `text`, in file order): each at its modal feed (the reader's
+/// [`GcodeMove::feed`], the print speed before the program sets one),
+/// `G0` at the travel feed, after the dwells written since the previous
+/// move.
 pub fn time_moves(text: &str, moves: &[GcodeMove], rules: &FeedRules) -> Vec<TimedMove> {
     let mut out = Vec::with_capacity(moves.len());
     let mut lines = numbered_lines(text).peekable();
-    let mut feed = positive(rules.print_speed_mm_s);
     let travel = positive(rules.travel_speed_mm_s);
     let mut clock = 0.0;
     for m in moves {
-        // Every line up to and including the move's own.
+        // Dwells on every line up to and including the move's own.
         while let Some(&(n, line)) = lines.peek() {
             if n > m.line {
                 break;
             }
             lines.next();
-            if let Some(f) = feed_word(line) {
-                feed = positive(rules.feed_mm_s(f));
-            }
             if let Some(s) = rules.dwell.as_ref().and_then(|d| d.seconds(line)) {
                 clock += s;
             }
         }
-        let speed = if m.rapid { travel } else { feed };
+        let speed = if m.rapid {
+            travel
+        } else {
+            positive(
+                m.feed
+                    .map_or(rules.print_speed_mm_s, |f| rules.feed_mm_s(f)),
+            )
+        };
         let length = (m.to - m.from).length();
         let duration_s = match speed {
             Some(v) if length.is_finite() => length / v,
@@ -654,21 +614,24 @@ mod tests {
     }
 
     #[test]
-    fn words_are_read_past_comments_checksums_and_line_numbers() {
-        assert_eq!(feed_word("N10 G1 X1 F1200*57"), Some(1200.0));
-        assert_eq!(feed_word("G1 X1 ; F99"), None);
-        assert_eq!(feed_word("G1 (F99) X1"), None);
-        assert_eq!(feed_word("g1 x1 f 90"), Some(90.0));
-        assert_eq!(feed_word("G1 F-5"), None);
+    fn dwell_lines_are_read_past_comments_and_case() {
         let ms = DwellWord::of_template("G4 P{ms}").unwrap();
         assert_eq!(ms.seconds("G4 P250"), Some(0.25));
         assert_eq!(ms.seconds("g4 p1000 ; wait"), Some(1.0));
         assert_eq!(ms.seconds("G1 X1"), None);
         assert_eq!(DwellWord::of_template("{ms}"), None);
         assert_eq!(DwellWord::of_template("G4 P{x}"), None);
-        // Lines as the reader counts them, after a byte-order mark.
-        let lines: Vec<_> = numbered_lines("\u{feff}a\r\nb\rc\n\nd").collect();
-        assert_eq!(lines, vec![(1, "a"), (2, "b"), (3, "c"), (4, ""), (5, "d")]);
+    }
+
+    /// An `F` under `G20` is inches a minute: one inch at 60 in/min takes
+    /// a second (read as mm it took 25.4).
+    #[test]
+    fn feeds_under_g20_are_inches() {
+        let t = timeline("G20 G90\nG0 X0 Y0 Z0\nG1 X1 F60\n", &marlin_rules());
+        // (The G0 starts nowhere known: the G1 is the one move.)
+        let m = t.moves();
+        assert_eq!(m.len(), 1);
+        assert!((m[0].duration_s - 1.0).abs() < 1e-9, "{:?}", m[0]);
     }
 
     #[test]

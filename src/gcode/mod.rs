@@ -48,6 +48,7 @@ pub use profile::{
     BuildVolume, CommentStyle, FeedUnits, MachineProfile, BLOCK_TOKENS, DEFAULT_DECIMALS,
     DWELL_TOKENS,
 };
+pub(crate) use read::numbered_lines;
 pub use read::{
     read_gcode, GcodeLineProblem, GcodeMove, GcodeProgram, GcodeReadError, UnknownMove,
     UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,

@@ -71,6 +71,11 @@ pub struct GcodeMove {
     /// `G0` (a rapid, whose path some controllers do not keep straight: the
     /// checker may want to treat it with more care) rather than `G1`.
     pub rapid: bool,
+    /// The modal feed of the move: the last positive `F` word up to and
+    /// including its line, its length unit in mm (an `F` under `G20` is
+    /// in inches) and its time unit the controller's (mm/min on most, the
+    /// profile's `feed_units`); `None` before the program sets one.
+    pub feed: Option<f64>,
 }
 
 /// Why a move could not be placed in the frame.
@@ -298,18 +303,17 @@ fn read_with_limits(
             max: limits.bytes,
         });
     }
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut reader = Reader::new(file);
     let mut lines = 0;
-    for line in split_lines(text) {
-        lines += 1;
-        if lines > limits.lines {
+    for (n, line) in numbered_lines(text) {
+        if n > limits.lines {
             return Err(GcodeReadError::TooManyLines {
                 file: file.into(),
                 max: limits.lines,
             });
         }
-        reader.line(lines, line)?;
+        reader.line(n, line)?;
+        lines = n;
     }
     Ok(GcodeProgram {
         moves: reader.moves,
@@ -319,16 +323,19 @@ fn read_with_limits(
     })
 }
 
-/// Lines ended by `\n`, `\r\n` or a lone `\r` (classic Mac files), so that
-/// line numbers match what an editor shows.
-fn split_lines(text: &str) -> impl Iterator<Item = &str> {
-    let mut rest = text;
+/// Lines ended by `\n`, `\r\n` or a lone `\r` (classic Mac files),
+/// numbered from 1 after a byte-order mark, so that line numbers match what
+/// an editor shows (the preview finds a move's line by them too).
+pub(crate) fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut n = 0;
     std::iter::from_fn(move || {
         if rest.is_empty() {
             return None;
         }
+        n += 1;
         let Some(end) = rest.find(['\n', '\r']) else {
-            return Some(std::mem::take(&mut rest));
+            return Some((n, std::mem::take(&mut rest)));
         };
         let line = &rest[..end];
         let after = if rest[end..].starts_with("\r\n") {
@@ -337,7 +344,7 @@ fn split_lines(text: &str) -> impl Iterator<Item = &str> {
             end + 1
         };
         rest = &rest[after..];
-        Some(line)
+        Some((n, line))
     })
 }
 
@@ -1045,6 +1052,8 @@ struct Reader<'f> {
     offset: [f64; 3],
     /// Offsets put aside by `G92.2`.
     suspended: Option<[f64; 3]>,
+    /// The modal feed (see [`GcodeMove::feed`]).
+    feed: Option<f64>,
     moves: Vec<GcodeMove>,
     unknown: Vec<UnknownMove>,
     notes: Notes,
@@ -1062,6 +1071,7 @@ impl<'f> Reader<'f> {
             position: [None; 3],
             offset: [0.0; 3],
             suspended: None,
+            feed: None,
             moves: Vec::new(),
             unknown: Vec::new(),
             notes: Notes::default(),
@@ -1188,6 +1198,7 @@ impl<'f> Reader<'f> {
         let mut consumer: Option<(Consumer, u32, usize)> = None;
         let mut unknown_g: Option<u32> = None;
         let mut m: Option<Option<u32>> = None;
+        let mut feed = None;
         let mut commands = 0;
         for w in words {
             let word_col = || (word_text(line, w), column(line, w.start));
@@ -1281,8 +1292,16 @@ impl<'f> Reader<'f> {
                     other_axes = true;
                     self.notes.add(NoteKind::Extrusion, n);
                 }
+                b'F' => match w.value {
+                    Value::Number(v) if v.is_finite() && v > 0.0 => feed = Some(v),
+                    _ => {}
+                },
                 _ => {}
             }
+        }
+        // After the line's units word, which governs its F too.
+        if let Some(f) = feed {
+            self.feed = Some(if self.inch { f * 25.4 } else { f });
         }
         if commands > 1 {
             self.notes.add(NoteKind::SeveralCommands, n);
@@ -1403,6 +1422,7 @@ impl<'f> Reader<'f> {
                 from,
                 to,
                 rapid: mode == Motion::Rapid,
+                feed: self.feed,
             }),
             _ => {
                 self.unknown.push(UnknownMove {
@@ -1588,6 +1608,36 @@ mod tests {
             "{:?}",
             aerotech.notes
         );
+    }
+
+    /// Each move carries the modal feed, read past comments, checksums and
+    /// line numbers, in mm after `G20` (the preview times moves by it).
+    #[test]
+    fn moves_carry_the_modal_feed_in_mm() {
+        let p = read(
+            "G21 G90\nG0 X0 Y0 Z1\nG1 X0.5\nN10 G1 X1 F1200*53\nG1 X2 ; F99\nG1 (F99) X3\n\
+             g1 x4 f 90\nG1 X5 F-5\nM117 F7 text\nG20 G1 X0.5 F10\n",
+        );
+        let feeds: Vec<Option<f64>> = p.moves.iter().map(|m| m.feed).collect();
+        assert_eq!(
+            feeds,
+            // (The first G0 starts nowhere known: not a move.)
+            [
+                None,
+                Some(1200.0),
+                Some(1200.0),
+                Some(1200.0),
+                Some(90.0),
+                Some(90.0),
+                Some(254.0)
+            ]
+        );
+    }
+
+    #[test]
+    fn lines_are_numbered_as_an_editor_shows_them() {
+        let lines: Vec<_> = numbered_lines("\u{feff}a\r\nb\rc\n\nd").collect();
+        assert_eq!(lines, vec![(1, "a"), (2, "b"), (3, "c"), (4, ""), (5, "d")]);
     }
 
     /// The same absolute moves in mm, written in absolute or relative
