@@ -17,7 +17,7 @@ use super::{
     TypedArray, MIB, PAGE_MAX_DRAWN_MOVES,
 };
 use crate::demo::{self, parts::DemoPart};
-use crate::fiducials::{find_fiducials, find_fiducials_sized, Fiducial};
+use crate::fiducials::{find_fiducials_sized, Fiducial};
 use crate::job::{self, InputFile, PreparedScan, RegistrationSettings};
 use crate::mesh::{ImportOptions, ImportedMesh};
 use crate::params::Nozzle;
@@ -123,8 +123,7 @@ impl ScanBuffer {
         Ok(ScanImport {
             file,
             imported,
-            fiducials: None,
-            registration: None,
+            registered: None,
         })
     }
 }
@@ -149,8 +148,9 @@ impl ScanBuffer {
 pub struct ScanImport {
     file: InputFile,
     imported: ImportedMesh,
-    fiducials: Option<Vec<Fiducial>>,
-    registration: Option<(Registration, RegistrationMethod)>,
+    /// The fiducial holes (scanner frame) and the registration found with
+    /// them, once [`ScanImport::register`] succeeded.
+    registered: Option<(Vec<Fiducial>, Registration, RegistrationMethod)>,
 }
 
 #[wasm_bindgen]
@@ -159,30 +159,26 @@ impl ScanImport {
         self.imported.mesh.triangle_count()
     }
 
-    /// Finds the fiducial holes (once, in the scanner frame) and registers
-    /// with `registration` (RegistrationSettings), as [`job::prepare_scan`]
-    /// does. A failure (kind `registration`) leaves the import usable.
+    /// Finds the fiducial holes (in the scanner frame, ranked for the
+    /// settings' dot diameter) and registers with `registration`
+    /// (RegistrationSettings), as [`job::prepare_scan`] does. A failure
+    /// (kind `registration`) leaves the import usable.
     pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
         let settings: RegistrationSettings = from_js("registration settings", registration)?;
         let mesh = &self.imported.mesh;
-        let holes = self
-            .fiducials
-            .get_or_insert_with(|| find_fiducials_sized(mesh, settings.dot_diameter_mm));
+        let holes = find_fiducials_sized(mesh, settings.dot_diameter_mm);
         // Placement on the bed included, as job::prepare_scan does.
-        let reg = job::registration_for_scan(mesh, holes, &settings).map_err(core_err)?;
-        self.registration = Some((reg, settings.method));
+        let reg = job::registration_for_scan(mesh, &holes, &settings).map_err(core_err)?;
+        self.registered = Some((holes, reg, settings.method));
         Ok(())
     }
 
     /// Builds the registered surface and its spatial index: the [`Session`]
     /// that plans. Call [`ScanImport::register`] first.
     pub fn index(self) -> Result<Session, JsValue> {
-        let Some((registration, method)) = self.registration else {
+        let Some((fiducials, registration, method)) = self.registered else {
             return Err(JsError::new("the scan must be registered before it is indexed").into());
         };
-        let fiducials = self
-            .fiducials
-            .unwrap_or_else(|| find_fiducials(&self.imported.mesh));
         let scan_bbox = self.imported.mesh.bbox();
         let prepared =
             PreparedScan::assemble(self.file, self.imported, fiducials, registration, method)
