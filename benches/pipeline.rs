@@ -144,10 +144,8 @@ fn motion_benches(c: &mut Criterion<Clock>) {
 /// Issue 14: W4, a million raw points, read and meshed (target: under 2 s
 /// natively).
 fn cloud_benches(c: &mut Criterion<Clock>) {
-    // As examples/workloads.rs writes W4: the film's grid, at most
-    // CLOUD_SIDE points a side.
-    let side = (n() + 1).min(workloads::CLOUD_SIDE);
-    let points = workloads::film_cloud(side);
+    // As examples/workloads.rs writes W4.
+    let points = workloads::film_cloud(n());
     let xyz = workloads::to_xyz(&points);
     let mut g = c.benchmark_group("cloud");
     g.sample_size(10).sampling_mode(SamplingMode::Flat);

@@ -110,8 +110,10 @@ fn run() -> Result<(), String> {
     drop(obj);
 
     // W4: the film as a million raw points (fewer with a smaller film).
-    let side = (cells + 1).min(workloads::CLOUD_SIDE);
-    let cloud = workloads::to_xyz(&workloads::film_cloud(side));
+    let points = workloads::film_cloud(cells);
+    let cloud_points = points.len();
+    let cloud = workloads::to_xyz(&points);
+    drop(points);
     write(&dir, workloads::W4_XYZ, cloud.as_bytes())?;
     let cloud_bytes = cloud.len();
     drop(cloud);
@@ -136,7 +138,7 @@ fn run() -> Result<(), String> {
         },
         "W2": path_summary(&surface, &w2, workloads::W2_SVG, &s2)?,
         "W3": path_summary(&surface, &w3, workloads::W3_SVG, &s3)?,
-        "W4": { "points": side * side, "xyz_bytes": cloud_bytes },
+        "W4": { "points": cloud_points, "xyz_bytes": cloud_bytes },
     });
     write(&dir, "workloads.json", json(&manifest)?.as_bytes())?;
     println!(

@@ -47,9 +47,11 @@ pub const W4_XYZ: &str = "W4.xyz";
 /// Points per side of W4 at full size (1,000,000 points).
 pub const CLOUD_SIDE: usize = 1000;
 
-/// W4: the film's heights at `side` x `side` points over 100 mm, each
-/// moved by up to 0.2 of the spacing in x and y (deterministic).
-pub fn film_cloud(side: usize) -> Vec<glam::DVec3> {
+/// W4 for the film of `cells` cells a side: its grid's heights, at most
+/// [`CLOUD_SIDE`] points a side over 100 mm, each moved by up to 0.2 of
+/// the spacing in x and y (deterministic).
+pub fn film_cloud(cells: usize) -> Vec<glam::DVec3> {
+    let side = (cells + 1).min(CLOUD_SIDE);
     let film = wrinkled_film(side.max(2) - 1);
     let spacing = FILM_MM / (side.max(2) - 1) as f64;
     let mut rng = Rng(0xD1B5_4A32_D192_ED03);
