@@ -187,7 +187,12 @@ pub(super) fn plan(
         // much less rise (section 7 measures the filament's distance from
         // Ta_j, so a sideways offset w and a rise e give about
         // sqrt(w^2 + (d + e cos a)^2)).
-        let lift = c.rise_needed(surface, t);
+        // A point at its cap was found clear when the cap was chosen.
+        let lift = if low_cap[j] == Some(w[j]) {
+            0.0
+        } else {
+            c.rise_needed(surface, t)
+        };
         if lift > 0.0 {
             let g = &geometry[j];
             let side = DVec3::new(-g.v.y, g.v.x, 0.0);
