@@ -685,21 +685,17 @@ pub fn write_outputs(
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
-    let write = |header: &[(String, String)]| {
-        write_program(
-            &GcodeJob {
-                toolpaths: &toolpaths,
-                speed_mm_s: settings.process.speed_mm_s,
-                dwell_s: settings.process.dwell_s,
-                header,
-                scan_top_z_mm: scan.surface.top_z(),
-            },
-            profile,
-        )
+    let job = |header| GcodeJob {
+        toolpaths: &toolpaths,
+        speed_mm_s: settings.process.speed_mm_s,
+        dwell_s: settings.process.dwell_s,
+        header,
+        scan_top_z_mm: scan.surface.top_z(),
     };
     // The header has the same lines whatever the check finds, so the moves'
     // line numbers from this first writing hold for the final one.
-    let first = write(&provenance(&report)).map_err(|e| {
+    let draft = provenance(&report);
+    let first = write_program(&job(&draft), profile).map_err(|e| {
         let fit =
             crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
         match e {
@@ -726,7 +722,12 @@ pub fn write_outputs(
     }
     report.motion.risk_accepted = checked.touching_moves > 0;
     report.motion.program = checked;
-    let gcode = write(&provenance(&report))?.text;
+    // The final header on the moves already written.
+    let header = provenance(&report);
+    let gcode = match first.with_header(&job(&header), profile)? {
+        Some(text) => text,
+        None => write_program(&job(&header), profile)?.text,
+    };
     Ok((report, gcode))
 }
 

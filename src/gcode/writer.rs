@@ -64,6 +64,31 @@ pub struct WrittenMove {
 pub struct WrittenProgram {
     pub text: String,
     pub moves: Vec<WrittenMove>,
+    /// Where the header's comments end in `text` (bytes) and how many
+    /// lines they take: [`WrittenProgram::with_header`] swaps them.
+    header: (usize, usize),
+}
+
+impl WrittenProgram {
+    /// The text `write_program` writes for `job`, which differs from the
+    /// job this program was written for only in its header values, when
+    /// the new header takes as many lines (so that `moves` still hold):
+    /// the new header and the rest of this text, without writing the moves
+    /// again. `None` when the line counts differ.
+    pub fn with_header(
+        &self,
+        job: &GcodeJob,
+        profile: &MachineProfile,
+    ) -> Result<Option<String>, GcodeError> {
+        let safe_z = checked_safe_height(job, profile)?;
+        let mut w = Program::new(job, profile, safe_z);
+        w.header(job, safe_z);
+        if w.lines != self.header.1 {
+            return Ok(None);
+        }
+        w.out.push_str(&self.text[self.header.0..]);
+        Ok(Some(w.out))
+    }
 }
 
 /// Writes the job as one program in the dialect of `profile`.
@@ -88,19 +113,9 @@ pub fn write_program(
     check_job(job)?;
     let safe_z = checked_safe_height(job, profile)?;
 
-    let mut w = Program {
-        out: String::new(),
-        lines: 0,
-        at: None,
-        moves: Vec::new(),
-        profile,
-        source,
-        decimals: profile.decimals,
-        safe_z: fixed(safe_z, profile.decimals),
-        travel_f: feed_word(profile, profile.travel_feed_mm_s),
-        print_f: feed_word(profile, job.speed_mm_s),
-    };
+    let mut w = Program::new(job, profile, safe_z);
     w.header(job, safe_z);
+    let header = (w.out.len(), w.lines);
     w.block("start", &profile.start)?;
 
     let dwell = w.dwell_line(job.dwell_s)?;
@@ -120,6 +135,7 @@ pub fn write_program(
     Ok(WrittenProgram {
         text: w.out,
         moves: w.moves,
+        header,
     })
 }
 
@@ -209,7 +225,7 @@ struct Program<'p> {
     print_f: String,
 }
 
-impl Program<'_> {
+impl<'p> Program<'p> {
     fn line(&mut self, text: &str) {
         self.out.push_str(text);
         self.out.push('\n');
@@ -241,6 +257,21 @@ impl Program<'_> {
     fn comment(&mut self, text: &str) {
         let line = comment_line(&self.profile.comment, text);
         self.line(&line);
+    }
+
+    fn new(job: &GcodeJob, profile: &'p MachineProfile, safe_z: f64) -> Program<'p> {
+        Program {
+            out: String::new(),
+            lines: 0,
+            at: None,
+            moves: Vec::new(),
+            profile,
+            source: format!("{} (in memory)", profile.name),
+            decimals: profile.decimals,
+            safe_z: fixed(safe_z, profile.decimals),
+            travel_f: feed_word(profile, profile.travel_feed_mm_s),
+            print_f: feed_word(profile, job.speed_mm_s),
+        }
     }
 
     fn header(&mut self, job: &GcodeJob, safe_z: f64) {
@@ -423,6 +454,24 @@ mod tests {
             DVec3::new(11.0, 20.0, 1.5),
             DVec3::new(12.0, 20.0, 1.25),
         ]]
+    }
+
+    #[test]
+    fn a_new_header_on_written_moves_is_the_program_written_afresh() {
+        let paths = line_path();
+        let pair = |v: &str| [("check".to_string(), v.to_string())];
+        let (draft, last) = (pair("pending"), pair("0 touching moves, min 0.102 mm"));
+        for name in MachineProfile::builtin_names() {
+            let p = MachineProfile::builtin(name).unwrap();
+            let first = write_program(&job(&paths, &draft), &p).unwrap();
+            let swapped = first.with_header(&job(&paths, &last), &p).unwrap();
+            let afresh = write_program(&job(&paths, &last), &p).unwrap();
+            assert_ne!(first.text, afresh.text);
+            assert_eq!(swapped.as_deref(), Some(afresh.text.as_str()), "{name}");
+            // A header of another length would move the lines: refused.
+            let longer = [draft[0].clone(), ("more".to_string(), "x".to_string())];
+            assert_eq!(first.with_header(&job(&paths, &longer), &p).unwrap(), None);
+        }
     }
 
     #[test]
