@@ -21,6 +21,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::gcode::WrittenMove;
+use crate::parallel;
 use crate::params::Nozzle;
 use crate::surface::{Surface, SweepGap};
 
@@ -140,45 +141,84 @@ pub fn insert_waypoints_capped(
         return out;
     };
     out.points.push(first);
-    let mut min = f64::INFINITY;
     let cap = cap.max(clearance.tol_mm);
-    for (j, pair) in planned.windows(2).enumerate() {
-        let (p, q) = (pair[0], pair[1]);
-        // The move's clearance matters only below the smallest so far and
-        // the cap (and always below tol).
-        let gap = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
-        if let Some(g) = gap {
-            min = min.min(g.gap_mm.max(clearance.tol_mm - TIE_MM));
+    // The moves are independent: each chunk of them is made safe on its
+    // own (on every core natively), and the results are taken in order, so
+    // the path and its sums do not depend on how the moves were cut.
+    let chunks = parallel::map_chunks(planned.len() - 1, MIN_CHUNK, |moves| {
+        let mut fixes: Vec<MoveFix> = Vec::new();
+        let mut min = f64::INFINITY;
+        for j in moves {
+            let (p, q) = (planned[j], planned[j + 1]);
+            // The move's clearance matters only below the smallest so far
+            // and the cap (and always below tol); the smallest over all
+            // chunks is the same as over one.
+            let gap = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
+            if let Some(g) = gap {
+                min = min.min(g.gap_mm.max(clearance.tol_mm - TIE_MM));
+            }
+            if gap.is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
+                continue;
+            }
+            let mut added = Vec::new();
+            let mut unresolved = false;
+            if !resolve(surface, clearance, p, q, gap, &mut added) {
+                added = rise_over(surface, clearance, p, q);
+                if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
+                    unresolved = true;
+                    added.clear();
+                }
+            }
+            fixes.push(MoveFix {
+                j,
+                added,
+                unresolved,
+            });
         }
-        if gap.is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
-            out.points.push(q);
-            continue;
-        }
-        let mut added = Vec::new();
-        if !resolve(surface, clearance, p, q, gap, &mut added) {
-            added = rise_over(surface, clearance, p, q);
-            if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
-                out.unresolved.push(j);
-                added.clear();
+        (fixes, min)
+    });
+    let mut min = f64::INFINITY;
+    let mut next = 1;
+    for (fixes, chunk_min) in chunks {
+        min = min.min(chunk_min);
+        for fix in fixes {
+            let (p, q) = (planned[fix.j], planned[fix.j + 1]);
+            out.points.extend_from_slice(&planned[next..=fix.j]);
+            next = fix.j + 1;
+            if fix.unresolved {
+                out.unresolved.push(fix.j);
+            }
+            if !fix.added.is_empty() {
+                let before = p.distance(q);
+                let mut after = 0.0;
+                let mut prev = p;
+                for &w in fix.added.iter().chain(std::iter::once(&q)) {
+                    after += prev.distance(w);
+                    prev = w;
+                }
+                out.extra_length_mm += after - before;
+                out.waypoints += fix.added.len();
+                out.points.extend_from_slice(&fix.added);
             }
         }
-        if !added.is_empty() {
-            let before = p.distance(q);
-            let mut after = 0.0;
-            let mut prev = p;
-            for &w in added.iter().chain(std::iter::once(&q)) {
-                after += prev.distance(w);
-                prev = w;
-            }
-            out.extra_length_mm += after - before;
-            out.waypoints += added.len();
-            out.points.extend_from_slice(&added);
-        }
-        out.points.push(q);
     }
+    out.points.extend_from_slice(&planned[next..]);
     out.min_clearance_mm = min.is_finite().then_some(min);
     out
 }
+
+/// The waypoints one move needed (`added`), or that it could not be made
+/// safe.
+struct MoveFix {
+    /// The move from planned point j to j + 1.
+    j: usize,
+    added: Vec<DVec3>,
+    unresolved: bool,
+}
+
+/// The fewest moves a thread checks at once (each is one swept query, a
+/// few microseconds).
+const MIN_CHUNK: usize = 256;
 
 fn path_clear(surface: &Surface, c: &Clearance, p: DVec3, mid: &[DVec3], q: DVec3) -> bool {
     let mut prev = p;
@@ -365,37 +405,59 @@ pub fn check_moves_capped(
     clearance: &Clearance,
     cap: f64,
 ) -> MotionSummary {
-    let mut s = MotionSummary::default();
-    let mut min = f64::INFINITY;
+    let moves: Vec<(DVec3, DVec3, Option<usize>)> = moves.into_iter().collect();
     let cap = cap.max(clearance.tol_mm);
-    for (index, (a, b, line)) in moves.into_iter().enumerate() {
-        s.moves += 1;
-        // Only a clearance below tol, or below the smallest so far and the
-        // cap, matters.
-        let Some(g) = clearance.gap(surface, a, b, min.min(cap).max(clearance.tol_mm)) else {
-            continue;
-        };
-        let at = a.lerp(b, g.at);
-        if g.gap_mm < min {
-            min = g.gap_mm;
-            s.min_clearance_mm = Some(g.gap_mm);
-            s.min_clearance_at = Some(arr(at));
-            s.min_clearance_line = line;
-        }
-        if g.gap_mm < clearance.tol_mm - TIE_MM {
-            s.touching_moves += 1;
-            if s.touching.len() < MAX_LISTED {
-                s.touching.push(Touch {
-                    index,
-                    line,
-                    from: arr(a),
-                    to: arr(b),
-                    at: arr(at),
-                    clearance_mm: g.gap_mm,
-                    rise_mm: clearance.tol_mm - g.gap_mm,
-                });
+    // Chunks of moves checked on their own (on every core natively), their
+    // summaries joined in order: the same summary as one pass.
+    let chunks = parallel::map_chunks(moves.len(), MIN_CHUNK, |range| {
+        let mut s = MotionSummary::default();
+        let mut min = f64::INFINITY;
+        for index in range {
+            let (a, b, line) = moves[index];
+            s.moves += 1;
+            // Only a clearance below tol, or below the smallest so far and
+            // the cap, matters.
+            let Some(g) = clearance.gap(surface, a, b, min.min(cap).max(clearance.tol_mm)) else {
+                continue;
+            };
+            let at = a.lerp(b, g.at);
+            if g.gap_mm < min {
+                min = g.gap_mm;
+                s.min_clearance_mm = Some(g.gap_mm);
+                s.min_clearance_at = Some(arr(at));
+                s.min_clearance_line = line;
+            }
+            if g.gap_mm < clearance.tol_mm - TIE_MM {
+                s.touching_moves += 1;
+                if s.touching.len() < MAX_LISTED {
+                    s.touching.push(Touch {
+                        index,
+                        line,
+                        from: arr(a),
+                        to: arr(b),
+                        at: arr(at),
+                        clearance_mm: g.gap_mm,
+                        rise_mm: clearance.tol_mm - g.gap_mm,
+                    });
+                }
             }
         }
+        s
+    });
+    let mut s = MotionSummary::default();
+    for c in chunks {
+        s.moves += c.moves;
+        // The first move with the smallest clearance, as in one pass.
+        if c.min_clearance_mm
+            .is_some_and(|m| s.min_clearance_mm.is_none_or(|least| m < least))
+        {
+            s.min_clearance_mm = c.min_clearance_mm;
+            s.min_clearance_at = c.min_clearance_at;
+            s.min_clearance_line = c.min_clearance_line;
+        }
+        s.touching_moves += c.touching_moves;
+        let room = MAX_LISTED - s.touching.len();
+        s.touching.extend(c.touching.into_iter().take(room));
     }
     s
 }
@@ -512,6 +574,64 @@ pub(crate) mod tests {
         let bad = [DVec3::new(3.0, 5.0, 0.7), DVec3::new(6.0, 5.0, 1.0)];
         let safe = insert_waypoints(&s, &bad, &c);
         assert_eq!(safe.unresolved, vec![0]);
+    }
+
+    /// Moves across the step's wall at heights that wander in and out of
+    /// reach: thousands, so that the work is cut into many chunks.
+    fn wandering_moves(n: usize) -> Vec<DVec3> {
+        (0..=n)
+            .map(|i| {
+                let t = i as f64;
+                DVec3::new(
+                    5.0 + 2.0 * (0.013 * t).sin(),
+                    1.0 + 8.0 * i as f64 / n as f64,
+                    2.2 + 0.3 * (0.071 * t).sin() + 0.2 * (0.0031 * t).cos(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn chunked_checks_agree_with_one_move_at_a_time() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        let pts = wandering_moves(5000);
+        let moves: Vec<_> = pts.windows(2).map(|w| (w[0], w[1], None)).collect();
+        let sum = check_moves(&s, moves.clone(), &c);
+        // The oracle: each move's clearance on its own, taken in order.
+        let gaps: Vec<Option<SweepGap>> = moves
+            .iter()
+            .map(|&(a, b, _)| c.gap(&s, a, b, f64::INFINITY))
+            .collect();
+        let touching: Vec<usize> = (0..moves.len())
+            .filter(|&i| gaps[i].is_some_and(|g| g.gap_mm < c.tol_mm - TIE_MM))
+            .collect();
+        assert!(touching.len() > MAX_LISTED, "{}", touching.len());
+        assert!(touching[0] > 0 && *touching.last().unwrap() > 2500);
+        assert_eq!(sum.moves, moves.len());
+        assert_eq!(sum.touching_moves, touching.len());
+        let listed: Vec<usize> = sum.touching.iter().map(|t| t.index).collect();
+        assert_eq!(listed, touching[..MAX_LISTED]);
+        let least = (0..moves.len())
+            .filter(|&i| gaps[i].is_some())
+            .min_by(|&i, &j| gaps[i].unwrap().gap_mm.total_cmp(&gaps[j].unwrap().gap_mm))
+            .unwrap();
+        let g = gaps[least].unwrap();
+        assert_eq!(sum.min_clearance_mm, Some(g.gap_mm));
+        let (a, b, _) = moves[least];
+        assert_eq!(sum.min_clearance_at, Some(arr(a.lerp(b, g.at))));
+        // Waypoints: the same as making each move safe on its own.
+        let safe = insert_waypoints(&s, &pts, &c);
+        let mut points = vec![pts[0]];
+        let mut unresolved = Vec::new();
+        for (j, w) in pts.windows(2).enumerate() {
+            let one = insert_waypoints(&s, w, &c);
+            points.extend_from_slice(&one.points[1..]);
+            unresolved.extend(one.unresolved.iter().map(|_| j));
+        }
+        assert!(safe.waypoints > 0);
+        assert_eq!(safe.points, points);
+        assert_eq!(safe.unresolved, unresolved);
     }
 
     #[test]

@@ -39,6 +39,7 @@ use glam::DVec3;
 
 use super::PlannedPoints;
 use crate::motion::{Clearance, PLANNING_MARGIN_MM};
+use crate::parallel;
 use crate::params::{Nozzle, Process};
 use crate::spline::LocalGeometry;
 use crate::surface::Surface;
@@ -80,6 +81,10 @@ const LATERAL_STEPS: usize = 4;
 /// The step of the search for a place behind the target that clears (the
 /// slide goes back at most do).
 const SLIDE_STEP_MM: f64 = 0.02;
+
+/// The fewest points a thread takes at once (each costs a few point
+/// queries, a few microseconds).
+const MIN_CHUNK: usize = 256;
 
 /// How far behind the first surface point the back of the tip starts: the
 /// filament starts at the back of the tip, so a start ahead of Ta_0 would
@@ -143,21 +148,20 @@ pub(super) fn plan(
     // from the surface, rising by e moves it e cos(a): the tip stays back
     // only where that costs less than half the rise, so a plain slope is
     // still handled by rising.
-    let low_cap: Vec<Option<f64>> = (0..n)
-        .map(|j| {
-            let rise = c.rise_needed(surface, at(j, target[j], height[j]));
-            if rise == 0.0 {
-                return Some(target[j]);
-            }
-            let a = geometry[j].slope_rad;
-            let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
-            (1..=steps)
-                .map(|k| k as f64 * SLIDE_STEP_MM)
-                .take_while(|&back| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a))
-                .map(|back| target[j] - back)
-                .find(|&w| c.rise_needed(surface, at(j, w, height[j])) == 0.0)
-        })
-        .collect();
+    // (Each point on its own: on every core natively.)
+    let low_cap: Vec<Option<f64>> = parallel::map(n, MIN_CHUNK, |j| {
+        let rise = c.rise_needed(surface, at(j, target[j], height[j]));
+        if rise == 0.0 {
+            return Some(target[j]);
+        }
+        let a = geometry[j].slope_rad;
+        let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
+        (1..=steps)
+            .map(|k| k as f64 * SLIDE_STEP_MM)
+            .take_while(|&back| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a))
+            .map(|back| target[j] - back)
+            .find(|&w| c.rise_needed(surface, at(j, w, height[j])) == 0.0)
+    });
     // Backward: every point at most its cap and at least one advance
     // behind the next; a point that cannot stay low within the slide is
     // raised where progress puts it.
@@ -175,46 +179,53 @@ pub(super) fn plan(
             _ => w[j] = target[j].min(next),
         }
     }
-    let mut out = PlannedPoints {
-        toolpath: Vec::with_capacity(n),
-        ..Default::default()
-    };
-    for j in 0..n {
-        let mut t = at(j, w[j], height[j]);
+    // Each point raised on its own (on every core natively), then taken in
+    // order: (the tool-path point, how far it was raised).
+    let placed: Vec<(DVec3, f64)> = parallel::map(n, MIN_CHUNK, |j| {
+        let t = at(j, w[j], height[j]);
         // Raise to the lowest height that keeps tol, where staying back
         // did not clear (or progress moved the point off its cap); on a
         // slope across the path a small step sideways, downhill, may need
         // much less rise (section 7 measures the filament's distance from
         // Ta_j, so a sideways offset w and a rise e give about
-        // sqrt(w^2 + (d + e cos a)^2)).
-        // A point at its cap was found clear when the cap was chosen.
-        let lift = if low_cap[j] == Some(w[j]) {
-            0.0
-        } else {
-            c.rise_needed(surface, t)
-        };
-        if lift > 0.0 {
-            let g = &geometry[j];
-            let side = DVec3::new(-g.v.y, g.v.x, 0.0);
-            let cos_a = libm::cos(g.slope_rad);
-            let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
-            let mut best = (cost(0.0, lift), t, lift);
-            for k in 1..=LATERAL_STEPS {
-                let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
-                for sgn in [-1.0, 1.0] {
-                    let q = t + sgn * w * side;
-                    let e = c.rise_needed(surface, q);
-                    let cq = cost(w, e);
-                    if cq < best.0 {
-                        best = (cq, q, e);
-                    }
+        // sqrt(w^2 + (d + e cos a)^2)). A point at its cap was found
+        // clear when the cap was chosen.
+        if low_cap[j] == Some(w[j]) {
+            return (t, 0.0);
+        }
+        let lift = c.rise_needed(surface, t);
+        if lift.is_nan() || lift <= 0.0 {
+            return (t, 0.0);
+        }
+        let g = &geometry[j];
+        let side = DVec3::new(-g.v.y, g.v.x, 0.0);
+        let cos_a = libm::cos(g.slope_rad);
+        let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+        let mut best = (cost(0.0, lift), t, lift);
+        for k in 1..=LATERAL_STEPS {
+            let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+            for sgn in [-1.0, 1.0] {
+                let q = t + sgn * w * side;
+                let e = c.rise_needed(surface, q);
+                let cq = cost(w, e);
+                if cq < best.0 {
+                    best = (cq, q, e);
                 }
             }
-            t = best.1;
-            if best.2 > 0.0 {
-                out.lifted.push((j, best.2));
-                t.z += best.2;
-            }
+        }
+        let mut t = best.1;
+        if best.2 > 0.0 {
+            t.z += best.2;
+        }
+        (t, best.2)
+    });
+    let mut out = PlannedPoints {
+        toolpath: Vec::with_capacity(n),
+        ..Default::default()
+    };
+    for (j, (t, lift)) in placed.into_iter().enumerate() {
+        if lift > 0.0 {
+            out.lifted.push((j, lift));
         }
         if !t.is_finite() {
             out.uncleared.push(j);
