@@ -50,11 +50,14 @@ fn ownership(mesh: &TriMesh) -> Vec<u8> {
             }
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             let (lo, hi) = (a.min(b), a.max(b));
-            let first = fans
+            // The fan lists its triangles in index order and holds t: t
+            // owns the edge when no triangle before it has the edge too.
+            let earlier = fans
                 .get(lo)
                 .iter()
-                .find(|&&u| mesh.triangles[u as usize].contains(&hi));
-            if first == Some(&t) {
+                .take_while(|&&u| u < t)
+                .any(|&u| mesh.triangles[u as usize].contains(&hi));
+            if !earlier {
                 owned[t as usize] |= 8 << k;
             }
         }
@@ -365,6 +368,37 @@ fn segment_triangle(o: DVec3, dir: DVec3, t: [DVec3; 3]) -> Option<f64> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    #[test]
+    fn each_corner_and_edge_is_owned_by_its_first_triangle() {
+        // A 6 x 5 grid of vertices, its triangles in a scrambled order.
+        let mut m = TriMesh::default();
+        for y in 0..5 {
+            for x in 0..6 {
+                m.vertices.push(DVec3::new(x as f64, y as f64, 0.0));
+            }
+        }
+        for y in 0..4u32 {
+            for x in 0..5u32 {
+                let v = y * 6 + x;
+                m.triangles.push([v, v + 1, v + 7]);
+                m.triangles.push([v, v + 7, v + 6]);
+            }
+        }
+        let n = m.triangles.len();
+        m.triangles = (0..n).map(|i| m.triangles[(i * 7) % n]).collect();
+        let owned = ownership(&m);
+        let first_with = |has: &dyn Fn(&[u32; 3]) -> bool| m.triangles.iter().position(has);
+        for (t, tri) in m.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let corner = first_with(&|u| u.contains(&a)) == Some(t);
+                let edge = first_with(&|u| u.contains(&a) && u.contains(&b)) == Some(t);
+                assert_eq!(owned[t] & (1 << k) != 0, corner, "corner {a} of {t}");
+                assert_eq!(owned[t] & (8 << k) != 0, edge, "edge {a}-{b} of {t}");
+            }
+        }
+    }
 
     /// The highest z of the scan over the XY disk, by its own exact
     /// per-triangle geometry (independent of the sweep's): the reference
