@@ -331,6 +331,63 @@ impl Body<'_> {
         }
     }
 
+    /// One record of `element` (index `i`) read field by field.
+    fn read_record(
+        &mut self,
+        element: &Element,
+        roles: &[Role],
+        r: &mut BinReader,
+        i: usize,
+        polygon: &mut Vec<u32>,
+    ) -> Result<(), MeshError> {
+        let file = self.file;
+        let truncated = |i: usize| {
+            MeshError::invalid(
+                file,
+                format!(
+                    "PLY data ends inside '{}' element {i} of {} (truncated file or wrong count?)",
+                    element.name, element.count
+                ),
+            )
+        };
+        let mut xyz = [0.0; 3];
+        for (prop, role) in element.props.iter().zip(roles) {
+            match (prop.kind, role) {
+                (Kind::Scalar(s), Role::Axis(axis)) => {
+                    xyz[*axis] = r.f64(s).ok_or_else(|| truncated(i))?;
+                }
+                (Kind::Scalar(s), _) => r.skip(s.size()).ok_or_else(|| truncated(i))?,
+                (Kind::List { count, item }, role) => {
+                    let n = r.int(count).ok_or_else(|| truncated(i))?;
+                    let n = usize::try_from(n).map_err(|_| {
+                        MeshError::invalid(
+                            file,
+                            format!(
+                                "'{}' element {i}: list '{}' has negative length {n}",
+                                element.name, prop.name
+                            ),
+                        )
+                    })?;
+                    if *role == Role::FaceIndices {
+                        polygon.clear();
+                        for _ in 0..n {
+                            let v = r.index(item).ok_or_else(|| truncated(i))?;
+                            polygon.push(self.index(i, v, None)?);
+                        }
+                        self.push_polygon(polygon);
+                    } else {
+                        let len = n.checked_mul(item.size()).ok_or_else(|| truncated(i))?;
+                        r.skip(len).ok_or_else(|| truncated(i))?;
+                    }
+                }
+            }
+        }
+        if element.name == "vertex" {
+            self.push_vertex(xyz, None)?;
+        }
+        Ok(())
+    }
+
     fn read_binary(
         &mut self,
         header: &Header,
@@ -358,56 +415,58 @@ impl Body<'_> {
                 })
                 .sum();
             let count = check_count(file, element, min_bytes, r.remaining(), "binary data")?;
-            let truncated = |i: usize| {
-                MeshError::invalid(
-                    file,
-                    format!(
-                        "PLY data ends inside '{}' element {i} of {} (truncated file or wrong count?)",
-                        element.name, element.count
-                    ),
-                )
-            };
             match element.name.as_str() {
                 "vertex" => self.vertices.reserve_exact(count),
                 "face" => self.triangles.reserve(count),
                 _ => {}
             }
-            for i in 0..count {
-                let mut xyz = [0.0; 3];
-                for (prop, role) in element.props.iter().zip(&roles) {
-                    match (prop.kind, role) {
-                        (Kind::Scalar(s), Role::Axis(axis)) => {
-                            xyz[*axis] = r.f64(s).ok_or_else(|| truncated(i))?;
-                        }
-                        (Kind::Scalar(s), _) => r.skip(s.size()).ok_or_else(|| truncated(i))?,
-                        (Kind::List { count, item }, role) => {
-                            let n = r.int(count).ok_or_else(|| truncated(i))?;
-                            let n = usize::try_from(n).map_err(|_| {
-                                MeshError::invalid(
-                                    file,
-                                    format!(
-                                        "'{}' element {i}: list '{}' has negative length {n}",
-                                        element.name, prop.name
-                                    ),
-                                )
-                            })?;
-                            if *role == Role::FaceIndices {
-                                polygon.clear();
-                                for _ in 0..n {
-                                    let v = r.index(item).ok_or_else(|| truncated(i))?;
-                                    polygon.push(self.index(i, v, None)?);
-                                }
-                                self.push_polygon(&polygon);
-                            } else {
-                                let len = n.checked_mul(item.size()).ok_or_else(|| truncated(i))?;
-                                r.skip(len).ok_or_else(|| truncated(i))?;
-                            }
-                        }
-                    }
-                }
-                if element.name == "vertex" {
+            let mut i = 0;
+            // The layouts scanners write, read in one pass: the same values
+            // and the same checks as record by record below, which takes
+            // over at the first record they do not fit (and reports any
+            // error there).
+            if let Some((stride, axes)) = fixed_vertex(element, &roles) {
+                let n = (r.remaining() / stride).min(count);
+                let records = &r.bytes[r.pos..r.pos + n * stride];
+                for rec in records.chunks_exact(stride) {
+                    let xyz = axes.map(|(at, s)| {
+                        let mut field = BinReader {
+                            bytes: rec,
+                            pos: at,
+                            big_endian,
+                        };
+                        field.f64(s).unwrap_or(f64::NAN)
+                    });
                     self.push_vertex(xyz, None)?;
                 }
+                r.pos += n * stride;
+                i = n;
+            }
+            let triangles = triangle_list(element, &roles);
+            while i < count {
+                if let Some(item) = triangles {
+                    if let Some(rec) = r.bytes.get(r.pos..r.pos + 13).filter(|b| b[0] == 3) {
+                        let mut tri = [0u32; 3];
+                        for (k, v) in tri.iter_mut().enumerate() {
+                            let mut b: [u8; 4] =
+                                rec[1 + 4 * k..5 + 4 * k].try_into().unwrap_or([0; 4]);
+                            if big_endian {
+                                b.reverse();
+                            }
+                            let value = match item {
+                                Scalar::I32 => i64::from(i32::from_le_bytes(b)),
+                                _ => i64::from(u32::from_le_bytes(b)),
+                            };
+                            *v = self.index(i, value, None)?;
+                        }
+                        self.triangles.push(tri);
+                        r.pos += 13;
+                        i += 1;
+                        continue;
+                    }
+                }
+                self.read_record(element, &roles, &mut r, i, &mut polygon)?;
+                i += 1;
             }
         }
         Ok(())
@@ -565,6 +624,45 @@ impl<'a> Tokens<'a> {
     }
 }
 
+/// A vertex element of scalars only (fixed-size records): the record's
+/// size and each axis's offset and type; `None` for any list property.
+fn fixed_vertex(element: &Element, roles: &[Role]) -> Option<(usize, [(usize, Scalar); 3])> {
+    if element.name != "vertex" {
+        return None;
+    }
+    let mut axes = [(0, Scalar::F32); 3];
+    let mut at = 0;
+    for (prop, role) in element.props.iter().zip(roles) {
+        let Kind::Scalar(s) = prop.kind else {
+            return None;
+        };
+        if let Role::Axis(axis) = *role {
+            axes[axis] = (at, s);
+        }
+        at += s.size();
+    }
+    (at > 0).then_some((at, axes))
+}
+
+/// The item type of a face element whose one property is its index list
+/// with a uchar count and 32-bit indices (13 bytes to a triangle).
+fn triangle_list(element: &Element, roles: &[Role]) -> Option<Scalar> {
+    match (element.props.as_slice(), roles) {
+        (
+            [Property {
+                kind:
+                    Kind::List {
+                        count: Scalar::U8,
+                        item: item @ (Scalar::I32 | Scalar::U32),
+                    },
+                ..
+            }],
+            [Role::FaceIndices],
+        ) => Some(*item),
+        _ => None,
+    }
+}
+
 struct BinReader<'a> {
     bytes: &'a [u8],
     pos: usize,
@@ -680,5 +778,107 @@ mod tests {
         assert_eq!(r.f64(Scalar::F32), Some(1.0));
         assert_eq!(r.int(Scalar::I16), Some(-2));
         assert_eq!(r.int(Scalar::U8), None);
+    }
+
+    /// A binary PLY of `verts` (x y z float, then a float normal and a
+    /// uchar colour) and `faces` (uchar count, `item` indices).
+    fn binary(verts: &[[f32; 3]], faces: &[Vec<i64>], big: bool, item: &str) -> Vec<u8> {
+        let order = if big { "big" } else { "little" };
+        let mut b = format!(
+            "ply\nformat binary_{order}_endian 1.0\nelement vertex {}\n\
+             property float x\nproperty float y\nproperty float z\nproperty float nx\n\
+             property uchar red\nelement face {}\nproperty list uchar {item} vertex_indices\n\
+             end_header\n",
+            verts.len(),
+            faces.len()
+        )
+        .into_bytes();
+        let put = |bytes: &mut Vec<u8>, mut v: Vec<u8>| {
+            if big {
+                v.reverse();
+            }
+            bytes.extend(v);
+        };
+        for v in verts {
+            for c in v.iter().chain(&[0.5]) {
+                put(&mut b, c.to_le_bytes().to_vec());
+            }
+            b.push(200);
+        }
+        for f in faces {
+            b.push(f.len() as u8);
+            for &i in f {
+                let bytes = match item {
+                    "int" => (i as i32).to_le_bytes().to_vec(),
+                    _ => (i as u32).to_le_bytes().to_vec(),
+                };
+                put(&mut b, bytes);
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn binary_records_read_alike_in_every_layout() {
+        let verts: Vec<[f32; 3]> = (0..9)
+            .map(|i| [(i % 3) as f32, (i / 3) as f32, 0.25 * i as f32])
+            .collect();
+        // Triangles, a quad in the middle (read record by record), then
+        // triangles again.
+        let faces: Vec<Vec<i64>> = vec![
+            vec![0, 1, 4],
+            vec![0, 4, 3],
+            vec![1, 2, 5, 4],
+            vec![3, 4, 7],
+            vec![3, 7, 6],
+            vec![4, 5, 8],
+        ];
+        let expected: Vec<[u32; 3]> = vec![
+            [0, 1, 4],
+            [0, 4, 3],
+            [1, 2, 5],
+            [1, 5, 4],
+            [3, 4, 7],
+            [3, 7, 6],
+            [4, 5, 8],
+        ];
+        for big in [false, true] {
+            for item in ["int", "uint"] {
+                let p = parse(&binary(&verts, &faces, big, item), "b.ply").unwrap();
+                let got: Vec<[f32; 3]> = p
+                    .vertices
+                    .iter()
+                    .map(|v| v.to_array().map(|c| c as f32))
+                    .collect();
+                assert_eq!(got, verts, "{big} {item}");
+                assert_eq!(p.triangles, expected, "{big} {item}");
+            }
+        }
+        // Errors name the record, on the fast path too.
+        let mut bad = faces.clone();
+        bad[4][1] = 9;
+        let e = parse(&binary(&verts, &bad, false, "int"), "b.ply").unwrap_err();
+        assert!(
+            e.to_string().contains("face 4 refers to vertex index 9"),
+            "{e}"
+        );
+        bad[4][1] = -1;
+        let e = parse(&binary(&verts, &bad, true, "int"), "b.ply").unwrap_err();
+        assert!(
+            e.to_string().contains("face 4 refers to vertex index -1"),
+            "{e}"
+        );
+        let mut nan = verts.clone();
+        nan[7][2] = f32::NAN;
+        let e = parse(&binary(&nan, &faces, false, "int"), "b.ply").unwrap_err();
+        assert!(e.to_string().contains("vertex 7"), "{e}");
+        let whole = binary(&verts, &faces, false, "uint");
+        for cut in [whole.len() - 3, whole.len() - 40, whole.len() - 100] {
+            let e = parse(&whole[..cut], "b.ply").unwrap_err().to_string();
+            assert!(
+                e.contains("truncated") || e.contains("declares"),
+                "{cut}: {e}"
+            );
+        }
     }
 }
