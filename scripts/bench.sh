@@ -7,8 +7,15 @@
 # (examples/peak_memory.rs), and prints one markdown table, also saved to
 # target/bench/table.md. Progress goes to stderr, the table to stdout.
 #
-# Everything runs single-threaded. Needs no stdin, works as root; installs
-# nothing itself (scripts/setup.sh does, idempotently).
+# The stages run single-threaded (PCPP_THREADS=1: the per-thread work, the
+# same as wasm32, which has one thread). The end-to-end row runs `pcpp plan`
+# as a user does, on every core, timed by the kernel's wall clock and peak
+# resident set (scripts/bench_e2e.py, needs python3), beside a reference
+# run: the same scan loaded with trimesh and the same points projected with
+# Embree (scripts/reference_trimesh.py; its packages go into
+# target/bench/venv the first time, left out when they cannot be had).
+# Needs no stdin, works as root; the toolchain comes from scripts/setup.sh
+# (idempotent).
 #   PCPP_BENCH_QUICK=1  a fast smoke run (criterion --quick, fewer wasm runs)
 #   PCPP_BENCH_N=300    a smaller film (grid cells per side, default 1000);
 #                       the targets are for the full size
@@ -60,7 +67,7 @@ else
 fi
 # Estimates older than this marker are from an earlier run: refused below.
 touch "$OUT/.started"
-PCPP_BENCH_N="$CELLS" cargo bench --bench pipeline -- "${CRITERION_ARGS[@]}" </dev/null >&2
+PCPP_THREADS=1 PCPP_BENCH_N="$CELLS" cargo bench --bench pipeline -- "${CRITERION_ARGS[@]}" </dev/null >&2
 
 log "wasm package for Node (wasm-pack, release)"
 wasm-pack build --release --target nodejs --out-dir target/pkg-node --no-pack </dev/null >&2
@@ -69,6 +76,33 @@ log "wasm timings in Node (scripts/bench-wasm.mjs)"
 WASM_ARGS=(--pkg target/pkg-node --workloads "$WL" --json "$OUT/wasm.json")
 [ "$QUICK" = 1 ] && WASM_ARGS+=(--quick)
 node scripts/bench-wasm.mjs "${WASM_ARGS[@]}" </dev/null
+
+log "end to end: pcpp plan of W2 on W1.ply, every core (scripts/bench_e2e.py)"
+rm -f "$OUT/e2e.json" "$OUT/e2e-reference.json"
+E2E_RUNS=5
+[ "$QUICK" = 1 ] && E2E_RUNS=2
+if command -v python3 >/dev/null; then
+  cargo build --release --bin pcpp </dev/null >&2
+  PLACE="$(node -p "require('./$WL/W2.settings.json').plan.placement.offset_mm.join(',')")"
+  PLAN=(target/release/pcpp plan -q --scan "$WL/W1.ply" --path "$WL/W2.svg" --place "$PLACE" -o "$OUT/W2.gcode")
+  "${PLAN[@]}" </dev/null >&2
+  python3 scripts/bench_e2e.py --runs "$E2E_RUNS" -- "${PLAN[@]}" </dev/null >"$OUT/e2e.json"
+  VENV="$OUT/venv"
+  has_reference() { "$VENV/bin/python" -c 'import trimesh, embreex' 2>/dev/null; }
+  if ! has_reference; then
+    log "installing the reference's packages into $VENV (numpy, trimesh, embreex)"
+    { python3 -m venv "$VENV" && "$VENV/bin/pip" install -q numpy 'trimesh==5.2.0' 'embreex==4.4.0.post1'; } \
+      </dev/null >&2 || log "could not install them: the reference run is left out"
+  fi
+  if has_reference; then
+    log "reference: the same scan and points with trimesh + Embree (scripts/reference_trimesh.py)"
+    python3 scripts/bench_e2e.py --runs "$E2E_RUNS" -- \
+      "$VENV/bin/python" scripts/reference_trimesh.py "$WL/W1.ply" "$OUT/W2.gcode" \
+      </dev/null >"$OUT/e2e-reference.json"
+  fi
+else
+  log "no python3: the end-to-end row is left out"
+fi
 
 MACHINE="$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)"
 MACHINE="${MACHINE:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo)"
@@ -125,6 +159,9 @@ const w4TriS = bench('cloud/W4 points: triangulate').median_s;
 const w4SessionS = bench('cloud/W4 points: XYZ + index').median_s;
 const memW4 = readFileSync('target/bench/native-memory-w4.txt', 'utf8');
 const peakW4 = Number(/peak_rss_bytes=(\d+)/.exec(memW4)?.[1] ?? die('no peak_rss_bytes for W4'));
+const readJson = (p) => (existsSync(p) ? JSON.parse(readFileSync(p, 'utf8')) : null);
+const e2e = readJson('target/bench/e2e.json');
+const ref = readJson('target/bench/e2e-reference.json');
 
 const f = (x, d) => x.toFixed(d);
 const ms = (s) => (s < 0.1 ? f(s * 1e3, 1) : f(s * 1e3, 0)) + ' ms';
@@ -147,12 +184,22 @@ const rows = [
     '-', wasm.w4_session_s == null ? 'not run' : f(wasm.w4_session_s, 2) + ' s', true],
   ['peak memory holding W4 ready to plan', '-', f(peakW4 / 1e6, 0) + ' MB (c)', true, '-', '-', true],
 ];
+if (e2e) {
+  const beside = (mine, theirs, unit, scale, d) => theirs == null ? ' (no reference run)'
+    : ` (reference ${f(theirs * scale, d)} ${unit}: ${f(theirs / mine, 1)}x)`;
+  rows.push(['end to end: `pcpp plan` of W2 on W1.ply, wall clock, every core (f)', '<= 0.2 s',
+    f(e2e.wall_median_s, 2) + ' s' + beside(e2e.wall_median_s, ref?.wall_median_s, 's', 1, 2),
+    e2e.wall_median_s <= 0.2, '-', '-', true]);
+  rows.push(['peak memory of that run (f)', '<= 150 MB',
+    f(e2e.peak_bytes / 1e6, 0) + ' MB' + beside(e2e.peak_bytes, ref?.peak_bytes, 'MB', 1e-6, 0),
+    e2e.peak_bytes <= 150e6, '-', '-', true]);
+}
 const e = process.env;
 const out = [];
 const clock = e.PCPP_BENCH_CLOCK === 'cpu' && wasm.clock === 'cpu'
   ? "CPU time of the thread running each stage (other processes' share left out)"
   : 'wall time';
-out.push(`Measured ${new Date().toISOString().slice(0, 10)} on ${e.MACHINE}, single-threaded, ` +
+out.push(`Measured ${new Date().toISOString().slice(0, 10)} on ${e.MACHINE}, stages single-threaded, ` +
   `${clock}; load average ${e.LOAD}; commit ${e.COMMIT}; ${e.RUSTC}; Node ${wasm.node}.`);
 out.push(`W1 ${wasm.triangles.toLocaleString('en-US')} triangles (${f(wasm.ply_bytes / 1e6, 1)} MB PLY, ` +
   `${f(wasm.obj_bytes / 1e6, 1)} MB OBJ), W2 ${wasm.w2_points} points, W3 ${wasm.w3_points} points` +
@@ -182,6 +229,14 @@ out.push('');
 out.push(`(e) of which the triangulation alone (spade's bulk load, the nearest-neighbour spacing, ` +
   `the edge-length filter) ${f(w4TriS, 2)} s.`);
 out.push('');
+if (e2e) {
+  out.push(`(f) Median of ${e2e.runs} runs of the whole command (read the files, import, hash, ` +
+    `index, plan, check every move, write the G-code), wall clock and peak resident set from ` +
+    `the kernel (scripts/bench_e2e.py); the reference loads the same PLY with trimesh and ` +
+    `projects the points of the G1 moves pcpp wrote for W2 with Embree, nothing more ` +
+    `(scripts/reference_trimesh.py): the ratio is how many times longer or larger it is.`);
+  out.push('');
+}
 out.push(`Medians (wasm: W1 imports ${wasm.runs.ply_ms.length}x, plans ${wasm.runs.w2_ms.length}x and ` +
   `${wasm.runs.w3_ms.length}x after a warm-up); the first W1.ply Session in a fresh Node took ` +
   `${f(wasm.ply_session_first_s, 2)} s (V8's baseline code). MB = 10^6 bytes.`);
