@@ -229,8 +229,51 @@ impl<'a> Cursor<'a> {
     }
 }
 
+/// A decimal number as Rust's `str::parse::<f64>` reads it (correctly
+/// rounded), with a fast path for the plain decimals scanners write.
 pub(super) fn parse_f64(token: &[u8]) -> Option<f64> {
-    std::str::from_utf8(token).ok()?.parse().ok()
+    plain_decimal(token).or_else(|| std::str::from_utf8(token).ok()?.parse().ok())
+}
+
+/// `[+-]digits[.digits]` (at least one digit) whose digits, read as one
+/// integer m, stay below 2^53, with at most 22 after the point: m and
+/// 10^k are then exact doubles and m / 10^k is one correctly rounded
+/// division, the value `str::parse` gives (Clinger's fast path, which it
+/// takes too). `None` for anything else (exponents, long mantissas, inf,
+/// nan), which `str::parse` reads.
+fn plain_decimal(token: &[u8]) -> Option<f64> {
+    const POW10: [f64; 23] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+        1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    ];
+    let (negative, body) = match token {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        _ => (false, token),
+    };
+    let (mut m, mut digits, mut fraction) = (0u64, 0usize, None::<usize>);
+    for &c in body {
+        match c {
+            b'0'..=b'9' => {
+                m = m * 10 + u64::from(c - b'0');
+                if m >= 1 << 53 {
+                    return None;
+                }
+                digits += 1;
+                if let Some(k) = fraction.as_mut() {
+                    *k += 1;
+                }
+            }
+            b'.' if fraction.is_none() => fraction = Some(0),
+            _ => return None,
+        }
+    }
+    let k = fraction.unwrap_or(0);
+    if digits == 0 || k >= POW10.len() {
+        return None;
+    }
+    let v = m as f64 / POW10[k];
+    Some(if negative { -v } else { v })
 }
 
 /// A signed decimal integer, `None` on anything else or overflow.
@@ -256,6 +299,79 @@ pub(super) fn parse_i64(token: &[u8]) -> Option<i64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// What `str::parse` reads, bit for bit (NaN as NaN).
+    fn std_f64(token: &[u8]) -> Option<u64> {
+        let v: f64 = std::str::from_utf8(token).ok()?.parse().ok()?;
+        Some(if v.is_nan() { 0 } else { v.to_bits() })
+    }
+
+    fn ours(token: &[u8]) -> Option<u64> {
+        parse_f64(token).map(|v| if v.is_nan() { 0 } else { v.to_bits() })
+    }
+
+    #[test]
+    fn numbers_read_as_str_parse_reads_them() {
+        let fixed = [
+            "0",
+            "-0",
+            "+0",
+            "-0.0",
+            "1",
+            "1.",
+            ".5",
+            "-.5",
+            "0.1",
+            "0.3",
+            "-12.345678",
+            "9007199254740991",
+            "9007199254740992",
+            "123456789012.345",
+            "0.0000000000000000000001",
+            "0.00000000000000000000001",
+            "1e3",
+            "1E-3",
+            "-2.5e+10",
+            "inf",
+            "-inf",
+            "NaN",
+            "infinity",
+            ".",
+            "-",
+            "+",
+            "",
+            "1.2.3",
+            "1-2",
+            "0x10",
+            " 1",
+            "1 ",
+            "--1",
+            "١",
+        ];
+        for t in fixed {
+            assert_eq!(ours(t.as_bytes()), std_f64(t.as_bytes()), "{t:?}");
+        }
+        // The fast path takes the plain decimals (and only where it is exact).
+        assert_eq!(plain_decimal(b"-12.345678"), Some(-12.345678));
+        assert_eq!(plain_decimal(b"1e3"), None);
+        assert_eq!(plain_decimal(b"9007199254740992"), None);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        #[test]
+        fn printed_doubles_read_back_alike(v in proptest::num::f64::NORMAL, k in 0usize..25) {
+            let t = format!("{v:.k$}");
+            prop_assert_eq!(ours(t.as_bytes()), std_f64(t.as_bytes()), "{}", t);
+        }
+
+        #[test]
+        fn digit_strings_read_alike(t in "[-+]?[0-9]{0,20}(\\.[0-9]{0,24})?") {
+            prop_assert_eq!(ours(t.as_bytes()), std_f64(t.as_bytes()), "{}", t);
+        }
+    }
 
     fn parse_str(s: &str) -> Result<Parsed, MeshError> {
         parse(s.as_bytes(), "t.obj")
