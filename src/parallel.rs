@@ -35,15 +35,19 @@ pub fn join<A: Send, B: Send>(
 }
 
 /// The threads [`map_chunks`] uses: `PCPP_THREADS` if set to a positive
-/// number, else the cores available; 1 in wasm32.
-pub fn threads() -> usize {
+/// number, else the cores available; 1 in wasm32. Found once (the core
+/// count comes from the cgroup files on Linux, not worth reading per call).
+fn threads() -> usize {
     #[cfg(not(target_arch = "wasm32"))]
     {
-        std::env::var("PCPP_THREADS")
-            .ok()
-            .and_then(|v| v.trim().parse::<usize>().ok())
-            .filter(|&n| n > 0)
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+        *THREADS.get_or_init(|| {
+            std::env::var("PCPP_THREADS")
+                .ok()
+                .and_then(|v| v.trim().parse::<usize>().ok())
+                .filter(|&n| n > 0)
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        })
     }
     #[cfg(target_arch = "wasm32")]
     {
@@ -68,8 +72,11 @@ pub fn map_chunks<T: Send>(
     min_chunk: usize,
     f: impl Fn(Range<usize>) -> T + Sync,
 ) -> Vec<T> {
+    if n <= min_chunk.max(1) {
+        return vec![f(0..n)];
+    }
     let threads = threads();
-    if threads <= 1 || n <= min_chunk.max(1) {
+    if threads <= 1 {
         return vec![f(0..n)];
     }
     let size = n
