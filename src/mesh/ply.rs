@@ -445,22 +445,15 @@ impl Body<'_> {
             let triangles = triangle_list(element, &roles);
             while i < count {
                 if let Some(item) = triangles {
-                    if let Some(rec) = r.bytes.get(r.pos..r.pos + 13).filter(|b| b[0] == 3) {
+                    // A triangle: its count 3 and three indices, all present.
+                    if r.remaining() >= 13 && r.bytes[r.pos] == 3 {
+                        r.pos += 1;
                         let mut tri = [0u32; 3];
-                        for (k, v) in tri.iter_mut().enumerate() {
-                            let mut b: [u8; 4] =
-                                rec[1 + 4 * k..5 + 4 * k].try_into().unwrap_or([0; 4]);
-                            if big_endian {
-                                b.reverse();
-                            }
-                            let value = match item {
-                                Scalar::I32 => i64::from(i32::from_le_bytes(b)),
-                                _ => i64::from(u32::from_le_bytes(b)),
-                            };
+                        for v in &mut tri {
+                            let value = r.int(item).unwrap_or(-1);
                             *v = self.index(i, value, None)?;
                         }
                         self.triangles.push(tri);
-                        r.pos += 13;
                         i += 1;
                         continue;
                     }
