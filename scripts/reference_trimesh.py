@@ -20,6 +20,8 @@ XY = re.compile(r"^G1\b[^;(]*?X(-?[0-9.]+)\s+Y(-?[0-9.]+)")
 
 def main():
     scan, program = sys.argv[1], sys.argv[2]
+    if not trimesh.ray.has_embree:
+        sys.exit("[bench] trimesh runs without Embree here")
     mesh = trimesh.load(scan, force="mesh")
     with open(program) as f:
         xy = np.array([[float(m[1]), float(m[2])] for m in map(XY.match, f) if m])
@@ -27,8 +29,6 @@ def main():
     origins = np.column_stack([xy, np.full(len(xy), top)])
     directions = np.tile([0.0, 0.0, -1.0], (len(xy), 1))
     hits, rays, _ = mesh.ray.intersects_location(origins, directions, multiple_hits=False)
-    if not trimesh.ray.has_embree:
-        sys.exit("[bench] trimesh runs without Embree here")
     print(f"{len(xy)} points, {len(set(rays.tolist()))} hit, {len(mesh.faces)} faces")
 
 
