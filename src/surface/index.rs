@@ -225,25 +225,62 @@ impl Grid {
         }
         let origin = bbox.0.truncate();
         let inv_cell = DVec2::ONE / cell;
-        let cell_of = |p: DVec2| -> usize {
-            let cx = (((p.x - origin.x) * inv_cell.x) as usize).min(nx - 1);
-            let cy = (((p.y - origin.y) * inv_cell.y) as usize).min(ny - 1);
-            cy * nx + cx
-        };
-        // Counting sort of the triangles by cell, in index order within one.
+        // One pass over the triangles: each one's home cell (where its box's
+        // centre lies), counted for the sort, and the cells' z ranges, XY
+        // boxes and the reach out of them, so no triangle's box is found
+        // twice. A cell's f32 bound is rounded outwards from the f64 value
+        // only when that value extends it: the same bits as rounding every
+        // triangle's box (the rounding is monotone).
         let wide = 1.5 * cell;
         let mut home = vec![u32::MAX; n];
         let mut count = vec![0u32; nx * ny + 1];
         let mut big = Vec::new();
+        let mut zs = vec![[f32::INFINITY, f32::NEG_INFINITY]; nx * ny];
+        let mut xys = vec![
+            [
+                f32::INFINITY,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::NEG_INFINITY
+            ];
+            nx * ny
+        ];
+        let mut reach = DVec2::ZERO;
         for (i, slot) in home.iter_mut().enumerate() {
             let (lo, hi) = triangle_box(mesh, i);
             if hi.x - lo.x > wide.x || hi.y - lo.y > wide.y {
                 big.push((i as u32, box32(lo, hi)));
-            } else {
-                let c = cell_of(0.5 * (lo.truncate() + hi.truncate()));
-                *slot = c as u32;
-                count[c + 1] += 1;
+                continue;
             }
+            let mid = 0.5 * (lo.truncate() + hi.truncate());
+            let cx = (((mid.x - origin.x) * inv_cell.x) as usize).min(nx - 1);
+            let cy = (((mid.y - origin.y) * inv_cell.y) as usize).min(ny - 1);
+            let c = cy * nx + cx;
+            *slot = c as u32;
+            count[c + 1] += 1;
+            let (z, xy) = (&mut zs[c], &mut xys[c]);
+            if lo.z < z[0] as f64 {
+                z[0] = f32_down(lo.z);
+            }
+            if hi.z > z[1] as f64 {
+                z[1] = f32_up(hi.z);
+            }
+            if lo.x < xy[0] as f64 {
+                xy[0] = f32_down(lo.x);
+            }
+            if lo.y < xy[1] as f64 {
+                xy[1] = f32_down(lo.y);
+            }
+            if hi.x > xy[2] as f64 {
+                xy[2] = f32_up(hi.x);
+            }
+            if hi.y > xy[3] as f64 {
+                xy[3] = f32_up(hi.y);
+            }
+            let cell_lo = origin + DVec2::new(cx as f64, cy as f64) * cell;
+            let cell_hi = cell_lo + cell;
+            let out = (cell_lo - lo.truncate()).max(hi.truncate() - cell_hi);
+            reach = reach.max(out);
         }
         if picky && big.len() > (n / MAX_BIG_SHARE).max(64) {
             return None;
@@ -256,22 +293,12 @@ impl Grid {
                 return None;
             }
         }
+        // Counting sort of the triangles by cell, in index order within one.
         for c in 1..count.len() {
             count[c] += count[c - 1];
         }
         let start = count.clone();
         let mut items = vec![0u32; n - big.len()];
-        let mut zs = vec![[f32::INFINITY, f32::NEG_INFINITY]; nx * ny];
-        let mut xys = vec![
-            [
-                f32::INFINITY,
-                f32::INFINITY,
-                f32::NEG_INFINITY,
-                f32::NEG_INFINITY
-            ];
-            nx * ny
-        ];
-        let mut reach = DVec2::ZERO;
         for (i, &c) in home.iter().enumerate() {
             if c == u32::MAX {
                 continue;
@@ -279,20 +306,8 @@ impl Grid {
             let c = c as usize;
             items[count[c] as usize] = i as u32;
             count[c] += 1;
-            let (lo, hi) = triangle_box(mesh, i);
-            let b = box32(lo, hi);
-            let (z, xy) = (&mut zs[c], &mut xys[c]);
-            z[0] = z[0].min(b[2]);
-            z[1] = z[1].max(b[5]);
-            xy[0] = xy[0].min(b[0]);
-            xy[1] = xy[1].min(b[1]);
-            xy[2] = xy[2].max(b[3]);
-            xy[3] = xy[3].max(b[4]);
-            let cell_lo = origin + DVec2::new((c % nx) as f64, (c / nx) as f64) * cell;
-            let cell_hi = cell_lo + cell;
-            let out = (cell_lo - lo.truncate()).max(hi.truncate() - cell_hi);
-            reach = reach.max(out);
         }
+        drop(home);
         // Rounding in the home cell's index: a hair more.
         let reach = reach * (1.0 + 1e-9) + 1e-9 * cell;
         let bnx = nx.div_ceil(BLOCK);
