@@ -102,26 +102,20 @@ impl Surface {
         tol: f64,
         limit: f64,
     ) -> Option<SweepGap> {
-        let (lo, hi) = move_box(a, b, radius + tol, limit);
-        let q = QueryBox { lo, hi };
         let sweep = Sweep::new(a, b, radius, tol, limit);
+        let q = &sweep.q;
         let mut best = sweep.start();
-        QUEUES.with_borrow_mut(|queue| {
-            queue.items.clear();
-            queue.visited = 0;
-            self.index.visit(&q, |i| {
-                // The triangle's rank: its place in the index's order, which
-                // breaks exact ties (see `Best`).
-                let rank = queue.visited;
-                queue.visited += 1;
+        QUEUE.with_borrow_mut(|queue| {
+            queue.clear();
+            // How many triangles the index has handed over: the next one's
+            // rank, its place in the index's order, which breaks exact ties
+            // (see `Best`).
+            let mut handed = 0u32;
+            self.index.visit(q, |i| {
+                let rank = handed;
+                handed += 1;
                 let t = self.mesh.triangle(i);
-                if !meets(&t, &q) {
-                    return;
-                }
-                // First by its top alone (every contact's h is at most
-                // tol), then by its distance from the move as well.
-                let top = t[0].z.max(t[1].z).max(t[2].z);
-                if sweep.low_tip - top - tol > best.gap {
+                if !meets(&t, q) {
                     return;
                 }
                 let Some(low) = sweep.bound(&t, best.gap) else {
@@ -130,10 +124,10 @@ impl Surface {
                 if low > best.gap {
                     return;
                 }
-                if queue.items.len() == QUEUE {
+                if queue.len() == QUEUE_LEN {
                     self.drain(&sweep, queue, &mut best);
                 }
-                queue.items.push((low, i as u32, rank));
+                queue.push((low, i as u32, rank));
             });
             self.drain(&sweep, queue, &mut best);
         });
@@ -143,10 +137,9 @@ impl Surface {
     /// Tries the queued triangles lowest bound first: those set a small
     /// best value early, and once a triangle's bound cannot beat or tie it,
     /// neither can any after it.
-    fn drain(&self, sweep: &Sweep, queue: &mut Queue, best: &mut Best) {
-        let items = &mut queue.items[..];
-        items.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
-        for &(low, i, rank) in items.iter() {
+    fn drain(&self, sweep: &Sweep, queue: &mut Vec<(f64, u32, u32)>, best: &mut Best) {
+        queue.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+        for &(low, i, rank) in queue.iter() {
             if low > best.gap {
                 break;
             }
@@ -154,7 +147,7 @@ impl Surface {
             best.trying = rank;
             sweep.visit(self.mesh.triangle(i), self.owned[i], best);
         }
-        queue.items.clear();
+        queue.clear();
     }
 
     /// The smallest gap along the move between the tip and the highest
@@ -197,28 +190,21 @@ fn rim_steps(r: f64, tol: f64) -> ([(f64, f64); 4], usize) {
 }
 
 /// Triangles a query gathers before it tries them, lowest bound first.
-const QUEUE: usize = 256;
-
-/// The triangles waiting for their exact test: (bound, triangle, rank).
-/// One per thread, kept between queries so a query allocates nothing.
-struct Queue {
-    items: Vec<(f64, u32, u32)>,
-    /// Triangles the index has handed over so far (the next one's rank).
-    visited: u32,
-}
+const QUEUE_LEN: usize = 256;
 
 thread_local! {
-    static QUEUES: std::cell::RefCell<Queue> = const {
-        std::cell::RefCell::new(Queue {
-            items: Vec::new(),
-            visited: 0,
-        })
-    };
+    /// The triangles waiting for their exact test: (bound, triangle,
+    /// rank). One per thread, kept between queries so a query allocates
+    /// nothing.
+    static QUEUE: std::cell::RefCell<Vec<(f64, u32, u32)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// One move's query.
 struct Sweep {
     m: Move,
+    /// The box a triangle must meet to matter ([`move_box`]).
+    q: QueryBox,
     steps: ([(f64, f64); 4], usize),
     low_tip: f64,
     limit: f64,
@@ -228,7 +214,9 @@ struct Sweep {
 
 impl Sweep {
     fn new(a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> Sweep {
+        let (lo, hi) = move_box(a, b, radius + tol, limit);
         Sweep {
+            q: QueryBox { lo, hi },
             m: Move {
                 a,
                 d: (b - a).truncate(),
@@ -279,11 +267,7 @@ impl Sweep {
         let d = point_segment_dist2(c, a, a + self.m.d).sqrt() - half;
         let d = d - self.hair - 1e-8 * half;
         let steps = &self.steps.0[..self.steps.1];
-        let h = if d <= steps[0].0 {
-            steps[0].1
-        } else {
-            steps.iter().find(|&&(radius, _)| d <= radius)?.1
-        };
+        let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
         let by_box = self.low_tip - hi.z - h;
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         // The plane is not needed when the box bound alone is enough, and
@@ -871,11 +855,6 @@ mod tests {
         }
     }
 
-    /// Trying each corner and edge in its owner only gives the same
-    /// smallest clearance (to 1e-12 mm) as trying it in every triangle that
-    /// holds it:
-    /// random moves (rising, level, descending, and standing still) over a
-    /// bumpy field with a step and over the step block.
     /// The query as it was before the bounds and the order: every
     /// triangle the index hands over whose box meets the query box, tried
     /// in the index's order with nothing skipped.
@@ -887,16 +866,14 @@ mod tests {
         tol: f64,
         limit: f64,
     ) -> Option<SweepGap> {
-        let (lo, hi) = move_box(a, b, r + tol, limit);
-        let q = QueryBox { lo, hi };
         let sweep = Sweep::new(a, b, r, tol, limit);
         let mut best = sweep.start();
         let mut rank = 0;
-        s.index.visit(&q, |i| {
+        s.index.visit(&sweep.q, |i| {
             best.trying = rank;
             rank += 1;
             let t = s.mesh.triangle(i);
-            if meets(&t, &q) {
+            if meets(&t, &sweep.q) {
                 sweep.visit(t, s.owned[i], &mut best);
             }
         });
@@ -958,6 +935,11 @@ mod tests {
         assert!(found > 2000, "too few queries found a contact: {found}");
     }
 
+    /// Trying each corner and edge in its owner only gives the same
+    /// smallest clearance (to 1e-12 mm) as trying it in every triangle that
+    /// holds it:
+    /// random moves (rising, level, descending, and standing still) over a
+    /// bumpy field with a step and over the step block.
     #[test]
     fn owners_only_give_the_same_clearance_as_every_triangle() {
         let bumpy = grid(24, 6.0, |x, y| {
