@@ -319,6 +319,79 @@ impl Body<'_> {
         Ok(())
     }
 
+    /// Fixed-size vertex records, read field by field as [`BinReader`]
+    /// reads them; the layouts scanners write (three little-endian floats
+    /// or doubles) in a loop of their own.
+    fn push_fixed_vertices(
+        &mut self,
+        records: &[u8],
+        stride: usize,
+        axes: [(usize, Scalar); 3],
+        big_endian: bool,
+    ) -> Result<(), MeshError> {
+        fn field<const N: usize>(rec: &[u8], at: usize) -> [u8; N] {
+            let mut b = [0; N];
+            b.copy_from_slice(&rec[at..at + N]);
+            b
+        }
+        let at = axes.map(|(at, _)| at);
+        match (axes.map(|(_, s)| s), big_endian) {
+            ([Scalar::F32, Scalar::F32, Scalar::F32], false) => {
+                for rec in records.chunks_exact(stride) {
+                    let xyz = at.map(|at| f64::from(f32::from_le_bytes(field(rec, at))));
+                    self.push_vertex(xyz, None)?;
+                }
+            }
+            ([Scalar::F64, Scalar::F64, Scalar::F64], false) => {
+                for rec in records.chunks_exact(stride) {
+                    let xyz = at.map(|at| f64::from_le_bytes(field(rec, at)));
+                    self.push_vertex(xyz, None)?;
+                }
+            }
+            _ => {
+                for rec in records.chunks_exact(stride) {
+                    let xyz = axes.map(|(at, s)| {
+                        let mut field = BinReader {
+                            bytes: rec,
+                            pos: at,
+                            big_endian,
+                        };
+                        field.f64(s).unwrap_or(f64::NAN)
+                    });
+                    self.push_vertex(xyz, None)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Little-endian triangle records (count 3, three 32-bit indices of
+    /// type `item`) from the start of `bytes`, at most `count`: how many
+    /// were read. Stops at the first record that is not a triangle of
+    /// indices in range, which the record-by-record reader then reads (and
+    /// reports, if it is an error).
+    fn push_triangle_records(&mut self, bytes: &[u8], count: usize, item: Scalar) -> usize {
+        // Indices at or past this are out of range, or negative as i32.
+        let limit = match item {
+            Scalar::I32 => self.vertex_count.min(1 << 31),
+            _ => self.vertex_count.min(1 << 32),
+        };
+        let mut done = 0;
+        for rec in bytes.chunks_exact(13).take(count) {
+            let tri = [1, 5, 9].map(|at| {
+                let mut b = [0; 4];
+                b.copy_from_slice(&rec[at..at + 4]);
+                u32::from_le_bytes(b)
+            });
+            if rec[0] != 3 || tri.iter().any(|&v| u64::from(v) >= limit) {
+                break;
+            }
+            self.triangles.push(tri);
+            done += 1;
+        }
+        done
+    }
+
     /// Fan triangulation of a face polygon (scanner faces are convex).
     fn push_polygon(&mut self, polygon: &[u32]) {
         match polygon {
@@ -428,21 +501,16 @@ impl Body<'_> {
             if let Some((stride, axes)) = fixed_vertex(element, &roles) {
                 let n = (r.remaining() / stride).min(count);
                 let records = &r.bytes[r.pos..r.pos + n * stride];
-                for rec in records.chunks_exact(stride) {
-                    let xyz = axes.map(|(at, s)| {
-                        let mut field = BinReader {
-                            bytes: rec,
-                            pos: at,
-                            big_endian,
-                        };
-                        field.f64(s).unwrap_or(f64::NAN)
-                    });
-                    self.push_vertex(xyz, None)?;
-                }
+                self.push_fixed_vertices(records, stride, axes, big_endian)?;
                 r.pos += n * stride;
                 i = n;
             }
             let triangles = triangle_list(element, &roles);
+            if let (Some(item), false) = (triangles, big_endian) {
+                let done = self.push_triangle_records(&r.bytes[r.pos..], count - i, item);
+                r.pos += 13 * done;
+                i += done;
+            }
             while i < count {
                 if let Some(item) = triangles {
                     // A triangle: its count 3 and three indices, all present.
@@ -812,6 +880,50 @@ mod tests {
     }
 
     #[test]
+    fn binary_doubles_read_alike_in_both_byte_orders() {
+        let verts = [[0.1, 0.2, 0.3], [1.0, -0.0, 2.5e-7], [0.0, 1.0, 1e300]];
+        for big in [false, true] {
+            let order = if big { "big" } else { "little" };
+            let mut b = format!(
+                "ply\nformat binary_{order}_endian 1.0\nelement vertex 3\n\
+                 property double x\nproperty double y\nproperty double z\n\
+                 element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+            )
+            .into_bytes();
+            for v in verts {
+                for c in v {
+                    let mut bytes = f64::to_le_bytes(c);
+                    if big {
+                        bytes.reverse();
+                    }
+                    b.extend(bytes);
+                }
+            }
+            b.push(3);
+            for i in [0u32, 1, 2] {
+                let mut bytes = i.to_le_bytes();
+                if big {
+                    bytes.reverse();
+                }
+                b.extend(bytes);
+            }
+            let p = parse(&b, "d.ply").unwrap();
+            let got: Vec<[f64; 3]> = p.vertices.iter().map(|v| v.to_array()).collect();
+            assert_eq!(got, verts, "{order}");
+            assert_eq!(p.triangles, vec![[0, 1, 2]], "{order}");
+            // An infinite coordinate is refused, naming the vertex.
+            let at = b.len() - 13 - 8;
+            b[at..at + 8].copy_from_slice(&if big {
+                f64::INFINITY.to_be_bytes()
+            } else {
+                f64::INFINITY.to_le_bytes()
+            });
+            let e = parse(&b, "d.ply").unwrap_err().to_string();
+            assert!(e.contains("vertex 2"), "{order}: {e}");
+        }
+    }
+
+    #[test]
     fn binary_records_read_alike_in_every_layout() {
         let verts: Vec<[f32; 3]> = (0..9)
             .map(|i| [(i % 3) as f32, (i / 3) as f32, 0.25 * i as f32])
@@ -856,11 +968,13 @@ mod tests {
             "{e}"
         );
         bad[4][1] = -1;
-        let e = parse(&binary(&verts, &bad, true, "int"), "b.ply").unwrap_err();
-        assert!(
-            e.to_string().contains("face 4 refers to vertex index -1"),
-            "{e}"
-        );
+        for big in [false, true] {
+            let e = parse(&binary(&verts, &bad, big, "int"), "b.ply").unwrap_err();
+            assert!(
+                e.to_string().contains("face 4 refers to vertex index -1"),
+                "{e}"
+            );
+        }
         let mut nan = verts.clone();
         nan[7][2] = f32::NAN;
         let e = parse(&binary(&nan, &faces, false, "int"), "b.ply").unwrap_err();
