@@ -18,6 +18,8 @@
 //! integration tests name the binary) it is an empty `main`, and its
 //! dependencies (clap, clap_complete, indicatif) are native-only.
 
+#[cfg(target_os = "linux")]
+mod alloc;
 #[cfg(not(target_arch = "wasm32"))]
 mod args;
 #[cfg(not(target_arch = "wasm32"))]
@@ -36,6 +38,10 @@ mod progress;
 mod settings;
 #[cfg(not(target_arch = "wasm32"))]
 mod values;
+
+#[cfg(target_os = "linux")]
+#[global_allocator]
+static ALLOCATOR: alloc::HugePages = alloc::HugePages;
 
 #[cfg(not(target_arch = "wasm32"))]
 use native::{usage, CliResult, Failure, VERSION};
