@@ -15,7 +15,8 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::mesh::buckets::Buckets;
-use crate::mesh::TriMesh;
+use crate::mesh::topology::valid_triangle;
+use crate::mesh::{Topology, TriMesh, MAX_TOPOLOGY_TRIANGLES};
 
 /// A loop is taken as a boundary of the scan (not a hole) when its area is at
 /// least this fraction of the largest loop's area ...
@@ -141,7 +142,20 @@ pub fn find_fiducials(mesh: &TriMesh) -> Vec<Fiducial> {
 /// [`ROUND_ENOUGH`] first, then ascending diameter, then centroid x, y, z
 /// for a deterministic order.
 pub fn find_fiducials_sized(mesh: &TriMesh, dot_diameter_mm: f64) -> Vec<Fiducial> {
-    let loops = boundary_loops(mesh);
+    if mesh.triangles.len() > MAX_TOPOLOGY_TRIANGLES {
+        return Vec::new();
+    }
+    find_fiducials_in(mesh, &Topology::of(mesh), dot_diameter_mm)
+}
+
+/// [`find_fiducials_sized`] with the mesh's [`Topology`] already found
+/// (the surface's index needs it too: one pass serves both).
+pub fn find_fiducials_in(
+    mesh: &TriMesh,
+    topology: &Topology,
+    dot_diameter_mm: f64,
+) -> Vec<Fiducial> {
+    let loops = loops_of(mesh, &topology.boundary_edges);
     let Some(mesh_extent) = mesh_extent(mesh) else {
         return Vec::new();
     };
@@ -184,10 +198,6 @@ pub fn find_fiducials_sized(mesh: &TriMesh, dot_diameter_mm: f64) -> Vec<Fiducia
     out
 }
 
-fn valid_triangle(t: &[u32; 3], n: usize) -> bool {
-    t.iter().all(|&i| (i as usize) < n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
-}
-
 /// Bounding-box diagonal of the vertices of valid triangles.
 fn mesh_extent(mesh: &TriMesh) -> Option<f64> {
     let n = mesh.vertices.len();
@@ -205,45 +215,23 @@ fn mesh_extent(mesh: &TriMesh) -> Option<f64> {
 
 /// Every closed loop of boundary edges, in no particular order.
 ///
-/// Edges are bucketed by their lower vertex ([`Buckets`]) and each bucket
-/// sorted, so a 2M triangle scan costs O(n) and no per-edge allocation.
+/// The boundary edges come from [`Topology::of`]: edges used exactly once;
+/// twice is interior; three or more times is non-manifold, neither a
+/// hole's rim nor interior, and left out (spec 2).
 pub fn boundary_loops(mesh: &TriMesh) -> Vec<BoundaryLoop> {
-    let n = mesh.vertices.len();
-    // Each undirected edge (lo, hi) bucketed by lo (a counting sort, O(n)),
-    // then each bucket (a vertex's few higher neighbours) sorted by hi.
-    let mut his = Buckets::new(n, || {
-        mesh.triangles
-            .iter()
-            .filter(|t| valid_triangle(t, n))
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .map(|(a, b)| (a.min(b), a.max(b)))
-    });
-
-    // Used exactly once: boundary. Twice: interior. Three or more times:
-    // non-manifold, neither a hole's rim nor interior; left out (spec 2).
-    let mut edges: Vec<[u32; 2]> = Vec::new();
-    for lo in 0..n as u32 {
-        let bucket = his.get_mut(lo);
-        bucket.sort_unstable();
-        let mut i = 0;
-        while i < bucket.len() {
-            let mut j = i + 1;
-            while j < bucket.len() && bucket[j] == bucket[i] {
-                j += 1;
-            }
-            if j - i == 1 {
-                edges.push([lo, bucket[i]]);
-            }
-            i = j;
-        }
+    if mesh.triangles.len() > MAX_TOPOLOGY_TRIANGLES {
+        return Vec::new();
     }
-    drop(his);
+    loops_of(mesh, &Topology::of(mesh).boundary_edges)
+}
+
+/// The closed loops of `edges`, boundary edges of `mesh`.
+fn loops_of(mesh: &TriMesh, edges: &[[u32; 2]]) -> Vec<BoundaryLoop> {
     if edges.is_empty() {
         return Vec::new();
     }
-
-    let graph = Graph::new(n, &edges);
-    let raw = graph.loops(&edges);
+    let graph = Graph::new(mesh.vertices.len(), edges);
+    let raw = graph.loops(edges);
     raw.into_iter()
         .filter(|l| l.len() >= 3)
         .filter_map(|l| measure(mesh, l))

@@ -11,10 +11,10 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::error::{Error, Result};
-use crate::fiducials::find_fiducials_sized;
+use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
-use crate::mesh::{CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits};
+use crate::mesh::{CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology};
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::placement::{RegistrationStatus, ScanPlacement};
@@ -111,7 +111,12 @@ pub fn registration_for_scan(
     settings: &RegistrationSettings,
 ) -> Result<Registration> {
     settings.validate()?;
-    let Some(bbox) = mesh.bbox() else {
+    // Only a placement on the bed needs the scan's bounds (a pass over it).
+    let bbox = match settings.scan_placement {
+        ScanPlacement::OnBed { .. } => mesh.bbox(),
+        ScanPlacement::AsScanned => None,
+    };
+    let Some(bbox) = bbox else {
         return registration_for(holes, settings);
     };
     match (
@@ -405,29 +410,40 @@ pub fn prepare_scan(
     let (prepared, file) = crate::parallel::join(
         || -> Result<_> {
             let imported = pipeline::load_scan(bytes, name, scan)?;
-            let fiducials = find_fiducials_sized(&imported.mesh, registration.dot_diameter_mm);
+            // One pass over the edges for the holes and the index.
+            let topology = Topology::of(&imported.mesh);
+            let fiducials =
+                find_fiducials_in(&imported.mesh, &topology, registration.dot_diameter_mm);
             let reg = registration_for_scan(&imported.mesh, &fiducials, registration)?;
-            Ok((imported, fiducials, reg))
+            Ok((imported, topology, fiducials, reg))
         },
         || InputFile::new(name, bytes),
     );
-    let (imported, fiducials, reg) = prepared?;
-    PreparedScan::assemble(file, imported, fiducials, reg, registration.method)
+    let (imported, topology, fiducials, reg) = prepared?;
+    PreparedScan::assemble(
+        file,
+        imported,
+        topology,
+        fiducials,
+        reg,
+        registration.method,
+    )
 }
 
 impl PreparedScan {
     /// The last stage of [`prepare_scan`]: the registered surface and its
-    /// index over an imported scan whose holes were found (in the scanner
-    /// frame) and registered. The page runs the stages one by one to show
-    /// progress between them.
+    /// index over an imported scan whose topology and holes were found (in
+    /// the scanner frame) and registered. The page runs the stages one by
+    /// one to show progress between them.
     pub fn assemble(
         file: InputFile,
         imported: ImportedMesh,
+        topology: Topology,
         fiducials: Vec<Fiducial>,
         registration: Registration,
         method: RegistrationMethod,
     ) -> Result<PreparedScan> {
-        let surface = pipeline::registered_surface(imported.mesh, &registration)?;
+        let surface = pipeline::registered_surface_with(imported.mesh, topology, &registration)?;
         Ok(PreparedScan {
             file,
             format: imported.format,

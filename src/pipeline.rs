@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, TriMesh};
+use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, Topology, TriMesh};
 use crate::motion::{
     backward_moves, check_moves_capped, insert_waypoints_capped, Clearance, PLANNING_MARGIN_MM,
 };
@@ -58,6 +58,19 @@ pub fn registered_surface(mut mesh: TriMesh, registration: &Registration) -> Res
         mesh.transform(&registration.matrix);
     }
     Surface::new(mesh)
+}
+
+/// [`registered_surface`] with the scan's [`Topology`] found before (for
+/// its fiducials): G moves the vertices, not the triangles, so it holds.
+pub fn registered_surface_with(
+    mut mesh: TriMesh,
+    topology: Topology,
+    registration: &Registration,
+) -> Result<Surface> {
+    if registration.matrix != glam::DMat4::IDENTITY {
+        mesh.transform(&registration.matrix);
+    }
+    Surface::with_topology(mesh, topology)
 }
 
 /// A drawn path read from an SVG, with notes on what was skipped.

@@ -1,7 +1,7 @@
 //! Values grouped by a small integer key in O(n): a counting sort into the
-//! compressed layout (CSR) the topology passes share: a vertex's
-//! triangles (the sweep's ownership, `surface`), a vertex's higher
-//! neighbours and a boundary vertex's edges (`fiducials`).
+//! compressed layout (CSR) the topology passes share: the edges at a
+//! vertex (`topology`, the boundary and the sweep's owners) and a boundary
+//! vertex's edges (`fiducials`).
 
 /// Values grouped by key: group `k` is `items[start[k]..start[k + 1]]`,
 /// its values in the order they came.
@@ -39,11 +39,6 @@ impl Buckets {
     #[inline]
     pub fn get(&self, k: u32) -> &[u32] {
         &self.items[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
-    }
-
-    /// Group `k`, to reorder it.
-    pub fn get_mut(&mut self, k: u32) -> &mut [u32] {
-        &mut self.items[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
     }
 }
 

@@ -22,11 +22,13 @@ mod obj;
 mod pcd;
 mod ply;
 mod stl;
+pub(crate) mod topology;
 mod xyz;
 
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use import::{detect_format, import_mesh};
+pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
 /// Largest scan file read (bytes). A 20 M triangle binary STL is 1 GB; a
 /// browser tab cannot hold much more than this plus its mesh in wasm memory.

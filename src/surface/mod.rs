@@ -13,8 +13,7 @@ mod sweep;
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
-use crate::mesh::buckets::Buckets;
-use crate::mesh::TriMesh;
+use crate::mesh::{Topology, TriMesh, MAX_TOPOLOGY_TRIANGLES};
 pub use index::SpatialIndex;
 use index::{Index, QueryBox};
 pub use sweep::{SweepGap, RIM_STEPS};
@@ -25,44 +24,10 @@ pub struct Surface {
     index: Index,
     bbox: (DVec3, DVec3),
     /// Per triangle, which of its corners (bits 0-2) and edges (bits 3-5,
-    /// edge k from corner k to k + 1) it owns: the lowest-numbered
-    /// triangle holding a vertex or an edge owns it. The swept query
-    /// tries each corner and edge in its owner only (see `sweep.rs`).
+    /// edge k from corner k to k + 1) it owns ([`Topology::owned`]). The
+    /// swept query tries each corner and edge in its owner only (see
+    /// `sweep.rs`).
     owned: Vec<u8>,
-}
-
-/// The ownership bits of [`Surface::owned`], from each vertex's triangles
-/// in order (a counting sort, O(n)): a vertex's owner is the first of its
-/// triangles, an edge's the first of its lower vertex's triangles that
-/// holds its higher vertex too.
-fn ownership(mesh: &TriMesh) -> Vec<u8> {
-    let fans = Buckets::new(mesh.vertices.len(), || {
-        (0u32..)
-            .zip(&mesh.triangles)
-            .flat_map(|(t, tri)| tri.map(|v| (v, t)))
-    });
-    let mut owned = vec![0u8; mesh.triangles.len()];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let t = t as u32;
-        for k in 0..3 {
-            if fans.get(tri[k]).first() == Some(&t) {
-                owned[t as usize] |= 1 << k;
-            }
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            let (lo, hi) = (a.min(b), a.max(b));
-            // The fan lists its triangles in index order and holds t: t
-            // owns the edge when no triangle before it has the edge too.
-            let earlier = fans
-                .get(lo)
-                .iter()
-                .take_while(|&&u| u < t)
-                .any(|&u| mesh.triangles[u as usize].contains(&hi));
-            if !earlier {
-                owned[t as usize] |= 8 << k;
-            }
-        }
-    }
-    owned
 }
 
 /// Where the horizontal tip disk C_j cuts the surface (spec section 6c).
@@ -94,33 +59,78 @@ impl Surface {
     /// [`Self::new`] with a chosen spatial index (tests and benchmarks
     /// compare them; results agree to the last bit but for summation order).
     pub fn with_index(mesh: TriMesh, kind: SpatialIndex) -> Result<Surface> {
-        let Some(bbox) = mesh.bbox() else {
-            return Err(Error::Plan("the scan has no triangles".into()));
-        };
-        if !(bbox.0.is_finite() && bbox.1.is_finite()) {
-            return Err(Error::Plan(
-                "the scan has a non-finite vertex coordinate".into(),
-            ));
-        }
-        let n = mesh.vertices.len();
-        if let Some(i) = mesh
-            .triangles
-            .iter()
-            .position(|t| t.iter().any(|&k| k as usize >= n))
-        {
+        let bbox = Surface::check(&mesh)?;
+        let topology = Topology::of(&mesh);
+        Ok(Surface::build(mesh, bbox, topology, kind))
+    }
+
+    /// [`Self::new`] with the mesh's [`Topology`] already found (the
+    /// fiducials need it too: one pass serves both). A topology of another
+    /// mesh is refused when its triangle count differs; one of a mesh with
+    /// the same triangles moved (the registration) is the same.
+    pub fn with_topology(mesh: TriMesh, topology: Topology) -> Result<Surface> {
+        let bbox = Surface::check(&mesh)?;
+        if topology.owned.len() != mesh.triangles.len() {
             return Err(Error::Plan(format!(
-                "triangle {i} refers to a vertex past the {n} the scan has"
+                "the topology given is of {} triangles, the scan has {}",
+                topology.owned.len(),
+                mesh.triangles.len()
             )));
         }
-        // First: its transient arrays are freed before the index's grow.
-        let owned = ownership(&mesh);
+        Ok(Surface::build(mesh, bbox, topology, SpatialIndex::Auto))
+    }
+
+    /// What the surface's queries rely on (triangles, finite vertices,
+    /// indices in range, not too many to number their edges): the bounds.
+    fn check(mesh: &TriMesh) -> Result<(DVec3, DVec3)> {
+        // One pass: each triangle's indices checked before they are read.
+        let n = mesh.vertices.len();
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            if t.iter().any(|&k| k as usize >= n) {
+                return Err(Error::Plan(format!(
+                    "triangle {i} refers to a vertex past the {n} the scan has"
+                )));
+            }
+            for &k in t {
+                let v = mesh.vertices[k as usize];
+                if !v.is_finite() {
+                    return Err(Error::Plan(format!(
+                        "vertex {k} of the scan has a non-finite coordinate"
+                    )));
+                }
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        if mesh.triangles.is_empty() {
+            return Err(Error::Plan("the scan has no triangles".into()));
+        }
+        let bbox = (lo, hi);
+        if mesh.triangles.len() > MAX_TOPOLOGY_TRIANGLES {
+            return Err(Error::Plan(format!(
+                "the scan has {} triangles, more than the {MAX_TOPOLOGY_TRIANGLES} this program \
+                 indexes",
+                mesh.triangles.len()
+            )));
+        }
+        Ok(bbox)
+    }
+
+    fn build(
+        mesh: TriMesh,
+        bbox: (DVec3, DVec3),
+        topology: Topology,
+        kind: SpatialIndex,
+    ) -> Surface {
         let index = Index::build(&mesh, bbox, kind);
-        Ok(Surface {
+        Surface {
             mesh,
             index,
             bbox,
-            owned,
-        })
+            owned: topology.owned,
+        }
     }
 
     /// Which spatial index the scan got.
@@ -387,7 +397,7 @@ pub(crate) mod tests {
         }
         let n = m.triangles.len();
         m.triangles = (0..n).map(|i| m.triangles[(i * 7) % n]).collect();
-        let owned = ownership(&m);
+        let owned = Topology::of(&m).owned;
         let first_with = |has: &dyn Fn(&[u32; 3]) -> bool| m.triangles.iter().position(has);
         for (t, tri) in m.triangles.iter().enumerate() {
             for k in 0..3 {
@@ -570,5 +580,31 @@ pub(crate) mod tests {
     #[test]
     fn empty_mesh_is_an_error() {
         assert!(Surface::new(TriMesh::default()).is_err());
+    }
+
+    #[test]
+    fn bad_meshes_built_in_code_are_errors_not_panics() {
+        let good = grid(3, 1.0, |_, _| 0.0);
+        let mut past = good.clone();
+        past.triangles[4][2] = 99;
+        let e = Surface::new(past).unwrap_err().to_string();
+        assert!(e.contains("triangle 4 refers to a vertex past"), "{e}");
+        let mut nan = good.clone();
+        let k = nan.triangles[3][1];
+        nan.vertices[k as usize].z = f64::NAN;
+        let e = Surface::new(nan).unwrap_err().to_string();
+        assert!(e.contains(&format!("vertex {k} ")), "{e}");
+        // A topology of another mesh.
+        let other = Topology::of(&grid(4, 1.0, |_, _| 0.0));
+        let e = Surface::with_topology(good.clone(), other)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the topology given is of"), "{e}");
+        // The mesh's own, found before, gives the surface Surface::new gives.
+        let own = Topology::of(&good);
+        let with = Surface::with_topology(good.clone(), own).unwrap();
+        let new = Surface::new(good).unwrap();
+        assert_eq!(with.owned, new.owned);
+        assert_eq!(with.bbox, new.bbox);
     }
 }

@@ -17,9 +17,9 @@ use super::{
     TypedArray, MIB, PAGE_MAX_DRAWN_MOVES,
 };
 use crate::demo::{self, parts::DemoPart};
-use crate::fiducials::{find_fiducials_sized, Fiducial};
+use crate::fiducials::{find_fiducials_in, Fiducial};
 use crate::job::{self, InputFile, PreparedScan, RegistrationSettings};
-use crate::mesh::{ImportOptions, ImportedMesh};
+use crate::mesh::{ImportOptions, ImportedMesh, Topology};
 use crate::params::Nozzle;
 use crate::pipeline::{self, DrawnPath, Plan, PlanSettings, SurfacePath};
 use crate::placement;
@@ -120,9 +120,12 @@ impl ScanBuffer {
         let options: ImportOptions = from_js("scan settings", scan)?;
         let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
         let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize());
+        // One pass over the edges for the holes and the index.
+        let topology = Topology::of(&imported.mesh);
         Ok(ScanImport {
             file,
             imported,
+            topology,
             registered: None,
         })
     }
@@ -148,6 +151,8 @@ impl ScanBuffer {
 pub struct ScanImport {
     file: InputFile,
     imported: ImportedMesh,
+    /// Its boundary edges and owners, found once for every registration.
+    topology: Topology,
     /// The fiducial holes (scanner frame) and the registration found with
     /// them, once [`ScanImport::register`] succeeded.
     registered: Option<(Vec<Fiducial>, Registration, RegistrationMethod)>,
@@ -166,7 +171,7 @@ impl ScanImport {
     pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
         let settings: RegistrationSettings = from_js("registration settings", registration)?;
         let mesh = &self.imported.mesh;
-        let holes = find_fiducials_sized(mesh, settings.dot_diameter_mm);
+        let holes = find_fiducials_in(mesh, &self.topology, settings.dot_diameter_mm);
         // Placement on the bed included, as job::prepare_scan does.
         let reg = job::registration_for_scan(mesh, &holes, &settings).map_err(core_err)?;
         self.registered = Some((holes, reg, settings.method));
@@ -180,9 +185,15 @@ impl ScanImport {
             return Err(JsError::new("the scan must be registered before it is indexed").into());
         };
         let scan_bbox = self.imported.mesh.bbox();
-        let prepared =
-            PreparedScan::assemble(self.file, self.imported, fiducials, registration, method)
-                .map_err(core_err)?;
+        let prepared = PreparedScan::assemble(
+            self.file,
+            self.imported,
+            self.topology,
+            fiducials,
+            registration,
+            method,
+        )
+        .map_err(core_err)?;
         Ok(Session::from_prepared(prepared, scan_bbox))
     }
 }
