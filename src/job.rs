@@ -6,6 +6,8 @@
 //! prepared scan, the report and the checked write of the outputs belong
 //! together, as the one contract the two adapters share.
 
+use std::borrow::Cow;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -14,7 +16,9 @@ use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
-use crate::mesh::{CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology};
+use crate::mesh::{
+    CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology, TriMesh,
+};
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::placement::{RegistrationStatus, ScanPlacement};
@@ -22,7 +26,7 @@ use crate::planners::PlannerKind;
 use crate::quality::QualitySummary;
 use crate::registration::{register, Registration, RegistrationError, RegistrationMethod};
 use crate::stats::PathStats;
-use crate::surface::Surface;
+use crate::surface::{Indexed, SpatialIndex, Surface};
 
 /// Where the scan's fiducials come from.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -404,22 +408,64 @@ pub fn prepare_scan(
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
+    prepare(Cow::Borrowed(bytes), name, scan, registration)
+}
+
+/// [`prepare_scan`] of bytes it may free once they are read: the file's
+/// bytes are not held while the scan is indexed (the CLI's peak memory).
+pub fn prepare_scan_owned(
+    bytes: Vec<u8>,
+    name: &str,
+    scan: &ImportOptions,
+    registration: &RegistrationSettings,
+) -> Result<PreparedScan> {
+    prepare(Cow::Owned(bytes), name, scan, registration)
+}
+
+fn prepare(
+    bytes: Cow<'_, [u8]>,
+    name: &str,
+    scan: &ImportOptions,
+    registration: &RegistrationSettings,
+) -> Result<PreparedScan> {
     registration.validate()?;
-    // The provenance hash off the critical path (issue 15): natively on
-    // a second thread while the scan is read, indexed and registered.
-    let (prepared, file) = crate::parallel::join(
-        || -> Result<_> {
-            let imported = pipeline::load_scan(bytes, name, scan)?;
-            // One pass over the edges for the holes and the index.
-            let topology = Topology::of(&imported.mesh);
-            let fiducials =
-                find_fiducials_in(&imported.mesh, &topology, registration.dot_diameter_mm);
-            let reg = registration_for_scan(&imported.mesh, &fiducials, registration)?;
-            Ok((imported, topology, fiducials, reg))
-        },
-        || InputFile::new(name, bytes),
+    // The provenance hash off the critical path (issue 15): natively on a
+    // second thread while the scan is read.
+    let (imported, file) = crate::parallel::join(
+        || pipeline::load_scan(&bytes, name, scan),
+        || InputFile::new(name, &bytes),
     );
-    let (imported, topology, fiducials, reg) = prepared?;
+    drop(bytes);
+    let imported = imported?;
+    let mesh = &imported.mesh;
+    let dot = registration.dot_diameter_mm;
+    // Only `auto` fiducials register with the holes. Without them, and
+    // with the scan staying where it is (the registration moves no
+    // vertex), the index is built on this mesh while its topology and
+    // holes are found (natively on a second thread).
+    let holes_needed = matches!(registration.fiducials, FiducialSource::Auto)
+        && !matches!(registration.scan_placement, ScanPlacement::OnBed { .. });
+    if !holes_needed {
+        let reg = registration_for_scan(mesh, &[], registration)?;
+        if reg.matrix == glam::DMat4::IDENTITY {
+            let ((topology, fiducials), indexed) = crate::parallel::join(
+                || {
+                    let topology = Topology::of(mesh);
+                    let fiducials = find_fiducials_in(mesh, &topology, dot);
+                    (topology, fiducials)
+                },
+                || Indexed::build(mesh, SpatialIndex::Auto),
+            );
+            let indexed = indexed?;
+            return PreparedScan::new(file, imported, fiducials, reg, registration.method, |m| {
+                Surface::from_index(m, indexed, topology)
+            });
+        }
+    }
+    // One pass over the edges for the holes and the index.
+    let topology = Topology::of(mesh);
+    let fiducials = find_fiducials_in(mesh, &topology, dot);
+    let reg = registration_for_scan(mesh, &fiducials, registration)?;
     PreparedScan::assemble(
         file,
         imported,
@@ -443,17 +489,40 @@ impl PreparedScan {
         registration: Registration,
         method: RegistrationMethod,
     ) -> Result<PreparedScan> {
-        let surface = pipeline::registered_surface_with(imported.mesh, topology, &registration)?;
+        let g = registration.clone();
+        PreparedScan::new(file, imported, fiducials, registration, method, |mesh| {
+            pipeline::registered_surface_with(mesh, topology, &g)
+        })
+    }
+
+    /// The prepared scan whose surface `surface` makes of the imported
+    /// mesh.
+    fn new(
+        file: InputFile,
+        imported: ImportedMesh,
+        fiducials: Vec<Fiducial>,
+        registration: Registration,
+        method: RegistrationMethod,
+        surface: impl FnOnce(TriMesh) -> Result<Surface>,
+    ) -> Result<PreparedScan> {
+        let ImportedMesh {
+            mesh,
+            format,
+            units,
+            warnings,
+            cloud,
+            ..
+        } = imported;
         Ok(PreparedScan {
             file,
-            format: imported.format,
-            units: imported.units,
-            warnings: imported.warnings,
-            cloud: imported.cloud,
+            format,
+            units,
+            warnings,
+            cloud,
             fiducials,
             registration,
             method,
-            surface,
+            surface: surface(mesh)?,
         })
     }
 }
@@ -1006,6 +1075,51 @@ mod tests {
         assert_eq!(r[0][3], 1.0);
         assert_eq!(r[2][3], 3.0);
         assert_eq!(r[3], [0.0, 0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn index_built_beside_the_topology_gives_what_the_stages_give() {
+        let bytes = crate::demo::to_binary_ply(&test_part::test_part());
+        let scan = ImportOptions::DEFAULT;
+        let bed = ScanPlacement::OnBed {
+            bed: crate::placement::Bed::of_profile(&MachineProfile::builtin("marlin").unwrap()),
+            rotation_deg: 10.0,
+            offset_mm: DVec3::ZERO,
+        };
+        // As scanned (the index beside the topology), and placed on the
+        // bed (one after the other, the mesh moved first).
+        for placement in [ScanPlacement::AsScanned, bed] {
+            let settings = RegistrationSettings {
+                scan_placement: placement,
+                ..Default::default()
+            };
+            let got = prepare_scan_owned(bytes.clone(), "part.ply", &scan, &settings).unwrap();
+            let imported = pipeline::load_scan(&bytes, "part.ply", &scan).unwrap();
+            let topology = Topology::of(&imported.mesh);
+            let holes = find_fiducials_in(&imported.mesh, &topology, settings.dot_diameter_mm);
+            let reg = registration_for_scan(&imported.mesh, &holes, &settings).unwrap();
+            let file = InputFile::new("part.ply", &bytes);
+            let want =
+                PreparedScan::assemble(file, imported, topology, holes, reg, settings.method)
+                    .unwrap();
+            assert_eq!(got.file, want.file);
+            assert_eq!(got.fiducials, want.fiducials);
+            assert_eq!(got.registration, want.registration);
+            assert_eq!(got.surface.mesh(), want.surface.mesh());
+            assert_eq!(got.surface.bbox(), want.surface.bbox());
+            let (lo, hi) = want.surface.bbox();
+            for i in 0..400 {
+                let (u, v) = ((i % 20) as f64 / 19.0, (i / 20) as f64 / 19.0);
+                let xy = lo.truncate() + (hi - lo).truncate() * glam::DVec2::new(u, v);
+                let a = xy.extend(hi.z + 1.0);
+                let b = (xy + glam::DVec2::new(3.0, -2.0)).extend(lo.z + 0.5);
+                assert_eq!(got.surface.highest_hit(xy), want.surface.highest_hit(xy));
+                assert_eq!(
+                    got.surface.nozzle_gap(a, b, 0.45, 0.1, f64::INFINITY),
+                    want.surface.nozzle_gap(a, b, 0.45, 0.1, f64::INFINITY)
+                );
+            }
+        }
     }
 
     #[test]

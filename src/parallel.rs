@@ -9,29 +9,27 @@
 
 use std::ops::Range;
 
-/// Runs `a` and `b` and returns both results; natively `b` runs on a
-/// scoped thread while `a` runs on this one. A panic in either is
-/// resumed here, as if both had run on this thread.
+/// Runs `a` and `b` and returns both results; natively (unless
+/// `PCPP_THREADS` is 1) `b` runs on a scoped thread while `a` runs on this
+/// one. A panic in either is resumed here, as if both had run on this
+/// thread.
 pub fn join<A: Send, B: Send>(
     a: impl FnOnce() -> A + Send,
     b: impl FnOnce() -> B + Send,
 ) -> (A, B) {
     #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::thread::scope(|s| {
+    if threads() > 1 {
+        return std::thread::scope(|s| {
             let other = s.spawn(b);
             let ra = a();
             match other.join() {
                 Ok(rb) => (ra, rb),
                 Err(panic) => std::panic::resume_unwind(panic),
             }
-        })
+        });
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        let ra = a();
-        (ra, b())
-    }
+    let ra = a();
+    (ra, b())
 }
 
 /// The threads [`map_chunks`] uses: `PCPP_THREADS` if set to a positive

@@ -30,6 +30,27 @@ pub struct Surface {
     owned: Vec<u8>,
 }
 
+/// A scan's bounds and spatial index, built on the borrowed mesh: the
+/// other half of a [`Surface`], with its [`Topology`]
+/// ([`Surface::from_index`]).
+pub(crate) struct Indexed {
+    index: Index,
+    bbox: (DVec3, DVec3),
+    triangles: usize,
+}
+
+impl Indexed {
+    /// Checks `mesh` ([`Surface::check`]) and builds its index.
+    pub(crate) fn build(mesh: &TriMesh, kind: SpatialIndex) -> Result<Indexed> {
+        let bbox = Surface::check(mesh)?;
+        Ok(Indexed {
+            index: Index::build(mesh, bbox, kind),
+            bbox,
+            triangles: mesh.triangles.len(),
+        })
+    }
+}
+
 /// Where the horizontal tip disk C_j cuts the surface (spec section 6c).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DiskContact {
@@ -59,9 +80,9 @@ impl Surface {
     /// [`Self::new`] with a chosen spatial index (tests and benchmarks
     /// compare them; results agree to the last bit but for summation order).
     pub fn with_index(mesh: TriMesh, kind: SpatialIndex) -> Result<Surface> {
-        let bbox = Surface::check(&mesh)?;
+        let indexed = Indexed::build(&mesh, kind)?;
         let topology = Topology::of(&mesh);
-        Ok(Surface::build(mesh, bbox, topology, kind))
+        Surface::from_index(mesh, indexed, topology)
     }
 
     /// [`Self::new`] with the mesh's [`Topology`] already found (the
@@ -69,15 +90,35 @@ impl Surface {
     /// mesh is refused when its triangle count differs; one of a mesh with
     /// the same triangles moved (the registration) is the same.
     pub fn with_topology(mesh: TriMesh, topology: Topology) -> Result<Surface> {
-        let bbox = Surface::check(&mesh)?;
-        if topology.owned.len() != mesh.triangles.len() {
-            return Err(Error::Plan(format!(
-                "the topology given is of {} triangles, the scan has {}",
-                topology.owned.len(),
-                mesh.triangles.len()
-            )));
+        let indexed = Indexed::build(&mesh, SpatialIndex::Auto)?;
+        Surface::from_index(mesh, indexed, topology)
+    }
+
+    /// The surface of `mesh` from its index, built on `mesh` (borrowed,
+    /// so that its topology could be found at the same time), and its
+    /// topology.
+    pub(crate) fn from_index(
+        mesh: TriMesh,
+        indexed: Indexed,
+        topology: Topology,
+    ) -> Result<Surface> {
+        for (what, count) in [
+            ("index", indexed.triangles),
+            ("topology", topology.owned.len()),
+        ] {
+            if count != mesh.triangles.len() {
+                return Err(Error::Plan(format!(
+                    "the {what} given is of {count} triangles, the scan has {}",
+                    mesh.triangles.len()
+                )));
+            }
         }
-        Ok(Surface::build(mesh, bbox, topology, SpatialIndex::Auto))
+        Ok(Surface {
+            mesh,
+            index: indexed.index,
+            bbox: indexed.bbox,
+            owned: topology.owned,
+        })
     }
 
     /// What the surface's queries rely on (triangles, finite vertices,
@@ -116,21 +157,6 @@ impl Surface {
             )));
         }
         Ok(bbox)
-    }
-
-    fn build(
-        mesh: TriMesh,
-        bbox: (DVec3, DVec3),
-        topology: Topology,
-        kind: SpatialIndex,
-    ) -> Surface {
-        let index = Index::build(&mesh, bbox, kind);
-        Surface {
-            mesh,
-            index,
-            bbox,
-            owned: topology.owned,
-        }
     }
 
     /// Which spatial index the scan got.

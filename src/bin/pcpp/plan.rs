@@ -46,13 +46,15 @@ pub fn load_scan(
     let scan = read_bytes(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
     progress.step(format!("importing and indexing {scan_name}..."));
-    let prepared = job::prepare_scan(&scan, &scan_name, &settings.scan, &settings.registration)
-        .map_err(|e| match e {
-            Error::Registration(r) => {
-                Failure::Input(format!("registration of {}: {r}", scan_path.display()))
-            }
-            other => Failure::Input(in_file(scan_path, &scan_name, &other.to_string())),
-        })?;
+    let prepared =
+        job::prepare_scan_owned(scan, &scan_name, &settings.scan, &settings.registration).map_err(
+            |e| match e {
+                Error::Registration(r) => {
+                    Failure::Input(format!("registration of {}: {r}", scan_path.display()))
+                }
+                other => Failure::Input(in_file(scan_path, &scan_name, &other.to_string())),
+            },
+        )?;
     progress.note(&format!(
         "scan: {} triangles",
         thousands(prepared.triangle_count())
