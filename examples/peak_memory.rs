@@ -1,7 +1,7 @@
 //! Native peak memory holding W1 ready to plan (issue 5: <= 250 MB):
 //! reads the scan file, imports, registers and indexes it (the same
-//! `job::prepare_scan` the CLI and the page's Session run), drops the file's
-//! bytes, checks the surface answers a query, and prints the process's peak
+//! `job::prepare_scan_owned` the CLI runs, which frees the file's bytes once
+//! they are read), checks the surface answers a query, and prints the process's peak
 //! resident set (VmHWM, Linux `/proc/self/status`) and its resident set now:
 //!
 //! ```text
@@ -9,12 +9,13 @@
 //! peak_rss_bytes=... rss_bytes=... triangles=...
 //! ```
 //!
-//! The peak includes the file's bytes, held while they are imported, as the
-//! page holds them. Write W1 with `examples/workloads.rs` first.
+//! The peak includes the file's bytes while they are imported (the page
+//! holds them throughout; its peak is measured in wasm). Write W1 with
+//! `examples/workloads.rs` first.
 
 use std::process::ExitCode;
 
-use pcpp::job::{prepare_scan, RegistrationSettings};
+use pcpp::job::{prepare_scan_owned, RegistrationSettings};
 use pcpp::mesh::ImportOptions;
 use pcpp::DVec3;
 
@@ -44,8 +45,8 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let scan = match prepare_scan(
-        &bytes,
+    let scan = match prepare_scan_owned(
+        bytes,
         &path,
         &ImportOptions::DEFAULT,
         &RegistrationSettings::default(),
@@ -56,7 +57,6 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    drop(bytes);
     // Ready to plan: one query through the surface's index.
     let (lo, hi) = scan.surface.bbox();
     let mid = 0.5 * (lo + hi);

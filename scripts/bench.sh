@@ -219,9 +219,10 @@ out.push('');
 out.push(`(b) Session.plan: the plan, its report and G-code, converted to JS; ` +
   `the same job natively: W2 ${ms(w2JobS)}, W3 ${ms(w3JobS)}.`);
 out.push('');
-out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs: the file's bytes, the mesh and ` +
-  `its index; ${f(Number(/ rss_bytes=(\d+)/.exec(mem)?.[1] ?? 0) / 1e6, 0)} MB resident once ` +
-  `the bytes are dropped.`);
+out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs, which prepares the scan as ` +
+  `the CLI does (job::prepare_scan_owned: the file's bytes freed once read, then the mesh, its ` +
+  `topology and index); ${f(Number(/ rss_bytes=(\d+)/.exec(mem)?.[1] ?? 0) / 1e6, 0)} MB ` +
+  `resident once ready.`);
 out.push('');
 out.push(`(d) memory.buffer.byteLength holding a Session on W1.ply (wasm memory never shrinks: ` +
   `also the peak while preparing it).`);
