@@ -142,10 +142,13 @@ pub fn find_fiducials(mesh: &TriMesh) -> Vec<Fiducial> {
 /// [`ROUND_ENOUGH`] first, then ascending diameter, then centroid x, y, z
 /// for a deterministic order.
 pub fn find_fiducials_sized(mesh: &TriMesh, dot_diameter_mm: f64) -> Vec<Fiducial> {
-    if mesh.triangles.len() > MAX_TOPOLOGY_TRIANGLES {
-        return Vec::new();
-    }
-    find_fiducials_in(mesh, &Topology::of(mesh), dot_diameter_mm)
+    topology_of(mesh).map_or_else(Vec::new, |t| find_fiducials_in(mesh, &t, dot_diameter_mm))
+}
+
+/// The mesh's topology, `None` past [`MAX_TOPOLOGY_TRIANGLES`] (no
+/// importer keeps that many; such a mesh has no holes listed).
+fn topology_of(mesh: &TriMesh) -> Option<Topology> {
+    (mesh.triangles.len() <= MAX_TOPOLOGY_TRIANGLES).then(|| Topology::of(mesh))
 }
 
 /// [`find_fiducials_sized`] with the mesh's [`Topology`] already found
@@ -219,10 +222,7 @@ fn mesh_extent(mesh: &TriMesh) -> Option<f64> {
 /// twice is interior; three or more times is non-manifold, neither a
 /// hole's rim nor interior, and left out (spec 2).
 pub fn boundary_loops(mesh: &TriMesh) -> Vec<BoundaryLoop> {
-    if mesh.triangles.len() > MAX_TOPOLOGY_TRIANGLES {
-        return Vec::new();
-    }
-    loops_of(mesh, &Topology::of(mesh).boundary_edges)
+    topology_of(mesh).map_or_else(Vec::new, |t| loops_of(mesh, &t.boundary_edges))
 }
 
 /// The closed loops of `edges`, boundary edges of `mesh`.

@@ -445,8 +445,12 @@ fn prepare(
     // holes are found (natively on a second thread).
     let holes_needed = matches!(registration.fiducials, FiducialSource::Auto)
         && !matches!(registration.scan_placement, ScanPlacement::OnBed { .. });
-    if !holes_needed {
-        let reg = registration_for_scan(mesh, &[], registration)?;
+    let early = if holes_needed {
+        None
+    } else {
+        Some(registration_for_scan(mesh, &[], registration)?)
+    };
+    if let Some(reg) = early.clone() {
         if reg.matrix == glam::DMat4::IDENTITY {
             let ((topology, fiducials), indexed) = crate::parallel::join(
                 || {
@@ -465,7 +469,10 @@ fn prepare(
     // One pass over the edges for the holes and the index.
     let topology = Topology::of(mesh);
     let fiducials = find_fiducials_in(mesh, &topology, dot);
-    let reg = registration_for_scan(mesh, &fiducials, registration)?;
+    let reg = match early {
+        Some(reg) => reg,
+        None => registration_for_scan(mesh, &fiducials, registration)?,
+    };
     PreparedScan::assemble(
         file,
         imported,
@@ -491,7 +498,7 @@ impl PreparedScan {
     ) -> Result<PreparedScan> {
         let g = registration.clone();
         PreparedScan::new(file, imported, fiducials, registration, method, |mesh| {
-            pipeline::registered_surface_with(mesh, topology, &g)
+            pipeline::registered_surface(mesh, topology, &g)
         })
     }
 

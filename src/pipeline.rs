@@ -52,17 +52,10 @@ pub fn load_scan(bytes: &[u8], file: &str, options: &ImportOptions) -> Result<Im
     Ok(import_mesh(bytes, file, options)?)
 }
 
-/// Stage 2: Sa = G S, and the acceleration structure over it.
-pub fn registered_surface(mut mesh: TriMesh, registration: &Registration) -> Result<Surface> {
-    if registration.matrix != glam::DMat4::IDENTITY {
-        mesh.transform(&registration.matrix);
-    }
-    Surface::new(mesh)
-}
-
-/// [`registered_surface`] with the scan's [`Topology`] found before (for
-/// its fiducials): G moves the vertices, not the triangles, so it holds.
-pub fn registered_surface_with(
+/// Stage 2: Sa = G S, and the acceleration structure over it, with the
+/// scan's [`Topology`] found before (for its fiducials): G moves the
+/// vertices, not the triangles, so it holds.
+pub fn registered_surface(
     mut mesh: TriMesh,
     topology: Topology,
     registration: &Registration,

@@ -436,7 +436,6 @@ impl WeldTable {
         }
     }
 
-    /// Twice the slots, every kept vertex placed again.
     /// Asks the processor to fetch the slot where a probe for `hash`
     /// starts: the probes of a batch of vertices then wait on memory
     /// together rather than one after another.
@@ -455,6 +454,7 @@ impl WeldTable {
         let _ = hash;
     }
 
+    /// Twice the slots, every kept vertex placed again.
     fn grow(&mut self, kept: &[DVec3]) {
         self.slots = vec![FREE; 2 * self.slots.len()];
         let mask = self.slots.len() - 1;

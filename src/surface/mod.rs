@@ -43,11 +43,16 @@ impl Indexed {
     /// Checks `mesh` ([`Surface::check`]) and builds its index.
     pub(crate) fn build(mesh: &TriMesh, kind: SpatialIndex) -> Result<Indexed> {
         let bbox = Surface::check(mesh)?;
-        Ok(Indexed {
+        Ok(Indexed::with_bounds(mesh, bbox, kind))
+    }
+
+    /// The index of a checked mesh whose bounds are `bbox`.
+    fn with_bounds(mesh: &TriMesh, bbox: (DVec3, DVec3), kind: SpatialIndex) -> Indexed {
+        Indexed {
             index: Index::build(mesh, bbox, kind),
             bbox,
             triangles: mesh.triangles.len(),
-        })
+        }
     }
 }
 
@@ -80,8 +85,10 @@ impl Surface {
     /// [`Self::new`] with a chosen spatial index (tests and benchmarks
     /// compare them; results agree to the last bit but for summation order).
     pub fn with_index(mesh: TriMesh, kind: SpatialIndex) -> Result<Surface> {
-        let indexed = Indexed::build(&mesh, kind)?;
+        let bbox = Surface::check(&mesh)?;
+        // First: its transient arrays are freed before the index's grow.
         let topology = Topology::of(&mesh);
+        let indexed = Indexed::with_bounds(&mesh, bbox, kind);
         Surface::from_index(mesh, indexed, topology)
     }
 
