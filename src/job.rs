@@ -237,6 +237,25 @@ fn permute(
     }
 }
 
+/// The SHA-256 of `bytes` (see [`hash_in_pieces`]).
+pub fn sha256(bytes: &[u8]) -> [u8; 32] {
+    let mut hasher = Sha256::new();
+    hash_in_pieces(&mut hasher, bytes);
+    hasher.finalize().into()
+}
+
+/// Feeds `bytes` to `hasher` in pieces of 64 KiB. V8 runs a long wasm call
+/// in its baseline tier to its end (it has no on-stack replacement for
+/// wasm) and tiers a function up only for its later calls: hashed in one
+/// call, a 50 MB scan took 4 s in Node, in pieces 0.3 s. Natively the
+/// pieces change nothing.
+pub fn hash_in_pieces(hasher: &mut Sha256, bytes: &[u8]) {
+    // A multiple of SHA-256's 64-byte block.
+    for piece in bytes.chunks(1 << 16) {
+        hasher.update(piece);
+    }
+}
+
 /// A file as the report names it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct InputFile {
@@ -247,7 +266,7 @@ pub struct InputFile {
 
 impl InputFile {
     pub fn new(name: &str, bytes: &[u8]) -> Self {
-        InputFile::from_digest(name, bytes.len(), &Sha256::digest(bytes))
+        InputFile::from_digest(name, bytes.len(), &sha256(bytes))
     }
 
     /// From a SHA-256 made elsewhere (the page hashes a scan as it reads
