@@ -11,88 +11,132 @@ use super::import::Parsed;
 use super::MeshError;
 
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
-    let mut vertices: Vec<DVec3> = Vec::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut polygon: Vec<u32> = Vec::with_capacity(8);
-    let mut faces = 0usize;
-    let mut line_no = 0usize;
-    let mut rest = bytes;
-    while !rest.is_empty() {
-        line_no += 1;
-        let (line, next) = match rest.iter().position(|&c| c == b'\n') {
-            Some(i) => rest.split_at(i + 1),
-            None => (rest, &[][..]),
-        };
-        rest = next;
-        let mut cur = Cursor { line, pos: 0 };
-        cur.skip_space();
-        match (cur.peek(0), cur.peek(1)) {
-            (Some(b'v'), Some(c)) if is_space(c) => {
-                cur.pos += 1;
-                let mut xyz = [0.0f64; 3];
-                for (axis, slot) in xyz.iter_mut().enumerate() {
-                    let token = cur.token().ok_or_else(|| {
-                        MeshError::syntax(
-                            file,
-                            line_no,
-                            format!("vertex has {axis} coordinate(s), needs x y z"),
-                        )
-                    })?;
-                    *slot = parse_f64(token).ok_or_else(|| {
-                        MeshError::syntax(
-                            file,
-                            line_no,
-                            format!("'{}' is not a number", String::from_utf8_lossy(token)),
-                        )
-                    })?;
-                }
-                // Extra values (w, or the vertex colours some scanners
-                // append) carry no geometry.
-                let v = DVec3::from_array(xyz);
-                if !v.is_finite() {
-                    return Err(MeshError::NonFiniteVertex {
-                        file: file.into(),
-                        vertex: vertices.len() + 1,
-                        line: Some(line_no),
-                        value: xyz.into_iter().find(|c| !c.is_finite()).unwrap_or(f64::NAN),
-                    });
-                }
-                vertices.push(v);
-            }
-            (Some(b'f'), Some(c)) if is_space(c) => {
-                cur.pos += 1;
-                polygon.clear();
-                while let Some(token) = cur.token() {
-                    let index = resolve(token, vertices.len()).map_err(|e| match e {
-                        IndexError::Syntax(message) => MeshError::syntax(file, line_no, message),
-                        IndexError::Range(index) => MeshError::IndexOutOfRange {
-                            file: file.into(),
-                            face: faces,
-                            line: Some(line_no),
-                            index,
-                            vertex_count: vertices.len(),
-                        },
-                    })?;
-                    polygon.push(index);
-                }
-                if polygon.len() < 3 {
-                    return Err(MeshError::syntax(
-                        file,
-                        line_no,
-                        format!("face has {} vertices, needs at least 3", polygon.len()),
-                    ));
-                }
-                triangulate(&polygon, &vertices, &mut triangles);
-                faces += 1;
-            }
-            _ => {}
-        }
+    let mut p = Parser {
+        file,
+        cur: Cursor { bytes, pos: 0 },
+        line_no: 0,
+        vertices: Vec::new(),
+        triangles: Vec::new(),
+        polygon: Vec::with_capacity(8),
+        faces: 0,
+    };
+    // A batch of lines per call: V8 runs a long wasm call in its baseline
+    // tier to its end and tiers a function up only for its later calls (see
+    // `job::hash_in_pieces`), so one call over the whole file would read
+    // it all in the baseline tier.
+    while p.cur.pos < bytes.len() {
+        p.lines(LINES_PER_CALL)?;
     }
     Ok(Parsed {
-        vertices,
-        triangles,
+        vertices: p.vertices,
+        triangles: p.triangles,
         warnings: Vec::new(),
     })
+}
+
+/// Lines [`Parser::lines`] reads in one call.
+const LINES_PER_CALL: usize = 1 << 12;
+
+struct Parser<'a> {
+    file: &'a str,
+    /// At the start of the next line.
+    cur: Cursor<'a>,
+    /// The line number of the last line read.
+    line_no: usize,
+    vertices: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    polygon: Vec<u32>,
+    faces: usize,
+}
+
+impl Parser<'_> {
+    /// Reads up to `count` lines, each in one pass over its bytes (its
+    /// statement's tokens, then the rest of the line).
+    #[inline(never)]
+    fn lines(&mut self, count: usize) -> Result<(), MeshError> {
+        for _ in 0..count {
+            if self.cur.pos >= self.cur.bytes.len() {
+                break;
+            }
+            self.line_no += 1;
+            self.cur.skip_space();
+            match (self.cur.peek(0), self.cur.peek(1)) {
+                (Some(b'v'), Some(c)) if is_space(c) => {
+                    self.cur.pos += 1;
+                    self.vertex()?;
+                }
+                (Some(b'f'), Some(c)) if is_space(c) => {
+                    self.cur.pos += 1;
+                    self.face()?;
+                }
+                _ => {}
+            }
+            self.cur.next_line();
+        }
+        Ok(())
+    }
+
+    fn vertex(&mut self) -> Result<(), MeshError> {
+        let (file, line_no) = (self.file, self.line_no);
+        let mut xyz = [0.0f64; 3];
+        for (axis, slot) in xyz.iter_mut().enumerate() {
+            let number = self.cur.number().ok_or_else(|| {
+                MeshError::syntax(
+                    file,
+                    line_no,
+                    format!("vertex has {axis} coordinate(s), needs x y z"),
+                )
+            })?;
+            *slot = number.map_err(|token| {
+                MeshError::syntax(
+                    file,
+                    line_no,
+                    format!("'{}' is not a number", String::from_utf8_lossy(token)),
+                )
+            })?;
+        }
+        // Extra values (w, or the vertex colours some scanners append)
+        // carry no geometry.
+        let v = DVec3::from_array(xyz);
+        if !v.is_finite() {
+            return Err(MeshError::NonFiniteVertex {
+                file: file.into(),
+                vertex: self.vertices.len() + 1,
+                line: Some(line_no),
+                value: xyz.into_iter().find(|c| !c.is_finite()).unwrap_or(f64::NAN),
+            });
+        }
+        self.vertices.push(v);
+        Ok(())
+    }
+
+    fn face(&mut self) -> Result<(), MeshError> {
+        let (file, line_no) = (self.file, self.line_no);
+        self.polygon.clear();
+        while let Some(token) = self.cur.token() {
+            let index = resolve(token, self.vertices.len()).map_err(|e| match e {
+                IndexError::Syntax(message) => MeshError::syntax(file, line_no, message),
+                IndexError::Range(index) => MeshError::IndexOutOfRange {
+                    file: file.into(),
+                    face: self.faces,
+                    line: Some(line_no),
+                    index,
+                    vertex_count: self.vertices.len(),
+                },
+            })?;
+            self.polygon.push(index);
+        }
+        if self.polygon.len() < 3 {
+            return Err(MeshError::syntax(
+                file,
+                line_no,
+                format!("face has {} vertices, needs at least 3", self.polygon.len()),
+            ));
+        }
+        triangulate(&self.polygon, &self.vertices, &mut self.triangles);
+        self.faces += 1;
+        Ok(())
+    }
 }
 
 /// Polygons above this many corners are fanned without the ear test (its
@@ -198,34 +242,60 @@ fn is_space(c: u8) -> bool {
     matches!(c, b' ' | b'\t' | b'\r' | b'\n' | b'\x0c' | b'\x0b')
 }
 
+/// A place in the file; the line it is in ends at its next newline.
 struct Cursor<'a> {
-    line: &'a [u8],
+    bytes: &'a [u8],
     pos: usize,
 }
 
 impl<'a> Cursor<'a> {
     fn peek(&self, ahead: usize) -> Option<u8> {
-        self.line.get(self.pos + ahead).copied()
+        self.bytes.get(self.pos + ahead).copied()
     }
 
+    /// Skips spaces within the line.
     fn skip_space(&mut self) {
-        while self.peek(0).is_some_and(is_space) {
+        while self.peek(0).is_some_and(|c| c != b'\n' && is_space(c)) {
             self.pos += 1;
         }
     }
 
-    /// The next whitespace-separated token; `None` at the end of the line
-    /// or at a trailing comment.
+    /// The line's next whitespace-separated token; `None` at the end of
+    /// the line or at a trailing comment.
     fn token(&mut self) -> Option<&'a [u8]> {
         self.skip_space();
         let start = self.pos;
-        if self.peek(0).is_none_or(|c| c == b'#') {
+        if self.peek(0).is_none_or(|c| c == b'#' || c == b'\n') {
             return None;
         }
         while self.peek(0).is_some_and(|c| !is_space(c)) {
             self.pos += 1;
         }
-        self.line.get(start..self.pos)
+        self.bytes.get(start..self.pos)
+    }
+
+    /// The line's next token as a number, read in the same pass as the
+    /// token where it is a plain decimal; `None` at the end of the line or
+    /// at a trailing comment, `Some(Err(token))` when it is no number.
+    fn number(&mut self) -> Option<Result<f64, &'a [u8]>> {
+        self.skip_space();
+        if let Some((v, end)) = scan_decimal(self.bytes, self.pos) {
+            if self.bytes.get(end).is_none_or(|&c| is_space(c)) {
+                self.pos = end;
+                return Some(Ok(v));
+            }
+        }
+        let token = self.token()?;
+        Some(parse_f64(token).ok_or(token))
+    }
+
+    /// To the start of the next line (or the end of the file).
+    fn next_line(&mut self) {
+        let rest = self.bytes.get(self.pos..).unwrap_or_default();
+        self.pos = match rest.iter().position(|&c| c == b'\n') {
+            Some(i) => self.pos + i + 1,
+            None => self.bytes.len(),
+        };
     }
 }
 
@@ -242,38 +312,51 @@ pub(super) fn parse_f64(token: &[u8]) -> Option<f64> {
 /// takes too). `None` for anything else (exponents, long mantissas, inf,
 /// nan), which `str::parse` reads.
 fn plain_decimal(token: &[u8]) -> Option<f64> {
+    match scan_decimal(token, 0) {
+        Some((v, end)) if end == token.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// The plain decimal (see [`plain_decimal`]) that starts at `bytes[i]`
+/// and the index where it stops: its value is the token's when the token
+/// ends there. `None` when what is there is no plain decimal, or not one
+/// within the fast path's bounds.
+#[inline]
+fn scan_decimal(bytes: &[u8], mut i: usize) -> Option<(f64, usize)> {
     const POW10: [f64; 23] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
         1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
     ];
-    let (negative, body) = match token {
-        [b'-', rest @ ..] => (true, rest),
-        [b'+', rest @ ..] => (false, rest),
-        _ => (false, token),
-    };
+    let negative = bytes.get(i) == Some(&b'-');
+    if negative || bytes.get(i) == Some(&b'+') {
+        i += 1;
+    }
     let (mut m, mut digits, mut fraction) = (0u64, 0usize, None::<usize>);
-    for &c in body {
-        match c {
-            b'0'..=b'9' => {
-                m = m * 10 + u64::from(c - b'0');
-                if m >= 1 << 53 {
-                    return None;
-                }
-                digits += 1;
-                if let Some(k) = fraction.as_mut() {
-                    *k += 1;
-                }
+    while let Some(&c) = bytes.get(i) {
+        let d = c.wrapping_sub(b'0');
+        if d <= 9 {
+            m = m * 10 + u64::from(d);
+            if m >= 1 << 53 {
+                return None;
             }
-            b'.' if fraction.is_none() => fraction = Some(0),
-            _ => return None,
+            digits += 1;
+            if let Some(k) = fraction.as_mut() {
+                *k += 1;
+            }
+        } else if c == b'.' && fraction.is_none() {
+            fraction = Some(0);
+        } else {
+            break;
         }
+        i += 1;
     }
     let k = fraction.unwrap_or(0);
     if digits == 0 || k >= POW10.len() {
         return None;
     }
     let v = m as f64 / POW10[k];
-    Some(if negative { -v } else { v })
+    Some((if negative { -v } else { v }, i))
 }
 
 /// A signed decimal integer, `None` on anything else or overflow.
@@ -286,13 +369,25 @@ pub(super) fn parse_i64(token: &[u8]) -> Option<i64> {
     if digits.is_empty() {
         return None;
     }
-    let mut value: i64 = 0;
-    for &d in digits {
-        if !d.is_ascii_digit() {
+    // Leading zeros aside, at most 19 digits, which a u64 holds: no
+    // checked_mul, which on wasm32 (no 128-bit multiply) was a library
+    // call per digit, a sixth of an OBJ's import.
+    let significant = match digits.iter().position(|&c| c != b'0') {
+        Some(i) => &digits[i..],
+        None => &[],
+    };
+    if significant.len() > 19 {
+        return None;
+    }
+    let mut value: u64 = 0;
+    for &c in significant {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
             return None;
         }
-        value = value.checked_mul(10)?.checked_add(i64::from(d - b'0'))?;
+        value = value * 10 + u64::from(d);
     }
+    let value = i64::try_from(value).ok()?;
     Some(if negative { -value } else { value })
 }
 
@@ -311,51 +406,88 @@ mod tests {
         parse_f64(token).map(|v| if v.is_nan() { 0 } else { v.to_bits() })
     }
 
+    /// Tokens at and around the edges of the decimal fast path.
+    const NUMBERS: [&str; 34] = [
+        "0",
+        "-0",
+        "+0",
+        "-0.0",
+        "1",
+        "1.",
+        ".5",
+        "-.5",
+        "0.1",
+        "0.3",
+        "-12.345678",
+        "9007199254740991",
+        "9007199254740992",
+        "123456789012.345",
+        "0.0000000000000000000001",
+        "0.00000000000000000000001",
+        "1e3",
+        "1E-3",
+        "-2.5e+10",
+        "inf",
+        "-inf",
+        "NaN",
+        "infinity",
+        ".",
+        "-",
+        "+",
+        "",
+        "1.2.3",
+        "1-2",
+        "0x10",
+        " 1",
+        "1 ",
+        "--1",
+        "١",
+    ];
+
     #[test]
     fn numbers_read_as_str_parse_reads_them() {
-        let fixed = [
-            "0",
-            "-0",
-            "+0",
-            "-0.0",
-            "1",
-            "1.",
-            ".5",
-            "-.5",
-            "0.1",
-            "0.3",
-            "-12.345678",
-            "9007199254740991",
-            "9007199254740992",
-            "123456789012.345",
-            "0.0000000000000000000001",
-            "0.00000000000000000000001",
-            "1e3",
-            "1E-3",
-            "-2.5e+10",
-            "inf",
-            "-inf",
-            "NaN",
-            "infinity",
-            ".",
-            "-",
-            "+",
-            "",
-            "1.2.3",
-            "1-2",
-            "0x10",
-            " 1",
-            "1 ",
-            "--1",
-            "١",
-        ];
-        for t in fixed {
+        for t in NUMBERS {
             assert_eq!(ours(t.as_bytes()), std_f64(t.as_bytes()), "{t:?}");
         }
         // The fast path takes the plain decimals (and only where it is exact).
         assert_eq!(plain_decimal(b"-12.345678"), Some(-12.345678));
         assert_eq!(plain_decimal(b"1e3"), None);
         assert_eq!(plain_decimal(b"9007199254740992"), None);
+    }
+
+    /// A vertex's coordinates, read in one pass with their tokens, are the
+    /// numbers parse_f64 reads from the tokens alone, whatever follows them
+    /// on the line.
+    #[test]
+    fn vertex_coordinates_read_as_their_tokens() {
+        for t in NUMBERS.iter().filter(|t| !t.is_empty() && !t.contains(' ')) {
+            for tail in ["\n", "\r\n", "", " 7\n", "#c\n", " #c", "\t\n"] {
+                let text = format!("v {t} 0 0{tail}");
+                let got = parse_str(&text);
+                let token = if tail.starts_with('#') {
+                    format!("{t}#c")
+                } else {
+                    t.to_string()
+                };
+                match parse_f64(token.as_bytes()) {
+                    Some(v) if v.is_finite() => {
+                        let x = got.unwrap_or_else(|e| panic!("{text:?}: {e}")).vertices[0].x;
+                        assert_eq!(x.to_bits(), v.to_bits(), "{text:?}");
+                    }
+                    Some(_) => assert!(
+                        matches!(got, Err(MeshError::NonFiniteVertex { .. })),
+                        "{text:?}"
+                    ),
+                    None => {
+                        let e = got
+                            .err()
+                            .unwrap_or_else(|| panic!("{text:?} read"))
+                            .to_string();
+                        assert!(e.contains("is not a number"), "{text:?}: {e}");
+                    }
+                }
+            }
+        }
     }
 
     proptest! {
@@ -451,5 +583,22 @@ mod tests {
         assert_eq!(parse_i64(b"+7"), Some(7));
         assert_eq!(parse_i64(b"-"), None);
         assert_eq!(parse_i64(b"1.5"), None);
+        // At and past the ends of i64 it reads what str::parse reads, and
+        // None where that overflows (i64::MIN's magnitude included).
+        for text in [
+            "9223372036854775807",
+            "9223372036854775808",
+            "9223372036854775810",
+            "922337203685477580",
+            "922337203685477581",
+            "-9223372036854775807",
+            "-9223372036854775808",
+            "99999999999999999999",
+            "0009223372036854775807",
+            "+0",
+        ] {
+            let want = text.parse::<i64>().ok().filter(|&v| v != i64::MIN);
+            assert_eq!(parse_i64(text.as_bytes()), want, "{text}");
+        }
     }
 }
