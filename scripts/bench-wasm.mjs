@@ -3,9 +3,11 @@
 // the workloads written by `cargo run --release --example workloads`:
 //   - Session from W1.ply's bytes (import, fiducial holes, registration,
 //     the surface's acceleration structure);
-//   - Session from W1.obj's bytes (MB/s of the file; the API imports only
-//     through a Session, so this includes the index: a lower bound on the OBJ
-//     importer's own speed);
+//   - Session from W1.obj's bytes (MB/s of the file, with the holes and
+//     the index);
+//   - W1.obj and W1.ply through the page's own steps (ScanBuffer.write,
+//     importScan, register, index), each timed: importScan is the importer
+//     alone, the stage the native `import/W1 OBJ text` bench times;
 //   - Session.plan of W2 and W3 on W1 (plan, report and G-code, converted to
 //     JS);
 //   - wasm memory (memory.buffer.byteLength) holding W1 ready to plan. Wasm
@@ -148,6 +150,44 @@ if (existsSync(w4Path)) {
   }
 }
 
+// 2c. The page's own steps (web/worker.js), each timed: the file written
+// into wasm memory in 8 MiB chunks with its SHA-256 (ScanBuffer.write), the
+// import alone (importScan), the holes, topology and registration
+// (register), the surface and its index (index).
+function staged(bytes, name) {
+  const chunk = 8 << 20;
+  let t0 = now();
+  const buf = new pcpp.ScanBuffer(name, bytes.length);
+  for (let at = 0; at < bytes.length; at += chunk) buf.write(bytes.subarray(at, at + chunk));
+  const read_ms = now() - t0;
+  t0 = now();
+  const imp = buf.importScan(w2.s.scan);
+  const import_ms = now() - t0;
+  t0 = now();
+  imp.register(w2.s.registration);
+  const register_ms = now() - t0;
+  t0 = now();
+  const s = imp.index();
+  const index_ms = now() - t0;
+  s.free();
+  return { read_ms, import_ms, register_ms, index_ms };
+}
+function stagedRuns(bytes, name, n) {
+  const all = [];
+  for (let k = 0; k < n; k++) {
+    const t = staged(bytes, name);
+    all.push(t);
+    log(`${name} in the page's steps: write + SHA-256 ${t.read_ms.toFixed(0)} ms, import ` +
+      `${t.import_ms.toFixed(0)} ms (${(bytes.length / 1e3 / t.import_ms).toFixed(1)} MB/s), ` +
+      `register ${t.register_ms.toFixed(0)} ms, index ${t.index_ms.toFixed(0)} ms`);
+  }
+  const med = (key) => median(all.map((t) => t[key]));
+  return { read_ms: med('read_ms'), import_ms: med('import_ms'), register_ms: med('register_ms'),
+    index_ms: med('index_ms'), runs: all };
+}
+const objStaged = stagedRuns(obj, 'W1.obj', runs.obj);
+const plyStaged = stagedRuns(ply, 'W1.ply', runs.obj);
+
 // 3. Plans on one W1 Session (accept risk: the timing must not depend on
 // whether some raster point could not be cleared).
 const scan = session(ply, 'W1.ply');
@@ -177,6 +217,9 @@ const result = {
   ply_session_first_s: plyMs[0] / 1e3,
   obj_session_s: median(objMs) / 1e3,
   obj_session_mb_s: obj.length / 1e6 / (median(objMs) / 1e3),
+  obj_import_mb_s: obj.length / 1e3 / objStaged.import_ms,
+  obj_staged: objStaged,
+  ply_staged: plyStaged,
   w4_session_s: w4Ms.length ? median(w4Ms) / 1e3 : null,
   w4_triangles: w4Triangles,
   w2_plan_ms: median(p2.ms),

@@ -94,7 +94,7 @@ impl ScanBuffer {
             )));
         }
         self.bytes.extend_from_slice(chunk);
-        self.sha256.update(chunk);
+        job::hash_in_pieces(&mut self.sha256, chunk);
         Ok(())
     }
 
@@ -120,12 +120,10 @@ impl ScanBuffer {
         let options: ImportOptions = from_js("scan settings", scan)?;
         let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
         let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize());
-        // One pass over the edges for the holes and the index.
-        let topology = Topology::of(&imported.mesh);
         Ok(ScanImport {
             file,
             imported,
-            topology,
+            topology: None,
             registered: None,
         })
     }
@@ -136,7 +134,7 @@ impl ScanBuffer {
     fn full(part: DemoPart) -> ScanBuffer {
         let bytes = demo::to_binary_ply(&part.mesh());
         let mut sha256 = Sha256::new();
-        sha256.update(&bytes);
+        job::hash_in_pieces(&mut sha256, &bytes);
         ScanBuffer {
             name: part.scan_name(),
             size: bytes.len(),
@@ -151,8 +149,10 @@ impl ScanBuffer {
 pub struct ScanImport {
     file: InputFile,
     imported: ImportedMesh,
-    /// Its boundary edges and owners, found once for every registration.
-    topology: Topology,
+    /// Its boundary edges and owners (one pass over the edges for the
+    /// holes and the index), found by the first [`ScanImport::register`]
+    /// and kept for every registration after it.
+    topology: Option<Topology>,
     /// The fiducial holes (scanner frame) and the registration found with
     /// them, once [`ScanImport::register`] succeeded.
     registered: Option<(Vec<Fiducial>, Registration, RegistrationMethod)>,
@@ -171,7 +171,8 @@ impl ScanImport {
     pub fn register(&mut self, registration: JsValue) -> Result<(), JsValue> {
         let settings: RegistrationSettings = from_js("registration settings", registration)?;
         let mesh = &self.imported.mesh;
-        let holes = find_fiducials_in(mesh, &self.topology, settings.dot_diameter_mm);
+        let topology = self.topology.get_or_insert_with(|| Topology::of(mesh));
+        let holes = find_fiducials_in(mesh, topology, settings.dot_diameter_mm);
         // Placement on the bed included, as job::prepare_scan does.
         let reg = job::registration_for_scan(mesh, &holes, &settings).map_err(core_err)?;
         self.registered = Some((holes, reg, settings.method));
@@ -181,14 +182,16 @@ impl ScanImport {
     /// Builds the registered surface and its spatial index: the [`Session`]
     /// that plans. Call [`ScanImport::register`] first.
     pub fn index(self) -> Result<Session, JsValue> {
-        let Some((fiducials, registration, method)) = self.registered else {
+        let (Some((fiducials, registration, method)), Some(topology)) =
+            (self.registered, self.topology)
+        else {
             return Err(JsError::new("the scan must be registered before it is indexed").into());
         };
         let scan_bbox = self.imported.mesh.bbox();
         let prepared = PreparedScan::assemble(
             self.file,
             self.imported,
-            self.topology,
+            topology,
             fiducials,
             registration,
             method,
