@@ -6,8 +6,6 @@
 //! prepared scan, the report and the checked write of the outputs belong
 //! together, as the one contract the two adapters share.
 
-use std::borrow::Cow;
-
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -427,32 +425,25 @@ pub fn prepare_scan(
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
-    prepare(Cow::Borrowed(bytes), name, scan, registration)
+    prepare_scan_owned(bytes, name, scan, registration)
 }
 
-/// [`prepare_scan`] of bytes it may free once they are read: the file's
-/// bytes are not held while the scan is indexed (the CLI's peak memory).
+/// [`prepare_scan`] of bytes it may free once they are read (a `Vec<u8>`,
+/// or the CLI's mapping of the file): the file's bytes are not held while
+/// the scan is indexed (the CLI's peak memory).
 pub fn prepare_scan_owned(
-    bytes: Vec<u8>,
-    name: &str,
-    scan: &ImportOptions,
-    registration: &RegistrationSettings,
-) -> Result<PreparedScan> {
-    prepare(Cow::Owned(bytes), name, scan, registration)
-}
-
-fn prepare(
-    bytes: Cow<'_, [u8]>,
+    bytes: impl AsRef<[u8]>,
     name: &str,
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
     registration.validate()?;
+    let read = bytes.as_ref();
     // The provenance hash off the critical path (issue 15): natively on a
     // second thread while the scan is read.
     let (imported, file) = crate::parallel::join(
-        || pipeline::load_scan(&bytes, name, scan),
-        || InputFile::new(name, &bytes),
+        || pipeline::load_scan(read, name, scan),
+        || InputFile::new(name, read),
     );
     drop(bytes);
     let imported = imported?;

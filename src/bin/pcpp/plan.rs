@@ -9,7 +9,7 @@ use pcpp::registration::{Registration, RegistrationMethod};
 use pcpp::Error;
 
 use crate::args::{CompareArgs, JobArgs, PlanArgs, ScanArgs};
-use crate::files::{file_name, in_file, read_bytes, to_json, write_one, Staged};
+use crate::files::{file_name, in_file, read_bytes, read_scan, to_json, write_one, Staged};
 use crate::progress::{thousands, Progress};
 use crate::settings::job_settings;
 use crate::{CliResult, Failure, VERSION};
@@ -43,7 +43,7 @@ pub fn load_scan(
 ) -> CliResult<PreparedScan> {
     let scan_path = &a.scan;
     progress.step(format!("reading scan {}...", scan_path.display()));
-    let scan = read_bytes(scan_path, "scan")?;
+    let scan = read_scan(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
     progress.step(format!("importing and indexing {scan_name}..."));
     let prepared =
