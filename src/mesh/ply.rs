@@ -365,33 +365,6 @@ impl Body<'_> {
         Ok(())
     }
 
-    /// Little-endian triangle records (count 3, three 32-bit indices of
-    /// type `item`) from the start of `bytes`, at most `count`: how many
-    /// were read. Stops at the first record that is not a triangle of
-    /// indices in range, which the record-by-record reader then reads (and
-    /// reports, if it is an error).
-    fn push_triangle_records(&mut self, bytes: &[u8], count: usize, item: Scalar) -> usize {
-        // Indices at or past this are out of range, or negative as i32.
-        let limit = match item {
-            Scalar::I32 => self.vertex_count.min(1 << 31),
-            _ => self.vertex_count.min(1 << 32),
-        };
-        let mut done = 0;
-        for rec in bytes.chunks_exact(13).take(count) {
-            let tri = [1, 5, 9].map(|at| {
-                let mut b = [0; 4];
-                b.copy_from_slice(&rec[at..at + 4]);
-                u32::from_le_bytes(b)
-            });
-            if rec[0] != 3 || tri.iter().any(|&v| u64::from(v) >= limit) {
-                break;
-            }
-            self.triangles.push(tri);
-            done += 1;
-        }
-        done
-    }
-
     /// Fan triangulation of a face polygon (scanner faces are convex).
     fn push_polygon(&mut self, polygon: &[u32]) {
         match polygon {
@@ -467,68 +440,123 @@ impl Body<'_> {
         body: &[u8],
         big_endian: bool,
     ) -> Result<(), MeshError> {
-        let file = self.file;
         let mut r = BinReader {
             bytes: body,
             pos: 0,
             big_endian,
         };
         let mut polygon = Vec::new();
-        for element in &header.elements {
-            let roles = roles(element, file)?;
-            if element.props.is_empty() {
-                continue;
-            }
-            let min_bytes: usize = element
-                .props
-                .iter()
-                .map(|p| match p.kind {
-                    Kind::Scalar(s) => s.size(),
-                    Kind::List { count, .. } => count.size(),
-                })
-                .sum();
-            let count = check_count(file, element, min_bytes, r.remaining(), "binary data")?;
-            match element.name.as_str() {
-                "vertex" => self.vertices.reserve_exact(count),
-                "face" => self.triangles.reserve(count),
-                _ => {}
-            }
-            let mut i = 0;
-            // The layouts scanners write, read in one pass: the same values
-            // and the same checks as record by record below, which takes
-            // over at the first record they do not fit (and reports any
-            // error there).
-            if let Some((stride, axes)) = fixed_vertex(element, &roles) {
-                let n = (r.remaining() / stride).min(count);
-                let records = &r.bytes[r.pos..r.pos + n * stride];
-                self.push_fixed_vertices(records, stride, axes, big_endian)?;
-                r.pos += n * stride;
-                i = n;
-            }
-            let triangles = triangle_list(element, &roles);
-            if let (Some(item), false) = (triangles, big_endian) {
-                let done = self.push_triangle_records(&r.bytes[r.pos..], count - i, item);
-                r.pos += 13 * done;
-                i += done;
-            }
-            while i < count {
-                if let Some(item) = triangles {
-                    // A triangle: its count 3 and three indices, all present.
-                    if r.remaining() >= 13 && r.bytes[r.pos] == 3 {
-                        r.pos += 1;
-                        let mut tri = [0u32; 3];
-                        for v in &mut tri {
-                            let value = r.int(item).unwrap_or(-1);
-                            *v = self.index(i, value, None)?;
-                        }
-                        self.triangles.push(tri);
-                        i += 1;
-                        continue;
-                    }
+        // Where the triangles' place in the body is known from the header
+        // (only fixed-size records before them), they are read on a second
+        // thread natively while the elements before them are (issue 15),
+        // with the same values and checks as in this thread.
+        let ahead = if big_endian {
+            None
+        } else {
+            triangles_ahead(header, body.len(), self.file)
+        };
+        let split = ahead.as_ref().map_or(header.elements.len(), |a| a.element);
+        let limit = ahead.as_ref().map_or(0, |a| self.index_limit(a.item));
+        let (head, mut early) = crate::parallel::join(
+            || -> Result<(), MeshError> {
+                for element in &header.elements[..split] {
+                    self.read_element(element, &mut r, &mut polygon, None)?;
                 }
-                self.read_record(element, &roles, &mut r, i, &mut polygon)?;
-                i += 1;
+                Ok(())
+            },
+            || ahead.map(|a| (a.start, triangle_records(&body[a.start..], a.count, limit))),
+        );
+        head?;
+        for element in &header.elements[split..] {
+            // Read ahead where this element starts, as it must after
+            // fixed-size records: else it is read here.
+            let pre = early.take().filter(|(start, _)| *start == r.pos);
+            self.read_element(element, &mut r, &mut polygon, pre.map(|(_, t)| t))?;
+        }
+        Ok(())
+    }
+
+    /// The largest index (exclusive) a triangle record of `item` may hold:
+    /// past it an index is out of range, or negative as i32.
+    fn index_limit(&self, item: Scalar) -> u64 {
+        match item {
+            Scalar::I32 => self.vertex_count.min(1 << 31),
+            _ => self.vertex_count.min(1 << 32),
+        }
+    }
+
+    /// One element's records from `r`. `early`: the triangle records read
+    /// ahead from the element's start ([`triangle_records`]).
+    fn read_element(
+        &mut self,
+        element: &Element,
+        r: &mut BinReader,
+        polygon: &mut Vec<u32>,
+        early: Option<Vec<[u32; 3]>>,
+    ) -> Result<(), MeshError> {
+        let file = self.file;
+        let roles = roles(element, file)?;
+        if element.props.is_empty() {
+            return Ok(());
+        }
+        let min_bytes: usize = element
+            .props
+            .iter()
+            .map(|p| match p.kind {
+                Kind::Scalar(s) => s.size(),
+                Kind::List { count, .. } => count.size(),
+            })
+            .sum();
+        let count = check_count(file, element, min_bytes, r.remaining(), "binary data")?;
+        match element.name.as_str() {
+            "vertex" => self.vertices.reserve_exact(count),
+            "face" if early.is_none() => self.triangles.reserve(count),
+            _ => {}
+        }
+        let mut i = 0;
+        // The layouts scanners write, read in one pass: the same values
+        // and the same checks as record by record below, which takes over
+        // at the first record they do not fit (and reports any error
+        // there).
+        if let Some((stride, axes)) = fixed_vertex(element, &roles) {
+            let n = (r.remaining() / stride).min(count);
+            let records = &r.bytes[r.pos..r.pos + n * stride];
+            self.push_fixed_vertices(records, stride, axes, r.big_endian)?;
+            r.pos += n * stride;
+            i = n;
+        }
+        let triangles = triangle_list(element, &roles);
+        if let (Some(item), false) = (triangles, r.big_endian) {
+            let read = match early {
+                Some(read) => read,
+                None => triangle_records(&r.bytes[r.pos..], count - i, self.index_limit(item)),
+            };
+            let done = read.len();
+            if self.triangles.is_empty() {
+                self.triangles = read;
+            } else {
+                self.triangles.extend_from_slice(&read);
             }
+            r.pos += 13 * done;
+            i += done;
+        }
+        while i < count {
+            if let Some(item) = triangles {
+                // A triangle: its count 3 and three indices, all present.
+                if r.remaining() >= 13 && r.bytes[r.pos] == 3 {
+                    r.pos += 1;
+                    let mut tri = [0u32; 3];
+                    for v in &mut tri {
+                        let value = r.int(item).unwrap_or(-1);
+                        *v = self.index(i, value, None)?;
+                    }
+                    self.triangles.push(tri);
+                    i += 1;
+                    continue;
+                }
+            }
+            self.read_record(element, &roles, r, i, polygon)?;
+            i += 1;
         }
         Ok(())
     }
@@ -722,6 +750,69 @@ fn triangle_list(element: &Element, roles: &[Role]) -> Option<Scalar> {
         ) => Some(*item),
         _ => None,
     }
+}
+
+/// Little-endian triangle records (count 3, three 32-bit indices below
+/// `limit`, see [`Body::index_limit`]) from the start of `bytes`, at most
+/// `count`. Stops at the first record that is not a triangle of indices in
+/// range, which the record-by-record reader then reads (and reports, if it
+/// is an error).
+fn triangle_records(bytes: &[u8], count: usize, limit: u64) -> Vec<[u32; 3]> {
+    let mut out = Vec::with_capacity(count.min(bytes.len() / 13));
+    for rec in bytes.chunks_exact(13).take(count) {
+        let tri = [1, 5, 9].map(|at| {
+            let mut b = [0; 4];
+            b.copy_from_slice(&rec[at..at + 4]);
+            u32::from_le_bytes(b)
+        });
+        if rec[0] != 3 || tri.iter().any(|&v| u64::from(v) >= limit) {
+            break;
+        }
+        out.push(tri);
+    }
+    out
+}
+
+/// Triangle records whose place in a binary body is known from the header.
+struct Ahead {
+    /// Which element they are.
+    element: usize,
+    /// Where the element starts in the body.
+    start: usize,
+    count: usize,
+    item: Scalar,
+}
+
+/// The first element of [`triangle_list`] records, when every element
+/// before it has fixed-size records that fit in the body's `len` bytes, so
+/// its start is known before they are read.
+fn triangles_ahead(header: &Header, len: usize, file: &str) -> Option<Ahead> {
+    let mut start = 0usize;
+    for (k, element) in header.elements.iter().enumerate() {
+        let roles = roles(element, file).ok()?;
+        if let Some(item) = triangle_list(element, &roles) {
+            let count = usize::try_from(element.count).ok()?;
+            return (start < len).then_some(Ahead {
+                element: k,
+                start,
+                count,
+                item,
+            });
+        }
+        let mut size = 0usize;
+        for p in &element.props {
+            let Kind::Scalar(s) = p.kind else {
+                return None;
+            };
+            size += s.size();
+        }
+        let count = usize::try_from(element.count).ok()?;
+        start = start.checked_add(size.checked_mul(count)?)?;
+        if start > len {
+            return None;
+        }
+    }
+    None
 }
 
 struct BinReader<'a> {
@@ -987,5 +1078,76 @@ mod tests {
                 "{cut}: {e}"
             );
         }
+    }
+
+    /// A little-endian file of two triangles with `extra` (an element's
+    /// header lines and its records' bytes) between the vertices and the
+    /// faces.
+    fn with_element_between(extra: Option<(&str, &[u8])>) -> Vec<u8> {
+        let (decl, records) = extra.unwrap_or(("", &[]));
+        let mut b = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 4\n\
+             property float x\nproperty float y\nproperty float z\n{decl}\
+             element face 2\nproperty list uchar uint vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        for v in [[0f32, 0., 0.], [1., 0., 0.], [1., 1., 0.5], [0., 1., 0.]] {
+            for c in v {
+                b.extend(c.to_le_bytes());
+            }
+        }
+        b.extend(records);
+        for t in [[0u32, 1, 2], [0, 2, 3]] {
+            b.push(3);
+            for i in t {
+                b.extend(i.to_le_bytes());
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn triangles_are_read_ahead_only_where_their_start_is_known() {
+        let ahead = |b: &[u8]| {
+            let h = parse_header(b, "a.ply").unwrap();
+            triangles_ahead(&h, b.len() - h.body_start, "a.ply").map(|a| (a.element, a.start))
+        };
+        // Faces right after the vertices: 4 records of 12 bytes.
+        let plain = with_element_between(None);
+        assert_eq!(ahead(&plain), Some((1, 48)));
+        // A fixed-size element between: its 2 records of 5 bytes too.
+        let fixed = with_element_between(Some((
+            "element camera 2\nproperty float k\nproperty uchar id\n",
+            &[0; 10],
+        )));
+        assert_eq!(ahead(&fixed), Some((2, 58)));
+        // A list before the faces: their start is known only once it is read.
+        let listed = with_element_between(Some((
+            "element range 1\nproperty list uchar int idx\n",
+            &[2, 0, 0, 0, 0, 1, 0, 0, 0],
+        )));
+        assert_eq!(ahead(&listed), None);
+        for (b, what) in [(&plain, "plain"), (&fixed, "fixed"), (&listed, "listed")] {
+            let p = parse(b, "a.ply").unwrap();
+            assert_eq!(p.vertices.len(), 4, "{what}");
+            assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]], "{what}");
+        }
+        // A header that declares more vertices than there are: the faces
+        // cannot start where it says, nothing is read ahead, and the
+        // vertices' count is refused as before.
+        let body = plain.len() - 48 - 26;
+        let header = String::from_utf8(plain[..body].to_vec()).unwrap();
+        let mut b = header.replace("vertex 4", "vertex 40").into_bytes();
+        b.extend_from_slice(&plain[body..]);
+        assert_eq!(ahead(&b), None);
+        let e = parse(&b, "a.ply").unwrap_err().to_string();
+        assert!(e.contains("declares") || e.contains("truncated"), "{e}");
+        // Read ahead, then refused by the vertices before them: the
+        // vertices' error is the one reported.
+        let mut nan = plain.clone();
+        nan[body + 12..body + 16].copy_from_slice(&f32::NAN.to_le_bytes());
+        assert_eq!(ahead(&nan), Some((1, 48)));
+        let e = parse(&nan, "a.ply").unwrap_err().to_string();
+        assert!(e.contains("vertex 1"), "{e}");
     }
 }
