@@ -6,16 +6,103 @@
 //! byte for byte; the only fix needed is `-0.000`, which some controllers
 //! reject and which would make golden files depend on rounding noise.
 
+use std::fmt::Write as _;
+
 use super::profile::CommentStyle;
 
 /// `value` with exactly `decimals` digits after the point, never `-0.000`.
 /// The caller has checked that `value` is finite.
 pub(crate) fn fixed(value: f64, decimals: u32) -> String {
+    let Some((negative, q)) = scaled(value, decimals) else {
+        return fixed_by_format(value, decimals);
+    };
+    let p = POW10[decimals as usize] as u64;
+    let mut text = String::with_capacity(24);
+    if negative && q != 0 {
+        text.push('-');
+    }
+    let (whole, part) = (q / p, q % p);
+    // (Writing to a String cannot fail.)
+    let _ = write!(text, "{whole}");
+    if decimals > 0 {
+        let _ = write!(text, ".{part:0width$}", width = decimals as usize);
+    }
+    text
+}
+
+/// [`fixed`] through `{:.N}`, for what [`scaled`] does not take.
+fn fixed_by_format(value: f64, decimals: u32) -> String {
     let text = format!("{:.*}", decimals as usize, value);
     match text.strip_prefix('-') {
         Some(magnitude) if magnitude.bytes().all(|b| b == b'0' || b == b'.') => magnitude.into(),
         _ => text,
     }
+}
+
+/// The value a controller reads from [`fixed`]'s text: the f64 nearest
+/// it, as parsing the text gives (issue 15: the writer reads back every
+/// coordinate it writes, and formatting and parsing each cost more than
+/// the rest of writing the move).
+pub(crate) fn read_back(value: f64, decimals: u32) -> f64 {
+    match scaled(value, decimals) {
+        // q < 2^53 and the power of ten are exact, and IEEE division
+        // rounds the exact quotient to the nearest f64, as parsing does.
+        Some((negative, q)) => {
+            let v = q as f64 / POW10[decimals as usize];
+            if negative && q != 0 {
+                -v
+            } else {
+                v
+            }
+        }
+        None => fixed(value, decimals).parse().unwrap_or(value),
+    }
+}
+
+/// 10^k, exact in f64.
+const POW10: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+
+/// `value` times 10^`decimals`, rounded to an integer as `{:.N}` rounds:
+/// the exact binary value, ties to even; as (sign, magnitude). `None`
+/// past 9 decimals, for non-finite values, and where the magnitude
+/// reaches 2^53 (it is then left to `{:.N}`).
+fn scaled(value: f64, decimals: u32) -> Option<(bool, u64)> {
+    if decimals as usize >= POW10.len() || !value.is_finite() {
+        return None;
+    }
+    let bits = value.to_bits();
+    let negative = bits >> 63 == 1;
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let frac = bits & ((1 << 52) - 1);
+    // |value| = m 2^e exactly.
+    let (m, e) = if exp == 0 {
+        (frac, -1074)
+    } else {
+        (frac | 1 << 52, exp - 1075)
+    };
+    // m 10^d < 2^53 2^30.
+    let n = u128::from(m) * 10u128.pow(decimals);
+    let q = if e >= 0 {
+        if e > 20 {
+            return None;
+        }
+        n << e
+    } else if e <= -100 {
+        // n < 2^83 lies below half of 2^-e: rounds to 0.
+        0
+    } else {
+        let s = (-e) as u32;
+        let (q, r, half) = (n >> s, n & ((1 << s) - 1), 1u128 << (s - 1));
+        if r > half || (r == half && q & 1 == 1) {
+            q + 1
+        } else {
+            q
+        }
+    };
+    u64::try_from(q)
+        .ok()
+        .filter(|&q| q < 1 << 53)
+        .map(|q| (negative, q))
 }
 
 /// Like [`fixed`] with trailing zeros dropped (`F300`, `F2.5`): feeds are
@@ -77,6 +164,46 @@ mod tests {
         CommentStyle {
             prefix: prefix.into(),
             suffix: suffix.into(),
+        }
+    }
+
+    /// A reproducible stream of bits (xorshift64*).
+    struct Bits(u64);
+    impl Bits {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+    }
+
+    #[test]
+    fn fixed_writes_and_reads_back_what_format_and_parse_give() {
+        let mut bits = Bits(0x9e37_79b9_7f4a_7c15);
+        let mut values = vec![
+            0.0, -0.0, 0.5, 1.5, 2.5, -2.5, 1e-320, -5e-324, 9.0e15, 1.0e16,
+        ];
+        // Exact ties at every decimal count: j / 2^k with small k.
+        for j in -300..300 {
+            for k in 0..12 {
+                values.push(j as f64 / (1u64 << k) as f64);
+            }
+        }
+        for _ in 0..200_000 {
+            let b = bits.next();
+            // Coordinates in mm, large values, tiny ones and any bits.
+            values.push((b >> 11) as f64 / (1u64 << 53) as f64 * 400.0 - 200.0);
+            values.push(f64::from_bits(b) % 1e13);
+            values.push(f64::from_bits(b >> 2));
+        }
+        for v in values.into_iter().filter(|v| v.is_finite()) {
+            for d in [0, 1, 3, 4, 6, 9, 12] {
+                let want = fixed_by_format(v, d);
+                assert_eq!(fixed(v, d), want, "{v:e} at {d} decimals");
+                let back: f64 = want.parse().unwrap();
+                assert_eq!(read_back(v, d).to_bits(), back.to_bits(), "{v:e} at {d}");
+            }
         }
     }
 

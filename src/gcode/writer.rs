@@ -234,7 +234,7 @@ impl<'p> Program<'p> {
 
     /// A coordinate as the controller reads it.
     fn read_back(&self, v: f64) -> f64 {
-        fixed(v, self.decimals).parse().unwrap_or(v)
+        super::format::read_back(v, self.decimals)
     }
 
     /// Records the move the last written line commands, to `to` (rounded
