@@ -13,16 +13,22 @@ use crate::job::JobSettings;
 use crate::mesh::TriMesh;
 use crate::svg::Placement;
 
-/// A small deterministic generator (xorshift64*), so workloads are the same
-/// on every machine without a dependency.
-struct Rng(u64);
+/// A small deterministic generator (xorshift64*), so workloads (and the
+/// tests' random inputs) are the same on every machine without a
+/// dependency. The seed must not be 0.
+pub(crate) struct Rng(pub u64);
 
 impl Rng {
-    fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    /// Uniform in [0, 1).
+    pub(crate) fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 

@@ -167,20 +167,9 @@ mod tests {
         }
     }
 
-    /// A reproducible stream of bits (xorshift64*).
-    struct Bits(u64);
-    impl Bits {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-        }
-    }
-
     #[test]
     fn fixed_writes_and_reads_back_what_format_and_parse_give() {
-        let mut bits = Bits(0x9e37_79b9_7f4a_7c15);
+        let mut bits = crate::demo::workloads::Rng(0x9e37_79b9_7f4a_7c15);
         let mut values = vec![
             0.0, -0.0, 0.5, 1.5, 2.5, -2.5, 1e-320, -5e-324, 9.0e15, 1.0e16,
         ];
@@ -190,8 +179,8 @@ mod tests {
                 values.push(j as f64 / (1u64 << k) as f64);
             }
         }
-        for _ in 0..200_000 {
-            let b = bits.next();
+        for _ in 0..60_000 {
+            let b = bits.next_u64();
             // Coordinates in mm, large values, tiny ones and any bits.
             values.push((b >> 11) as f64 / (1u64 << 53) as f64 * 400.0 - 200.0);
             values.push(f64::from_bits(b) % 1e13);
