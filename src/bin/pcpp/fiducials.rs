@@ -7,7 +7,7 @@ use pcpp::fiducials::find_fiducials_sized;
 use pcpp::registration::register;
 
 use crate::args::{FiducialsArgs, RegisterArgs};
-use crate::files::{file_name, in_file, read_bytes, to_json};
+use crate::files::{file_name, in_file, read_scan, to_json};
 use crate::progress::{thousands, Progress};
 use crate::settings::import_options;
 use crate::{CliResult, Failure};
@@ -16,10 +16,10 @@ pub fn cmd_fiducials(a: &FiducialsArgs, progress: &Progress) -> CliResult<()> {
     let options = import_options(&a.scan);
     let path = &a.scan.scan;
     progress.step(format!("reading scan {}...", path.display()));
-    let bytes = read_bytes(path, "scan")?;
+    let bytes = read_scan(path, "scan")?;
     let name = file_name(path);
     progress.step(format!("importing {name}..."));
-    let imported = pcpp::pipeline::load_scan(&bytes, &name, &options)
+    let imported = pcpp::pipeline::load_scan(bytes.as_ref(), &name, &options)
         .map_err(|e| Failure::Input(in_file(path, &name, &e.to_string())))?;
     if let Some(cloud) = &imported.cloud {
         progress.note(&cloud.to_string());

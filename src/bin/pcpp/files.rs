@@ -41,16 +41,19 @@ impl AsRef<[u8]> for ScanBytes {
     }
 }
 
-/// Maps `path` where it can, else reads it ([`ScanBytes`]).
+/// Maps `path` where it can, else reads it ([`ScanBytes`]): the file is
+/// opened once either way.
 pub fn read_scan(path: &Path, what: &str) -> CliResult<ScanBytes> {
+    use std::io::Read as _;
+    let mut file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
     #[cfg(target_os = "linux")]
-    {
-        let file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
-        if let Some(m) = mapped::Mapped::of(&file) {
-            return Ok(ScanBytes::Mapped(m));
-        }
+    if let Some(m) = mapped::Mapped::of(&file) {
+        return Ok(ScanBytes::Mapped(m));
     }
-    read_bytes(path, what).map(ScanBytes::Read)
+    let mut bytes = Vec::new();
+    file.read_to_end(&mut bytes)
+        .map_err(|e| cannot_read(path, what, e))?;
+    Ok(ScanBytes::Read(bytes))
 }
 
 #[cfg(target_os = "linux")]
