@@ -37,7 +37,13 @@ pub struct Topology {
 /// Whether a triangle's indices are in range for `n` vertices and distinct:
 /// the fiducials count only such triangles' edges.
 pub(crate) fn valid_triangle(t: &[u32; 3], n: usize) -> bool {
-    t.iter().all(|&i| (i as usize) < n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+    in_range(t, n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+}
+
+/// Whether a triangle's indices are all below `n`: only such triangles own
+/// or bound anything.
+fn in_range(t: &[u32; 3], n: usize) -> bool {
+    t.iter().all(|&i| (i as usize) < n)
 }
 
 impl Topology {
@@ -52,12 +58,11 @@ impl Topology {
             tris.len() <= MAX_TOPOLOGY_TRIANGLES,
             "Topology::of takes at most {MAX_TOPOLOGY_TRIANGLES} triangles"
         );
-        let in_range = |t: &[u32; 3]| t.iter().all(|&i| (i as usize) < n);
         let mut owned = vec![0u8; tris.len()];
 
         // A vertex's owner: the first triangle to hold it.
         let mut seen = vec![0u64; n.div_ceil(64)];
-        for (t, tri) in tris.iter().enumerate().filter(|(_, t)| in_range(t)) {
+        for (t, tri) in tris.iter().enumerate().filter(|(_, t)| in_range(t, n)) {
             for (k, &v) in tri.iter().enumerate() {
                 let (word, bit) = (v as usize / 64, 1u64 << (v % 64));
                 if seen[word] & bit == 0 {
@@ -104,10 +109,9 @@ impl Topology {
 /// end, in a plain loop ([`Buckets::group`]): the scan's largest grouping,
 /// 6 M edges for 2 M triangles.
 fn edges_by_lower(n: usize, tris: &[[u32; 3]]) -> Buckets {
-    let in_range = |t: &[u32; 3]| t.iter().all(|&i| (i as usize) < n);
     Buckets::group(n, |emit| {
         for (e, t) in (0u32..).step_by(3).zip(tris) {
-            if in_range(t) {
+            if in_range(t, n) {
                 emit(t[0].min(t[1]), e);
                 emit(t[1].min(t[2]), e + 1);
                 emit(t[2].min(t[0]), e + 2);
