@@ -464,7 +464,14 @@ impl Body<'_> {
                 }
                 Ok(())
             },
-            || ahead.map(|a| (a.start, triangle_records(&body[a.start..], a.count, limit))),
+            || {
+                ahead.map(|a| {
+                    let bytes = &body[a.start..];
+                    let mut read = Vec::with_capacity(a.count.min(bytes.len() / 13));
+                    triangle_records(bytes, a.count, limit, &mut read);
+                    (a.start, read)
+                })
+            },
         );
         head?;
         for element in &header.elements[split..] {
@@ -527,16 +534,17 @@ impl Body<'_> {
         }
         let triangles = triangle_list(element, &roles);
         if let (Some(item), false) = (triangles, r.big_endian) {
-            let read = match early {
-                Some(read) => read,
-                None => triangle_records(&r.bytes[r.pos..], count - i, self.index_limit(item)),
-            };
-            let done = read.len();
-            if self.triangles.is_empty() {
-                self.triangles = read;
-            } else {
-                self.triangles.extend_from_slice(&read);
+            let before = self.triangles.len();
+            match early {
+                // Only fixed-size records came before: no triangle yet.
+                Some(read) if before == 0 => self.triangles = read,
+                Some(read) => self.triangles.extend_from_slice(&read),
+                None => {
+                    let limit = self.index_limit(item);
+                    triangle_records(&r.bytes[r.pos..], count - i, limit, &mut self.triangles);
+                }
             }
+            let done = self.triangles.len() - before;
             r.pos += 13 * done;
             i += done;
         }
@@ -754,11 +762,10 @@ fn triangle_list(element: &Element, roles: &[Role]) -> Option<Scalar> {
 
 /// Little-endian triangle records (count 3, three 32-bit indices below
 /// `limit`, see [`Body::index_limit`]) from the start of `bytes`, at most
-/// `count`. Stops at the first record that is not a triangle of indices in
-/// range, which the record-by-record reader then reads (and reports, if it
-/// is an error).
-fn triangle_records(bytes: &[u8], count: usize, limit: u64) -> Vec<[u32; 3]> {
-    let mut out = Vec::with_capacity(count.min(bytes.len() / 13));
+/// `count`, pushed onto `out`. Stops at the first record that is not a
+/// triangle of indices in range, which the record-by-record reader then
+/// reads (and reports, if it is an error).
+fn triangle_records(bytes: &[u8], count: usize, limit: u64, out: &mut Vec<[u32; 3]>) {
     for rec in bytes.chunks_exact(13).take(count) {
         let tri = [1, 5, 9].map(|at| {
             let mut b = [0; 4];
@@ -770,7 +777,6 @@ fn triangle_records(bytes: &[u8], count: usize, limit: u64) -> Vec<[u32; 3]> {
         }
         out.push(tri);
     }
-    out
 }
 
 /// Triangle records whose place in a binary body is known from the header.
