@@ -55,7 +55,7 @@ pub(crate) fn read_back(value: f64, decimals: u32) -> f64 {
                 v
             }
         }
-        None => fixed(value, decimals).parse().unwrap_or(value),
+        None => fixed_by_format(value, decimals).parse().unwrap_or(value),
     }
 }
 
