@@ -42,7 +42,7 @@ pub(super) struct QueryBox {
 }
 
 /// An f32 box rounded outward: lo xyz, hi xyz.
-type Box32 = [f32; 6];
+pub(super) type Box32 = [f32; 6];
 
 impl QueryBox {
     #[inline]
@@ -133,8 +133,17 @@ impl Index {
     /// more), each once.
     #[inline]
     pub fn visit(&self, q: &QueryBox, f: impl FnMut(usize)) {
+        self.visit_pruned(q, |_| true, f)
+    }
+
+    /// [`Self::visit`], leaving out the triangles of the grid's cells
+    /// whose box (lo x, lo y, lo z, hi x, hi y, hi z; holding every
+    /// triangle of the cell) `keep` refuses. The triangles still come in
+    /// the index's order.
+    #[inline]
+    pub fn visit_pruned(&self, q: &QueryBox, keep: impl Fn(&Box32) -> bool, f: impl FnMut(usize)) {
         match self {
-            Index::Grid(g) => g.visit(q, f),
+            Index::Grid(g) => g.visit(q, keep, f),
             Index::Bvh(b) => b.visit(q, f),
         }
     }
@@ -355,7 +364,7 @@ impl Grid {
     }
 
     #[inline]
-    fn visit(&self, q: &QueryBox, mut f: impl FnMut(usize)) {
+    fn visit(&self, q: &QueryBox, keep: impl Fn(&Box32) -> bool, mut f: impl FnMut(usize)) {
         for (i, b) in &self.big {
             if q.hits(b) {
                 f(*i as usize);
@@ -394,14 +403,20 @@ impl Grid {
                 let cx0 = x0.max(bx * BLOCK);
                 let cx1 = x1.min(bx * BLOCK + BLOCK - 1);
                 for c in row + cx0..=row + cx1 {
-                    self.visit_cell(c, q, &mut f);
+                    self.visit_cell(c, q, &keep, &mut f);
                 }
             }
         }
     }
 
     #[inline]
-    fn visit_cell(&self, c: usize, q: &QueryBox, f: &mut impl FnMut(usize)) {
+    fn visit_cell(
+        &self,
+        c: usize,
+        q: &QueryBox,
+        keep: &impl Fn(&Box32) -> bool,
+        f: &mut impl FnMut(usize),
+    ) {
         let [zlo, zhi] = self.zs[c];
         if (zlo as f64) > q.hi.z || (zhi as f64) < q.lo.z {
             return;
@@ -412,6 +427,9 @@ impl Grid {
             || (ylo as f64) > q.hi.y
             || (yhi as f64) < q.lo.y
         {
+            return;
+        }
+        if !keep(&[xlo, ylo, zlo, xhi, yhi, zhi]) {
             return;
         }
         let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);

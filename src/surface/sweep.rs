@@ -55,7 +55,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::index::QueryBox;
+use super::index::{Box32, QueryBox};
 use super::{meets, Surface};
 
 /// The clearance of a move (see the module comment).
@@ -102,16 +102,52 @@ impl Surface {
         tol: f64,
         limit: f64,
     ) -> Option<SweepGap> {
+        self.nozzle_gap_until(a, b, radius, tol, limit, &|_| false)
+    }
+
+    /// [`Self::nozzle_gap`] for a caller that needs the clearance only
+    /// while `enough` does not hold for it: the query stops at the first
+    /// clearance it finds below `limit` for which `enough` holds, and
+    /// returns that one, which may be larger than the smallest (the
+    /// triangles not yet tried could lower it). `enough` must be monotone:
+    /// true for a clearance, true for every smaller one; then `enough`
+    /// holds for the smallest clearance exactly when it holds for the one
+    /// returned, and where it does not hold, the one returned is the
+    /// smallest, to the last bit and the reported place.
+    ///
+    /// For the questions the planners ask many times over about points
+    /// that touch: whether a point clears at all (`|_| true`: the first
+    /// contact found answers it) and whether a rise is more than some
+    /// amount.
+    pub fn nozzle_gap_until(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        radius: f64,
+        tol: f64,
+        limit: f64,
+        enough: &dyn Fn(f64) -> bool,
+    ) -> Option<SweepGap> {
         let sweep = Sweep::new(a, b, radius, tol, limit);
         let q = &sweep.q;
         let mut best = sweep.start();
+        // Set once `enough` holds for the best clearance found: nothing
+        // more is tried.
+        let mut done = false;
         QUEUE.with_borrow_mut(|queue| {
             queue.clear();
             // How many triangles the index has handed over: the next one's
             // rank, its place in the index's order, which breaks exact ties
             // (see `Best`).
             let mut handed = 0u32;
-            self.index.visit(q, |i| {
+            // A cell all of whose triangles are bounded above the value a
+            // finding must beat is left out whole.
+            let start = best.gap;
+            let keep = |b: &Box32| sweep.box_bound(b).is_some_and(|low| low <= start);
+            self.index.visit_pruned(q, keep, |i| {
+                if done {
+                    return;
+                }
                 let rank = handed;
                 handed += 1;
                 let t = self.mesh.triangle(i);
@@ -125,29 +161,45 @@ impl Surface {
                     return;
                 }
                 if queue.len() == QUEUE_LEN {
-                    self.drain(&sweep, queue, &mut best);
+                    done = self.drain(&sweep, queue, &mut best, enough);
                 }
                 queue.push((low, i as u32, rank));
             });
-            self.drain(&sweep, queue, &mut best);
+            if !done {
+                self.drain(&sweep, queue, &mut best, enough);
+            }
         });
         sweep.finish(best)
     }
 
     /// Tries the queued triangles lowest bound first: those set a small
     /// best value early, and once a triangle's bound cannot beat or tie it,
-    /// neither can any after it.
-    fn drain(&self, sweep: &Sweep, queue: &mut Vec<(f64, u32, u32)>, best: &mut Best) {
+    /// neither can any after it. True when it stopped because `enough`
+    /// holds for the best clearance found.
+    fn drain(
+        &self,
+        sweep: &Sweep,
+        queue: &mut Vec<(f64, u32, u32)>,
+        best: &mut Best,
+        enough: &dyn Fn(f64) -> bool,
+    ) -> bool {
         queue.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+        let mut done = false;
         for &(low, i, rank) in queue.iter() {
             if low > best.gap {
                 break;
             }
             let i = i as usize;
             best.trying = rank;
+            let before = best.gap;
             sweep.visit(self.mesh.triangle(i), self.owned[i], best);
+            if best.gap < before && enough(best.gap + sweep.m.tol) {
+                done = true;
+                break;
+            }
         }
         queue.clear();
+        done
     }
 
     /// The smallest gap along the move between the tip and the highest
@@ -210,11 +262,20 @@ struct Sweep {
     limit: f64,
     /// What [`Sweep::bound`] gives up of a distance for rounding.
     hair: f64,
+    /// 1 / |d|^2 and 1 / |d| of the move in XY (0 for a move that does
+    /// not move in XY).
+    inv_dd: f64,
+    inv_len: f64,
 }
+
+/// What [`Sweep::within_reach`] widens its interval by on each side at
+/// least.
+const REACH_HAIR: f64 = 1e-9;
 
 impl Sweep {
     fn new(a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> Sweep {
         let (lo, hi) = move_box(a, b, radius + tol, limit);
+        let dd = (b - a).truncate().length_squared();
         Sweep {
             q: QueryBox { lo, hi },
             m: Move {
@@ -228,6 +289,8 @@ impl Sweep {
             low_tip: a.z.min(b.z),
             limit,
             hair: 1e-8 * (1.0 + (b - a).truncate().length() + radius + tol),
+            inv_dd: if dd > 1e-30 { 1.0 / dd } else { 0.0 },
+            inv_len: if dd > 1e-30 { 1.0 / dd.sqrt() } else { 0.0 },
         }
     }
 
@@ -268,7 +331,13 @@ impl Sweep {
         let d = d - self.hair - 1e-8 * half;
         let steps = &self.steps.0[..self.steps.1];
         let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
-        let by_box = self.low_tip - hi.z - h;
+        // The part of the move where the triangle can be within the
+        // widest step's reach (its box's circle, of radius `half` around
+        // `c`, meets that step's disk around p(s)); the tip's lowest
+        // height there.
+        let (s0, s1) = self.within_reach(c, half, steps[steps.len() - 1].0);
+        let low = self.m.a.z + if self.m.dz >= 0.0 { s0 } else { s1 } * self.m.dz;
+        let by_box = low - hi.z - h;
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         // The plane is not needed when the box bound alone is enough, and
         // steep planes give nothing better than the box.
@@ -283,6 +352,8 @@ impl Sweep {
         let off = a - t[0].truncate();
         let v0 = self.m.a.z - t[0].z - g.dot(off) - rise;
         let v1 = v0 + self.m.dz - g.dot(self.m.d);
+        // Linear in s: least at an end of the part within reach.
+        let (v0, v1) = (v0 + s0 * (v1 - v0), v0 + s1 * (v1 - v0));
         let hair = 1e-9
             * (1.0
                 + self.m.a.z.abs()
@@ -290,6 +361,67 @@ impl Sweep {
                 + self.m.dz.abs()
                 + gl * (steps[steps.len() - 1].0 + off.length() + self.m.d.length()));
         Some(by_box.max(v0.min(v1) - hair))
+    }
+
+    /// A lower bound of every candidate value of every surface point in
+    /// the box `b` (of a cell of the index: lo xyz, hi xyz), from the box
+    /// alone as in [`Self::bound`], or `None` when no point of it comes
+    /// within the rim's reach of the move.
+    #[inline]
+    fn box_bound(&self, b: &Box32) -> Option<f64> {
+        let lo = DVec2::new(b[0] as f64, b[1] as f64);
+        let hi = DVec2::new(b[3] as f64, b[4] as f64);
+        let c = 0.5 * (lo + hi);
+        let half = 0.5 * (hi - lo).length();
+        let a = self.m.a.truncate();
+        let d = point_segment_dist2(c, a, a + self.m.d).sqrt() - half;
+        let d = d - self.hair - 1e-8 * half;
+        let steps = &self.steps.0[..self.steps.1];
+        let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
+        let (s0, s1) = self.within_reach(c, half, steps[steps.len() - 1].0);
+        let low = self.m.a.z + if self.m.dz >= 0.0 { s0 } else { s1 } * self.m.dz;
+        Some(low - b[5] as f64 - h - self.hair)
+    }
+
+    /// The fractions s of the move at which a circle of radius `half`
+    /// around `c` can come within `radius` of the tip's axis: an interval
+    /// that holds all of them (widened past every rounding, so it may hold
+    /// a little more), [0, 1] for a move too short in XY to tell.
+    ///
+    /// Found from the circle's closest approach to the move's line, at
+    /// fraction `along`, and its distance `e` from it there: within reach
+    /// for |s - along| |d| <= sqrt((radius + half)^2 - e^2). The reach
+    /// gets the margin of the distance test in [`Self::bound`] (more than
+    /// the exact tests' slack lets in) and more than the rounding of `e`,
+    /// so the square root is never taken of less than the true room (near
+    /// a tangency a small error in `e` would move the ends far); the ends
+    /// get a slack larger than the rounding of `along` and of the root,
+    /// which grows as the move shortens. An interval too wide only weakens
+    /// the bound.
+    #[inline]
+    fn within_reach(&self, c: DVec2, half: f64, radius: f64) -> (f64, f64) {
+        if self.inv_dd == 0.0 {
+            return (0.0, 1.0);
+        }
+        let w = c - self.m.a.truncate();
+        let along = w.dot(self.m.d) * self.inv_dd;
+        let e2 = (w - self.m.d * along).length_squared();
+        let wl = w.x.abs() + w.y.abs();
+        // As far as the distance test in `bound` reaches (which holds the
+        // exact tests' slack), and past the rounding of `e`.
+        let r = radius + half + self.hair + 1e-8 * half + 1e-12 * (1.0 + wl);
+        let room = r * r - e2;
+        if room.is_nan() || room < 0.0 {
+            return (0.0, 1.0);
+        }
+        let spread = room.sqrt() * self.inv_len;
+        let slack = REACH_HAIR + 1e-12 * (wl + r) * self.inv_len;
+        let s0 = (along - spread - slack).max(0.0);
+        let s1 = (along + spread + slack).min(1.0);
+        if s0 > s1 {
+            return (0.0, 1.0);
+        }
+        (s0, s1)
     }
 
     #[inline]
@@ -855,6 +987,107 @@ mod tests {
         }
     }
 
+    #[test]
+    fn a_corner_the_exact_tests_reach_by_their_slack_is_not_bounded_away() {
+        // A descent almost straight down (1e-7 mm in XY over 5 mm) away
+        // from a tiny triangle's corner about the widest step's reach
+        // behind its start: the corner test's slack takes the corner in
+        // for the first thousandths of the move, the tip lowest at their
+        // end. Ground set to clear by a hair more than that corner: the
+        // bound of the corner's triangle must not be taken from a part of
+        // the move that stops short of that end (a hundredth of a mm
+        // higher), or the ground would win.
+        let (r, tol) = (0.45, 0.1);
+        let reach = r + tol;
+        let (a, b) = (DVec3::new(0.0, 0.0, 5.0), DVec3::new(1e-7, 0.0, 0.0));
+        let surface = |v: DVec3, ground: Option<f64>| {
+            let mut m = TriMesh {
+                vertices: vec![
+                    v,
+                    v + DVec3::new(1e-12, 1e-12, 0.0),
+                    v + DVec3::new(0.0, 2e-12, 0.0),
+                ],
+                triangles: vec![[0, 1, 2]],
+            };
+            if let Some(z) = ground {
+                m.vertices.extend([
+                    DVec3::new(-20.0, -20.0, z),
+                    DVec3::new(20.0, -20.0, z),
+                    DVec3::new(0.0, 20.0, z),
+                ]);
+                m.triangles.push([3, 4, 5]);
+            }
+            Surface::new(m).unwrap()
+        };
+        let mut tested = 0;
+        for k in -20..20 {
+            let v = DVec3::new(-reach * (1.0 + 1e-12 * k as f64), 0.0, -0.2);
+            let Some(alone) = surface(v, None).nozzle_gap(a, b, r, tol, f64::INFINITY) else {
+                continue;
+            };
+            tested += 1;
+            let s = surface(v, Some(-(alone.gap_mm + 5e-6)));
+            let got = s.nozzle_gap(a, b, r, tol, f64::INFINITY);
+            assert_eq!(got, in_index_order(&s, a, b, r, tol, f64::INFINITY), "{k}");
+            assert_eq!(got, Some(alone), "{k}");
+        }
+        assert!(tested > 10, "{tested}");
+    }
+
+    #[test]
+    fn a_query_stops_where_the_answer_is_known() {
+        let bumpy = grid(40, 8.0, |x, y| {
+            (x * 1.7).sin() * 0.4 + (y * 2.3).cos() * 0.3
+        });
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut unit = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut stopped, mut found) = (0, 0);
+        for surf in [Surface::new(bumpy).unwrap(), step_block()] {
+            let (lo, hi) = surf.bbox();
+            for k in 0..400 {
+                let mut at = || {
+                    DVec3::new(
+                        lo.x + (hi.x - lo.x) * unit(),
+                        lo.y + (hi.y - lo.y) * unit(),
+                        hi.z + 0.3 - 2.5 * unit(),
+                    )
+                };
+                let a = at();
+                let b = if k % 2 == 0 { a } else { a + (at() - a) * 0.2 };
+                for limit in [f64::INFINITY, 0.1] {
+                    let full = surf.nozzle_gap(a, b, 0.45, 0.1, limit);
+                    // Whether there is any clearance below the limit.
+                    let any = surf.nozzle_gap_until(a, b, 0.45, 0.1, limit, &|_| true);
+                    assert_eq!(any.is_some(), full.is_some(), "{a} -> {b}");
+                    let Some(f) = full else { continue };
+                    found += 1;
+                    let x = any.unwrap();
+                    assert!(x.gap_mm >= f.gap_mm, "{a} -> {b}: {x:?} below {f:?}");
+                    stopped += usize::from(x.gap_mm > f.gap_mm);
+                    // Whether it is below a threshold: the smallest
+                    // whenever it is not.
+                    for thr in [f.gap_mm - 0.05, f.gap_mm, f.gap_mm + 1e-12, f.gap_mm + 0.05] {
+                        let got = surf.nozzle_gap_until(a, b, 0.45, 0.1, limit, &|g| g < thr);
+                        let g = got.unwrap();
+                        if f.gap_mm < thr {
+                            assert!(g.gap_mm < thr && g.gap_mm >= f.gap_mm, "{a} -> {b}");
+                        } else {
+                            assert_eq!(got, full, "{a} -> {b}, threshold {thr}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(found > 300, "{found}");
+        // Stopping at the first clearance found does happen.
+        assert!(stopped > found / 10, "{stopped} of {found}");
+    }
+
     /// The query as it was before the bounds and the order: every
     /// triangle the index hands over whose box meets the query box, tried
     /// in the index's order with nothing skipped.
@@ -912,12 +1145,17 @@ mod tests {
                     )
                 };
                 let a = at(2.5);
-                let b = match k % 4 {
+                let b = match k % 6 {
                     0 => a,
                     // Level moves: ties along the whole move on a flat top.
                     1 => DVec3::new(a.x + 0.7, a.y - 0.2, a.z),
                     2 => a + (at(2.5) - a) * 0.15,
-                    _ => a + (at(2.5) - a) * 0.6,
+                    3 => a + (at(2.5) - a) * 0.6,
+                    // Descents and rises almost straight down or up: the
+                    // part of the move within a triangle's reach is
+                    // ill-conditioned, and the height changes fast in it.
+                    4 => a + DVec3::new(1e-9 * unit(), 1e-9, -2.0 * unit()),
+                    _ => a + DVec3::new(3e-6, -2e-6 * unit(), 2.0 * unit() - 1.0),
                 };
                 for (tol, limit) in [
                     (0.0, f64::INFINITY),
