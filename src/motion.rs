@@ -72,22 +72,49 @@ impl Clearance {
         surface.nozzle_gap(a, b, self.radius_mm, self.tol_mm, limit)
     }
 
-    /// Whether the straight move `a` -> `b` stays clear.
+    /// Whether the straight move `a` -> `b` stays clear (the first
+    /// contact found answers it: no smallest clearance is sought).
     pub fn is_clear(&self, surface: &Surface, a: DVec3, b: DVec3) -> bool {
-        self.touching(surface, a, b).is_none()
+        self.touching_until(surface, a, b, |_| true).is_none()
     }
 
     /// The gap of the move `a` -> `b` if it is below tol.
     pub fn touching(&self, surface: &Surface, a: DVec3, b: DVec3) -> Option<SweepGap> {
-        self.gap(surface, a, b, self.tol_mm - TIE_MM)
+        self.touching_until(surface, a, b, |_| false)
+    }
+
+    /// [`Self::touching`], stopping at a gap for which `enough` holds (see
+    /// [`Surface::nozzle_gap_until`]: `enough` must hold for every gap
+    /// below one it holds for).
+    fn touching_until(
+        &self,
+        surface: &Surface,
+        a: DVec3,
+        b: DVec3,
+        enough: impl Fn(f64) -> bool,
+    ) -> Option<SweepGap> {
+        let limit = self.tol_mm - TIE_MM;
+        surface.nozzle_gap_until(a, b, self.radius_mm, self.tol_mm, limit, &enough)
     }
 
     /// How far the tip at `p` must rise to keep tol from the surface (0
     /// when it does), with a hair more so that the raised point's own
     /// moves never fail on an exact tie with rounding.
     pub fn rise_needed(&self, surface: &Surface, p: DVec3) -> f64 {
-        match self.touching(surface, p, p) {
-            Some(g) => self.tol_mm - g.gap_mm + 1e-6,
+        self.rise_until(surface, p, |_| false)
+    }
+
+    /// [`Self::rise_needed`] for a caller that needs it only while
+    /// `enough` does not hold for it: where `enough` holds for the rise
+    /// needed, the value returned may be smaller, but `enough` holds for it
+    /// too (and it is positive); otherwise it is the rise needed. `enough`
+    /// must be monotone: true for a rise, true for every larger one.
+    pub fn rise_until(&self, surface: &Surface, p: DVec3, enough: impl Fn(f64) -> bool) -> f64 {
+        // The rise of a gap falls as the gap grows, so a gap below one
+        // whose rise is enough has a rise that is enough too.
+        let rise = |gap: f64| self.tol_mm - gap + 1e-6;
+        match self.touching_until(surface, p, p, |gap| enough(rise(gap))) {
+            Some(g) => rise(g.gap_mm),
             None => 0.0,
         }
     }
@@ -632,6 +659,42 @@ pub(crate) mod tests {
         assert!(safe.waypoints > 0);
         assert_eq!(safe.points, points);
         assert_eq!(safe.unresolved, unresolved);
+    }
+
+    #[test]
+    fn a_rise_asked_only_up_to_a_threshold_is_exact_below_it() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        let (mut needed, mut short) = (0, 0);
+        for i in 0..400 {
+            let t = i as f64;
+            let p = DVec3::new(
+                3.0 + 3.0 * (0.37 * t).sin().abs(),
+                1.0 + 8.0 * (0.11 * t).cos().abs(),
+                (0.013 * t * t).sin() * 1.5 + 1.0,
+            );
+            let rise = c.rise_needed(&s, p);
+            assert_eq!(c.rise_until(&s, p, |_| false), rise);
+            assert_eq!(c.is_clear(&s, p, p), rise == 0.0);
+            if rise == 0.0 {
+                continue;
+            }
+            needed += 1;
+            for x in [0.5 * rise, rise, 1.5 * rise] {
+                let got = c.rise_until(&s, p, |r| r >= x);
+                if rise >= x {
+                    assert!(
+                        got >= x && got <= rise && got > 0.0,
+                        "{p}: {got} for {rise}"
+                    );
+                    short += usize::from(got < rise);
+                } else {
+                    assert_eq!(got, rise, "{p}");
+                }
+            }
+        }
+        assert!(needed > 50, "{needed}");
+        assert!(short > 0, "the query never stopped short");
     }
 
     #[test]

@@ -149,18 +149,22 @@ pub(super) fn plan(
     // only where that costs less than half the rise, so a plain slope is
     // still handled by rising.
     // (Each point on its own: on every core natively.)
+    let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
     let low_cap: Vec<Option<f64>> = parallel::map(n, MIN_CHUNK, |j| {
-        let rise = c.rise_needed(surface, at(j, target[j], height[j]));
+        let a = geometry[j].slope_rad;
+        let worth = |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
+        // The rise matters only until it makes the whole slide worth
+        // trying (`worth` grows with the rise): the query stops there.
+        let furthest = steps as f64 * SLIDE_STEP_MM;
+        let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
         if rise == 0.0 {
             return Some(target[j]);
         }
-        let a = geometry[j].slope_rad;
-        let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
         (1..=steps)
             .map(|k| k as f64 * SLIDE_STEP_MM)
-            .take_while(|&back| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a))
+            .take_while(|&back| worth(back, rise))
             .map(|back| target[j] - back)
-            .find(|&w| c.rise_needed(surface, at(j, w, height[j])) == 0.0)
+            .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])))
     });
     // Backward: every point at most its cap and at least one advance
     // behind the next; a point that cannot stay low within the slide is
@@ -206,7 +210,9 @@ pub(super) fn plan(
             let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
             for sgn in [-1.0, 1.0] {
                 let q = t + sgn * w * side;
-                let e = c.rise_needed(surface, q);
+                // Off the path (w > 0) the cost grows with the rise: the
+                // query stops once the rise is too much to beat the best.
+                let e = c.rise_until(surface, q, |e| cost(w, e) >= best.0);
                 let cq = cost(w, e);
                 if cq < best.0 {
                     best = (cq, q, e);
