@@ -114,6 +114,9 @@ pub fn surface_path(
     let mut warnings = Vec::new();
     let mut pieces = Vec::new();
     let mut any_sample = false;
+    // The subpaths too small to print, and whether any was large enough.
+    let mut dots: Vec<String> = Vec::new();
+    let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
     for sub in drawn {
         // Sampled after placement so the spacing is d/2 in printer mm.
@@ -124,6 +127,20 @@ pub fn surface_path(
             lo = lo.min(*p);
             hi = hi.max(*p);
         }
+        if let [dot] = samples[..] {
+            // A dot, a zero-length segment, or a shape far smaller than
+            // the nozzle: its samples d/2 apart are one point.
+            warnings.push(format!(
+                "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to print with                  samples {spacing:.4} mm apart; it is not printed",
+                sub.source,
+                dot.x,
+                dot.y,
+                placed.length_mm()
+            ));
+            dots.push(sub.source.clone());
+            continue;
+        }
+        any_line |= samples.len() >= 2;
         for piece in project_subpath(
             surface,
             &sub.source,
@@ -142,7 +159,27 @@ pub fn surface_path(
     }
     if pieces.is_empty() {
         let (slo, shi) = surface.bbox();
-        return Err(Error::Plan(if any_sample {
+        let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
+        return Err(Error::Plan(if !any_line && !dots.is_empty() {
+            format!(
+                "nothing to print at the nozzle's scale: every path of the drawing ({} of them: \
+                 '{}'{}) is a dot or a shape shorter than the samples' spacing of {spacing:.4} mm \
+                 as placed; check the drawing's units and the placement's scale",
+                dots.len(),
+                dots[0],
+                if dots.len() > 1 { ", ..." } else { "" }
+            )
+        } else if any_sample && inside {
+            format!(
+                "no part of the path lies over the scan's surface: the path spans x \
+                 {:.3}..{:.3}, y {:.3}..{:.3} mm, inside the scan's extent (x {:.3}..{:.3}, y \
+                 {:.3}..{:.3} mm, printer frame) but over its holes or gaps (a bore of the part, \
+                 a point cloud's dropouts); move the drawing onto the surface (the placement \
+                 offset), and for a point cloud a larger maximum edge (--max-edge) closes wider \
+                 gaps",
+                lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
+            )
+        } else if any_sample {
             format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \

@@ -68,6 +68,7 @@ pub fn sample_subpath(sub: &Subpath2, max_spacing_mm: f64) -> Vec<DVec2> {
         .filter(|(_, p)| p.is_finite())
         .map(|(i, &p)| (p, corner_flag(sub, i)))
         .unzip();
+    let (points, corner) = merge_close(&points, &corner, spacing);
     let Some(pieces) = pieces(&points, &corner) else {
         return Vec::new();
     };
@@ -110,7 +111,8 @@ pub fn try_sample_subpath_marked(
         });
     }
     let corner: Vec<bool> = (0..sub.points.len()).map(|i| corner_flag(sub, i)).collect();
-    let Some(pieces) = pieces(&sub.points, &corner) else {
+    let (points, corner) = merge_close(&sub.points, &corner, max_spacing_mm);
+    let Some(pieces) = pieces(&points, &corner) else {
         return Ok(Samples {
             points: Vec::new(),
             corner: Vec::new(),
@@ -124,7 +126,53 @@ pub fn try_sample_subpath_marked(
             spacing_mm: max_spacing_mm,
         });
     }
-    Ok(emit(&sub.points, &corner, &pieces, max_spacing_mm))
+    Ok(emit(&points, &corner, &pieces, max_spacing_mm))
+}
+
+/// Drawn points closer together than this share of the spacing are one
+/// point (at most [`MAX_MERGE_MM`] apart): a drawing's zero-length and
+/// near-zero-length segments (an exporter's `v 0`, a curve of 0.001 units
+/// that ends where it began, a circle far smaller than the nozzle) would
+/// otherwise give samples that coincide, which no spline passes through,
+/// or a tangent taken from a micrometre of drawing.
+pub const MERGE_FRACTION: f64 = 0.01;
+
+/// The most [`MERGE_FRACTION`] merges over, whatever the spacing (an
+/// infinite spacing keeps only the corners).
+pub const MAX_MERGE_MM: f64 = 0.01;
+
+/// Points closer than this are one (see [`MERGE_FRACTION`]).
+fn merge_distance(spacing: f64) -> f64 {
+    (MERGE_FRACTION * spacing).min(MAX_MERGE_MM)
+}
+
+/// The drawn polyline with each run of points within the merge distance
+/// of the first one kept taken as one point, a corner if any of them is:
+/// at the last of them where that is a corner and the one kept is not, or
+/// where it ends the path (so the ends, and the corners, stay where they
+/// were drawn). Sampling the merged polyline keeps the spacing and the
+/// corners exactly.
+fn merge_close(points: &[DVec2], corner: &[bool], spacing: f64) -> (Vec<DVec2>, Vec<bool>) {
+    let merge = merge_distance(spacing);
+    let mut out: Vec<DVec2> = Vec::with_capacity(points.len());
+    let mut flags: Vec<bool> = Vec::with_capacity(points.len());
+    let last = points.len().saturating_sub(1);
+    for (i, &p) in points.iter().enumerate() {
+        let c = corner.get(i).copied().unwrap_or(false);
+        match (out.last_mut(), flags.last_mut()) {
+            (Some(q), Some(f)) if q.distance(p) < merge => {
+                if i == last || (c && !*f) {
+                    *q = p;
+                }
+                *f |= c;
+            }
+            _ => {
+                out.push(p);
+                flags.push(c);
+            }
+        }
+    }
+    (out, flags)
 }
 
 /// Ends of open subpaths are always corners; a missing flag (a hand-made
@@ -162,8 +210,26 @@ fn pieces(points: &[DVec2], corner: &[bool]) -> Option<Vec<Piece>> {
 fn count(pieces: &[Piece], spacing: f64) -> f64 {
     1.0 + pieces
         .iter()
-        .map(|p| intervals(p.len, spacing))
+        .map(|p| intervals(p.len, spacing).max(LOOP_INTERVALS))
         .sum::<f64>()
+}
+
+/// The fewest intervals a piece that ends where it starts is sampled with
+/// (a drawn loop smaller than the spacing, a circle far smaller than the
+/// nozzle): one interval would give two samples at the same place, two a
+/// move out and back.
+const LOOP_INTERVALS: f64 = 3.0;
+
+/// Intervals of `piece` (see [`intervals`]), at least [`LOOP_INTERVALS`]
+/// for a loop.
+fn piece_intervals(points: &[DVec2], piece: &Piece, spacing: f64) -> f64 {
+    let n = intervals(piece.len, spacing);
+    let ends = points[piece.a].distance(points[piece.b]);
+    if n > 0.0 && ends < merge_distance(spacing) {
+        n.max(LOOP_INTERVALS)
+    } else {
+        n
+    }
 }
 
 fn intervals(len: f64, spacing: f64) -> f64 {
@@ -191,7 +257,7 @@ fn emit(points: &[DVec2], corner: &[bool], pieces: &[Piece], spacing: f64) -> Sa
     out.points.push(first);
     out.corner.push(corner.first().copied().unwrap_or(true));
     for piece in pieces {
-        let n = intervals(piece.len, spacing);
+        let n = piece_intervals(points, piece, spacing);
         if n == 0.0 {
             continue; // coincident corners: one sample already stands there
         }
@@ -261,6 +327,107 @@ mod tests {
         let out = sample_subpath(&s, 0.5);
         assert!(out.contains(&DVec2::new(1.05, 0.0)));
         assert_eq!(out.len(), 7);
+    }
+
+    /// No two consecutive samples closer than a hundredth of the spacing,
+    /// and a spline through them.
+    fn assert_apart(points: &[DVec2], spacing: f64) {
+        if points.len() >= 2 {
+            let flat: Vec<glam::DVec3> = points.iter().map(|p| p.extend(0.0)).collect();
+            crate::spline::local_geometry(&flat).unwrap();
+        }
+        for (i, w) in points.windows(2).enumerate() {
+            assert!(
+                w[0].distance(w[1]) >= 0.01 * spacing,
+                "samples {i} and {} at {} and {}",
+                i + 1,
+                w[0],
+                w[1]
+            );
+        }
+    }
+
+    #[test]
+    fn regression_a_tiny_curve_that_ends_where_it_began_gave_coincident_samples() {
+        // An exporter's `M 5,10 c 0,0.001 0.001,0.001 0,0 L 35,10` (and
+        // Illustrator's `v 0 c 0,1e-3 1e-3,1e-3 0,0`): a corner, a 0.001 mm
+        // loop, a corner at the same place, then a line.
+        let s = sub(
+            &[
+                (5.0, 10.0),
+                (5.0, 10.0007),
+                (5.0008, 10.0007),
+                (5.0, 10.0),
+                (5.0, 10.0),
+                (35.0, 10.0),
+            ],
+            &[true, false, false, true, true, true],
+            false,
+        );
+        for spacing in [0.3015, 0.05] {
+            let out = try_sample_subpath(&s, spacing).unwrap();
+            assert_apart(&out, spacing);
+            assert_eq!(out[0], DVec2::new(5.0, 10.0));
+            assert_eq!(*out.last().unwrap(), DVec2::new(35.0, 10.0));
+            let widest = out
+                .windows(2)
+                .map(|w| w[0].distance(w[1]))
+                .fold(0.0, f64::max);
+            assert!(widest <= spacing * (1.0 + 1e-12), "{widest} for {spacing}");
+            assert_apart(&sample_subpath(&s, spacing), spacing);
+        }
+    }
+
+    #[test]
+    fn a_loop_smaller_than_the_spacing_keeps_its_shape() {
+        // A closed circle of radius 0.036 mm (a footprint's via): 0.23 mm
+        // around, less than d/2; one interval would put both samples at
+        // its start.
+        let n = 64;
+        let pts: Vec<(f64, f64)> = (0..=n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                (1.0 + 0.036 * a.cos(), 2.0 + 0.036 * a.sin())
+            })
+            .collect();
+        let s = sub(&pts, &[], true);
+        let out = try_sample_subpath(&s, 0.3015).unwrap();
+        assert_eq!(out.len(), 4, "{out:?}");
+        assert_apart(&out, 0.3015);
+        assert_eq!(out[0], out[3]);
+        // A dot (all its points within the merge distance) is one sample.
+        let dot = sub(&[(1.0, 1.0), (1.001, 1.0), (1.0, 1.0)], &[], true);
+        assert_eq!(try_sample_subpath(&dot, 0.3015).unwrap().len(), 1);
+    }
+
+    #[test]
+    fn points_closer_than_the_merge_distance_are_one_keeping_corners_and_ends() {
+        // A corner 2 um past a smooth point, and an end 1 um past another.
+        let s = sub(
+            &[
+                (0.0, 0.0),
+                (1.0, 0.0),
+                (1.000002, 0.0),
+                (1.0, 1.0),
+                (1.0, 1.000001),
+            ],
+            &[true, false, true, false, true],
+            false,
+        );
+        let m = merge_close(&s.points, &[true, false, true, false, true], 0.3);
+        assert_eq!(
+            m.0,
+            vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(1.000002, 0.0),
+                DVec2::new(1.0, 1.000001)
+            ]
+        );
+        assert_eq!(m.1, vec![true, true, true]);
+        let out = try_sample_subpath(&s, 0.3).unwrap();
+        assert!(out.contains(&DVec2::new(1.000002, 0.0)));
+        assert_eq!(*out.last().unwrap(), DVec2::new(1.0, 1.000001));
+        assert_apart(&out, 0.3);
     }
 
     #[test]

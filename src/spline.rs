@@ -30,9 +30,10 @@ impl Spline {
             )));
         }
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+            let p = points[i];
             return Err(Error::Plan(format!(
-                "point {i} of the path is not finite: {:?}",
-                points[i]
+                "point {i} of the path is not finite: ({}, {}, {})",
+                p.x, p.y, p.z
             )));
         }
         let p = 3.min(n - 1);
@@ -46,10 +47,13 @@ impl Spline {
         }
         for (i, w) in params.windows(2).enumerate() {
             if w[1] - w[0] <= 1e-12 * total.max(1.0) {
+                let p = points[i];
                 return Err(Error::Plan(format!(
-                    "points {i} and {} of the path coincide at {:?}",
+                    "points {i} and {} of the path coincide at ({:.4}, {:.4}, {:.4})",
                     i + 1,
-                    points[i]
+                    p.x,
+                    p.y,
+                    p.z
                 )));
             }
         }

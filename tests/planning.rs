@@ -381,3 +381,94 @@ fn even_beats_the_papers_planners_on_every_part() {
         );
     }
 }
+
+/// Real drawings carry elements far below the nozzle's scale: an
+/// exporter's `v 0` and a curve of 0.001 units that ends where it began
+/// (Fritzing and Illustrator files), a footprint's via drawn as a circle
+/// of 0.036 mm radius, a lone dot. The plan went down on the first of them
+/// ("points 0 and 1 of the path coincide"); now the loop keeps its shape,
+/// the dot is left out with a warning naming it, the rest is printed.
+#[test]
+fn regression_tiny_elements_of_a_real_drawing_stopped_the_whole_plan() {
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
+      <path id="trace" d="M 5,10 v 0 c 0,0.001 0.001,0.001 0,0 L 35,10" stroke="black" fill="none"/>
+      <circle id="via" cx="20" cy="20" r="0.036" stroke="black" fill="none"/>
+      <path id="dot" d="M 30,30 l 0.0001,0" stroke="black" fill="none"/>
+    </svg>"#;
+    let drawn = pipeline::load_path(svg.as_bytes(), "board.svg").unwrap();
+    let s = Surface::new(height_field(
+        &range(0.0, 40.0, 40),
+        &range(0.0, 40.0, 40),
+        |_, _| 1.0,
+    ))
+    .unwrap();
+    let settings = PlanSettings {
+        placement: pcpp::svg::Placement {
+            offset_mm: DVec2::new(0.0, 40.0),
+            ..pcpp::svg::Placement::IDENTITY
+        },
+        ..PlanSettings::default()
+    };
+    let plan = pipeline::plan(&s, &drawn.subpaths, &settings).unwrap();
+    let sources: Vec<&str> = plan.pieces.iter().map(|p| p.source.as_str()).collect();
+    assert_eq!(sources, ["trace", "via"], "{:?}", plan.warnings);
+    let trace = &plan.pieces[0].surface_path;
+    assert!(
+        (trace.last().unwrap().x - 35.0).abs() < 1e-5,
+        "{:?} {:?}",
+        trace.first(),
+        trace.last()
+    );
+    assert!(
+        plan.warnings
+            .iter()
+            .any(|w| w.contains("'dot'") && w.contains("too small")),
+        "{:?}",
+        plan.warnings
+    );
+    assert_eq!(plan.uncleared, vec![]);
+}
+
+#[test]
+fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
+    let settings = PlanSettings::default();
+    // Two pads of a footprint drawn as zero-length lines (their width is
+    // the stroke's): nothing the nozzle can draw.
+    let pads = vec![line(DVec2::new(5.0, 5.0), DVec2::new(5.0, 5.0)); 2];
+    let flat = Surface::new(height_field(
+        &range(0.0, 40.0, 4),
+        &range(0.0, 40.0, 4),
+        |_, _| 0.0,
+    ))
+    .unwrap();
+    let e = pipeline::plan(&flat, &pads, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("nothing to print at the nozzle's scale") && e.contains("'line'"),
+        "{e}"
+    );
+    // Two plates 20 mm apart; a line between them lies inside the scan's
+    // extent, over the gap: not a placement that misses the scan.
+    let mut m = height_field(&range(0.0, 10.0, 2), &range(0.0, 40.0, 2), |_, _| 0.0);
+    let right = height_field(&range(30.0, 40.0, 2), &range(0.0, 40.0, 2), |_, _| 0.0);
+    let k = m.vertices.len() as u32;
+    m.vertices.extend(right.vertices);
+    m.triangles
+        .extend(right.triangles.iter().map(|t| t.map(|i| i + k)));
+    let plates = Surface::new(m).unwrap();
+    let gap = [line(DVec2::new(15.0, 20.0), DVec2::new(25.0, 20.0))];
+    let e = pipeline::plan(&plates, &gap, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("inside the scan's extent") && e.contains("holes or gaps"),
+        "{e}"
+    );
+    // Off the scan altogether: the placement is what to check.
+    let off = [line(DVec2::new(50.0, 20.0), DVec2::new(60.0, 20.0))];
+    let e = pipeline::plan(&plates, &off, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("misses the scan entirely"), "{e}");
+}
