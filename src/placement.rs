@@ -227,13 +227,16 @@ pub const FIT_SHARE: f64 = 0.9;
 
 /// The placement that puts the middle of the drawing's bounding box (as
 /// `current` turns and scales it) on the middle of a scan's footprint
-/// `footprint` (printer XY); when the drawing is larger than
-/// [`FIT_SHARE`] of the footprint it is scaled down to fit, and the note
-/// says so. `None` for a drawing without points.
+/// `footprint` (printer XY). With `fit`, a drawing larger than
+/// [`FIT_SHARE`] of the footprint is scaled down to fit, and the note says
+/// so; without, its scale is kept (an antenna's size sets its resonance)
+/// and the note says when it overhangs the footprint. `None` for a drawing
+/// without points.
 pub fn centre_drawing(
     drawn: &[Subpath2],
     footprint: (DVec2, DVec2),
     current: &Placement,
+    fit: bool,
 ) -> Option<(Placement, Option<String>)> {
     let turned = Placement {
         offset_mm: DVec2::ZERO,
@@ -259,11 +262,12 @@ pub fn centre_drawing(
     }
     let mut placement = turned;
     let mut note = None;
-    if scale < 1.0 {
+    if scale < 1.0 && fit {
         placement.scale *= scale;
         note = Some(format!(
             "the drawing ({:.1} x {:.1} mm) is larger than the scan's footprint ({:.1} x {:.1} \
-             mm): it was scaled by {:.3} to fit; set the scale to print it at its size",
+             mm): it was scaled by {:.3} to fit; a scale given with the placement (--place \
+             centre,ROT,SCALE; the page's scale) is kept as given",
             size.x,
             size.y,
             fhi.x - flo.x,
@@ -272,6 +276,17 @@ pub fn centre_drawing(
         ));
         lo *= scale;
         hi *= scale;
+    } else if size.x > fhi.x - flo.x || size.y > fhi.y - flo.y {
+        note = Some(format!(
+            "the drawing at scale {} ({:.1} x {:.1} mm) is larger than the scan's footprint \
+             ({:.1} x {:.1} mm): centred, kept at its scale; what lies off the scan is not \
+             printed",
+            current.scale,
+            size.x,
+            size.y,
+            fhi.x - flo.x,
+            fhi.y - flo.y,
+        ));
     }
     placement.offset_mm = 0.5 * (flo + fhi) - 0.5 * (lo + hi);
     Some((placement, note))
@@ -436,6 +451,7 @@ mod tests {
             std::slice::from_ref(&square),
             footprint,
             &Placement::IDENTITY,
+            true,
         )
         .unwrap();
         assert!(note.unwrap().contains("scaled by 0.360"));
@@ -454,9 +470,30 @@ mod tests {
             scale: 0.1,
             ..Placement::IDENTITY
         };
-        let (p, note) = centre_drawing(&[square], footprint, &current).unwrap();
+        let (p, note) =
+            centre_drawing(std::slice::from_ref(&square), footprint, &current, true).unwrap();
         assert!(note.is_none());
         assert_eq!((p.rotation_deg, p.scale), (30.0, 0.1));
-        assert!(centre_drawing(&[], footprint, &current).is_none());
+        assert!(centre_drawing(&[], footprint, &current, true).is_none());
+        // Not fitted: the scale given is kept, centred, and the note says
+        // that it overhangs.
+        let (p, note) = centre_drawing(
+            std::slice::from_ref(&square),
+            footprint,
+            &Placement::IDENTITY,
+            false,
+        )
+        .unwrap();
+        assert_eq!(p.scale, 1.0);
+        assert!(note.unwrap().contains("kept at its scale"));
+        let placed = p.apply_subpath(&square);
+        let lo = placed.points.iter().fold(DVec2::INFINITY, |a, b| a.min(*b));
+        let hi = placed
+            .points
+            .iter()
+            .fold(DVec2::NEG_INFINITY, |a, b| a.max(*b));
+        assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
+        let (_, note) = centre_drawing(&[square], footprint, &current, false).unwrap();
+        assert!(note.is_none());
     }
 }

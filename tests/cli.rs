@@ -986,6 +986,49 @@ fn plan_refuses_touching_gcode_unless_the_risk_is_accepted() {
 
 // ------------------------------------------------------------ placement
 
+/// `--place centre,ROT,SCALE` fitted a drawing larger than the scan to it
+/// whatever SCALE said (an antenna's size sets its resonance); a scale
+/// given is now kept, and only `--place centre` alone fits.
+#[test]
+fn regression_a_scale_given_with_centre_was_overridden_by_the_fit() {
+    let dir = temp_dir("centre-scale");
+    let scan = dir.join("part.ply");
+    std::fs::write(&scan, demo::to_binary_ply(&test_part::test_part())).unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="120mm" height="10mm" viewBox="0 0 120 10">
+             <path d="M 0,5 L 120,5" stroke="black" fill="none"/></svg>"#,
+    )
+    .unwrap();
+    let (out, report) = (dir.join("out.gcode"), dir.join("report.json"));
+    let scale_of = || {
+        let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        r["settings"]["placement"]["scale"].as_f64().unwrap()
+    };
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "centre", "-o", s(&out), "--report", s(&report)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stderr(&o).contains("scaled by"), "{}", stderr(&o));
+    assert!(scale_of() < 0.7);
+    for (given, scale) in [("centre,0,1", 1.0), ("centre,0,0.5", 0.5)] {
+        let o = plan_on(
+            &scan,
+            &svg,
+            &["--place", given, "-o", s(&out), "--report", s(&report)],
+        );
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        assert!(!stderr(&o).contains("scaled by"), "{given}: {}", stderr(&o));
+        assert_eq!(scale_of(), scale, "{given}");
+    }
+    let o = plan_on(&scan, &svg, &["--place", "centre,0,1", "-o", s(&out)]);
+    assert!(stderr(&o).contains("kept at its scale"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Issue 13: a scan still in its scanner's frame (the demo part turned and
 /// moved 800 mm down) with a spiral: the plan fails naming the placement
 /// flag; placed on the bed with the drawing centred, it succeeds, the

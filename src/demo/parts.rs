@@ -155,7 +155,7 @@ fn centred(svg: &str, centre: DVec2) -> Placement {
     crate::svg::import_svg(svg.as_bytes(), "demo.svg")
         .ok()
         .and_then(|drawn| {
-            crate::placement::centre_drawing(&drawn, (centre, centre), &Placement::IDENTITY)
+            crate::placement::centre_drawing(&drawn, (centre, centre), &Placement::IDENTITY, true)
         })
         .map_or(Placement::IDENTITY, |(placement, _)| placement)
 }

@@ -506,6 +506,7 @@ impl Session {
             &path.drawn.subpaths,
             (lo.truncate(), hi.truncate()),
             &current,
+            true,
         );
         Ok(match centred {
             Some((placement, note)) => to_js(&Centred { placement, note })?,

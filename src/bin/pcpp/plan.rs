@@ -80,16 +80,17 @@ pub fn registration_line(r: &Registration, method: RegistrationMethod) -> String
 }
 
 /// With `--place centre`, the drawing centred on the scan's footprint
-/// (scaled down to fit, with a warning, when it is larger).
+/// (scaled down to fit, with a warning, when it is larger, unless a scale
+/// was given: that one is kept).
 fn centre_on_scan(
     a: &JobArgs,
     inputs: &Inputs,
     plan: &mut pcpp::pipeline::PlanSettings,
     progress: &Progress,
 ) -> CliResult<()> {
-    if !a.place.is_some_and(|p| p.centre) {
+    let Some(place) = a.place.filter(|p| p.centre) else {
         return Ok(());
-    }
+    };
     let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
         .map_err(|e| Failure::Input(in_file(&inputs.svg_path, &inputs.svg_name, &e.to_string())))?;
     let (lo, hi) = inputs.prepared.surface.bbox();
@@ -97,6 +98,7 @@ fn centre_on_scan(
         &drawn.subpaths,
         (lo.truncate(), hi.truncate()),
         &plan.placement,
+        !place.scale_given,
     ) else {
         return Ok(());
     };

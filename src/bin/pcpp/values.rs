@@ -12,6 +12,9 @@ use pcpp::{DVec2, DVec3};
 pub struct PlaceArg {
     /// `centre`: the offset is found once the scan is read.
     pub centre: bool,
+    /// A scale was given (`centre` then keeps it rather than fit the
+    /// drawing to the scan).
+    pub scale_given: bool,
     pub placement: Placement,
 }
 
@@ -93,7 +96,11 @@ pub fn place(text: &str) -> Result<PlaceArg, String> {
         scale: v[3],
     };
     placement.validate().map_err(|e| e.to_string())?;
-    Ok(PlaceArg { centre, placement })
+    Ok(PlaceArg {
+        centre,
+        scale_given: first + parts.len() == 4,
+        placement,
+    })
 }
 
 /// `centre` or `center`, and what follows it.
@@ -143,8 +150,12 @@ mod tests {
         let p = place("0,80").unwrap();
         assert!(!p.centre);
         assert_eq!(p.placement.offset_mm, DVec2::new(0.0, 80.0));
+        assert!(!p.scale_given && !place("0,80,10").unwrap().scale_given);
+        assert!(place("0,80,10,2").unwrap().scale_given);
+        assert!(!place("centre").unwrap().scale_given);
+        assert!(!place("centre,90").unwrap().scale_given);
         let p = place(" centre,90,0.5").unwrap();
-        assert!(p.centre);
+        assert!(p.centre && p.scale_given);
         assert_eq!((p.placement.rotation_deg, p.placement.scale), (90.0, 0.5));
         assert!(place("Center").unwrap().centre);
         assert!(place("1,y").unwrap_err().contains("'y' is not a number"));
