@@ -889,6 +889,35 @@ pub fn check_gcode(
         program.moves.iter().map(|m| (m.from, m.to, Some(m.line))),
         &clearance,
     );
+    // With no limit, a move gets a clearance wherever the scan lies within
+    // the nozzle's reach of it in XY: none at all means the program and
+    // the scan are not in one frame, and nothing was checked.
+    if summary.min_clearance_mm.is_none() && !program.moves.is_empty() {
+        let (lo, hi) = program
+            .moves
+            .iter()
+            .flat_map(|m| [m.from, m.to])
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let (slo, shi) = scan.surface.bbox();
+        return Err(Error::Plan(format!(
+            "none of the {} moves of the program passes over the scan, so none could be checked: \
+             the moves span x {:.3}..{:.3}, y {:.3}..{:.3} mm, the scan x {:.3}..{:.3}, y \
+             {:.3}..{:.3} mm; the program and the scan are not in one frame: place or register \
+             the scan as it was when the program was planned (a pcpp program's header says how, \
+             e.g. placed on the bed: --place-scan bed)",
+            program.moves.len(),
+            lo.x,
+            hi.x,
+            lo.y,
+            hi.y,
+            slo.x,
+            shi.x,
+            slo.y,
+            shi.y
+        )));
+    }
     // Above the highest point by tol the nozzle clears everything, wherever
     // it is.
     let high = scan.surface.top_z() + tol_mm;

@@ -842,6 +842,29 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     }
 }
 
+/// A program planned on a scan placed on the bed, checked against the scan
+/// left where it was scanned: no move passes over it, and the check said
+/// "no move comes closer than tol" with exit 0 having checked nothing.
+#[test]
+fn regression_a_check_that_checked_no_move_passed() {
+    let dir = temp_dir("check-frame");
+    let g = dir.join("elsewhere.gcode");
+    std::fs::write(
+        &g,
+        "G21\nG90\nG0 Z20\nG0 X300 Y300 Z20\nG1 X300 Y300 Z1 F300\nG1 X310 Y300 Z1\nG0 Z20\n",
+    )
+    .unwrap();
+    let o = check_on_demo(&g, None);
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("none of the 3 moves") && err.contains("not in one frame"),
+        "{err}"
+    );
+    assert!(err.contains("--place-scan bed"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A hand-made program that climbs the region-1 block's wall in one
 /// straight move (issue 11's example): exit 1, naming the line.
 #[test]
