@@ -161,7 +161,8 @@ pub fn import_mesh(
     // 24 vertices), which would turn every seam into fake holes for the
     // fiducial detector, so they are welded here.
     let weld = matches!(format, MeshFormat::Obj | MeshFormat::Ply);
-    let (mesh, warnings) = finish(parsed, file, units.to_mm(), up_axis, weld)?;
+    let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis, weld)?;
+    warnings.extend(units_hint(&mesh, file, units));
     Ok(ImportedMesh {
         mesh,
         format,
@@ -191,6 +192,7 @@ fn import_cloud(
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
     let (mesh, info) = cloud::triangulate(vertices, max_edge_mm, file)?;
     check_triangle_count(mesh.triangle_count(), file)?;
+    warnings.extend(units_hint(&mesh, file, units));
     if info.merged > 0 {
         warnings.push(format!(
             "{file}: {} point(s) shared their XY with another; the highest of each was kept",
@@ -205,6 +207,44 @@ fn import_cloud(
         warnings,
         cloud: Some(info),
     })
+}
+
+/// A scan whose largest extent is below this (mm) is smaller than any
+/// substrate a nozzle of a few tenths of a millimetre prints on: most
+/// likely a file in metres or inches read as millimetres.
+pub const SMALL_SCAN_MM: f64 = 5.0;
+
+/// A warning for a scan so small that its units are likely wrong, with the
+/// size it would have in the units it may be in.
+fn units_hint(mesh: &TriMesh, file: &str, units: ScanUnits) -> Option<String> {
+    let (lo, hi) = mesh.bbox()?;
+    let size = hi - lo;
+    if size.max_element() >= SMALL_SCAN_MM {
+        return None;
+    }
+    let as_read = units.to_mm();
+    let others: Vec<String> = [(ScanUnits::M, "m"), (ScanUnits::In, "in")]
+        .into_iter()
+        .filter(|&(u, _)| u != units && u.to_mm() > as_read)
+        .map(|(u, name)| {
+            let k = u.to_mm() / as_read;
+            format!(
+                "in {name} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {name})",
+                size.x * k,
+                size.y * k,
+                size.z * k
+            )
+        })
+        .collect();
+    Some(format!(
+        "{file}: the scan is only {:.3} x {:.3} x {:.3} mm, read in {}: check its units{}{}",
+        size.x,
+        size.y,
+        size.z,
+        units,
+        if others.is_empty() { "" } else { "; " },
+        others.join(", ")
+    ))
 }
 
 /// The file's units to mm and its up axis to the printer's +Z.
@@ -635,6 +675,40 @@ mod tests {
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
+    }
+
+    #[test]
+    fn a_scan_too_small_for_its_units_gets_a_hint() {
+        // The Stanford bunny as its PLY comes, in metres: 0.16 m across.
+        let obj = b"v 0 0 0\nv 0.156 0 0\nv 0 0.154 0.12\nf 1 2 3\n";
+        let opts = |units| ImportOptions {
+            units,
+            ..ImportOptions::DEFAULT
+        };
+        let m = import_mesh(obj, "bunny.obj", &opts(None)).unwrap();
+        let hint = m.warnings.iter().find(|w| w.contains("check its units"));
+        let hint = hint.unwrap_or_else(|| panic!("{:?}", m.warnings));
+        assert!(
+            hint.starts_with("bunny.obj: the scan is only 0.156 x 0.154 x 0.120 mm, read in mm")
+                && hint.contains("in m it would be 156.0 x 154.0 x 120.0 mm (--scan-units m)"),
+            "{hint}"
+        );
+        // Read in metres, it is a bunny: no hint.
+        let m = import_mesh(obj, "bunny.obj", &opts(Some(ScanUnits::M))).unwrap();
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        // A 4 mm part read in inches is offered nothing larger than inches.
+        let small = b"v 0 0 0\nv 0.16 0 0\nv 0 0.1 0\nf 1 2 3\n";
+        let m = import_mesh(small, "chip.obj", &opts(Some(ScanUnits::In))).unwrap();
+        assert!(
+            m.warnings[0].contains("in m it would be"),
+            "{:?}",
+            m.warnings
+        );
+        assert!(
+            !m.warnings[0].contains("(--scan-units in)"),
+            "{:?}",
+            m.warnings
+        );
     }
 
     #[test]
