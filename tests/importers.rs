@@ -1016,3 +1016,63 @@ fn exhaustive_byte_corruption_never_panics() {
         }
     }
 }
+
+/// What real glTF files require beyond the core: compressed geometry is
+/// named (Draco's accessors have no data, which the validation reported
+/// accessor by accessor in 4 KB), glTF 1.0 written with a numeric version
+/// is named, appearance-only required extensions do not stop the import,
+/// and a POSITION accessor without min/max is read (its bounds come from
+/// the data).
+#[test]
+fn gltf_extensions_versions_and_missing_bounds() {
+    let mut g = GltfBuilder::default();
+    g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let tri = r#""meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]"#;
+    let with = |required: &str| {
+        g.gltf(&format!(
+            r#"{ONE_NODE},{tri},"extensionsUsed":[{required}],"extensionsRequired":[{required}]"#
+        ))
+    };
+    let e = import_mesh(
+        &with(r#""KHR_draco_mesh_compression""#),
+        "engine.gltf",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("compressed (KHR_draco_mesh_compression)") && e.len() < 300,
+        "{e}"
+    );
+    let e = import_mesh(
+        &with(r#""EXT_mesh_gpu_instancing""#),
+        "i.gltf",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("requires the extension EXT_mesh_gpu_instancing"),
+        "{e}"
+    );
+    let fine = with(
+        r#""KHR_materials_pbrSpecularGlossiness","KHR_texture_transform","KHR_mesh_quantization""#,
+    );
+    let m = import_mesh(&fine, "shiny.gltf", &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
+    // glTF 1.0, its version a number.
+    let v1 = br#"{"asset":{"version":1},"accessors":{"a":{"bufferView":"v","count":3}}}"#;
+    let e = import_mesh(v1, "truck.gltf", &ImportOptions::DEFAULT)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("glTF version 1") && e.contains("only glTF 2.0"),
+        "{e}"
+    );
+    // Bounds left out.
+    let bare = String::from_utf8(g.gltf(&format!("{ONE_NODE},{tri}"))).unwrap();
+    let cut = bare.replace(r#","min":[0.0, 0.0, 0.0],"max":[1.0, 1.0, 0.0]"#, "");
+    assert_ne!(cut, bare, "{bare}");
+    let m = import_mesh(cut.as_bytes(), "nobounds.gltf", &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
+}

@@ -35,7 +35,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     } else {
         (bytes, None)
     };
-    let root = gltf::json::Root::from_slice(json).map_err(|e| {
+    let mut root = gltf::json::Root::from_slice(json).map_err(|e| {
         // A glTF 1.0 file fails the 2.0 schema with an opaque serde message;
         // name the version instead.
         match gltf_version(json) {
@@ -46,7 +46,38 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             _ => not_gltf(&e),
         }
     })?;
+    // Compressed geometry cannot be read without its decoder; its accessors
+    // hold no data, which the validation would report accessor by accessor.
+    if let Some(ext) = root
+        .extensions_required
+        .iter()
+        .find(|e| COMPRESSION_EXTENSIONS.contains(&e.as_str()))
+    {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "its meshes are compressed ({ext}), which this program does not decode; export \
+                 the scan without mesh compression (Blender reads it and exports it uncompressed)"
+            ),
+        ));
+    }
+    // What the file requires of materials, textures and lights does not
+    // change its surface, and quantized positions are read here: only
+    // what would change the geometry stops the import.
+    root.extensions_required.retain(|e| {
+        e != "KHR_mesh_quantization" && !IGNORED_PREFIXES.iter().any(|p| e.starts_with(p))
+    });
+    if let Some(ext) = root.extensions_required.first() {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "it requires the extension {ext}, which this program does not read; export the \
+                 scan without it"
+            ),
+        ));
+    }
     check_position_accessors(&root, file)?;
+    fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
     let buffers = load_buffers(&gltf, blob, file)?;
     let mut scene = SceneReader {
@@ -105,10 +136,35 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     })
 }
 
-/// `asset.version` of a glTF JSON document, if it has one.
+/// Extensions that compress a glTF's geometry (its accessors then hold
+/// no data until decoded).
+const COMPRESSION_EXTENSIONS: [&str; 2] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
+
+/// Extensions of appearance only (materials, textures, lights): a file
+/// that requires them still describes its surface in full.
+const IGNORED_PREFIXES: [&str; 6] = [
+    "KHR_materials_",
+    "KHR_texture_",
+    "EXT_texture_",
+    "MSFT_texture_",
+    "KHR_lights_",
+    "EXT_lights_",
+];
+
+/// `asset.version` of a glTF JSON document, if it has one (glTF 1.0
+/// exporters wrote it as a string or as the number 1), or "1.0" for a
+/// document without one whose accessors are keyed by name (glTF 1.0's
+/// objects, glTF 2.0's arrays).
 fn gltf_version(json: &[u8]) -> Option<String> {
     let v: serde_json::Value = serde_json::from_slice(json).ok()?;
-    v.get("asset")?.get("version")?.as_str().map(str::to_string)
+    match v.get("asset").and_then(|a| a.get("version")) {
+        Some(serde_json::Value::String(s)) => Some(s.clone()),
+        Some(serde_json::Value::Number(n)) => Some(n.to_string()),
+        _ => v
+            .get("accessors")
+            .is_some_and(serde_json::Value::is_object)
+            .then(|| "1.0".to_string()),
+    }
 }
 
 /// The JSON and BIN chunks of a GLB container. Split here with checked
@@ -187,6 +243,36 @@ fn check_position_accessors(root: &gltf::json::Root, file: &str) -> Result<(), M
         }
     }
     Ok(())
+}
+
+/// glTF requires a POSITION accessor's `min` and `max`, but the bounds
+/// are found here from the data (and checked finite, naming the vertex):
+/// a file that leaves them out, or writes them as anything but three
+/// numbers, is read, not refused for them.
+fn fill_position_bounds(root: &mut gltf::json::Root) {
+    let positions: Vec<usize> = root
+        .meshes
+        .iter()
+        .flat_map(|m| &m.primitives)
+        .filter_map(|p| {
+            p.attributes
+                .get(&gltf::json::validation::Checked::Valid(Semantic::Positions))
+        })
+        .map(|a| a.value())
+        .collect();
+    for i in positions {
+        if let Some(a) = root.accessors.get_mut(i) {
+            for bound in [&mut a.min, &mut a.max] {
+                let three = bound.as_ref().is_some_and(|v| {
+                    v.as_array()
+                        .is_some_and(|n| n.len() == 3 && n.iter().all(|x| x.is_number()))
+                });
+                if !three {
+                    *bound = Some(serde_json::json!([0.0, 0.0, 0.0]));
+                }
+            }
+        }
+    }
 }
 
 fn load_buffers<'a>(
