@@ -741,6 +741,36 @@ pub fn run_on(
     })
 }
 
+/// The refusal of G-code on a registration whose fiducials miss their
+/// printer points by more than the nozzle's inner diameter d (RMS), unless
+/// the user accepts the risk: the scan is then not where the printer is,
+/// so neither where the path lands nor the clearance checked along the
+/// moves holds. (The paper's own fiducials leave 0.1-0.3 mm.)
+pub fn refuse_bad_registration(
+    registration: &Registration,
+    nozzle: &crate::params::Nozzle,
+    accept_risk: bool,
+) -> Result<()> {
+    let d = nozzle.inner_diameter_mm;
+    if accept_risk || registration.rms_mm <= d {
+        return Ok(());
+    }
+    let residuals: Vec<String> = registration
+        .residuals_mm
+        .iter()
+        .map(|r| format!("{r:.3}"))
+        .collect();
+    Err(Error::Plan(format!(
+        "the registration leaves the fiducials {:.3} mm RMS from the printer points (residuals \
+         [{}] mm), more than the nozzle's inner diameter d = {d} mm: the scan is not where the \
+         printer is, so neither where the path lands nor the clearance along the moves can be \
+         trusted; check the printer points (their order, values and units) and the scan's \
+         units; no G-code written",
+        registration.rms_mm,
+        residuals.join(", ")
+    )))
+}
+
 /// The refusal of a plan whose guarded planner could not clear some point
 /// (no G-code then), unless the user accepts the risk: the error lists the
 /// first ten points.
@@ -784,6 +814,7 @@ pub fn write_outputs(
     profile: &MachineProfile,
     accept_risk: bool,
 ) -> Result<(Report, String)> {
+    refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();

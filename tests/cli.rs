@@ -842,6 +842,49 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     }
 }
 
+/// A registration whose fiducials miss their printer points by 6.4 mm RMS
+/// (made-up printer points on a real scan) wrote G-code with exit 0 and a
+/// warning; past the nozzle's inner diameter it is refused, naming the
+/// scan, and written only with --accept-risk.
+#[test]
+fn regression_g_code_was_written_on_a_registration_metres_off() {
+    let dir = temp_dir("bad-registration");
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let svg = demo_file(demo::DEMO_PATH_NAME);
+    let out = dir.join("out.gcode");
+    let plan = |printer: &str, extra: &[&str]| {
+        let mut args = vec![
+            "--fiducials",
+            "auto",
+            "--printer-points",
+            printer,
+            "--place",
+            "0,80",
+            "-o",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        plan_on(&scan, &svg, &args)
+    };
+    // One printer point 2 mm off: about 0.9 mm RMS, more than d.
+    let o = plan("4,4,5;78,4,5;4,76,5", &[]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(demo::DEMO_SCAN_NAME)
+            && err.contains("mm RMS from the printer points")
+            && err.contains("--accept-risk"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let o = plan("4,4,5;78,4,5;4,76,5", &["--accept-risk"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    // The right points: written as before.
+    let o = plan("4,4,5;76,4,5;4,76,5", &[]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A program planned on a scan placed on the bed, checked against the scan
 /// left where it was scanned: no move passes over it, and the check said
 /// "no move comes closer than tol" with exit 0 having checked nothing.

@@ -118,6 +118,10 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
             inputs.scan_path.display()
         )),
         Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
+        Error::Plan(m) if m.starts_with("the registration leaves") => Failure::Input(format!(
+            "{}: {m} (--accept-risk writes it anyway)",
+            inputs.scan_path.display()
+        )),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
             inputs.svg_path.display()
