@@ -54,7 +54,13 @@ pub fn project_subpath(
         return Vec::new();
     };
     let last = hits.iter().rposition(Option::is_some).unwrap_or(first);
-    if first > 0 {
+    // (One sample off the scan is a point, not a stretch of 0 mm.)
+    if first == 1 {
+        warnings.push(format!(
+            "path '{source}': its first point {} lies off the scan; not printed",
+            fmt_xy(samples[0])
+        ));
+    } else if first > 0 {
         warnings.push(format!(
             "path '{source}': its start from {} to {} ({:.3} mm) lies off the scan; not printed",
             fmt_xy(samples[0]),
@@ -62,7 +68,12 @@ pub fn project_subpath(
             arc[first - 1] - arc[0]
         ));
     }
-    if last + 1 < n {
+    if last + 2 == n {
+        warnings.push(format!(
+            "path '{source}': its last point {} lies off the scan; not printed",
+            fmt_xy(samples[n - 1])
+        ));
+    } else if last + 1 < n {
         warnings.push(format!(
             "path '{source}': its end from {} to {} ({:.3} mm) lies off the scan; not printed",
             fmt_xy(samples[last + 1]),
@@ -196,5 +207,16 @@ mod tests {
             .collect();
         assert!(project_subpath(&s, "a", &far, 0.908, &mut w).is_empty());
         assert!(w[0].contains("misses the scan entirely"));
+        // One sample off at each end: a point, not a stretch of 0 mm.
+        let mut w = Vec::new();
+        let one: Vec<DVec2> = (0..12).map(|i| DVec2::new(-0.5 + i as f64, 5.0)).collect();
+        assert_eq!(project_subpath(&s, "a", &one, 0.908, &mut w).len(), 1);
+        assert_eq!(
+            w,
+            [
+                "path 'a': its first point (-0.500, 5.000) lies off the scan; not printed",
+                "path 'a': its last point (10.500, 5.000) lies off the scan; not printed"
+            ]
+        );
     }
 }

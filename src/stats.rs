@@ -5,6 +5,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::spline::LocalGeometry;
 
+/// Curvature (1/mm) at or below which a path counts as straight (a radius
+/// of a kilometre or more).
+pub const STRAIGHT_CURVATURE: f64 = 1e-6;
+
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct PathStats {
     pub subpaths: usize,
@@ -51,7 +55,9 @@ pub fn path_stats<'a>(
     if s.points > 0 {
         s.height_change_mm = zmax - zmin;
     }
-    if max_curv > 0.0 {
+    // A straight path's spline has curvature at the level of rounding
+    // (radii of 1e11 mm): straight, as a radius of over a kilometre is.
+    if max_curv > STRAIGHT_CURVATURE {
         s.min_radius_mm = 1.0 / max_curv;
     }
     if speed_mm_s > 0.0 {
@@ -75,7 +81,8 @@ mod tests {
         assert!((s.length_mm - 10.0 * 2f64.sqrt()).abs() < 1e-9);
         assert!((s.height_change_mm - 10.0).abs() < 1e-12);
         assert!((s.max_inclination_deg - 45.0).abs() < 1e-6);
-        assert!(s.min_radius_mm > 1e6);
+        // Straight: infinite, not the 1e11 mm of the spline's rounding.
+        assert_eq!(s.min_radius_mm, f64::INFINITY);
         assert!((s.print_time_s - s.length_mm / 5.0).abs() < 1e-12);
     }
 }
