@@ -159,6 +159,10 @@ pub(super) struct Grid {
     /// Cell c holds `items[start[c]..start[c + 1]]`.
     start: Vec<u32>,
     items: Vec<u32>,
+    /// The top of each item's triangle (f32 rounded up), beside `items`:
+    /// most triangles of a cell that a footprint query reads lie below it,
+    /// and are passed over without reading their vertices.
+    tops: Vec<f32>,
     /// The z range of each cell's triangles (lo > hi when it has none),
     /// apart from their XY box: a footprint query drops most cells on z.
     zs: Vec<[f32; 2]>,
@@ -242,6 +246,8 @@ impl Grid {
         // triangle's box (the rounding is monotone).
         let wide = 1.5 * cell;
         let mut home = vec![u32::MAX; n];
+        // Each triangle's top, found with its box, for `tops`.
+        let mut top = vec![0f32; n];
         let mut count = vec![0u32; nx * ny + 1];
         let mut big = Vec::new();
         let mut zs = vec![[f32::INFINITY, f32::NEG_INFINITY]; nx * ny];
@@ -255,8 +261,9 @@ impl Grid {
             nx * ny
         ];
         let mut reach = DVec2::ZERO;
-        for (i, slot) in home.iter_mut().enumerate() {
+        for (i, (slot, top)) in home.iter_mut().zip(&mut top).enumerate() {
             let (lo, hi) = triangle_box(mesh, i);
+            *top = f32_up(hi.z);
             if hi.x - lo.x > wide.x || hi.y - lo.y > wide.y {
                 big.push((i as u32, box32(lo, hi)));
                 continue;
@@ -308,14 +315,18 @@ impl Grid {
         }
         let start = count.clone();
         let mut items = vec![0u32; n - big.len()];
+        let mut tops = vec![0f32; n - big.len()];
         for (i, &c) in home.iter().enumerate() {
             if c == u32::MAX {
                 continue;
             }
             let c = c as usize;
-            items[count[c] as usize] = i as u32;
+            let k = count[c] as usize;
+            items[k] = i as u32;
+            tops[k] = top[i];
             count[c] += 1;
         }
+        drop(top);
         drop(home);
         // Rounding in the home cell's index: a hair more.
         let reach = reach * (1.0 + 1e-9) + 1e-9 * cell;
@@ -333,6 +344,7 @@ impl Grid {
             ny,
             start,
             items,
+            tops,
             zs,
             xys,
             reach,
@@ -433,8 +445,10 @@ impl Grid {
             return;
         }
         let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
-        for &i in &self.items[s..e] {
-            f(i as usize);
+        for (&i, &top) in self.items[s..e].iter().zip(&self.tops[s..e]) {
+            if top as f64 >= q.lo.z {
+                f(i as usize);
+            }
         }
     }
 }
