@@ -217,7 +217,17 @@ pub const SMALL_SCAN_MM: f64 = 5.0;
 /// A warning for a scan so small that its units are likely wrong, with the
 /// size it would have in the units it may be in.
 fn units_hint(mesh: &TriMesh, file: &str, units: ScanUnits) -> Option<String> {
-    let (lo, hi) = mesh.bbox()?;
+    // Over the vertices in order (a pass through memory), not through the
+    // triangles: a stray vertex no triangle uses can only hide the hint.
+    let (lo, hi) = mesh
+        .vertices
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    if mesh.triangles.is_empty() || !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
     let size = hi - lo;
     if size.max_element() >= SMALL_SCAN_MM {
         return None;
