@@ -434,6 +434,15 @@ mod tests {
         assert_eq!(back.rotation_deg, 10.0);
     }
 
+    /// The XY box of a subpath's points.
+    fn extent(s: &Subpath2) -> (DVec2, DVec2) {
+        s.points
+            .iter()
+            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            })
+    }
+
     #[test]
     fn drawings_are_centred_and_scaled_to_fit() {
         let square = Subpath2 {
@@ -456,12 +465,7 @@ mod tests {
         .unwrap();
         assert!(note.unwrap().contains("scaled by 0.360"));
         assert!((p.scale - 0.36).abs() < 1e-12);
-        let placed = p.apply_subpath(&square);
-        let lo = placed.points.iter().fold(DVec2::INFINITY, |a, b| a.min(*b));
-        let hi = placed
-            .points
-            .iter()
-            .fold(DVec2::NEG_INFINITY, |a, b| a.max(*b));
+        let (lo, hi) = extent(&p.apply_subpath(&square));
         assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
         assert!(lo.cmpge(footprint.0).all() && hi.cmple(footprint.1).all());
         // A small drawing keeps its scale and rotation.
@@ -486,12 +490,7 @@ mod tests {
         .unwrap();
         assert_eq!(p.scale, 1.0);
         assert!(note.unwrap().contains("kept at its scale"));
-        let placed = p.apply_subpath(&square);
-        let lo = placed.points.iter().fold(DVec2::INFINITY, |a, b| a.min(*b));
-        let hi = placed
-            .points
-            .iter()
-            .fold(DVec2::NEG_INFINITY, |a, b| a.max(*b));
+        let (lo, hi) = extent(&p.apply_subpath(&square));
         assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
         let (_, note) = centre_drawing(&[square], footprint, &current, false).unwrap();
         assert!(note.is_none());

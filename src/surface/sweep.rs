@@ -326,18 +326,9 @@ impl Sweep {
         let hi = t[0].max(t[1]).max(t[2]);
         let c = 0.5 * (lo.truncate() + hi.truncate());
         let half = 0.5 * (hi.truncate() - lo.truncate()).length();
+        let (by_box, s0, s1) = self.box_part(c, half, hi.z)?;
         let a = self.m.a.truncate();
-        let d = point_segment_dist2(c, a, a + self.m.d).sqrt() - half;
-        let d = d - self.hair - 1e-8 * half;
         let steps = &self.steps.0[..self.steps.1];
-        let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
-        // The part of the move where the triangle can be within the
-        // widest step's reach (its box's circle, of radius `half` around
-        // `c`, meets that step's disk around p(s)); the tip's lowest
-        // height there.
-        let (s0, s1) = self.within_reach(c, half, steps[steps.len() - 1].0);
-        let low = self.m.a.z + if self.m.dz >= 0.0 { s0 } else { s1 } * self.m.dz;
-        let by_box = low - hi.z - h;
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         // The plane is not needed when the box bound alone is enough, and
         // steep planes give nothing better than the box.
@@ -371,16 +362,28 @@ impl Sweep {
     fn box_bound(&self, b: &Box32) -> Option<f64> {
         let lo = DVec2::new(b[0] as f64, b[1] as f64);
         let hi = DVec2::new(b[3] as f64, b[4] as f64);
-        let c = 0.5 * (lo + hi);
-        let half = 0.5 * (hi - lo).length();
+        let (by_box, ..) = self.box_part(0.5 * (lo + hi), 0.5 * (hi - lo).length(), b[5] as f64)?;
+        Some(by_box - self.hair)
+    }
+
+    /// The box part of [`Self::bound`] for an XY box of centre `c` and
+    /// half-diagonal `half` whose points lie no higher than `top`: the
+    /// bound, and the part (s0, s1) of the move within reach of the box
+    /// ([`Self::within_reach`]); `None` when no point of the box comes
+    /// within the widest step's reach.
+    #[inline]
+    fn box_part(&self, c: DVec2, half: f64, top: f64) -> Option<(f64, f64, f64)> {
         let a = self.m.a.truncate();
         let d = point_segment_dist2(c, a, a + self.m.d).sqrt() - half;
         let d = d - self.hair - 1e-8 * half;
         let steps = &self.steps.0[..self.steps.1];
         let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
+        // The part of the move where the box can be within the widest
+        // step's reach (its circle, of radius `half` around `c`, meets
+        // that step's disk around p(s)); the tip's lowest height there.
         let (s0, s1) = self.within_reach(c, half, steps[steps.len() - 1].0);
         let low = self.m.a.z + if self.m.dz >= 0.0 { s0 } else { s1 } * self.m.dz;
-        Some(low - b[5] as f64 - h - self.hair)
+        Some((low - top - h, s0, s1))
     }
 
     /// The fractions s of the move at which a circle of radius `half`
