@@ -131,7 +131,8 @@ pub fn surface_path(
             // A dot, a zero-length segment, or a shape far smaller than
             // the nozzle: its samples d/2 apart are one point.
             warnings.push(format!(
-                "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to print with                  samples {spacing:.4} mm apart; it is not printed",
+                "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to print with \
+                 samples {spacing:.4} mm apart; it is not printed",
                 sub.source,
                 dot.x,
                 dot.y,

@@ -76,10 +76,10 @@ pub fn sample_subpath(sub: &Subpath2, max_spacing_mm: f64) -> Vec<DVec2> {
     let mut spacing = spacing;
     // Widening keeps memory bounded on absurd inputs; the count of pieces
     // (corners) still bounds what remains.
-    if count(&pieces, spacing) > MAX_SAMPLES as f64 {
+    if count(&points, &pieces, spacing) > MAX_SAMPLES as f64 {
         spacing = total / (MAX_SAMPLES as f64 - pieces.len() as f64).max(1.0);
     }
-    if count(&pieces, spacing) > MAX_SAMPLES as f64 {
+    if count(&points, &pieces, spacing) > MAX_SAMPLES as f64 {
         spacing = f64::INFINITY;
     }
     emit(&points, &corner, &pieces, spacing).points
@@ -118,7 +118,7 @@ pub fn try_sample_subpath_marked(
             corner: Vec::new(),
         });
     };
-    let n = count(&pieces, max_spacing_mm);
+    let n = count(&points, &pieces, max_spacing_mm);
     if n.is_nan() || n > MAX_SAMPLES as f64 {
         return Err(SamplingError::TooManySamples {
             element: sub.source.clone(),
@@ -207,10 +207,10 @@ fn pieces(points: &[DVec2], corner: &[bool]) -> Option<Vec<Piece>> {
 }
 
 /// Samples the pieces would produce (the start point included).
-fn count(pieces: &[Piece], spacing: f64) -> f64 {
+fn count(points: &[DVec2], pieces: &[Piece], spacing: f64) -> f64 {
     1.0 + pieces
         .iter()
-        .map(|p| intervals(p.len, spacing).max(LOOP_INTERVALS))
+        .map(|p| piece_intervals(points, p, spacing))
         .sum::<f64>()
 }
 

@@ -422,7 +422,7 @@ fn regression_tiny_elements_of_a_real_drawing_stopped_the_whole_plan() {
     assert!(
         plan.warnings
             .iter()
-            .any(|w| w.contains("'dot'") && w.contains("too small")),
+            .any(|w| w.contains("'dot'") && w.contains("too small to print with samples")),
         "{:?}",
         plan.warnings
     );
