@@ -755,20 +755,11 @@ pub fn refuse_bad_registration(
     if accept_risk || registration.rms_mm <= d {
         return Ok(());
     }
-    let residuals: Vec<String> = registration
-        .residuals_mm
-        .iter()
-        .map(|r| format!("{r:.3}"))
-        .collect();
-    Err(Error::Plan(format!(
-        "the registration leaves the fiducials {:.3} mm RMS from the printer points (residuals \
-         [{}] mm), more than the nozzle's inner diameter d = {d} mm: the scan is not where the \
-         printer is, so neither where the path lands nor the clearance along the moves can be \
-         trusted; check the printer points (their order, values and units) and the scan's \
-         units; no G-code written",
-        registration.rms_mm,
-        residuals.join(", ")
-    )))
+    Err(Error::Registration(RegistrationError::TooFarOff {
+        rms_mm: registration.rms_mm,
+        residuals_mm: registration.residuals_mm.clone(),
+        d_mm: d,
+    }))
 }
 
 /// The refusal of a plan whose guarded planner could not clear some point

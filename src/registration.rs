@@ -205,6 +205,23 @@ pub enum RegistrationError {
     /// Not `lsq` or `paper`.
     #[error("unknown registration method {0:?}: use \"lsq\" or \"paper\"")]
     UnknownMethod(String),
+    /// The fit leaves the fiducials farther from their printer points
+    /// (RMS) than the nozzle's inner diameter: the scan is not where the
+    /// printer is, so G-code on it is refused unless the risk is accepted
+    /// (`job::refuse_bad_registration`).
+    #[error(
+        "the registration leaves the fiducials {rms_mm:.3} mm RMS from the printer points \
+         (residuals [{}] mm), more than the nozzle's inner diameter d = {d_mm} mm: the scan is \
+         not where the printer is, so neither where the path lands nor the clearance along the \
+         moves can be trusted; check the printer points (their order, values and units) and \
+         the scan's units; no G-code written",
+        .residuals_mm.iter().map(|r| format!("{r:.3}")).collect::<Vec<_>>().join(", ")
+    )]
+    TooFarOff {
+        rms_mm: f64,
+        residuals_mm: Vec<f64>,
+        d_mm: f64,
+    },
 }
 
 fn list_1_based(indices: &[usize]) -> String {

@@ -150,12 +150,12 @@ pub(super) fn plan(
     // still handled by rising.
     // (Each point on its own: on every core natively.)
     let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
+    let furthest = steps as f64 * SLIDE_STEP_MM;
     let low_cap: Vec<Option<f64>> = parallel::map(n, MIN_CHUNK, |j| {
         let a = geometry[j].slope_rad;
         let worth = |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
         // The rise matters only until it makes the whole slide worth
         // trying (`worth` grows with the rise): the query stops there.
-        let furthest = steps as f64 * SLIDE_STEP_MM;
         let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
         if rise == 0.0 {
             return Some(target[j]);

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use pcpp::job::{self, FiducialSource, InputFile, JobSettings, PreparedScan};
-use pcpp::registration::{Registration, RegistrationMethod};
+use pcpp::registration::{Registration, RegistrationError, RegistrationMethod};
 use pcpp::Error;
 
 use crate::args::{CompareArgs, JobArgs, PlanArgs, ScanArgs};
@@ -118,8 +118,8 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
             inputs.scan_path.display()
         )),
         Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
-        Error::Plan(m) if m.starts_with("the registration leaves") => Failure::Input(format!(
-            "{}: {m} (--accept-risk writes it anyway)",
+        Error::Registration(r @ RegistrationError::TooFarOff { .. }) => Failure::Input(format!(
+            "{}: {r} (--accept-risk writes it anyway)",
             inputs.scan_path.display()
         )),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
