@@ -189,7 +189,7 @@ pub fn insert_waypoints_capped(
             }
             let mut added = Vec::new();
             let mut unresolved = false;
-            if !resolve(surface, clearance, p, q, gap, &mut added) {
+            if !resolve(surface, clearance, p, q, gap, &mut added, &mut 0) {
                 added = rise_over(surface, clearance, p, q);
                 if added.is_empty() || !path_clear(surface, clearance, p, &added, q) {
                     unresolved = true;
@@ -261,7 +261,11 @@ fn path_clear(surface: &Surface, c: &Clearance, p: DVec3, mid: &[DVec3], q: DVec
 /// Waypoints for p -> q by recursive splitting at the worst place; false
 /// when that did not succeed within the budget. `known` is the move's
 /// clearance when the caller has just found it below tol (the same query
-/// with a larger limit finds the same worst place).
+/// with a larger limit finds the same worst place). `made` counts the
+/// waypoints made for the move so far, those still waiting on the
+/// recursion's stack too: counting only those already in `out` bounded
+/// nothing while the first half kept splitting (a fuzzed scan recursed
+/// until the stack overflowed).
 fn resolve(
     surface: &Surface,
     c: &Clearance,
@@ -269,13 +273,15 @@ fn resolve(
     q: DVec3,
     known: Option<SweepGap>,
     out: &mut Vec<DVec3>,
+    made: &mut usize,
 ) -> bool {
     let Some(worst) = known.or_else(|| c.touching(surface, p, q)) else {
         return true;
     };
-    if out.len() >= MAX_WAYPOINTS_PER_MOVE {
+    if *made >= MAX_WAYPOINTS_PER_MOVE {
         return false;
     }
+    *made += 1;
     let x = p.lerp(q, worst.at);
     // As high as the footprint there needs: the nozzle standing at x has
     // the move's smallest clearance (the worst place is where the move's
@@ -294,9 +300,9 @@ fn resolve(
     if w.distance(p) < 1e-9 || w.distance(q) < 1e-9 {
         return false;
     }
-    resolve(surface, c, p, w, None, out) && {
+    resolve(surface, c, p, w, None, out, made) && {
         out.push(w);
-        resolve(surface, c, w, q, None, out)
+        resolve(surface, c, w, q, None, out, made)
     }
 }
 

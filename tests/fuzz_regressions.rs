@@ -164,3 +164,28 @@ fn svg_arc_to_a_huge_endpoint_returns_in_time() {
         );
     }
 }
+
+/// A fuzzed scan (a PLY grid) whose move kept splitting its first half:
+/// the waypoint search counted only the waypoints already placed, not
+/// those waiting on its recursion, and recursed until the stack
+/// overflowed. Now it gives up after its budget and the move rises over
+/// its footprint instead; the job ends either way.
+#[test]
+fn regression_waypoint_search_overflowed_the_stack() {
+    let bytes = std::fs::read(saved("pipeline-waypoint-recursion-overflowed-the-stack")).unwrap();
+    // On a thread with the harness's own stack size, where it overflowed.
+    let result = std::thread::spawn(move || {
+        let case = fuzz_input::decode(&bytes);
+        (
+            case.settings.planner,
+            fuzz_input::run(&case).map_err(|e| e.to_string()),
+        )
+    })
+    .join()
+    .expect("the job panicked or overflowed its stack");
+    // pcpp-guarded on a spiky grid: points it cannot clear, refused.
+    let (planner, outcome) = result;
+    assert_eq!(planner, pcpp::planners::PlannerKind::PcppGuarded);
+    let e = outcome.unwrap_err();
+    assert!(e.contains("would still touch the surface"), "{e}");
+}
