@@ -52,6 +52,22 @@ pub enum Error {
     /// Planning could not produce a tool path (names the path and point).
     #[error("{0}")]
     Plan(String),
+    /// G-code refused for a point cloud of a whole object (points under
+    /// its top were left out): its surface between the points on steep
+    /// sides is a guess, so the motion check does not hold for the part.
+    #[error(
+        "{file}: {hidden} of its {points} points lie under the surface seen from above: \
+         a scan of a whole object, not of a surface. Meshed from above, its surface between \
+         the points on steep sides and thin features is a guess, so the clearance checked \
+         along the moves does not hold for the real part; no G-code written. Export the \
+         scan as a mesh (PLY, OBJ, STL or glTF: the scanner's software makes one) and plan \
+         on that, or accept the risk"
+    )]
+    WholeObjectCloud {
+        file: String,
+        hidden: usize,
+        points: usize,
+    },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

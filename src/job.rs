@@ -105,17 +105,17 @@ pub struct JobSettings {
 }
 
 /// The registration the settings ask for, placement on the bed included:
-/// `mesh` is the imported scan (scanner frame), `holes` its fiducial
-/// candidates.
+/// `scan` is the imported scan (scanner frame: placed on the bed by its
+/// [`ImportedMesh::extent`]), `holes` its fiducial candidates.
 pub fn registration_for_scan(
-    mesh: &crate::mesh::TriMesh,
+    scan: &ImportedMesh,
     holes: &[Fiducial],
     settings: &RegistrationSettings,
 ) -> Result<Registration> {
     settings.validate()?;
     // Only a placement on the bed needs the scan's bounds (a pass over it).
     let bbox = match settings.scan_placement {
-        ScanPlacement::OnBed { .. } => mesh.bbox(),
+        ScanPlacement::OnBed { .. } => scan.extent(),
         ScanPlacement::AsScanned => None,
     };
     let Some(bbox) = bbox else {
@@ -458,7 +458,7 @@ pub fn prepare_scan_owned(
     let early = if holes_needed {
         None
     } else {
-        Some(registration_for_scan(mesh, &[], registration)?)
+        Some(registration_for_scan(&imported, &[], registration)?)
     };
     if let Some(reg) = early.clone() {
         if reg.matrix == glam::DMat4::IDENTITY {
@@ -481,7 +481,7 @@ pub fn prepare_scan_owned(
     let fiducials = find_fiducials_in(mesh, &topology, dot);
     let reg = match early {
         Some(reg) => reg,
-        None => registration_for_scan(mesh, &fiducials, registration)?,
+        None => registration_for_scan(&imported, &fiducials, registration)?,
     };
     PreparedScan::assemble(
         file,
@@ -762,6 +762,24 @@ pub fn refuse_bad_registration(
     }))
 }
 
+/// The refusal of G-code on a point cloud some of whose points lie under
+/// its top (a whole object's scan, [`crate::mesh::triangulate`] leaves
+/// them out), unless the user accepts the risk. The height field meshed
+/// from the rest is checked exactly, but between its points, where the
+/// part is steep or thin, the real surface can be higher: a scanned
+/// bunny planned on its cloud came 0.4 mm into the bunny's own mesh at
+/// its ears. A mesh has no such gap, and scanners export one.
+pub fn refuse_whole_object_cloud(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
+    match scan.cloud {
+        Some(c) if c.hidden > 0 && !accept_risk => Err(Error::WholeObjectCloud {
+            file: scan.file.name.clone(),
+            hidden: c.hidden,
+            points: c.points,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// The refusal of a plan whose guarded planner could not clear some point
 /// (no G-code then), unless the user accepts the risk: the error lists the
 /// first ten points.
@@ -806,6 +824,7 @@ pub fn write_outputs(
     accept_risk: bool,
 ) -> Result<(Report, String)> {
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
+    refuse_whole_object_cloud(scan, accept_risk)?;
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
@@ -1165,7 +1184,7 @@ mod tests {
             let imported = pipeline::load_scan(&bytes, "part.ply", &scan).unwrap();
             let topology = Topology::of(&imported.mesh);
             let holes = find_fiducials_in(&imported.mesh, &topology, settings.dot_diameter_mm);
-            let reg = registration_for_scan(&imported.mesh, &holes, &settings).unwrap();
+            let reg = registration_for_scan(&imported, &holes, &settings).unwrap();
             let file = InputFile::new("part.ply", &bytes);
             let want =
                 PreparedScan::assemble(file, imported, topology, holes, reg, settings.method)

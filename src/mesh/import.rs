@@ -199,6 +199,15 @@ fn import_cloud(
             info.merged
         ));
     }
+    if info.hidden > 0 {
+        warnings.push(format!(
+            "{file}: {} of its {} points lie under the surface seen from above (a whole \
+             object's scan) and were left out: the nozzle prints from above. Between the \
+             points on steep sides and thin features the real surface may be higher than the \
+             one meshed; the scan exported as a mesh has no such gap",
+            info.hidden, info.points
+        ));
+    }
     Ok(ImportedMesh {
         mesh,
         format,

@@ -239,3 +239,16 @@ pub struct ImportedMesh {
     /// For a point cloud, how it was meshed.
     pub cloud: Option<CloudInfo>,
 }
+
+impl ImportedMesh {
+    /// The extent of the scanned part: the mesh's bounds, reaching down to
+    /// the points of a cloud left out under others (the part rests on its
+    /// lowest point, meshed or not). `None` when empty.
+    pub fn extent(&self) -> Option<(DVec3, DVec3)> {
+        let (mut lo, hi) = self.mesh.bbox()?;
+        if let Some(floor) = self.cloud.and_then(|c| c.lowest_left_out_mm) {
+            lo.z = lo.z.min(floor);
+        }
+        Some((lo, hi))
+    }
+}

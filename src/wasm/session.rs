@@ -174,7 +174,8 @@ impl ScanImport {
         let topology = self.topology.get_or_insert_with(|| Topology::of(mesh));
         let holes = find_fiducials_in(mesh, topology, settings.dot_diameter_mm);
         // Placement on the bed included, as job::prepare_scan does.
-        let reg = job::registration_for_scan(mesh, &holes, &settings).map_err(core_err)?;
+        let reg =
+            job::registration_for_scan(&self.imported, &holes, &settings).map_err(core_err)?;
         self.registered = Some((holes, reg, settings.method));
         Ok(())
     }

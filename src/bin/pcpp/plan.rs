@@ -122,6 +122,9 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
             "{}: {r} (--accept-risk writes it anyway)",
             inputs.scan_path.display()
         )),
+        e @ Error::WholeObjectCloud { .. } => {
+            Failure::Input(format!("{e} (--accept-risk writes it anyway)"))
+        }
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
             inputs.svg_path.display()
