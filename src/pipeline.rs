@@ -231,6 +231,11 @@ pub struct Plan {
 /// the check to the triangles near the nozzle.
 pub const CLEARANCE_CAP_ABOVE_TOL_MM: f64 = 0.05;
 
+/// A tool-path point this many d above the surface right under the tip
+/// dispenses in the air: section 7 finds no filament there (D > 2d is
+/// floating with no crossing), and the plan says where.
+pub const FLOATING_HEIGHT_PER_D: f64 = 2.0;
+
 /// What the motion check says of a plan's print moves (the G-code's other
 /// moves, travel and descents, are checked when it is written).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -300,8 +305,8 @@ fn plan_stage(
     let mut warnings = sp.warnings.clone();
     let mut pieces = Vec::with_capacity(sp.pieces.len());
     let mut uncleared = Vec::new();
-    let mut lifted = 0usize;
-    let mut max_lift: (f64, DVec3) = (0.0, DVec3::ZERO);
+    let mut floating = 0usize;
+    let mut highest: (f64, DVec3) = (0.0, DVec3::ZERO);
     let clearance = Clearance::new(nozzle, process.tolerance_mm);
     let cap = process.tolerance_mm + CLEARANCE_CAP_ABOVE_TOL_MM;
     let mut motion = PlanMotion {
@@ -319,6 +324,10 @@ fn plan_stage(
             nozzle,
             process,
         );
+        let mut big_lift = vec![false; planned.toolpath.len()];
+        for &(j, lift) in &planned.lifted {
+            big_lift[j] = lift > nozzle.inner_diameter_mm;
+        }
         let moves = if safe_motion && planner.is_guarded() {
             let planning = clearance.with_margin(PLANNING_MARGIN_MM);
             let safe = insert_waypoints_capped(surface, &planned.toolpath, &planning, cap);
@@ -348,13 +357,30 @@ fn plan_stage(
             let side = DVec3::new(-g.v.y, g.v.x, 0.0);
             motion.max_sideways_mm = motion.max_sideways_mm.max((*t - *a).dot(side).abs());
         }
-        for &(j, lift) in &planned.lifted {
-            // A lift of more than d leaves the filament floating: the nozzle is
-            // wider than the feature it must pass there.
-            if lift > nozzle.inner_diameter_mm {
-                lifted += 1;
-                if lift > max_lift.0 {
-                    max_lift = (lift, piece.ta[j]);
+        // Where the tip dispenses far above the surface right under it (d
+        // over its target is what section 7 asks): planned points the
+        // planner lifted by more than d (the nozzle is wider than the
+        // feature it must pass) and the waypoints (rises over a feature
+        // between two points); the filament falls from there.
+        let mut next = 0;
+        for &p in &moves {
+            let planned_here = planned.toolpath.get(next) == Some(&p);
+            let suspect = if planned_here {
+                next += 1;
+                big_lift.get(next - 1).copied().unwrap_or(false)
+            } else {
+                true
+            };
+            if !suspect {
+                continue;
+            }
+            if let Some(z) = surface.highest_hit(p.truncate()) {
+                let above = p.z - z;
+                if above > FLOATING_HEIGHT_PER_D * nozzle.inner_diameter_mm {
+                    floating += 1;
+                    if above > highest.0 {
+                        highest = (above, p);
+                    }
                 }
             }
         }
@@ -378,13 +404,21 @@ fn plan_stage(
             quality,
         });
     }
-    if lifted > 0 {
-        let p = max_lift.1;
+    if floating > 0 {
+        let p = highest.1;
         warnings.push(format!(
-            "{lifted} point(s) where the nozzle (outer diameter {:.3} mm) is wider than the \
-             feature it must pass were lifted clear of the surface by more than d; the largest \
-             lift, {:.3} mm, is at ({:.3}, {:.3}, {:.3}); expect floating filament there",
-            nozzle.outer_diameter_mm, max_lift.0, p.x, p.y, p.z
+            "{}: {floating} point(s) of the tool path lifted where the nozzle (outer diameter \
+             {:.3} mm) is wider than the feature it must pass, or rising over one between \
+             points, dispense more than {:.3} mm ({FLOATING_HEIGHT_PER_D} d) above the surface \
+             right under the tip; the highest, {:.3} mm above it, is at ({:.3}, {:.3}, {:.3}): \
+             expect floating filament there",
+            planner.name(),
+            nozzle.outer_diameter_mm,
+            FLOATING_HEIGHT_PER_D * nozzle.inner_diameter_mm,
+            highest.0,
+            p.x,
+            p.y,
+            p.z
         ));
     }
     if planner.is_guarded() {

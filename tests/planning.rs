@@ -472,3 +472,59 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         .to_string();
     assert!(e.contains("misses the scan entirely"), "{e}");
 }
+
+/// A drawn line across a fin narrower than the nozzle (0.3 mm wide, 5 mm
+/// tall on a flat floor): the guarded planners must lift the tip over it
+/// while dispensing, so the filament there falls from far above the floor.
+/// The plan says so, naming the planner and a point of its tool path
+/// beside the fin with its height over the floor under it (the warning
+/// used to give the lift above the planned target, and no planner).
+#[test]
+fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
+    let mut xs = range(0.0, 20.0, 100);
+    xs.extend([9.85, 10.15]);
+    xs.sort_by(f64::total_cmp);
+    let ys = range(0.0, 10.0, 50);
+    let fin = |x: f64| (x - 10.0).abs() <= 0.15 + 1e-9;
+    let surface = Surface::new(height_field(
+        &xs,
+        &ys,
+        |x, _| if fin(x) { 5.0 } else { 0.0 },
+    ))
+    .unwrap();
+    let drawn = vec![line(DVec2::new(5.0, 5.0), DVec2::new(15.0, 5.0))];
+    for planner in [PlannerKind::Even, PlannerKind::PcppGuarded] {
+        let settings = PlanSettings {
+            planner,
+            ..Default::default()
+        };
+        let plan = pipeline::plan(&surface, &drawn, &settings).unwrap();
+        let name = planner.name();
+        let w = plan
+            .warnings
+            .iter()
+            .find(|w| w.contains("above the surface right under the tip"))
+            .unwrap_or_else(|| panic!("{name}: no floating named: {:?}", plan.warnings));
+        assert!(w.starts_with(&format!("{name}: ")), "{w}");
+        // "the highest, H mm above it, is at (x, y, z)"
+        let nums = |s: &str| -> Vec<f64> {
+            s.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+                .filter_map(|t| t.parse().ok())
+                .collect()
+        };
+        let tail = &w[w.find("the highest,").expect(w)..];
+        let v = nums(tail);
+        let (h, at) = (v[0], DVec3::new(v[1], v[2], v[3]));
+        assert!(
+            !fin(at.x) && h > 5.0 && (h - at.z).abs() < 1e-3,
+            "{name}: {w}"
+        );
+        assert!(
+            plan.pieces
+                .iter()
+                .flat_map(|p| &p.moves)
+                .any(|p| p.distance(at) < 1e-3),
+            "{name}: {at} is not a point of the tool path"
+        );
+    }
+}
