@@ -982,21 +982,34 @@ pub fn check_gcode(
             unchecked_lines.push(m.line);
         }
     }
+    // What the moves from or to a position the file does not give came to.
+    let mut start = Vec::new();
     if let Some(l) = from_start.first() {
-        notes.push(format!(
+        start.push(format!(
             "line {l}: the program starts by rising above the scan from wherever the head \
              stands; that starting position is not in the file, so the rise itself is not \
              checked"
         ));
     }
     if !cleared_high.is_empty() {
-        notes.push(format!(
+        start.push(format!(
             "{} move(s) from or to a position the file does not give (first at line {}) lie \
              wholly {:.3} mm or more above the scan's top: clear wherever they are",
             cleared_high.len(),
             cleared_high[0],
             tol_mm
         ));
+    }
+    // When every such move was cleared that way (a pcpp program's start:
+    // rise, then travel above the scan), one note says it all, in place of
+    // the reader's list of them.
+    if unchecked_lines.is_empty() && !start.is_empty() {
+        if let Some(i) = program.unknown_start_note {
+            notes.remove(i);
+        }
+        notes.push(start.join("; then "));
+    } else {
+        notes.extend(start);
     }
     if !unchecked_lines.is_empty() {
         notes.push(format!(

@@ -835,10 +835,26 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
         assert!(out.contains("no move comes closer than tol"), "{out}");
         assert!(out.contains("min clearance 0.10"), "{out}");
     }
-    // The golden programs in the three dialects check alike.
+    // The golden programs in the three dialects check alike, each with one
+    // note on its start (a rise from wherever the head stands, then travel
+    // above the scan): it printed three, the reader's list of the moves
+    // made before every axis was known among them.
     for dialect in DIALECTS {
         let o = check_on_demo(&golden_path(dialect), None);
         assert_eq!(code(&o), 0, "{dialect}: {}{}", stdout(&o), stderr(&o));
+        let err = stderr(&o);
+        let start: Vec<&str> = err
+            .lines()
+            .filter(|l| {
+                l.contains("wherever") || l.contains("before every axis had a known position")
+            })
+            .collect();
+        assert_eq!(start.len(), 1, "{dialect}: {err}");
+        assert!(
+            start[0].contains("from wherever the head stands")
+                && start[0].contains("clear wherever they are"),
+            "{dialect}: {err}"
+        );
     }
 }
 

@@ -123,6 +123,10 @@ pub struct GcodeProgram {
     /// G-code words, skipped (controller statements or macros such as
     /// `$DO[0].X = 1`); ...`.
     pub notes: Vec<String>,
+    /// Which of `notes` lists the moves made before every axis had a
+    /// known position (a checker that clears them all says so in its own
+    /// words instead).
+    pub unknown_start_note: Option<usize>,
     /// Lines in the file (`\n`, `\r\n` or `\r` end a line).
     pub lines: usize,
 }
@@ -315,10 +319,16 @@ fn read_with_limits(
         reader.line(n, line)?;
         lines = n;
     }
+    let unknown_start_note = reader
+        .notes
+        .0
+        .iter()
+        .position(|n| n.kind == NoteKind::UnknownStart);
     Ok(GcodeProgram {
         moves: reader.moves,
         unknown_moves: reader.unknown,
         notes: reader.notes.finish(),
+        unknown_start_note,
         lines,
     })
 }
