@@ -59,7 +59,7 @@ use std::collections::BinaryHeap;
 use glam::{DVec2, DVec3};
 
 use super::index::{Box32, QueryBox};
-use super::{meets, Surface};
+use super::{box_meets, corner_box, Surface};
 
 /// The clearance of a move (see the module comment).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,10 +154,11 @@ impl Surface {
                 let rank = handed;
                 handed += 1;
                 let t = self.mesh.triangle(i);
-                if !meets(&t, q) {
+                let (lo, hi) = corner_box(&t);
+                if !box_meets(lo, hi, q) {
                     return;
                 }
-                let Some(low) = sweep.bound(&t, best.gap) else {
+                let Some(low) = sweep.bound(&t, lo, hi, best.gap) else {
                     return;
                 };
                 if low > best.gap {
@@ -354,10 +355,9 @@ impl Sweep {
     ///
     /// A hair is given up of each, more than the coverage tests' slack and
     /// the rounding. The box bound alone when it is above `enough`.
+    /// `lo` and `hi` are the triangle's box ([`corner_box`]).
     #[inline]
-    fn bound(&self, t: &[DVec3; 3], enough: f64) -> Option<f64> {
-        let lo = t[0].min(t[1]).min(t[2]);
-        let hi = t[0].max(t[1]).max(t[2]);
+    fn bound(&self, t: &[DVec3; 3], lo: DVec3, hi: DVec3, enough: f64) -> Option<f64> {
         let c = 0.5 * (lo.truncate() + hi.truncate());
         let half = 0.5 * (hi.truncate() - lo.truncate()).length();
         let (by_box, s0, s1) = self.box_part(c, half, hi.z)?;
@@ -371,9 +371,15 @@ impl Sweep {
         }
         let g = DVec2::new(-n.x / n.z, -n.y / n.z);
         let gl = g.length();
-        let rise = steps
-            .iter()
-            .fold(f64::NEG_INFINITY, |m, &(radius, h)| m.max(gl * radius + h));
+        // (A comparison, not `f64::max`: the terms are finite.)
+        let rise = steps.iter().fold(f64::NEG_INFINITY, |m, &(radius, h)| {
+            let v = gl * radius + h;
+            if v > m {
+                v
+            } else {
+                m
+            }
+        });
         let off = a - t[0].truncate();
         let v0 = self.m.a.z - t[0].z - g.dot(off) - rise;
         let v1 = v0 + self.m.dz - g.dot(self.m.d);
@@ -877,6 +883,7 @@ fn segments_cross(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::meets;
     use super::super::tests::{grid, reference_max_height_in_disk};
     use super::*;
     use crate::mesh::TriMesh;
