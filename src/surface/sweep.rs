@@ -292,7 +292,12 @@ struct Sweep {
     m: Move,
     /// The box a triangle must meet to matter ([`move_box`]).
     q: QueryBox,
+    /// The rim's staircase ([`rim_steps`]): the steps and how many there
+    /// are; with tol = 0, one, and the others copies of it.
     steps: ([(f64, f64); 4], usize),
+    /// The move's XY segment for [`dist2_to_segment`]: its start, the
+    /// step to its end, and that step's squared length.
+    seg: (DVec2, DVec2, f64),
     low_tip: f64,
     limit: f64,
     /// What [`Sweep::bound`] gives up of a distance for rounding.
@@ -311,7 +316,10 @@ impl Sweep {
     fn new(a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> Sweep {
         let (lo, hi) = move_box(a, b, radius + tol, limit);
         let dd = (b - a).truncate().length_squared();
+        // As `point_segment_dist2` finds them from the two ends.
+        let ab = (a.truncate() + (b - a).truncate()) - a.truncate();
         Sweep {
+            seg: (a.truncate(), ab, ab.length_squared()),
             q: QueryBox { lo, hi },
             m: Move {
                 a,
@@ -362,7 +370,9 @@ impl Sweep {
         let half = 0.5 * (hi.truncate() - lo.truncate()).length();
         let (by_box, s0, s1) = self.box_part(c, half, hi.z)?;
         let a = self.m.a.truncate();
-        let steps = &self.steps.0[..self.steps.1];
+        // All four steps: with tol = 0 they are four copies of the one
+        // (see `Sweep::steps`), and a fixed count spares the loop's checks.
+        let steps = &self.steps.0;
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         // The plane is not needed when the box bound alone is enough, and
         // steep planes give nothing better than the box.
@@ -413,10 +423,11 @@ impl Sweep {
     /// within the widest step's reach.
     #[inline]
     fn box_part(&self, c: DVec2, half: f64, top: f64) -> Option<(f64, f64, f64)> {
-        let a = self.m.a.truncate();
-        let d = point_segment_dist2(c, a, a + self.m.d).sqrt() - half;
+        let (a, ab, l) = self.seg;
+        let d = dist2_to_segment(c, a, ab, l).sqrt() - half;
         let d = d - self.hair - 1e-8 * half;
-        let steps = &self.steps.0[..self.steps.1];
+        // All four steps, as in `bound`.
+        let steps = &self.steps.0;
         let h = steps.iter().find(|&&(radius, _)| d <= radius)?.1;
         // The part of the move where the box can be within the widest
         // step's reach (its circle, of radius `half` around `c`, meets
@@ -766,7 +777,13 @@ fn live_steps(room: f64, steps: &[(f64, f64)], best: f64) -> &[(f64, f64)] {
 /// Squared distance from `p` to the segment [a, b] (2-D).
 fn point_segment_dist2(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
-    let l = ab.length_squared();
+    dist2_to_segment(p, a, ab, ab.length_squared())
+}
+
+/// [`point_segment_dist2`] for the segment from `a` along `ab`, of squared
+/// length `l`, found once for many points.
+#[inline]
+fn dist2_to_segment(p: DVec2, a: DVec2, ab: DVec2, l: f64) -> f64 {
     let t = if l > 0.0 {
         ((p - a).dot(ab) / l).clamp(0.0, 1.0)
     } else {
