@@ -159,6 +159,7 @@ impl Spline {
     }
 
     /// Non-vanishing basis functions (NURBS Book A2.2).
+    #[inline]
     fn basis_funs(&self, span: usize, u: f64, out: &mut [f64; 4]) {
         if self.degree == 3 {
             // Every path of four points or more: the knots it reads taken
@@ -167,8 +168,15 @@ impl Spline {
                 .try_into()
                 .expect("six knots");
             cubic_basis_funs(knots, u, out);
-            return;
+        } else {
+            self.any_basis_funs(span, u, out);
         }
+    }
+
+    /// [`Self::basis_funs`] of any degree: out of line, so the cubic's
+    /// short path is inlined where the curve is evaluated.
+    #[inline(never)]
+    fn any_basis_funs(&self, span: usize, u: f64, out: &mut [f64; 4]) {
         let p = self.degree;
         let mut left = [0.0; 4];
         let mut right = [0.0; 4];
@@ -278,8 +286,16 @@ impl Spline {
         hint.set(span);
         let mut basis = [0.0; 4];
         self.basis_funs(span, u, &mut basis);
-        self.ctrl[span - p..=span]
-            .iter()
+        let ctrl = &self.ctrl[span - p..=span];
+        // A cubic's four control points as an array: the sum unrolled (the
+        // same sum, in the same order).
+        if let Ok(ctrl) = <&[DVec3; 4]>::try_from(ctrl) {
+            return ctrl
+                .iter()
+                .zip(&basis)
+                .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w);
+        }
+        ctrl.iter()
             .zip(&basis)
             .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w)
     }
