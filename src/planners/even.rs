@@ -151,21 +151,32 @@ pub(super) fn plan(
     // (Each point on its own: on every core natively.)
     let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
     let furthest = steps as f64 * SLIDE_STEP_MM;
-    let low_cap: Vec<Option<f64>> = parallel::map(n, MIN_CHUNK, |j| {
-        let a = geometry[j].slope_rad;
-        let worth = |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
-        // The rise matters only until it makes the whole slide worth
-        // trying (`worth` grows with the rise): the query stops there.
-        let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
-        if rise == 0.0 {
-            return Some(target[j]);
-        }
-        (1..=steps)
-            .map(|k| k as f64 * SLIDE_STEP_MM)
-            .take_while(|&back| worth(back, rise))
-            .map(|back| target[j] - back)
-            .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])))
-    });
+    // With each cap, the rise the target itself needs when the query found
+    // it whole (see below).
+    let (low_cap, target_rise): (Vec<Option<f64>>, Vec<Option<f64>>) =
+        parallel::map(n, MIN_CHUNK, |j| {
+            let a = geometry[j].slope_rad;
+            let worth =
+                |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
+            // The rise matters only until it makes the whole slide worth
+            // trying (`worth` grows with the rise): the query stops there.
+            let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
+            if rise == 0.0 {
+                return (Some(target[j]), None);
+            }
+            // Where the slide is not worth it, the query did not stop early
+            // and `rise` is the rise needed, to the last bit: a point left
+            // at its target is raised by it below without asking again.
+            let whole = (!worth(furthest, rise)).then_some(rise);
+            let cap = (1..=steps)
+                .map(|k| k as f64 * SLIDE_STEP_MM)
+                .take_while(|&back| worth(back, rise))
+                .map(|back| target[j] - back)
+                .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])));
+            (cap, whole)
+        })
+        .into_iter()
+        .unzip();
     // Backward: every point at most its cap and at least one advance
     // behind the next; a point that cannot stay low within the slide is
     // raised where progress puts it.
@@ -197,7 +208,12 @@ pub(super) fn plan(
         if low_cap[j] == Some(w[j]) {
             return (t, 0.0);
         }
-        let lift = c.rise_needed(surface, t);
+        // The same point as the target's own query (the same bits of w, so
+        // of t) when that query found the rise needed whole.
+        let lift = match target_rise[j] {
+            Some(rise) if w[j].to_bits() == target[j].to_bits() => rise,
+            _ => c.rise_needed(surface, t),
+        };
         if lift.is_nan() || lift <= 0.0 {
             return (t, 0.0);
         }
