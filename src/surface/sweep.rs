@@ -784,6 +784,7 @@ fn live_steps(room: f64, steps: &[(f64, f64)], best: f64) -> &[(f64, f64)] {
 }
 
 /// Squared distance from `p` to the segment [a, b] (2-D).
+#[inline]
 fn point_segment_dist2(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
     dist2_to_segment(p, a, ab, ab.length_squared())
