@@ -159,7 +159,24 @@ impl Spline {
     }
 
     /// Non-vanishing basis functions (NURBS Book A2.2).
+    #[inline]
     fn basis_funs(&self, span: usize, u: f64, out: &mut [f64; 4]) {
+        if self.degree == 3 {
+            // Every path of four points or more: the knots it reads taken
+            // once, and the loops of a known length unrolled.
+            let knots: &[f64; 6] = self.knots[span - 2..=span + 3]
+                .try_into()
+                .expect("six knots");
+            cubic_basis_funs(knots, u, out);
+        } else {
+            self.any_basis_funs(span, u, out);
+        }
+    }
+
+    /// [`Self::basis_funs`] of any degree: out of line, so the cubic's
+    /// short path is inlined where the curve is evaluated.
+    #[inline(never)]
+    fn any_basis_funs(&self, span: usize, u: f64, out: &mut [f64; 4]) {
         let p = self.degree;
         let mut left = [0.0; 4];
         let mut right = [0.0; 4];
@@ -269,8 +286,16 @@ impl Spline {
         hint.set(span);
         let mut basis = [0.0; 4];
         self.basis_funs(span, u, &mut basis);
-        self.ctrl[span - p..=span]
-            .iter()
+        let ctrl = &self.ctrl[span - p..=span];
+        // A cubic's four control points as an array: the sum unrolled (the
+        // same sum, in the same order).
+        if let Ok(ctrl) = <&[DVec3; 4]>::try_from(ctrl) {
+            return ctrl
+                .iter()
+                .zip(&basis)
+                .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w);
+        }
+        ctrl.iter()
             .zip(&basis)
             .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w)
     }
@@ -288,6 +313,26 @@ impl Spline {
             }
         }
         out
+    }
+}
+
+/// [`Spline::basis_funs`] of a cubic, from the knots span - 2 to span + 3:
+/// the same operations in the same order, so the same bits.
+#[inline]
+fn cubic_basis_funs(knots: &[f64; 6], u: f64, out: &mut [f64; 4]) {
+    let mut left = [0.0; 4];
+    let mut right = [0.0; 4];
+    out[0] = 1.0;
+    for j in 1..=3 {
+        left[j] = u - knots[3 - j];
+        right[j] = knots[2 + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            let temp = out[r] / (right[r + 1] + left[j - r]);
+            out[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        out[j] = saved;
     }
 }
 

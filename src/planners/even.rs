@@ -151,21 +151,32 @@ pub(super) fn plan(
     // (Each point on its own: on every core natively.)
     let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
     let furthest = steps as f64 * SLIDE_STEP_MM;
-    let low_cap: Vec<Option<f64>> = parallel::map(n, MIN_CHUNK, |j| {
-        let a = geometry[j].slope_rad;
-        let worth = |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
-        // The rise matters only until it makes the whole slide worth
-        // trying (`worth` grows with the rise): the query stops there.
-        let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
-        if rise == 0.0 {
-            return Some(target[j]);
-        }
-        (1..=steps)
-            .map(|k| k as f64 * SLIDE_STEP_MM)
-            .take_while(|&back| worth(back, rise))
-            .map(|back| target[j] - back)
-            .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])))
-    });
+    // With each cap, the rise the target itself needs when the query found
+    // it whole (see below).
+    let (low_cap, target_rise): (Vec<Option<f64>>, Vec<Option<f64>>) =
+        parallel::map(n, MIN_CHUNK, |j| {
+            let a = geometry[j].slope_rad;
+            let worth =
+                |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
+            // The rise matters only until it makes the whole slide worth
+            // trying (`worth` grows with the rise): the query stops there.
+            let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
+            if rise == 0.0 {
+                return (Some(target[j]), None);
+            }
+            // Where the slide is not worth it, the query did not stop early
+            // and `rise` is the rise needed, to the last bit: a point left
+            // at its target is raised by it below without asking again.
+            let whole = (!worth(furthest, rise)).then_some(rise);
+            let cap = (1..=steps)
+                .map(|k| k as f64 * SLIDE_STEP_MM)
+                .take_while(|&back| worth(back, rise))
+                .map(|back| target[j] - back)
+                .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])));
+            (cap, whole)
+        })
+        .into_iter()
+        .unzip();
     // Backward: every point at most its cap and at least one advance
     // behind the next; a point that cannot stay low within the slide is
     // raised where progress puts it.
@@ -197,33 +208,20 @@ pub(super) fn plan(
         if low_cap[j] == Some(w[j]) {
             return (t, 0.0);
         }
-        let lift = c.rise_needed(surface, t);
+        // The same point as the target's own query (the same bits of w, so
+        // of t) when that query found the rise needed whole.
+        let lift = match target_rise[j] {
+            Some(rise) if w[j].to_bits() == target[j].to_bits() => rise,
+            _ => c.rise_needed(surface, t),
+        };
         if lift.is_nan() || lift <= 0.0 {
             return (t, 0.0);
         }
-        let g = &geometry[j];
-        let side = DVec3::new(-g.v.y, g.v.x, 0.0);
-        let cos_a = libm::cos(g.slope_rad);
-        let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
-        let mut best = (cost(0.0, lift), t, lift);
-        for k in 1..=LATERAL_STEPS {
-            let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
-            for sgn in [-1.0, 1.0] {
-                let q = t + sgn * w * side;
-                // Off the path (w > 0) the cost grows with the rise: the
-                // query stops once the rise is too much to beat the best.
-                let e = c.rise_until(surface, q, |e| cost(w, e) >= best.0);
-                let cq = cost(w, e);
-                if cq < best.0 {
-                    best = (cq, q, e);
-                }
-            }
+        let (mut t, rise) = sideways(surface, &c, t, lift, &geometry[j], d);
+        if rise > 0.0 {
+            t.z += rise;
         }
-        let mut t = best.1;
-        if best.2 > 0.0 {
-            t.z += best.2;
-        }
-        (t, best.2)
+        (t, rise)
     });
     let mut out = PlannedPoints {
         toolpath: Vec::with_capacity(n),
@@ -265,9 +263,137 @@ fn isotonic(y: &[f64]) -> Vec<f64> {
     out
 }
 
+/// Where the tip `t` that must rise by `lift` (positive) to keep tol goes:
+/// itself, or a small step sideways (across the path, either way, up to
+/// [`LATERAL_MAX_MM`]) where that costs less, with the rise needed there
+/// ((point, rise)). The cost of a sideways offset w and a rise e is the
+/// change of the filament's thickness measured from Ta_j on a slope of
+/// `g.slope_rad` (see `plan`), for the thickness `d`; the first of equal
+/// costs is kept.
+fn sideways(
+    surface: &Surface,
+    c: &Clearance,
+    t: DVec3,
+    lift: f64,
+    g: &LocalGeometry,
+    d: f64,
+) -> (DVec3, f64) {
+    let side = DVec3::new(-g.v.y, g.v.x, 0.0);
+    let cos_a = libm::cos(g.slope_rad);
+    let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+    let mut best = (cost(0.0, lift), t, lift);
+    for k in 1..=LATERAL_STEPS {
+        let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+        for sgn in [-1.0, 1.0] {
+            // Off the path (w > 0) the cost grows with the rise e: e and
+            // cos a are not negative, so d + e cos a is at least d, each
+            // operation of `cost` keeps the order of its operands, and the
+            // root is at least d, so the absolute value changes nothing.
+            // So no rise costs less than none: when the cost of none
+            // cannot beat the best, the query could not change it, and it
+            // is not asked.
+            if cost(w, 0.0) >= best.0 {
+                continue;
+            }
+            let q = t + sgn * w * side;
+            // The query stops once the rise is too much to beat the best.
+            let e = c.rise_until(surface, q, |e| cost(w, e) >= best.0);
+            let cq = cost(w, e);
+            if cq < best.0 {
+                best = (cq, q, e);
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `sideways` as it was before it left out the queries that could not
+    /// change its answer: every offset asked.
+    fn sideways_asking_all(
+        surface: &Surface,
+        c: &Clearance,
+        t: DVec3,
+        lift: f64,
+        g: &LocalGeometry,
+        d: f64,
+    ) -> (DVec3, f64) {
+        let side = DVec3::new(-g.v.y, g.v.x, 0.0);
+        let cos_a = libm::cos(g.slope_rad);
+        let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+        let mut best = (cost(0.0, lift), t, lift);
+        for k in 1..=LATERAL_STEPS {
+            let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+            for sgn in [-1.0, 1.0] {
+                let q = t + sgn * w * side;
+                let e = c.rise_until(surface, q, |e| cost(w, e) >= best.0);
+                let cq = cost(w, e);
+                if cq < best.0 {
+                    best = (cq, q, e);
+                }
+            }
+        }
+        (best.1, best.2)
+    }
+
+    #[test]
+    fn sideways_skips_only_queries_that_cannot_change_its_answer() {
+        // Ridges across x with slopes across y: tips set low over them need
+        // rises of all sizes, and a step sideways often needs less.
+        let axis: Vec<f64> = (0..=120).map(|i| i as f64 * 0.05).collect();
+        let mesh = crate::mesh::TriMesh::height_field(&axis, &axis, |x, y| {
+            0.4 * (3.0 * x).sin() * (1.7 * y).cos() + 0.15 * y
+        });
+        let surface = Surface::new(mesh).unwrap();
+        let nozzle = Nozzle {
+            inner_diameter_mm: 0.603,
+            outer_diameter_mm: 0.908,
+        };
+        let c = Clearance::new(&nozzle, 0.1).with_margin(PLANNING_MARGIN_MM);
+        let d = nozzle.inner_diameter_mm;
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut unit = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut lifted, mut moved) = (0, 0);
+        for _ in 0..600 {
+            let (x, y) = (1.0 + 4.0 * unit(), 1.0 + 4.0 * unit());
+            let z = surface.highest_hit(glam::DVec2::new(x, y)).unwrap() + 0.6 * unit();
+            let t = DVec3::new(x, y, z);
+            let ang = std::f64::consts::TAU * unit();
+            let slope = 0.8 * (unit() - 0.5);
+            let v = DVec3::new(ang.cos(), ang.sin(), 0.0);
+            let g = LocalGeometry {
+                tangent: (v * slope.cos()).with_z(slope.sin()),
+                v,
+                n: DVec3::Z,
+                kappa: 0.0,
+                slope_rad: slope,
+                curvature_3d: 0.0,
+            };
+            let lift = c.rise_needed(&surface, t);
+            if lift.is_nan() || lift <= 0.0 {
+                continue;
+            }
+            lifted += 1;
+            let got = sideways(&surface, &c, t, lift, &g, d);
+            let want = sideways_asking_all(&surface, &c, t, lift, &g, d);
+            assert_eq!(
+                (got.0.to_array().map(f64::to_bits), got.1.to_bits()),
+                (want.0.to_array().map(f64::to_bits), want.1.to_bits()),
+                "{t} {g:?}"
+            );
+            moved += usize::from(got.0 != t);
+        }
+        // Enough tips needed a rise, and enough of them went sideways.
+        assert!(lifted > 200 && moved > 50, "{lifted} lifted, {moved} moved");
+    }
 
     #[test]
     fn isotonic_pools_violators() {
