@@ -259,6 +259,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         }
     }
 
+    let (mut filled_only, mut first_filled) = (0usize, None::<String>);
     let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
     while let Some(node) = stack.pop() {
         let path = match node {
@@ -297,6 +298,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             None if id.is_empty() => "use instance".to_string(),
             None => id.to_string(),
         };
+        // A filled shape with no stroke (an icon, a PCB pad) is printed
+        // along its outline: the nozzle draws lines, it does not fill.
+        if path.stroke().is_none() {
+            filled_only += 1;
+            first_filled.get_or_insert_with(|| label.clone());
+        }
         let local = shape
             .and_then(|s| exact_geometry(s, path.data()))
             .unwrap_or_else(|| from_tiny_skia(path.data()));
@@ -337,6 +344,13 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     if images > 0 {
         notes.push(format!(
             "{images} image(s) ignored: only outlines are printed"
+        ));
+    }
+    if let Some(first) = &first_filled {
+        notes.push(format!(
+            "{filled_only} shape(s) filled but not stroked (the first: '{first}') are printed \
+             along their outlines, not over their area: draw a fill as strokes (e.g. a \
+             serpentine) to print it"
         ));
     }
     if non_finite > 0 {
@@ -1510,5 +1524,30 @@ mod tests {
         };
         assert_eq!(p.shapes.len(), 2);
         assert!(p.text.contains("_pcpp-shape-2"));
+    }
+
+    /// A filled shape without a stroke (an icon, a PCB pad: the real-world
+    /// sweep's MDI and simple-icons files) is printed along its outline,
+    /// and the import says so, naming the first; stroked shapes, filled or
+    /// not, get no such note.
+    #[test]
+    fn fill_only_shapes_are_named_as_printed_along_their_outlines() {
+        let text = svg(
+            r#"<rect id="pad" x="1" y="1" width="4" height="2" fill="black"/><circle cx="8" cy="8" r="1"/><path d="M0 0 L9 0" stroke="red" fill="blue"/>"#,
+        );
+        let import = import_svg_with_notes(text.as_bytes(), "pads.svg").unwrap();
+        assert_eq!(import.subpaths.len(), 3);
+        let note = import
+            .notes
+            .iter()
+            .find(|n| n.contains("filled but not stroked"))
+            .unwrap_or_else(|| panic!("{:?}", import.notes));
+        assert!(
+            note.starts_with("2 shape(s)") && note.contains("'pad'"),
+            "{note}"
+        );
+        let text = svg(r#"<path d="M0 0 L9 0" stroke="red" fill="blue"/>"#);
+        let import = import_svg_with_notes(text.as_bytes(), "line.svg").unwrap();
+        assert!(import.notes.is_empty(), "{:?}", import.notes);
     }
 }
