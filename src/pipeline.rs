@@ -136,7 +136,8 @@ pub fn surface_path(
                 sub.source,
                 dot.x,
                 dot.y,
-                placed.length_mm()
+                // (A zero-length subpath measures -0.0.)
+                placed.length_mm().abs()
             ));
             dots.push(sub.source.clone());
             continue;

@@ -1206,3 +1206,53 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
     assert!(stderr(&o).contains("not both"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A drawing with many parts too small to print (30 zero-length paths
+/// beside a line, as PCB drawings have) gave a warning each, 117 lines on
+/// a real PCB drawing: the CLI prints the first 25 and how many more, and
+/// the report keeps them all. The zero length read "-0.0000 mm".
+#[test]
+fn a_flood_of_warnings_is_cut_short_and_the_report_keeps_them_all() {
+    let dir = temp_dir("many-warnings");
+    let dots: String = (0..30)
+        .map(|i| {
+            format!(
+                r#"<path id="dot{i}" d="M {x} 10 L {x} 10" stroke="black"/>"#,
+                x = 5 + 2 * i
+            )
+        })
+        .collect();
+    let svg = dir.join("dots.svg");
+    std::fs::write(
+        &svg,
+        format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="70mm" height="20mm" viewBox="0 0 70 20">{dots}<path d="M 5 15 L 65 15" stroke="black"/></svg>"#
+        ),
+    )
+    .unwrap();
+    let (out, report) = (dir.join("dots.gcode"), dir.join("dots.json"));
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "5,20", "-o", s(&out), "--report", s(&report)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let err = stderr(&o);
+    let dots_named = err.lines().filter(|l| l.contains("path 'dot")).count();
+    assert_eq!(dots_named, 25, "{err}");
+    assert!(
+        err.contains("... and 5 more warning(s), not shown"),
+        "{err}"
+    );
+    assert!(!err.contains("-0.0000"), "{err}");
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let kept = json["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w.as_str().unwrap().contains("path 'dot"))
+        .count();
+    assert_eq!(kept, 30);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -16,6 +16,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 pub const SHOW_AFTER: Duration = Duration::from_secs(1);
 const TICK: Duration = Duration::from_millis(100);
 
+/// At most this many warnings of one list are printed.
+pub const WARNINGS_SHOWN: usize = 25;
+
 pub struct Progress {
     /// `None` when nobody is watching.
     bar: Option<ProgressBar>,
@@ -63,10 +66,20 @@ impl Progress {
     }
 
     /// Warnings for the user: always printed, above the spinner if it shows.
+    /// Prints `warnings`, the first [`WARNINGS_SHOWN`] of them when there
+    /// are more (a large PCB drawing on a part gave 117 lines), then how
+    /// many more there are: the report keeps them all.
     pub fn warn(&self, warnings: &[String]) {
         let print = || {
-            for w in warnings {
+            for w in warnings.iter().take(WARNINGS_SHOWN) {
                 eprintln!("warning: {w}");
+            }
+            if warnings.len() > WARNINGS_SHOWN {
+                eprintln!(
+                    "warning: ... and {} more warning(s), not shown; --report FILE.json \
+                     writes them all",
+                    warnings.len() - WARNINGS_SHOWN
+                );
             }
         };
         match &self.bar {
