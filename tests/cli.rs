@@ -579,7 +579,7 @@ fn usage_errors_exit_2_and_name_the_flag() {
                 "-o",
                 "x.gcode",
                 "--scan-units",
-                "ft",
+                "yd",
             ],
             "--scan-units",
         ),

@@ -696,6 +696,34 @@ mod tests {
         assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
     }
 
+    /// Survey and LiDAR clouds come in feet (the real-world sweep's Autzen
+    /// cloud from laspy's tests): `ft` reads them, as the CLI's and the
+    /// page's unit names it.
+    #[test]
+    fn feet_are_a_unit() {
+        assert_eq!("ft".parse::<ScanUnits>(), Ok(ScanUnits::Ft));
+        assert_eq!("Feet".parse::<ScanUnits>(), Ok(ScanUnits::Ft));
+        assert_eq!(ScanUnits::Ft.to_string(), "ft");
+        let e = "yd".parse::<ScanUnits>().unwrap_err();
+        assert!(e.contains("in or ft"), "{e}");
+        let pts = b"0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
+        let m = import_mesh(
+            pts,
+            "survey.xyz",
+            &ImportOptions {
+                units: Some(ScanUnits::Ft),
+                ..ImportOptions::DEFAULT
+            },
+        )
+        .unwrap();
+        assert_eq!(m.units, ScanUnits::Ft);
+        let (lo, hi) = m.mesh.bbox().unwrap();
+        assert_eq!(
+            (lo, hi),
+            (DVec3::new(0.0, 0.0, 304.8), DVec3::new(304.8, 304.8, 304.8))
+        );
+    }
+
     #[test]
     fn a_scan_too_small_for_its_units_gets_a_hint() {
         // The Stanford bunny as its PLY comes, in metres: 0.16 m across.

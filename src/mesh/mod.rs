@@ -115,6 +115,9 @@ pub enum ScanUnits {
     Cm,
     M,
     In,
+    /// The international foot, 304.8 mm (a survey scanner's US survey foot
+    /// differs by 2 parts in a million).
+    Ft,
 }
 
 impl ScanUnits {
@@ -124,6 +127,7 @@ impl ScanUnits {
             ScanUnits::Cm => 10.0,
             ScanUnits::M => 1000.0,
             ScanUnits::In => 25.4,
+            ScanUnits::Ft => 304.8,
         }
     }
 }
@@ -136,8 +140,9 @@ impl FromStr for ScanUnits {
             "cm" => Ok(ScanUnits::Cm),
             "m" => Ok(ScanUnits::M),
             "in" | "inch" | "inches" => Ok(ScanUnits::In),
+            "ft" | "foot" | "feet" => Ok(ScanUnits::Ft),
             other => Err(format!(
-                "unknown scan units '{other}' (expected mm, cm, m or in)"
+                "unknown scan units '{other}' (expected mm, cm, m, in or ft)"
             )),
         }
     }
@@ -150,6 +155,7 @@ impl fmt::Display for ScanUnits {
             ScanUnits::Cm => "cm",
             ScanUnits::M => "m",
             ScanUnits::In => "in",
+            ScanUnits::Ft => "ft",
         })
     }
 }

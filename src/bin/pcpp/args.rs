@@ -524,7 +524,7 @@ fn part_values() -> Vec<PossibleValue> {
 }
 
 fn unit_values() -> Vec<PossibleValue> {
-    ["mm", "cm", "m", "in"].map(PossibleValue::new).into()
+    ["mm", "cm", "m", "in", "ft"].map(PossibleValue::new).into()
 }
 
 fn axis_values() -> Vec<PossibleValue> {
