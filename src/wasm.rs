@@ -63,7 +63,9 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 
 /// A core error as a JS `Error` with a `kind` naming the stage that failed
 /// (`mesh`, `svg`, `registration`, `gcode` for a G-code file that could not
-/// be read, `touching` for G-code refused by the motion check, or `other`):
+/// be read, `touching` for G-code refused by the motion check,
+/// `whole-object` for G-code refused on a point cloud of a whole object,
+/// or `other`):
 /// the page drops a file whose bytes could not be read but keeps one that
 /// only failed to register. A `touching` error also carries `touching`, the
 /// check's summary (`motion::MotionSummary`: the first touching moves with
@@ -82,6 +84,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "gcode"
     } else if matches!(e, Error::Touching(_)) {
         "touching"
+    } else if matches!(e, Error::WholeObjectCloud { .. }) {
+        "whole-object"
     } else {
         "other"
     };

@@ -1085,3 +1085,54 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
         &gcode[..800]
     );
 }
+
+/// A point cloud of a whole object (a pebble, top and underside, as a
+/// turntable scanner gives it): the page gets the refusal of its G-code
+/// with a kind of its own, naming the file, and the G-code once the user
+/// accepts the risk.
+#[wasm_bindgen_test]
+fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
+    let (a, c, step) = (10.0f64, 4.0f64, 0.25f64);
+    let rings = (std::f64::consts::PI * c / step).ceil() as usize;
+    let mut text = String::new();
+    for i in 0..=rings {
+        let phi = std::f64::consts::PI * i as f64 / rings as f64;
+        let r = a * phi.sin();
+        let k = ((std::f64::consts::TAU * r / step).ceil() as usize).max(1);
+        for j in 0..k {
+            let t = std::f64::consts::TAU * (j as f64 + 0.37 * i as f64) / k as f64;
+            text += &format!(
+                "{:.5} {:.5} {:.5}\n",
+                r * t.cos(),
+                r * t.sin(),
+                c - c * phi.cos()
+            );
+        }
+    }
+    // On the bed, where its centre goes to the bed's centre.
+    let mut settings = JobSettings::default();
+    let marlin = MachineProfile::builtin("marlin").unwrap();
+    settings.registration.scan_placement = pcpp::placement::ScanPlacement::on_bed(&marlin);
+    let centre = pcpp::placement::Bed::of_profile(&marlin).centre_mm;
+    settings.plan.placement.offset_mm = centre - pcpp::DVec2::new(6.0, 1.0);
+    let session = pcpp::wasm::Session::new(
+        text.as_bytes(),
+        "pebble.xyz",
+        js(&settings.scan),
+        js(&settings.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="12mm" height="2mm" viewBox="0 0 12 2"><path d="M0 1 H12" fill="none" stroke="black"/></svg>"#;
+    let err = session
+        .plan(svg, "line.svg", js(&settings.plan), "marlin", false, None)
+        .expect_err("G-code written for a whole object's cloud");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "whole-object", "{message}");
+    assert!(
+        message.contains("pebble.xyz") && message.contains("as a mesh"),
+        "{message}"
+    );
+    session
+        .plan(svg, "line.svg", js(&settings.plan), "marlin", true, None)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+}

@@ -291,6 +291,9 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'touching') {
     title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
     message += '\nThe settings, the drawing and the previous plan stay as they were.';
+  } else if (m.kind === 'whole-object') {
+    title = 'The scan is a point cloud of a whole object: no G-code';
+    message += '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
   }
   // A plan refused for its motion still compared the planners on the
   // settings that failed: the table shows why.
