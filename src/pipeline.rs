@@ -136,8 +136,7 @@ pub fn surface_path(
                 sub.source,
                 dot.x,
                 dot.y,
-                // (A zero-length subpath measures -0.0.)
-                placed.length_mm().abs()
+                placed.length_mm()
             ));
             dots.push(sub.source.clone());
             continue;

@@ -74,7 +74,11 @@ pub struct Subpath2 {
 impl Subpath2 {
     /// Length of the flattened polyline (mm).
     pub fn length_mm(&self) -> f64 {
-        self.points.windows(2).map(|w| w[0].distance(w[1])).sum()
+        // (From +0.0: `Sum` starts at -0.0, which a subpath with no
+        // segment would print as "-0.0000".)
+        self.points
+            .windows(2)
+            .fold(0.0, |sum, w| sum + w[0].distance(w[1]))
     }
 }
 
