@@ -324,10 +324,6 @@ fn plan_stage(
             nozzle,
             process,
         );
-        let mut big_lift = vec![false; planned.toolpath.len()];
-        for &(j, lift) in &planned.lifted {
-            big_lift[j] = lift > nozzle.inner_diameter_mm;
-        }
         let moves = if safe_motion && planner.is_guarded() {
             let planning = clearance.with_margin(PLANNING_MARGIN_MM);
             let safe = insert_waypoints_capped(surface, &planned.toolpath, &planning, cap);
@@ -361,19 +357,20 @@ fn plan_stage(
         // over its target is what section 7 asks): planned points the
         // planner lifted by more than d (the nozzle is wider than the
         // feature it must pass) and the waypoints (rises over a feature
-        // between two points); the filament falls from there.
+        // between two points, the points of `moves` not planned); the
+        // filament falls from there.
+        let lifted_far = planned
+            .lifted
+            .iter()
+            .filter(|&&(_, lift)| lift > nozzle.inner_diameter_mm)
+            .map(|&(j, _)| planned.toolpath[j]);
         let mut next = 0;
-        for &p in &moves {
-            let planned_here = planned.toolpath.get(next) == Some(&p);
-            let suspect = if planned_here {
-                next += 1;
-                big_lift.get(next - 1).copied().unwrap_or(false)
-            } else {
-                true
-            };
-            if !suspect {
-                continue;
-            }
+        let waypoints = moves.iter().copied().filter(|p| {
+            let planned_here = planned.toolpath.get(next) == Some(p);
+            next += usize::from(planned_here);
+            !planned_here
+        });
+        for p in lifted_far.chain(waypoints) {
             if let Some(z) = surface.highest_hit(p.truncate()) {
                 let above = p.z - z;
                 if above > FLOATING_HEIGHT_PER_D * nozzle.inner_diameter_mm {
