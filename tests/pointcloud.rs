@@ -303,24 +303,8 @@ fn a_larger_edge_limit_closes_the_fiducial_holes() {
 /// of an ellipsoid of semi-axes (10, 10, 4) mm resting on z = 0, about
 /// 0.25 mm apart, top and underside; and the ellipsoid as a fine mesh.
 fn pebble() -> (String, pcpp::mesh::TriMesh) {
-    let (a, c, step) = (10.0, 4.0, 0.25);
-    let at = |phi: f64, t: f64| {
-        let r = a * phi.sin();
-        DVec3::new(r * t.cos(), r * t.sin(), c - c * phi.cos())
-    };
-    let rings = (std::f64::consts::PI * c / step).ceil() as usize;
-    let mut text = String::new();
-    for i in 0..=rings {
-        let phi = std::f64::consts::PI * i as f64 / rings as f64;
-        let k = ((std::f64::consts::TAU * a * phi.sin() / step).ceil() as usize).max(1);
-        for j in 0..k {
-            let p = at(
-                phi,
-                std::f64::consts::TAU * (j as f64 + 0.37 * i as f64) / k as f64,
-            );
-            text += &format!("{:.5} {:.5} {:.5}\n", p.x, p.y, p.z);
-        }
-    }
+    let text = pcpp::demo::workloads::to_xyz(&pcpp::demo::pebble_cloud(0.25));
+    let at = pcpp::demo::pebble_point;
     // The true surface, finer than the cloud: 200 x 400 quads.
     let (n, m) = (200usize, 400usize);
     let mut mesh = pcpp::mesh::TriMesh::default();

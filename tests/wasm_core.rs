@@ -1092,23 +1092,7 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
 /// accepts the risk.
 #[wasm_bindgen_test]
 fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
-    let (a, c, step) = (10.0f64, 4.0f64, 0.25f64);
-    let rings = (std::f64::consts::PI * c / step).ceil() as usize;
-    let mut text = String::new();
-    for i in 0..=rings {
-        let phi = std::f64::consts::PI * i as f64 / rings as f64;
-        let r = a * phi.sin();
-        let k = ((std::f64::consts::TAU * r / step).ceil() as usize).max(1);
-        for j in 0..k {
-            let t = std::f64::consts::TAU * (j as f64 + 0.37 * i as f64) / k as f64;
-            text += &format!(
-                "{:.5} {:.5} {:.5}\n",
-                r * t.cos(),
-                r * t.sin(),
-                c - c * phi.cos()
-            );
-        }
-    }
+    let text = demo::workloads::to_xyz(&demo::pebble_cloud(0.25));
     // On the bed, where its centre goes to the bed's centre.
     let mut settings = JobSettings::default();
     let marlin = MachineProfile::builtin("marlin").unwrap();

@@ -12,6 +12,36 @@ pub const DEMO_SCAN_NAME: &str = "demo-test-part.ply";
 /// File name of the demo's drawn paths.
 pub const DEMO_PATH_NAME: &str = "demo-test-part-lines.svg";
 
+/// Semi-axes (across, half the height) of [`pebble_cloud`]'s ellipsoid, mm.
+pub const PEBBLE_MM: (f64, f64) = (10.0, 4.0);
+
+/// A point on the pebble's surface: `phi` from its lowest point (0) to its
+/// top (pi), `t` around.
+pub fn pebble_point(phi: f64, t: f64) -> glam::DVec3 {
+    let (a, c) = PEBBLE_MM;
+    let r = a * phi.sin();
+    glam::DVec3::new(r * t.cos(), r * t.sin(), c - c * phi.cos())
+}
+
+/// A whole object's point cloud, as a turntable scanner gives it: points
+/// about `step` mm apart on the whole surface of an ellipsoid ([`PEBBLE_MM`],
+/// centred on the z axis, its lowest point at the origin), top and
+/// underside, each ring of points turned a little as a scanner's would be.
+pub fn pebble_cloud(step: f64) -> Vec<glam::DVec3> {
+    let (a, c) = PEBBLE_MM;
+    let rings = (std::f64::consts::PI * c / step).ceil() as usize;
+    let mut pts = Vec::new();
+    for i in 0..=rings {
+        let phi = std::f64::consts::PI * i as f64 / rings as f64;
+        let k = ((std::f64::consts::TAU * a * phi.sin() / step).ceil() as usize).max(1);
+        for j in 0..k {
+            let t = std::f64::consts::TAU * (j as f64 + 0.37 * i as f64) / k as f64;
+            pts.push(pebble_point(phi, t));
+        }
+    }
+    pts
+}
+
 /// A mesh as binary little-endian PLY with double coordinates, so it goes
 /// through the importers like any user's scan and loses no precision.
 pub fn to_binary_ply(mesh: &TriMesh) -> Vec<u8> {

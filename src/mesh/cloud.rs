@@ -380,11 +380,11 @@ fn hidden_points(t: &DelaunayTriangulation<Vertex>, pos: &[DVec3], spacing: f64)
     drop(fill);
     let r2 = radius * radius;
     let top = &top;
+    let reach = (radius / cell).ceil() as usize;
     while let Some(i) = queue.pop() {
         let i = i as usize;
         let p = pos[i];
         let (x, y) = cell_of(p);
-        let reach = (radius / cell).ceil() as usize;
         // The cells that can hold a point above p: within the disk, and
         // with a top above the slope at their nearest to p; nearest first
         // (a hidden point is settled by a few points near it).
@@ -499,29 +499,10 @@ mod tests {
         assert!((area - 25.0).abs() < 1e-9, "area {area}");
     }
 
-    /// Points on the whole surface of an ellipsoid of semi-axes (a, a, c)
-    /// centred at (0, 0, c), about `step` apart: what a turntable scanner
-    /// gives of a pebble, top and underside.
-    fn ellipsoid(a: f64, c: f64, step: f64) -> Vec<DVec3> {
-        let mut pts = Vec::new();
-        let rings = (std::f64::consts::PI * c / step).ceil() as usize;
-        for i in 0..=rings {
-            let phi = std::f64::consts::PI * i as f64 / rings as f64;
-            let r = a * phi.sin();
-            let k = ((std::f64::consts::TAU * r / step).ceil() as usize).max(1);
-            for j in 0..k {
-                // Each ring turned a little, as a scanner's rings would be.
-                let t = std::f64::consts::TAU * (j as f64 + 0.37 * i as f64) / k as f64;
-                pts.push(DVec3::new(r * t.cos(), r * t.sin(), c - c * phi.cos()));
-            }
-        }
-        pts
-    }
-
     #[test]
     fn a_whole_objects_underside_is_left_out_and_the_top_is_meshed() {
-        let (a, c) = (10.0, 4.0);
-        let pts = ellipsoid(a, c, 0.25);
+        let (a, c) = crate::demo::PEBBLE_MM;
+        let pts = crate::demo::pebble_cloud(0.25);
         let inside = |p: &DVec3| p.x * p.x + p.y * p.y < (a - 0.5) * (a - 0.5);
         let under = pts.iter().filter(|p| p.z < c && inside(p)).count();
         let (m, info) = triangulate(pts, None, "pebble.xyz").unwrap();

@@ -354,13 +354,8 @@ mod tests {
         };
         let c = Clearance::new(&nozzle, 0.1).with_margin(PLANNING_MARGIN_MM);
         let d = nozzle.inner_diameter_mm;
-        let mut seed = 0x2545_F491_4F6C_DD1Du64;
-        let mut unit = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::demo::workloads::Rng(0x2545_F491_4F6C_DD1D);
+        let mut unit = move || rng.next_f64();
         let (mut lifted, mut moved) = (0, 0);
         for _ in 0..600 {
             let (x, y) = (1.0 + 4.0 * unit(), 1.0 + 4.0 * unit());
