@@ -65,10 +65,10 @@ impl Progress {
         }
     }
 
-    /// Warnings for the user: always printed, above the spinner if it shows.
-    /// Prints `warnings`, the first [`WARNINGS_SHOWN`] of them when there
-    /// are more (a large PCB drawing on a part gave 117 lines), then how
-    /// many more there are: the report keeps them all.
+    /// Warnings for the user, printed above the spinner if it shows: the
+    /// first [`WARNINGS_SHOWN`] of them when there are more (a large PCB
+    /// drawing on a part gave 117 lines), then how many more there are
+    /// (the report keeps them all).
     pub fn warn(&self, warnings: &[String]) {
         let print = || {
             for w in warnings.iter().take(WARNINGS_SHOWN) {
