@@ -375,8 +375,20 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
             [d1, d2]
         })
         .collect();
+    // Where the drawn path turns straight back (out and back along one
+    // line), the spline stops there: C' vanishes but for rounding, and the
+    // direction, slope and curvature found from it are noise (a profile
+    // curvature of 1e25/mm on a flat plate; the paper's forward shift then
+    // threw a tool-path point 1e24 mm away). Such a point takes its
+    // neighbour's geometry, as a vertical tangent takes its neighbour's V
+    // (spec section 5): the one it arrives from.
+    let speed = ders.iter().fold(0.0, |m: f64, d| m.max(d[0].length()));
+    let mut cusps = Vec::new();
     for (j, &[d1, d2]) in ders.iter().enumerate() {
         let len = d1.length();
+        if len <= CUSP * speed {
+            cusps.push(j);
+        }
         let tangent = if len > 0.0 { d1 / len } else { DVec3::Z };
         let h = d1.truncate().length();
         let v = if h > 1e-9 * len {
@@ -425,8 +437,27 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
             0.0
         };
     }
+    for &j in &cusps {
+        let from = (0..j)
+            .rev()
+            .chain(j + 1..out.len())
+            .find(|k| cusps.binary_search(k).is_err());
+        if let Some(k) = from {
+            let g = out[k];
+            out[j] = LocalGeometry {
+                curvature_3d: out[j].curvature_3d,
+                ..g
+            };
+        }
+    }
     out
 }
+
+/// |C'(u)| at most this share of its largest value along the spline marks
+/// a point where the path turns straight back ([`geometry_of`]): with
+/// chord-length parameters |C'| is about the path's length elsewhere, and
+/// at an exact reversal it is rounding, some 1e-15 of it.
+const CUSP: f64 = 1e-9;
 
 #[cfg(test)]
 mod tests {
@@ -500,6 +531,30 @@ mod tests {
             assert!((gj.v.length() - 1.0).abs() < 1e-12);
             assert_eq!(gj.v.z, 0.0);
             assert!(gj.kappa.is_finite());
+        }
+    }
+
+    #[test]
+    fn a_path_turning_straight_back_keeps_the_direction_it_arrives_with() {
+        // Out along a level line and back along it (a spike in a drawing):
+        // the spline stops at the far end, where C' is rounding.
+        let out: Vec<DVec3> = (0..=4)
+            .map(|i| DVec3::new(12.413 + 1e-4 * i as f64, 178.08 - 0.23 * i as f64, 5.0))
+            .collect();
+        let pts: Vec<DVec3> = out
+            .iter()
+            .chain(out.iter().rev().skip(1))
+            .copied()
+            .collect();
+        let g = local_geometry(&pts).unwrap();
+        let turn = &g[4];
+        assert_eq!(turn.v, g[3].v, "{turn:?}");
+        assert_eq!(turn.kappa, g[3].kappa, "{turn:?}");
+        assert_eq!(turn.slope_rad, g[3].slope_rad, "{turn:?}");
+        for gj in &g {
+            assert!(gj.kappa.abs() < 1e-6, "{gj:?}");
+            assert!(gj.slope_rad.abs() < 1e-9, "{gj:?}");
+            assert!(gj.v.y.abs() > 0.99, "{gj:?}");
         }
     }
 

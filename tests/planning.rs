@@ -528,3 +528,47 @@ fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
         );
     }
 }
+
+/// A drawn stroke that runs out and straight back along itself (a spike, as
+/// real drawings have: a pin's lead traced out and back), on a level
+/// plate: the spline stops at the far end, where its direction and
+/// curvature were rounding noise. Every planner keeps every point within
+/// reach of its surface point (the paper's forward shift had thrown one
+/// 1e24 mm away: a profile curvature of -1e25/mm there), and on a level
+/// plate none sees a slope.
+#[test]
+fn a_stroke_that_turns_straight_back_plans_like_any_other_on_a_level_plate() {
+    let xs = range(0.0, 40.0, 8);
+    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
+    let svg =
+        br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
+        <path d="M 12.413 10.9 L 12.4134 12.4 L 12.413 10.9" fill="none" stroke="black"/>
+    </svg>"#;
+    let drawn = pipeline::load_path(svg, "spike.svg").unwrap();
+    // The SVG's y runs down: its 40 mm square laid onto the plate.
+    let mut settings = PlanSettings::default();
+    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
+    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
+    let reach = settings.nozzle.outer_diameter_mm + settings.nozzle.inner_diameter_mm;
+    for plan in &plans {
+        for piece in &plan.pieces {
+            for (g, (t, a)) in piece
+                .geometry
+                .iter()
+                .zip(piece.toolpath.iter().zip(&piece.surface_path))
+            {
+                assert!(
+                    (*t - *a).length() <= reach,
+                    "{}: tool-path point {t:?} for surface point {a:?}",
+                    plan.planner.name()
+                );
+                assert!(g.slope_rad.abs() < 1e-9 && g.kappa.abs() < 1e-6, "{g:?}");
+            }
+        }
+        let q = &plan.quality;
+        assert!(
+            q.mean_abs_error_mm.is_finite() && q.mean_abs_error_mm < 1.0,
+            "{q:?}"
+        );
+    }
+}

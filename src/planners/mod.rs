@@ -101,8 +101,14 @@ pub struct PlannedPoints {
 }
 
 /// M_j of eq. 8-9: the forward shift on descents, from the profile curvature.
+/// The equations give 0.5 d (1 + d kappa) up to kappa = 1/d, which runs from
+/// 0 at kappa = -1/d to d; below -1/d (a crest sharper than radius d) they
+/// would turn the forward shift backwards, without bound as the crest
+/// sharpens, so it stays 0 there (decision: the paper is silent on it).
 fn forward_shift(d: f64, kappa: f64) -> f64 {
-    if kappa <= 1.0 / d {
+    if kappa <= -1.0 / d {
+        0.0
+    } else if kappa <= 1.0 / d {
         0.5 * d * (1.0 + d * kappa)
     } else {
         d
@@ -238,6 +244,11 @@ mod tests {
         assert!((forward_shift(d, 0.0) - 0.3015).abs() < 1e-12);
         assert_eq!(forward_shift(d, 10.0), d);
         assert!(forward_shift(d, -1.0) < 0.3015);
+        // Below kappa = -1/d (a crest sharper than radius d) no shift, not
+        // a backward one.
+        assert_eq!(forward_shift(d, -1.0 / d), 0.0);
+        assert_eq!(forward_shift(d, -10.0), 0.0);
+        assert_eq!(forward_shift(d, -1e25), 0.0);
     }
 
     use crate::surface::tests::flat;
