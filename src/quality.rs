@@ -157,7 +157,11 @@ pub fn predict(
         };
         let thickness = crossing.and_then(|p| {
             let lambda = (p - a).dot(g.n);
-            if lambda > 2.0 * d {
+            // The crossing lies on the normal line only within 2d of Ta_j
+            // (section 7): one further away, up the line or off it to the
+            // side (where the path turns, the curve may cross the plane
+            // normal to t_j far from the line), is no intersection.
+            if lambda > 2.0 * d || p.distance(a) > 2.0 * d {
                 None
             } else if lambda < 0.0 {
                 Some(0.0) // the filament's top is under the surface: crushed
