@@ -256,6 +256,22 @@ fn emit(points: &[DVec2], corner: &[bool], pieces: &[Piece], spacing: f64) -> Sa
     };
     out.points.push(first);
     out.corner.push(corner.first().copied().unwrap_or(true));
+    // A piece that ends where it began, shorter than a spacing (a curve
+    // out and back within a few hundredths of a mm, as icon sets draw
+    // one), would put its end sample on its start: a sample within the
+    // merge distance of the one before is that one, a corner if either is.
+    let merge = merge_distance(spacing);
+    let mut push = |out: &mut Samples, p: DVec2, c: bool| match out.points.last() {
+        Some(q) if q.distance(p) < merge => {
+            if let Some(f) = out.corner.last_mut() {
+                *f |= c;
+            }
+        }
+        _ => {
+            out.points.push(p);
+            out.corner.push(c);
+        }
+    };
     for piece in pieces {
         let n = piece_intervals(points, piece, spacing);
         if n == 0.0 {
@@ -278,12 +294,10 @@ fn emit(points: &[DVec2], corner: &[bool], pieces: &[Piece], spacing: f64) -> Sa
             } else {
                 0.0
             };
-            out.points.push(points[j].lerp(points[j + 1], t));
-            out.corner.push(false);
+            push(&mut out, points[j].lerp(points[j + 1], t), false);
         }
-        out.points.push(points[piece.b]);
-        out.corner
-            .push(corner.get(piece.b).copied().unwrap_or(true));
+        let c = corner.get(piece.b).copied().unwrap_or(true);
+        push(&mut out, points[piece.b], c);
     }
     out
 }
@@ -299,6 +313,37 @@ mod tests {
             closed,
             source: "test".into(),
         }
+    }
+
+    #[test]
+    fn a_curve_out_and_back_shorter_than_a_spacing_gives_no_coincident_samples() {
+        // mdi's wrench-clock icon: "M16 8C16 8 15.9 8 16 8C12.1 8.1 ...",
+        // a curve that leaves its start by 0.03 units and returns to it,
+        // flattened, at 0.2646 mm a unit, then the path goes on.
+        let mm = 0.2646;
+        let pts = [
+            (16.0, 8.0),
+            (15.97, 8.0),
+            (16.0, 8.0),
+            (12.1, 8.1),
+            (9.0, 11.2),
+        ];
+        let s = sub(
+            &pts.map(|(x, y)| (x * mm, y * mm)),
+            &[true, false, true, false, true],
+            false,
+        );
+        let got = try_sample_subpath_marked(&s, 0.3015).unwrap();
+        for w in got.points.windows(2) {
+            assert!(
+                w[0].distance(w[1]) >= merge_distance(0.3015),
+                "{:?}",
+                got.points
+            );
+        }
+        assert_eq!(got.points.len(), got.corner.len());
+        assert_eq!(got.points[0], DVec2::new(16.0 * mm, 8.0 * mm));
+        assert_eq!(*got.points.last().unwrap(), DVec2::new(9.0 * mm, 11.2 * mm));
     }
 
     #[test]
