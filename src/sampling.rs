@@ -261,7 +261,7 @@ fn emit(points: &[DVec2], corner: &[bool], pieces: &[Piece], spacing: f64) -> Sa
     // one), would put its end sample on its start: a sample within the
     // merge distance of the one before is that one, a corner if either is.
     let merge = merge_distance(spacing);
-    let mut push = |out: &mut Samples, p: DVec2, c: bool| match out.points.last() {
+    let push = |out: &mut Samples, p: DVec2, c: bool| match out.points.last() {
         Some(q) if q.distance(p) < merge => {
             if let Some(f) = out.corner.last_mut() {
                 *f |= c;
