@@ -514,6 +514,56 @@ fn svg_numbers(text: &str) -> impl Iterator<Item = f64> + '_ {
     })
 }
 
+/// The matrix [a b c d e f] (SVG's `matrix(a b c d e f)`) of a transform
+/// list, composed in f64; `None` when it does not parse or is not finite.
+fn compose_transform(text: &str) -> Option<[f64; 6]> {
+    let mul = |m: [f64; 6], n: [f64; 6]| {
+        [
+            m[0] * n[0] + m[2] * n[1],
+            m[1] * n[0] + m[3] * n[1],
+            m[0] * n[2] + m[2] * n[3],
+            m[1] * n[2] + m[3] * n[3],
+            m[0] * n[4] + m[2] * n[5] + m[4],
+            m[1] * n[4] + m[3] * n[5] + m[5],
+        ]
+    };
+    let translate = |x: f64, y: f64| [1.0, 0.0, 0.0, 1.0, x, y];
+    let mut m = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+    let mut rest = text.trim_start_matches(|c: char| c.is_whitespace() || c == ',');
+    while !rest.is_empty() {
+        let open = rest.find('(')?;
+        let close = rest.find(')')?;
+        if close < open {
+            return None;
+        }
+        let name = rest[..open].trim();
+        let args: Vec<f64> = svg_numbers(&rest[open + 1..close]).collect();
+        let rad = |deg: f64| deg.to_radians();
+        let step = match (name, args.as_slice()) {
+            ("matrix", &[a, b, c, d, e, f]) => [a, b, c, d, e, f],
+            ("translate", &[x]) => translate(x, 0.0),
+            ("translate", &[x, y]) => translate(x, y),
+            ("scale", &[k]) => [k, 0.0, 0.0, k, 0.0, 0.0],
+            ("scale", &[x, y]) => [x, 0.0, 0.0, y, 0.0, 0.0],
+            ("rotate", &[a]) => {
+                let (sin, cos) = rad(a).sin_cos();
+                [cos, sin, -sin, cos, 0.0, 0.0]
+            }
+            ("rotate", &[a, cx, cy]) => {
+                let (sin, cos) = rad(a).sin_cos();
+                let r = [cos, sin, -sin, cos, 0.0, 0.0];
+                mul(mul(translate(cx, cy), r), translate(-cx, -cy))
+            }
+            ("skewX", &[a]) => [1.0, 0.0, rad(a).tan(), 1.0, 0.0, 0.0],
+            ("skewY", &[a]) => [1.0, rad(a).tan(), 0.0, 1.0, 0.0, 0.0],
+            _ => return None,
+        };
+        m = mul(m, step);
+        rest = rest[close + 1..].trim_start_matches(|c: char| c.is_whitespace() || c == ',');
+    }
+    m.iter().all(|c| c.is_finite()).then_some(m)
+}
+
 fn prepare(text: &str) -> Result<Prepared, String> {
     let opt = roxmltree::ParsingOptions {
         allow_dtd: true,
@@ -567,12 +617,27 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     // Geometry far past any printer (usvg turns an arc of radius 1e40 into
     // cubics without limit, hanging or exhausting memory before our own
     // point budget applies) is refused up front, naming the element.
+    // A transform whose own numbers are large but whose product is not (a
+    // slight rotation about a far-away centre, as Inkscape writes one) is
+    // composed here in f64 and handed on as that matrix: usvg composes in
+    // f32, which would move the shape by several units.
+    let mut composed: Vec<(std::ops::Range<usize>, String)> = Vec::new();
     for node in root.descendants().filter(|n| n.is_element()) {
         for attr in node.attributes() {
             if !NUMERIC_ATTRIBUTES.contains(&attr.name()) {
                 continue;
             }
             if let Some(v) = svg_numbers(attr.value()).find(|v| v.abs() > MAX_COORDINATE) {
+                if attr.name() == "transform" && attr.namespace().is_none() {
+                    let range = attr.range_value();
+                    let small = compose_transform(attr.value())
+                        .filter(|m| m.iter().all(|c| c.abs() <= MAX_COORDINATE));
+                    if let (Some(m), Some(_)) = (small, text.get(range.clone())) {
+                        let [a, b, c, d, e, f] = m;
+                        composed.push((range, format!("matrix({a} {b} {c} {d} {e} {f})")));
+                        continue;
+                    }
+                }
                 let pos = doc.text_pos_at(node.range().start);
                 return Err(format!(
                     "line {}: <{}> attribute {} holds the number {v:e}, beyond the \
@@ -596,6 +661,18 @@ fn prepare(text: &str) -> Result<Prepared, String> {
 
     // (byte position, bytes to remove, text to insert), in document order.
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    // (Markers are removed whole below: a transform inside one is left.)
+    for (range, matrix) in composed {
+        let inside_marker = root.descendants().any(|n| {
+            n.is_element()
+                && n.tag_name().name() == "marker"
+                && n.range().start <= range.start
+                && range.end <= n.range().end
+        });
+        if !inside_marker {
+            edits.push((range.start, range.len(), matrix));
+        }
+    }
     if missing_ns {
         if let Some(at) = tag_name_end(text, root.range().start) {
             edits.push((at, 0, format!(" xmlns=\"{SVG_NS}\"")));
@@ -1457,6 +1534,48 @@ mod tests {
     }
 
     use super::*;
+
+    #[test]
+    fn a_transform_with_far_numbers_but_a_small_product_is_composed_in_f64() {
+        // Inkscape's tutorial-shapes.svg: a slight rotation about a centre
+        // 1.2489e8 units away; the product moves the shape by about
+        // (20, -4). Expected values by hand in f64 (Python's math module).
+        let body = r#"<path transform="translate(20 4177.7) rotate(.0019184 1.2489e8 0)" d="M 0 0 L 10 0" stroke="black" fill="none"/>"#;
+        let subs = import_svg(svg(body).as_bytes(), "far.svg").unwrap();
+        let p = &subs[0].points;
+        // The import's frame has y up: y is the SVG's y negated.
+        let want = [
+            (20.070005267858505, 3.916481900359031),
+            (30.070005252957344, 3.916147076395646),
+        ];
+        for (got, (x, y)) in p.iter().zip(want) {
+            assert!(
+                (got.x - x).abs() < 1e-6 && (got.y - y).abs() < 1e-6,
+                "{p:?}"
+            );
+        }
+        // A transform whose product is far off is still refused, naming it.
+        let body = r#"<path transform="translate(2e7 0)" d="M 0 0 L 10 0" stroke="black"/>"#;
+        let e = import_svg(svg(body).as_bytes(), "far.svg")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("transform") && e.contains("2e7"), "{e}");
+    }
+
+    #[test]
+    fn transform_lists_compose_as_svg_composes_them() {
+        let m = compose_transform("translate(1,2) scale(2) rotate(90)").unwrap();
+        // Applied right to left: (1, 0) -> (0, 1) -> (0, 2) -> (1, 4).
+        let (x, y) = (m[0] + m[4], m[1] + m[5]);
+        assert!((x - 1.0).abs() < 1e-12 && (y - 4.0).abs() < 1e-12, "{m:?}");
+        let m = compose_transform("skewX(45) matrix(1 0 0 1 3 4)").unwrap();
+        assert!(
+            (m[2] - 1.0).abs() < 1e-12 && (m[4] - 7.0).abs() < 1e-12,
+            "{m:?}"
+        );
+        assert_eq!(compose_transform("rotate(1 2)"), None);
+        assert_eq!(compose_transform("wobble(3)"), None);
+    }
 
     fn svg(body: &str) -> String {
         format!(
