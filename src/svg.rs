@@ -627,7 +627,13 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             if !NUMERIC_ATTRIBUTES.contains(&attr.name()) {
                 continue;
             }
-            if let Some(v) = svg_numbers(attr.value()).find(|v| v.abs() > MAX_COORDINATE) {
+            // A length attribute holds one number: usvg reads the first and
+            // drops the attribute if more follows (Fritzing's teensy_3.1_pcb
+            // writes a width "0,009632000000000005" with a decimal comma,
+            // which reads as 0 then 9.6e15).
+            let several = matches!(attr.name(), "d" | "points" | "viewBox" | "transform");
+            let mut numbers = svg_numbers(attr.value()).take(if several { usize::MAX } else { 1 });
+            if let Some(v) = numbers.find(|v| v.abs() > MAX_COORDINATE) {
                 if attr.name() == "transform" && attr.namespace().is_none() {
                     let range = attr.range_value();
                     let small = compose_transform(attr.value())
@@ -1560,6 +1566,24 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("transform") && e.contains("2e7"), "{e}");
+    }
+
+    #[test]
+    fn a_length_written_with_a_decimal_comma_is_not_read_as_two_numbers() {
+        // Fritzing's teensy_3.1_pcb.svg: an invisible rect whose width was
+        // written in a locale with decimal commas, "0,0096...", once read
+        // as 0 and 9.6e15 and refused the whole drawing; usvg drops such an
+        // attribute (and so the rect). The rest of the drawing is printed.
+        let body = r#"<rect width="0,009632000000000005" x="97,5" y="44,5" height="0,009632000000000005" fill="none" stroke="none"/>
+            <path d="M 0 0 L 10 0" stroke="black" fill="none"/>"#;
+        let subs = import_svg(svg(body).as_bytes(), "teensy.svg").unwrap();
+        assert_eq!(subs.len(), 1, "{subs:?}");
+        // A single length past the limit is still refused.
+        let body = r#"<rect width="2e7" height="1" stroke="black"/>"#;
+        let e = import_svg(svg(body).as_bytes(), "big.svg")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("width") && e.contains("2e7"), "{e}");
     }
 
     #[test]
