@@ -224,8 +224,21 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         .map_err(|e| parse_err(format!("not UTF-8 text ({e}); SVG is an XML text file")))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
 
-    let prepared = prepare(text).map_err(parse_err)?;
+    let (text, undeclared) = declare_prefixes(text);
+    let prepared = prepare(&text).map_err(parse_err)?;
     let mut notes = prepared.notes;
+    if !undeclared.is_empty() {
+        notes.push(format!(
+            "the drawing uses the XML prefix(es) {} without declaring them, which is not \
+             well-formed XML; read as if they were declared (their attributes are an \
+             editor's own and are not printed)",
+            undeclared
+                .iter()
+                .map(|p| format!("'{p}:'"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
 
     let options = usvg::Options {
         // Never read files or decode embedded images: only outlines are printed.
@@ -562,6 +575,45 @@ fn compose_transform(text: &str) -> Option<[f64; 6]> {
         rest = rest[close + 1..].trim_start_matches(|c: char| c.is_whitespace() || c == ',');
     }
     m.iter().all(|c| c.is_finite()).then_some(m)
+}
+
+/// Most prefixes [`declare_prefixes`] declares in one document.
+const MAX_UNDECLARED_PREFIXES: usize = 8;
+
+/// The document with a declaration added on its root `<svg>` for each
+/// namespace prefix it uses without declaring (Fritzing's ws2812b_pcb.svg
+/// writes `inkscape:` attributes with no `xmlns:inkscape`), and those
+/// prefixes. Such a document is not well-formed XML, but editors write it
+/// and read it back; the prefixed attributes are an editor's own. Anything
+/// else stays as it is (the parse after this one reports it).
+fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
+    let mut out = std::borrow::Cow::Borrowed(text);
+    let mut declared = Vec::new();
+    while declared.len() < MAX_UNDECLARED_PREFIXES {
+        let opt = roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        };
+        let prefix = match roxmltree::Document::parse_with_options(&out, opt) {
+            Err(roxmltree::Error::UnknownNamespace(prefix, _)) => prefix,
+            _ => break,
+        };
+        let name_ok = !prefix.is_empty()
+            && prefix
+                .chars()
+                .all(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | '.'));
+        let root = out
+            .match_indices("<svg")
+            .map(|(at, _)| at)
+            .find(|&at| tag_name_end(&out, at) == Some(at + 4));
+        let (true, Some(at), false) = (name_ok, root, declared.contains(&prefix)) else {
+            break;
+        };
+        let insert = format!(" xmlns:{prefix}=\"urn:pcpp:undeclared:{prefix}\"");
+        out = std::borrow::Cow::Owned(format!("{}{insert}{}", &out[..at + 4], &out[at + 4..]));
+        declared.push(prefix);
+    }
+    (out, declared)
 }
 
 fn prepare(text: &str) -> Result<Prepared, String> {
@@ -1584,6 +1636,29 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("width") && e.contains("2e7"), "{e}");
+    }
+
+    #[test]
+    fn an_undeclared_editor_prefix_is_read_as_declared_with_a_note() {
+        // Fritzing's ws2812b_pcb.svg: inkscape: attributes, no xmlns:inkscape.
+        let text = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100" inkscape:version="0.48"><path inkscape:connector-curvature="0" sodipodi:nodetypes="cc" d="M 0 0 L 10 0" stroke="black" fill="none"/></svg>"#;
+        let got = import_svg_with_notes(text.as_bytes(), "ws2812b.svg").unwrap();
+        assert_eq!(got.subpaths.len(), 1);
+        assert!(
+            got.notes
+                .iter()
+                .any(|n| n.contains("'inkscape:', 'sodipodi:'")),
+            "{:?}",
+            got.notes
+        );
+        // Other malformed XML is still refused.
+        let e = import_svg(
+            b"<svg xmlns=\"http://www.w3.org/2000/svg\"><path></svg>",
+            "bad.svg",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("not well-formed XML"), "{e}");
     }
 
     #[test]
