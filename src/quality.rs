@@ -77,13 +77,16 @@ impl QualitySummary {
 /// The back of the nozzle tip F_j (spec section 7, decision: the text's
 /// "back of the nozzle", not Algorithm 5's + (d/2) V_j).
 fn nozzle_back(t: DVec3, g: &LocalGeometry, nozzle: &Nozzle) -> DVec3 {
-    let k = if g.tangent.z < 0.0 {
+    let k = if g.descending() {
         0.5 * nozzle.outer_diameter_mm
     } else {
         0.5 * nozzle.inner_diameter_mm
     };
     t - k * g.v
 }
+
+/// An F_k this close to the plane of a crossing lies on it (mm).
+const ON_PLANE_MM: f64 = 1e-9;
 
 /// How many neighbours either side are searched for the crossing of the
 /// filament curve with the normal line; F_j lies at most do/2 + d behind
@@ -207,7 +210,19 @@ fn crossing_near(
     // curve crosses three times within one span (the spline overshoots
     // at a vertical step) any of them is a crossing; regula falsi starts
     // from the chord's crossing and usually ends at the one nearest it.
-    let fk = |k: usize| (back[k] - a).dot(tangent);
+    // An F_k within a nanometre of the plane lies on it: its distance is
+    // rounding (even puts F_j on the normal line, so (F_j - Ta_j) . t_j is
+    // d t_z, some 1e-14 mm on a level plate), and where the path turns
+    // sharply at k the curve touches the plane there without a change of
+    // sign, so that crossing was missed.
+    let fk = |k: usize| {
+        let f = (back[k] - a).dot(tangent);
+        if f.abs() <= ON_PLANE_MM {
+            0.0
+        } else {
+            f
+        }
+    };
     let mut f1 = fk(lo);
     for k in lo..hi {
         let f0 = f1;

@@ -355,6 +355,21 @@ pub struct LocalGeometry {
     pub curvature_3d: f64,
 }
 
+/// A unit tangent's z at most this far below 0 is level: rounding. On a
+/// level plate t_z comes out as +-1e-13 or so (the projected heights differ
+/// in their last bits), and the paper's switches on its sign (section 6c's
+/// case 3, section 7's back of the nozzle) then shifted points at random;
+/// a real descent of 1e-9 rad drops a nanometre a metre.
+pub const LEVEL_TZ: f64 = 1e-9;
+
+impl LocalGeometry {
+    /// Whether the path moves downward here (t_z < 0, sections 6c and 7)
+    /// by more than rounding ([`LEVEL_TZ`]).
+    pub fn descending(&self) -> bool {
+        self.tangent.z < -LEVEL_TZ
+    }
+}
+
 /// Fits the spline through `points` and evaluates the local geometry at
 /// each of them.
 pub fn local_geometry(points: &[DVec3]) -> Result<Vec<LocalGeometry>> {

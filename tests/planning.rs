@@ -610,3 +610,50 @@ fn the_filament_is_measured_on_the_normal_line_only() {
         assert!(plan.quality.mean_abs_error_mm <= d, "{:?}", plan.quality);
     }
 }
+
+/// On a level plate nothing descends: the sign of t_z there is rounding
+/// (+-1e-13), and the paper's switches on it (section 6c's case 3 shift of
+/// do/2 + M_j forward, section 7's back of the nozzle at do/2) had fired at
+/// random points. `pcpp` is `constant` there, and `even`, which puts the
+/// back of the tip over each surface point, lays the filament at d exactly
+/// by section 7, at sharp corners too (the crossing at F_j itself, where
+/// the curve touches the plane without a change of sign, had been missed).
+#[test]
+fn on_a_level_plate_nothing_descends_and_even_lays_the_filament_at_d() {
+    let xs = range(0.0, 40.0, 8);
+    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
+    // Corners of 150 degrees and more, as logos have them, and curves.
+    let svg =
+        br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
+        <path d="M 5 5 L 9.3 13.2 L 9.33 13.17 L 5.7 6.8 L 12 9 L 5 12" fill="none" stroke="black"/>
+        <path d="M 15 5 C 30 5 30 12 15 12 L 22 8.5" fill="none" stroke="black"/>
+        <path d="M 5 20 L 20 20 L 20 21 L 5 21 L 5 22.5 L 20 22.5" fill="none" stroke="black"/>
+    </svg>"#;
+    let drawn = pipeline::load_path(svg, "corners.svg").unwrap();
+    let mut settings = PlanSettings::default();
+    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
+    let d = settings.nozzle.inner_diameter_mm;
+    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
+    for plan in &plans {
+        for piece in &plan.pieces {
+            for (j, (t, a)) in piece.toolpath.iter().zip(&piece.surface_path).enumerate() {
+                if plan.planner == PlannerKind::Pcpp {
+                    let off = *t - (*a + d * DVec3::Z);
+                    assert!(
+                        off.length() < 1e-9,
+                        "pcpp point {j} of {}: {off:?}",
+                        piece.source
+                    );
+                }
+                if plan.planner == PlannerKind::Even {
+                    let e = piece.quality[j].error_mm;
+                    assert!(
+                        e.is_some_and(|e| e.abs() < 1e-6),
+                        "even point {j} of {}: e = {e:?}",
+                        piece.source
+                    );
+                }
+            }
+        }
+    }
+}

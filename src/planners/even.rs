@@ -66,7 +66,7 @@ fn back_offset(nozzle: &Nozzle, slope_rad: f64) -> f64 {
 
 /// Section 7's own back offset (its switch on the sign of t_z).
 fn model_back_offset(nozzle: &Nozzle, g: &LocalGeometry) -> f64 {
-    if g.tangent.z < 0.0 {
+    if g.descending() {
         0.5 * nozzle.outer_diameter_mm
     } else {
         0.5 * nozzle.inner_diameter_mm

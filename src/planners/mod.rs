@@ -120,7 +120,7 @@ fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, 
     let d = nozzle.inner_diameter_mm;
     let r = 0.5 * nozzle.outer_diameter_mm;
     let mut t = ta + d * DVec3::Z;
-    let descending = g.tangent.z < 0.0;
+    let descending = g.descending();
     let m = forward_shift(d, g.kappa);
     if let Some(c) = surface.disk_contact(t, r) {
         // Cases 1-2: push away from the centroid of C ∩ S (eq. 6-7, 10).

@@ -7,8 +7,8 @@
 ( planner: even )
 ( registration: unregistered  taken as it is [the scan's frame is the printer's]; G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000] )
 ( residuals: [] mm  rms 0.0000 mm )
-( path: 6 piece[s]  1362 points  457.516 mm  height change 4.504 mm  max inclination 86.9 deg  min radius 0.145 mm  print time 91.5 s )
-( predicted quality: mean |e| 0.0136 mm  mean e- -0.0101 mm  mean e+ 0.0193 mm  contact 0.00%  flattening 1.03%  floating 1.76% )
+( path: 6 piece[s]  1362 points  457.821 mm  height change 4.504 mm  max inclination 86.9 deg  min radius 0.145 mm  print time 91.6 s )
+( predicted quality: mean |e| 0.0109 mm  mean e- -0.0051 mm  mean e+ 0.0227 mm  contact 0.00%  flattening 0.59%  floating 1.76% )
 ( safe motion: min clearance 0.101 mm [tol 0.1 mm] along all 1444 moves; 70 waypoint[s] added [+3.680 mm] )
 ( warnings: 1 )
 ( profile: grbl )
@@ -20,8 +20,8 @@ G94
 M9
 G0 Z13.603
 ( subpath 0: 247 points )
-G0 X6.454 Y16.000 Z13.603
-G1 X6.454 Y16.000 Z5.603 F1500
+G0 X6.301 Y16.000 Z13.603
+G1 X6.301 Y16.000 Z5.603 F1500
 M8
 G1 X6.602 Y16.000 Z5.603 F300
 G1 X6.903 Y16.000 Z5.603
@@ -272,8 +272,8 @@ G1 X74.302 Y16.000 Z5.603
 M9
 G0 Z13.603
 ( subpath 1: 247 points )
-G0 X6.454 Y22.000 Z13.603
-G1 X6.454 Y22.000 Z5.603 F1500
+G0 X6.301 Y22.000 Z13.603
+G1 X6.301 Y22.000 Z5.603 F1500
 M8
 G1 X6.602 Y22.000 Z5.603 F300
 G1 X6.903 Y22.000 Z5.603
