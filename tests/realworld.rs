@@ -370,6 +370,43 @@ fn gltf_with_its_bin_reads_as_the_glb() {
     );
 }
 
+/// trimesh writes each buffer to a `.bin` of its own (the indices, then
+/// the positions): the `.gltf` with both reads as trimesh's `.glb`.
+#[test]
+fn trimesh_gltf_with_two_bins_reads_as_its_glb() {
+    let gltf = data!("mesh/trimesh/trimesh-icosphere.gltf");
+    let needed: Vec<String> = external_files_needed(gltf, "trimesh-icosphere.gltf")
+        .unwrap()
+        .into_iter()
+        .map(|r| r.path)
+        .collect();
+    assert_eq!(needed, ["gltf_buffer_0.bin", "gltf_buffer_1.bin"]);
+    let files = ExternalFiles::new()
+        .with("gltf_buffer_1.bin", data!("mesh/trimesh/gltf_buffer_1.bin"))
+        .with("gltf_buffer_0.bin", data!("mesh/trimesh/gltf_buffer_0.bin"));
+    let opts = ImportOptions::DEFAULT;
+    let m = import_mesh_with(gltf, "trimesh-icosphere.gltf", &opts, &files).unwrap();
+    assert_eq!(m.external_files, needed);
+    let glb = import(
+        data!("mesh/trimesh/trimesh-icosphere.glb"),
+        "trimesh-icosphere.glb",
+    );
+    assert_eq!(m.mesh, glb.mesh);
+    assert_eq!(m.mesh.triangle_count(), 80);
+    // A 10 m sphere in metres.
+    assert_bbox(&m.mesh, [-10_000.0; 3], [10_000.0; 3], 1e-3);
+    // Without the positions' file, it is the one named.
+    let one =
+        ExternalFiles::new().with("gltf_buffer_0.bin", data!("mesh/trimesh/gltf_buffer_0.bin"));
+    let e = import_mesh_with(gltf, "trimesh-icosphere.gltf", &opts, &one)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("buffer 1 ") && e.contains("'gltf_buffer_1.bin'"),
+        "{e}"
+    );
+}
+
 /// assimp's IndexOutOfRange model: a COLLADA2GLTF box whose first index
 /// is 255 of 24 vertices. With its `.bin` it is read, and refused naming
 /// the index and the vertex count.
