@@ -245,6 +245,21 @@ mod tests {
         );
     }
 
+    /// Hostile references give a path or an error naming the URI, never a
+    /// panic (a cut escape, a lone `%`, a cut UTF-8 sequence, odd schemes).
+    #[test]
+    fn hostile_uris_never_panic() {
+        for uri in [
+            "%", "%%", "%4", "a%", "%e2%82", "%00", ":", "a:", "1:/x", ".", "./", "..", "./.",
+            "C:", "\\", "é%", "%C3", "ab%C3%", "\u{0}", "?", "#", "a/b/",
+        ] {
+            match relative_path(uri, "h.gltf", 7) {
+                Ok(path) => assert!(!path.is_empty() && !path.starts_with('/'), "{uri}: {path}"),
+                Err(e) => assert!(e.to_string().contains(&format!("'{uri}'")), "{uri}: {e}"),
+            }
+        }
+    }
+
     #[test]
     fn files_match_by_path_then_by_file_name() {
         let files = ExternalFiles::new()
