@@ -4,7 +4,7 @@
 //! checks G-code and previews it). Part of [`crate::wasm`]: they only
 //! convert types; every decision is made by [`crate::job`] and the core.
 //!
-//! Length: about 800 lines of bindings, each a few lines of conversion.
+//! Length: about 860 lines of bindings, each a few lines of conversion.
 
 use glam::DVec3;
 use serde::Serialize;
