@@ -15,7 +15,7 @@ use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{
-    CloudInfo, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology, TriMesh,
+    CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology, TriMesh,
 };
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
@@ -260,6 +260,12 @@ pub struct InputFile {
     pub name: String,
     pub bytes: usize,
     pub sha256: String,
+    /// For a scan, the external files it was read from besides itself (a
+    /// `.gltf`'s `.bin` buffers), named by the paths the scan gives them:
+    /// the scan's own hash does not cover them. Left out when there are
+    /// none, so reports without them read as before.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub external_files: Vec<InputFile>,
 }
 
 impl InputFile {
@@ -274,7 +280,33 @@ impl InputFile {
             name: name.to_string(),
             bytes,
             sha256: sha256.iter().map(|b| format!("{b:02x}")).collect(),
+            external_files: Vec::new(),
         }
+    }
+
+    /// This scan with the external files it was read from.
+    pub fn with_external_files(mut self, files: Vec<InputFile>) -> Self {
+        self.external_files = files;
+        self
+    }
+
+    /// The external files of `imported` (by the paths it read them under,
+    /// [`ImportedMesh::external_files`]) that `given` holds, their SHA-256s
+    /// `digests[i]` for `given`'s file `i`.
+    pub fn external_of(
+        imported: &ImportedMesh,
+        given: &ExternalFiles,
+        digests: &[[u8; 32]],
+    ) -> Vec<InputFile> {
+        imported
+            .external_files
+            .iter()
+            .filter_map(|path| {
+                let i = given.position(path)?;
+                let (_, bytes) = given.iter().nth(i)?;
+                Some(InputFile::from_digest(path, bytes.len(), digests.get(i)?))
+            })
+            .collect()
     }
 }
 
@@ -437,16 +469,35 @@ pub fn prepare_scan_owned(
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
+    prepare_scan_owned_with(bytes, name, ExternalFiles::new(), scan, registration)
+}
+
+/// [`prepare_scan_owned`] of a scan with the external files it refers to
+/// (a `.gltf`'s buffers, [`crate::mesh::external_files_needed`]), freed
+/// with the scan's bytes; those it read are recorded with their SHA-256 in
+/// [`InputFile::external_files`].
+pub fn prepare_scan_owned_with(
+    bytes: impl AsRef<[u8]>,
+    name: &str,
+    external: ExternalFiles,
+    scan: &ImportOptions,
+    registration: &RegistrationSettings,
+) -> Result<PreparedScan> {
     registration.validate()?;
     let read = bytes.as_ref();
     // The provenance hash off the critical path (issue 15): natively on a
     // second thread while the scan is read.
-    let (imported, file) = crate::parallel::join(
-        || pipeline::load_scan(read, name, scan),
-        || InputFile::new(name, read),
+    let (imported, (file, digests)) = crate::parallel::join(
+        || pipeline::load_scan_with(read, name, scan, &external),
+        || {
+            let digests: Vec<[u8; 32]> = external.iter().map(|(_, b)| sha256(b)).collect();
+            (InputFile::new(name, read), digests)
+        },
     );
     drop(bytes);
     let imported = imported?;
+    let file = file.with_external_files(InputFile::external_of(&imported, &external, &digests));
+    drop(external);
     let mesh = &imported.mesh;
     let dot = registration.dot_diameter_mm;
     // Only `auto` fiducials register with the holes. Without them, and
@@ -633,6 +684,13 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             format!("{k} file"),
             format!("{} ({} bytes, sha256 {})", f.name, f.bytes, f.sha256),
         ));
+        // A .gltf's .bin buffers, which its own hash does not cover.
+        for e in &f.external_files {
+            h.push((
+                format!("{k} external file"),
+                format!("{} ({} bytes, sha256 {})", e.name, e.bytes, e.sha256),
+            ));
+        }
     }
     h.push((
         "nozzle".into(),
@@ -1265,6 +1323,64 @@ mod tests {
             );
         }
         assert_eq!(scan.triangle_count(), mesh.triangle_count());
+    }
+
+    /// A `.gltf` with its buffer in a `.bin` plans as the same scan as one
+    /// `.glb`, and the `.bin` is named with its hash in the report and the
+    /// G-code header (the `.gltf`'s own hash does not cover the geometry).
+    #[test]
+    fn a_gltfs_external_buffer_is_read_and_recorded() {
+        let part = crate::demo::parts::DemoPart::SteppedBlock;
+        let (gltf, bin) = crate::demo::to_gltf_separate(&part.mesh(), "block%20mesh.bin");
+        let glb = crate::demo::to_glb(&part.mesh());
+        let settings = PlanSettings {
+            placement: part.placement(),
+            ..Default::default()
+        };
+        let reg = RegistrationSettings::default();
+        let files = ExternalFiles::new().with("block mesh.bin", bin.clone());
+        let separate =
+            prepare_scan_owned_with(gltf, "block.gltf", files, &ImportOptions::DEFAULT, &reg)
+                .unwrap();
+        let want = vec![InputFile::new("block mesh.bin", &bin)];
+        assert_eq!(separate.file.external_files, want);
+        let one = prepare_scan(&glb, "block.glb", &ImportOptions::DEFAULT, &reg).unwrap();
+        assert!(one.file.external_files.is_empty());
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let svg = part.svg();
+        let run = |scan: &PreparedScan| {
+            run_on(scan, svg.as_bytes(), "p.svg", &settings, &profile, false).unwrap()
+        };
+        let (a, b) = (run(&separate), run(&one));
+        assert_eq!(a.report.inputs[0].external_files, want);
+        let line = format!(
+            "; scan external file: block mesh.bin ({} bytes, sha256 {})",
+            want[0].bytes, want[0].sha256
+        );
+        assert!(
+            a.gcode.contains(&format!("\n{line}\n")),
+            "{}",
+            &a.gcode[..800]
+        );
+        // Past the scan's lines, the same program.
+        let rest = |g: &str| -> Vec<String> {
+            g.lines()
+                .filter(|l| !l.starts_with("; scan "))
+                .map(String::from)
+                .collect()
+        };
+        assert_eq!(rest(&a.gcode), rest(&b.gcode));
+        // The field is left out without external files, and reports
+        // written before it read with none.
+        // (Only the inputs compared: serde_json's float parsing may miss
+        // the last bit of other numbers.)
+        let json = serde_json::to_string(&b.report).unwrap();
+        assert!(!json.contains("external_files"));
+        let back: Report = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.inputs, b.report.inputs);
+        let json = serde_json::to_string(&a.report).unwrap();
+        let back: Report = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.inputs, a.report.inputs);
     }
 
     #[test]

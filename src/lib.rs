@@ -7,8 +7,9 @@
 //!
 //! ## Features
 //! - Scan import from bytes: OBJ, PLY (ascii and binary), STL (ascii and
-//!   binary), glTF 2.0 (`.gltf` with embedded buffers, `.glb`), in mm, cm, m
-//!   or inches ([`mesh`]).
+//!   binary), glTF 2.0 (`.gltf` with embedded buffers or buffers in `.bin`
+//!   files given as bytes by name, `.glb`), in mm, cm, m or inches
+//!   ([`mesh`]).
 //! - Fiducial holes found as boundary loops ([`fiducials`]) and rigid
 //!   registration scanner -> printer, the paper's three-point construction or
 //!   a least-squares fit ([`registration`]).
@@ -23,8 +24,11 @@
 //!
 //! ## Limitations
 //! - A 3-axis stage only: the nozzle stays vertical, paths are projected along Z.
-//! - glTF buffers must be embedded (data URIs or the GLB binary chunk): the
-//!   core takes bytes and never opens other files.
+//! - The core takes bytes and never opens other files: a `.gltf`'s `.bin`
+//!   buffers are handed over by the caller ([`mesh::ExternalFiles`]; the CLI
+//!   reads them beside the `.gltf`, the page takes them from the files
+//!   selected with it); remote and absolute buffer URIs are refused, and
+//!   Draco- or meshopt-compressed meshes are not decoded.
 //! - SVG text is not converted to paths (no fonts are loaded).
 //!
 //! The core takes bytes and `&str`, never file paths, and knows nothing of

@@ -13,7 +13,9 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::mesh::{import_mesh, ImportOptions, ImportedMesh, Topology, TriMesh};
+use crate::mesh::{
+    import_mesh_with, ExternalFiles, ImportOptions, ImportedMesh, Topology, TriMesh,
+};
 use crate::motion::{
     backward_moves, check_moves_capped, insert_waypoints_capped, Clearance, PLANNING_MARGIN_MM,
 };
@@ -49,7 +51,18 @@ impl PlanSettings {
 
 /// Stage 1: the scan's bytes into a mesh in mm, +Z up (scanner frame).
 pub fn load_scan(bytes: &[u8], file: &str, options: &ImportOptions) -> Result<ImportedMesh> {
-    Ok(import_mesh(bytes, file, options)?)
+    load_scan_with(bytes, file, options, &ExternalFiles::new())
+}
+
+/// [`load_scan`] with the external files the scan refers to (a `.gltf`'s
+/// buffers, [`crate::mesh::external_files_needed`]), as bytes by name.
+pub fn load_scan_with(
+    bytes: &[u8],
+    file: &str,
+    options: &ImportOptions,
+    external: &ExternalFiles,
+) -> Result<ImportedMesh> {
+    Ok(import_mesh_with(bytes, file, options, external)?)
 }
 
 /// Stage 2: Sa = G S, and the acceleration structure over it, with the

@@ -593,6 +593,8 @@ struct HoleView {
 struct ScanView<'a> {
     name: &'a str,
     bytes: usize,
+    /// The files it was read from besides itself (a `.gltf`'s buffers).
+    external_files: &'a [crate::job::InputFile],
     format: crate::mesh::MeshFormat,
     units: crate::mesh::ScanUnits,
     triangles: usize,

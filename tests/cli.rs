@@ -1256,3 +1256,132 @@ fn a_flood_of_warnings_is_cut_short_and_the_report_keeps_them_all() {
     assert_eq!(kept, 30);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// ------------------------------------------------ glTF with a separate .bin
+
+/// The stepped block as a `.gltf` whose buffer is `buffers/block scan.bin`
+/// (percent-encoded in the file, in a sub-folder, as exporters write
+/// them), as one `.glb`, and its drawing, in a fresh folder.
+fn separate_gltf(test: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = temp_dir(test);
+    let part = demo::parts::DemoPart::SteppedBlock;
+    let (gltf, bin) = demo::to_gltf_separate(&part.mesh(), "buffers/block%20scan.bin");
+    std::fs::create_dir_all(dir.join("buffers")).unwrap();
+    let bin_path = dir.join("buffers/block scan.bin");
+    std::fs::write(&bin_path, bin).unwrap();
+    let gltf_path = dir.join("block.gltf");
+    std::fs::write(&gltf_path, gltf).unwrap();
+    std::fs::write(dir.join("block.glb"), demo::to_glb(&part.mesh())).unwrap();
+    std::fs::write(dir.join("block.svg"), part.svg()).unwrap();
+    (dir, gltf_path, bin_path)
+}
+
+/// Every command that reads a scan reads a `.gltf`'s buffer from the file
+/// beside it: `plan` writes the G-code of the same scan as one `.glb`
+/// (past the scan's header lines, which name the `.bin` and its hash),
+/// and `compare`, `check` and `fiducials` read it too.
+#[test]
+fn a_gltf_with_its_bin_beside_it_plans_like_the_glb() {
+    let (dir, gltf, bin) = separate_gltf("gltf-separate");
+    let svg = dir.join("block.svg");
+    let plan = |scan: &Path, out: &str| {
+        let (g, r) = (
+            dir.join(format!("{out}.gcode")),
+            dir.join(format!("{out}.json")),
+        );
+        let o = plan_on(
+            scan,
+            &svg,
+            &["--place", "0,40", "-o", s(&g), "--report", s(&r)],
+        );
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        let report: Value = serde_json::from_str(&std::fs::read_to_string(&r).unwrap()).unwrap();
+        (std::fs::read_to_string(&g).unwrap(), report)
+    };
+    let (a, report) = plan(&gltf, "separate");
+    let (b, glb_report) = plan(&dir.join("block.glb"), "one");
+    let bin_bytes = std::fs::read(&bin).unwrap();
+    let hash = job::InputFile::new("x", &bin_bytes).sha256;
+    assert_eq!(
+        report["inputs"][0]["external_files"],
+        serde_json::json!([{"name": "buffers/block scan.bin", "bytes": bin_bytes.len(), "sha256": hash}])
+    );
+    assert!(glb_report["inputs"][0].get("external_files").is_none());
+    let line = format!(
+        "; scan external file: buffers/block scan.bin ({} bytes, sha256 {hash})",
+        bin_bytes.len()
+    );
+    assert!(a.lines().any(|l| l == line), "{}", &a[..600]);
+    let rest = |g: &str| -> Vec<String> {
+        g.lines()
+            .filter(|l| !l.starts_with("; scan "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(rest(&a), rest(&b));
+    // The other commands that read a scan.
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&gltf),
+        "--gcode",
+        s(&dir.join("separate.gcode")),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = pcpp(&["fiducials", "--scan", s(&gltf)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = pcpp(&[
+        "compare",
+        "--scan",
+        s(&gltf),
+        "--path",
+        s(&svg),
+        "--place",
+        "0,40",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Without its `.bin`, every command that reads the scan stops with the
+/// library's message naming the buffer and the file, and where it looked.
+#[test]
+fn a_gltf_without_its_bin_names_the_file_it_looked_for() {
+    let (dir, gltf, bin) = separate_gltf("gltf-missing-bin");
+    std::fs::remove_file(&bin).unwrap();
+    let svg = dir.join("block.svg");
+    let out = dir.join("x.gcode");
+    let gcode = dir.join("any.gcode");
+    std::fs::write(&gcode, "G1 X1 Y1 Z20\n").unwrap();
+    for args in [
+        vec!["plan", "--scan", s(&gltf), "--path", s(&svg), "-o", s(&out)],
+        vec!["compare", "--scan", s(&gltf), "--path", s(&svg)],
+        vec!["check", "--scan", s(&gltf), "--gcode", s(&gcode)],
+        vec!["fiducials", "--scan", s(&gltf)],
+    ] {
+        let o = pcpp(&args);
+        assert_eq!(code(&o), 1, "{args:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains(&format!("{}: buffer 0 ", gltf.display()))
+                && err.contains("'buffers/block scan.bin'")
+                && err.contains("keep it next to block.gltf")
+                && err.contains(&format!("not found: {}", bin.display())),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!out.exists());
+    // A buffer on the web is refused before anything is read.
+    let remote = std::fs::read_to_string(&gltf)
+        .unwrap()
+        .replace("buffers/block%20scan.bin", "https://example.com/scan.bin");
+    std::fs::write(&gltf, remote).unwrap();
+    let o = pcpp(&["fiducials", "--scan", s(&gltf)]);
+    assert_eq!(code(&o), 1);
+    let err = stderr(&o);
+    assert!(
+        err.contains("buffer 0 refers to 'https://example.com/scan.bin', a remote URI"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -12,7 +12,10 @@ use std::collections::BTreeSet;
 use pcpp::fiducials::{boundary_loops, find_fiducials};
 use pcpp::gcode::MachineProfile;
 use pcpp::job::{prepare_scan, run_on, FiducialSource, RegistrationSettings};
-use pcpp::mesh::{ImportOptions, ImportedMesh, MeshFormat, ScanUnits, TriMesh};
+use pcpp::mesh::{
+    external_files_needed, import_mesh_with, ExternalFiles, ExternalRef, ImportOptions,
+    ImportedMesh, MeshFormat, ScanUnits, TriMesh,
+};
 use pcpp::pipeline::{load_path, DrawnPath, PlanSettings};
 use pcpp::svg::Placement;
 use pcpp::{DVec2, DVec3};
@@ -331,6 +334,97 @@ fn gltf_with_external_buffer_says_how_to_fix_it() {
         data!("mesh/Mesh_PrimitiveMode_00.gltf"),
         "Mesh_PrimitiveMode_00.gltf",
         &["external file 'Mesh_PrimitiveMode_00.bin'", ".glb"],
+    );
+}
+
+/// The same sample box as a `.gltf` whose buffer is `BoxTextured0.bin`
+/// (and a texture, `CesiumLogoFlat.png`, not needed for the surface): the
+/// importer lists only the `.bin`, and with it reads what the `.glb` holds.
+/// Without it, the error names it (assimp's `MissingBin` model is this
+/// `.gltf` alone).
+#[test]
+fn gltf_with_its_bin_reads_as_the_glb() {
+    let gltf = data!("mesh/BoxTextured.gltf");
+    let needed = external_files_needed(gltf, "BoxTextured.gltf").unwrap();
+    assert_eq!(
+        needed,
+        [ExternalRef {
+            buffer: 0,
+            uri: "BoxTextured0.bin".into(),
+            path: "BoxTextured0.bin".into()
+        }]
+    );
+    let files = ExternalFiles::new().with("BoxTextured0.bin", data!("mesh/BoxTextured0.bin"));
+    let m = import_mesh_with(gltf, "BoxTextured.gltf", &ImportOptions::DEFAULT, &files).unwrap();
+    assert_eq!(m.external_files, ["BoxTextured0.bin"]);
+    let glb = import(data!("mesh/BoxTextured.glb"), "BoxTextured.glb");
+    assert_eq!(m.mesh, glb.mesh);
+    assert_import_error(
+        gltf,
+        "BoxTextured.gltf",
+        &[
+            "buffer 0",
+            "external file 'BoxTextured0.bin'",
+            "select both files",
+        ],
+    );
+}
+
+/// trimesh writes each buffer to a `.bin` of its own (the indices, then
+/// the positions): the `.gltf` with both reads as trimesh's `.glb`.
+#[test]
+fn trimesh_gltf_with_two_bins_reads_as_its_glb() {
+    let gltf = data!("mesh/trimesh/trimesh-icosphere.gltf");
+    let needed: Vec<String> = external_files_needed(gltf, "trimesh-icosphere.gltf")
+        .unwrap()
+        .into_iter()
+        .map(|r| r.path)
+        .collect();
+    assert_eq!(needed, ["gltf_buffer_0.bin", "gltf_buffer_1.bin"]);
+    let files = ExternalFiles::new()
+        .with("gltf_buffer_1.bin", data!("mesh/trimesh/gltf_buffer_1.bin"))
+        .with("gltf_buffer_0.bin", data!("mesh/trimesh/gltf_buffer_0.bin"));
+    let opts = ImportOptions::DEFAULT;
+    let m = import_mesh_with(gltf, "trimesh-icosphere.gltf", &opts, &files).unwrap();
+    assert_eq!(m.external_files, needed);
+    let glb = import(
+        data!("mesh/trimesh/trimesh-icosphere.glb"),
+        "trimesh-icosphere.glb",
+    );
+    assert_eq!(m.mesh, glb.mesh);
+    assert_eq!(m.mesh.triangle_count(), 80);
+    // A 10 m sphere in metres.
+    assert_bbox(&m.mesh, [-10_000.0; 3], [10_000.0; 3], 1e-3);
+    // Without the positions' file, it is the one named.
+    let one =
+        ExternalFiles::new().with("gltf_buffer_0.bin", data!("mesh/trimesh/gltf_buffer_0.bin"));
+    let e = import_mesh_with(gltf, "trimesh-icosphere.gltf", &opts, &one)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("buffer 1 ") && e.contains("'gltf_buffer_1.bin'"),
+        "{e}"
+    );
+}
+
+/// assimp's IndexOutOfRange model: a COLLADA2GLTF box whose first index
+/// is 255 of 24 vertices. With its `.bin` it is read, and refused naming
+/// the index and the vertex count.
+#[test]
+fn gltf_index_out_of_range_in_its_bin_is_named() {
+    let files = ExternalFiles::new().with("IndexOutOfRange.bin", data!("mesh/IndexOutOfRange.bin"));
+    let e = import_mesh_with(
+        data!("mesh/IndexOutOfRange.gltf"),
+        "IndexOutOfRange.gltf",
+        &ImportOptions::DEFAULT,
+        &files,
+    )
+    .unwrap_err()
+    .to_string();
+    assert_eq!(
+        e,
+        "IndexOutOfRange.gltf: mesh 0 primitive 0: index 0 refers to vertex 255, but POSITION \
+         has 24 elements"
     );
 }
 

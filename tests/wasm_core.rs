@@ -1120,3 +1120,107 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
         .plan(svg, "line.svg", js(&settings.plan), "marlin", true, None)
         .unwrap_or_else(|e| panic!("{e:?}"));
 }
+
+/// A file written into a ScanBuffer in chunks, as the worker reads it.
+fn written(name: &str, bytes: &[u8]) -> pcpp::wasm::ScanBuffer {
+    let mut buf =
+        pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64).unwrap_or_else(|e| panic!("{e:?}"));
+    for chunk in bytes.chunks(100_000) {
+        buf.write(chunk).unwrap_or_else(|e| panic!("{e:?}"));
+    }
+    buf
+}
+
+/// The page's import of a `.gltf` with its buffer in a separate file: the
+/// scan lists the file it needs (decoded, with the name to select), takes
+/// it as a ScanBuffer of its own, and plans the G-code and report the CLI
+/// writes for the same files (the core's `prepare_scan_owned_with`); the
+/// scan's info names the `.bin` and its hash. Without it the import fails
+/// (kind `mesh`) naming the buffer and the file; a remote URI is refused
+/// when listed.
+#[wasm_bindgen_test]
+fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
+    let part = DemoPart::SteppedBlock;
+    let (gltf, bin) = demo::to_gltf_separate(&part.mesh(), "block%20scan.bin");
+    let mut settings = JobSettings::default();
+    settings.plan.placement = part.placement();
+
+    let mut scan = written("block.gltf", &gltf);
+    let needed: serde_json::Value =
+        serde_wasm_bindgen::from_value(scan.external_files().unwrap_or_else(|e| panic!("{e:?}")))
+            .unwrap();
+    assert_eq!(
+        needed,
+        serde_json::json!([{"buffer": 0, "uri": "block%20scan.bin", "path": "block scan.bin",
+            "file_name": "block scan.bin"}])
+    );
+    scan.add_external_file(written("block scan.bin", &bin))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session =
+        pcpp::wasm::Session::from_scan_buffer(scan, js(&settings.scan), js(&settings.registration))
+            .unwrap_or_else(|e| panic!("{e:?}"));
+    let info = json(session.info().unwrap());
+    let want = job::InputFile::new("block scan.bin", &bin);
+    assert_eq!(info["external_files"][0]["name"], "block scan.bin");
+    assert_eq!(info["external_files"][0]["sha256"], want.sha256.as_str());
+    session
+        .set_path(part.svg().as_bytes(), "block.svg")
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let out = session
+        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let files = pcpp::mesh::ExternalFiles::new().with("block scan.bin", bin.clone());
+    let native = job::prepare_scan_owned_with(
+        gltf.clone(),
+        "block.gltf",
+        files,
+        &settings.scan,
+        &settings.registration,
+    )
+    .unwrap();
+    let profile = MachineProfile::builtin("marlin").unwrap();
+    let want_gcode = job::run_on(
+        &native,
+        part.svg().as_bytes(),
+        "block.svg",
+        &settings.plan,
+        &profile,
+        false,
+    )
+    .unwrap()
+    .gcode;
+    let gcode = bytes_text(&get(&out, "gcode"));
+    assert!(
+        gcode.contains("; scan external file: block scan.bin ("),
+        "{}",
+        &gcode[..600]
+    );
+    assert_eq!(gcode, want_gcode);
+
+    // Without the .bin: the page's error names it.
+    let err = written("block.gltf", &gltf)
+        .import_scan(js(&settings.scan))
+        .err()
+        .expect("no import without the .bin");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "mesh");
+    assert!(
+        message.starts_with("block.gltf: buffer 0 ")
+            && message.contains("'block scan.bin'")
+            && message.contains("select both files together"),
+        "{message}"
+    );
+    // A buffer on the web, refused when listed.
+    let remote = String::from_utf8(gltf)
+        .unwrap()
+        .replace("block%20scan.bin", "https://example.com/scan.bin");
+    let err = written("block.gltf", remote.as_bytes())
+        .external_files()
+        .expect_err("a remote buffer is refused");
+    let (message, kind) = message_and_kind(&err);
+    assert_eq!(kind, "mesh");
+    assert!(
+        message.contains("buffer 0 refers to 'https://example.com/scan.bin', a remote URI"),
+        "{message}"
+    );
+}

@@ -19,6 +19,10 @@ const RESTORING_KEY = 'pcpp.restoring.v1';
 
 // G-code programs a user may check against the scan (by their extension).
 const GCODE_FILE = /\.(gcode|gco|g|nc|ngc|tap|txt)$/i;
+// Scans, by the extensions the core reads (a glTF first: only it names
+// other files, its buffers in .bin files).
+const GLTF_FILE = /\.(gltf|glb)$/i;
+const SCAN_FILE = /\.(gltf|glb|obj|ply|stl|xyz|csv|txt|asc|pts|pcd)$/i;
 
 async function openFile(file) {
   if (/\.svg$/i.test(file.name)) {
@@ -29,6 +33,26 @@ async function openFile(file) {
     checkGcodeFile(file);
     return;
   }
+  openScan(file, []);
+}
+
+// Files opened together (selected at once, or dropped): drawings and
+// G-code programs each on their own; of the others, one is the scan and
+// the rest go with it, for the files it names (a .gltf's .bin buffers:
+// the worker reads only those the scan needs).
+function openFiles(files) {
+  const rest = [];
+  for (const f of files) {
+    if (/\.svg$/i.test(f.name) || GCODE_FILE.test(f.name)) openFile(f);
+    else rest.push(f);
+  }
+  if (rest.length === 0) return;
+  const scan = rest.find((f) => GLTF_FILE.test(f.name)) || rest.find((f) => SCAN_FILE.test(f.name)) || rest[0];
+  openScan(scan, rest.filter((f) => f !== scan));
+}
+
+// `external`: the files opened with it (Files), for those it names.
+function openScan(file, external) {
   // Past the page's limit the file is refused before a byte is read, and
   // the loaded scan stays.
   try {
@@ -40,7 +64,9 @@ async function openFile(file) {
   }
   // The File itself goes to the worker, which reads it into wasm memory:
   // the scan's bytes never pass through this thread or a JS string.
-  const entry = { key: `file-${state.nextKey++}`, name: file.name, size: file.size, blob: file };
+  const entry = {
+    key: `file-${state.nextKey++}`, name: file.name, size: file.size, blob: file, external,
+  };
   state.pendingScan = entry;
   // The demo's fiducials belong to the demo part: a new scan is read
   // unregistered until the user sets its fiducials (the settings change
@@ -128,14 +154,18 @@ export function bindFiles() {
     if (f) openProfile(f);
     profileInput.value = '';
   });
-  for (const id of ['scan-input', 'svg-input']) {
-    const input = $(id);
-    input.addEventListener('change', () => {
-      const f = input.files && input.files[0];
-      if (f) openFile(f);
-      input.value = '';
-    });
-  }
+  // The scan input takes several files at once: a .gltf with its .bin.
+  const scanInput = $('scan-input');
+  scanInput.addEventListener('change', () => {
+    if (scanInput.files) openFiles([...scanInput.files]);
+    scanInput.value = '';
+  });
+  const svgInput = $('svg-input');
+  svgInput.addEventListener('change', () => {
+    const f = svgInput.files && svgInput.files[0];
+    if (f) openFile(f);
+    svgInput.value = '';
+  });
   const overlay = $('drop-overlay');
   let depth = 0;
   window.addEventListener('dragenter', (e) => {
@@ -152,7 +182,7 @@ export function bindFiles() {
     e.preventDefault();
     depth = 0;
     overlay.hidden = true;
-    for (const f of e.dataTransfer.files) openFile(f);
+    openFiles([...e.dataTransfer.files]);
   });
 }
 
@@ -198,13 +228,20 @@ export function dropCentre() {
 }
 
 // The pending scan was read: it becomes the scan, and the demo's fiducial
-// settings it was read without are dropped for good.
-export function acceptScan() {
+// settings it was read without are dropped for good. `info`, the scan as
+// the worker read it, names the files it was read from besides itself
+// (by the paths the scan gives; the browser's files have names only):
+// those are kept with it, not every file opened with it.
+export function acceptScan(info) {
   const scan = state.pendingScan;
   state.scan = scan;
   state.pendingScan = null;
+  if (info) {
+    const used = new Set(info.external_files.map((f) => f.name.split('/').pop()));
+    scan.external = (scan.external || []).filter((f) => used.has(f.name));
+  }
   if (scan.restored) endRestoring();
-  else keep('scan', scan.blob ? { name: scan.name, file: scan.blob } : null);
+  else keep('scan', scan.blob ? { name: scan.name, file: scan.blob, external: scan.external || [] } : null);
   if (scan.unregistered) {
     delete scan.unregistered;
     settings.fidSource = 'none';
@@ -271,8 +308,11 @@ export async function restoreInputs() {
       'The page closed or stopped while reading it last time. Open it again if you need it.');
     return;
   }
+  // The files kept with it (a .gltf's .bin buffers); a scan kept without
+  // one it needs fails to reopen, naming it.
+  const external = Array.isArray(scan.external) ? scan.external.filter((f) => f instanceof Blob) : [];
   state.pendingScan = {
-    key: `file-${state.nextKey++}`, name: scan.name, size: scan.file.size, blob: scan.file, restored: true,
+    key: `file-${state.nextKey++}`, name: scan.name, size: scan.file.size, blob: scan.file, external, restored: true,
   };
   $('scan-name').textContent = `${state.scan.name} (reopening ${scan.name}…)`;
 }

@@ -107,7 +107,7 @@ function runPlan() {
     type: 'plan',
     id,
     // A File is a handle: posting it copies no bytes (the worker reads it).
-    scan: { key: scan.key, name: scan.name, blob: scan.blob, part: scan.part },
+    scan: { key: scan.key, name: scan.name, blob: scan.blob, part: scan.part, external: scan.external },
     scanSettings: job.scan,
     registration: job.registration,
     svg: msgSvg,
@@ -184,7 +184,7 @@ function onWorkerMessage(e) {
       break;
     case 'scan':
       if (state.pendingScan && state.pendingScan.key === m.key) {
-        acceptScan();
+        acceptScan(m.info);
       }
       state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);

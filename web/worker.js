@@ -7,8 +7,9 @@
 // The scan arrives as a File (or null: a demo part, named by `part`). Posting a File copies no
 // bytes; this worker reads it in slices straight into wasm memory
 // (ScanBuffer), so the page's main thread never holds the scan and JS never
-// holds it whole. Results go back as typed arrays whose buffers are
-// transferred, not copied.
+// holds it whole. The files opened with it (`external`) are read the same
+// way, only those the scan names (a .gltf's .bin buffers). Results go back
+// as typed arrays whose buffers are transferred, not copied.
 import { initSync, initPanicHook, memoryBytes, ScanBuffer } from '../pkg/pcpp.js';
 
 // Slices of the file read per step: progress every 8 MiB.
@@ -50,28 +51,61 @@ function progress(id, step, label, fraction, first) {
   post({ type: 'progress', id, stage: step === 'plan' ? 'plan' : 'scan', step, label, fraction, first });
 }
 
+// A File read in slices into a new ScanBuffer named `name`, with progress.
+async function readFile(id, blob, name, first) {
+  progress(id, 'read', `reading ${name} (${mib(blob.size)} MiB)`, 0, first);
+  const buf = new ScanBuffer(name, blob.size);
+  try {
+    for (let at = 0; at < blob.size; at += CHUNK) {
+      const part = new Uint8Array(await blob.slice(at, at + CHUNK).arrayBuffer());
+      buf.write(part);
+      const done = at + part.length;
+      progress(id, 'read', `reading ${name}: ${mib(done)} of ${mib(blob.size)} MiB`, done / blob.size);
+    }
+  } catch (err) {
+    buf.free();
+    throw err;
+  }
+  return buf;
+}
+
+// Reads into `buf` the files its scan names (a .gltf's buffers) from
+// `files`, matched as the core matches them (the browser gives names
+// only); returns those it needs and was not given ({path, file_name}).
+async function readExternal(id, buf, files) {
+  const missing = [];
+  const added = new Set();
+  for (const need of buf.externalFiles()) {
+    const f = files.find((g) => g.name === need.path) || files.find((g) => g.name === need.file_name);
+    if (!f) {
+      missing.push(need);
+    } else if (!added.has(f)) {
+      added.add(f);
+      buf.addExternalFile(await readFile(id, f, f.name, false));
+    }
+  }
+  return missing;
+}
+
 // Reads, imports, registers and indexes the scan, with a progress message
 // between the steps.
 async function loadScan(m) {
   const { id } = m;
   const { name, blob } = m.scan;
+  const external = m.scan.external || [];
   const t0 = performance.now();
-  if (session && blob && blob.size > FREE_FIRST_BYTES) {
+  const size = blob ? external.reduce((n, f) => n + f.size, blob.size) : 0;
+  if (session && size > FREE_FIRST_BYTES) {
     session.free();
     session = null;
     sessionKey = null;
   }
   let buf;
+  let missing = [];
   if (blob) {
-    progress(id, 'read', `reading ${name} (${mib(blob.size)} MiB)`, 0, true);
-    buf = new ScanBuffer(name, blob.size);
+    buf = await readFile(id, blob, name, true);
     try {
-      for (let at = 0; at < blob.size; at += CHUNK) {
-        const part = new Uint8Array(await blob.slice(at, at + CHUNK).arrayBuffer());
-        buf.write(part);
-        const done = at + part.length;
-        progress(id, 'read', `reading ${name}: ${mib(done)} of ${mib(blob.size)} MiB`, done / blob.size);
-      }
+      missing = await readExternal(id, buf, external);
     } catch (err) {
       buf.free();
       throw err;
@@ -80,7 +114,20 @@ async function loadScan(m) {
     buf = ScanBuffer.demoPart(m.scan.part || 'test-part');
   }
   progress(id, 'import', `importing ${name}`, undefined, !blob);
-  const imp = buf.importScan(m.scanSettings);
+  let imp;
+  try {
+    imp = buf.importScan(m.scanSettings);
+  } catch (err) {
+    // The core's message names the file the scan needs; the page says how
+    // to give it (not when the scan failed for another reason first, a
+    // compressed mesh, say).
+    const named = err && err.kind === 'mesh' ? missing.filter((f) => String(err.message).includes(`'${f.path}'`)) : [];
+    if (named.length) {
+      const files = named.map((f) => f.file_name).join(' and ');
+      err.message += `\nSelect ${name} together with ${files} (both at once in the file dialog, or drop both on the page).`;
+    }
+    throw err;
+  }
   let s;
   try {
     progress(id, 'register', `finding fiducial holes and registering ${imp.triangles().toLocaleString('en')} triangles`);

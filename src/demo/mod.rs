@@ -1,9 +1,12 @@
 //! Built-in demo inputs, generated (no files a user must find): the paper's
 //! test part with its line paths, and antenna path generators.
 pub mod antennas;
+mod gltf;
 pub mod parts;
 pub mod test_part;
 pub mod workloads;
+
+pub use gltf::{to_glb, to_gltf_separate};
 
 use crate::mesh::TriMesh;
 

@@ -44,16 +44,36 @@ pub enum MeshError {
         index: i64,
         vertex_count: usize,
     },
-    /// glTF buffers outside the file: the core takes bytes and never opens
-    /// other files, so re-export as `.glb` or with embedded (data URI) buffers.
+    /// A glTF buffer stored in a separate file (`"uri": "scene.bin"`) that
+    /// was not given with the scan: the CLI reads it from the `.gltf`'s
+    /// folder, the page needs both files selected together.
     #[error(
-        "{file}: buffer {buffer} refers to the external file '{uri}', which is not read; \
-         export a .glb or embed the buffers as data URIs"
+        "{file}: buffer {buffer} is stored in the external file '{path}', which was not given: \
+         keep it next to {file} (command line) or select both files together (page), or export \
+         the scan as one .glb"
     )]
-    ExternalBuffer {
+    MissingExternalFile {
+        file: String,
+        buffer: usize,
+        /// The reference as written (percent-encoded).
+        uri: String,
+        /// The file it names, decoded and relative to the `.gltf`.
+        path: String,
+    },
+    /// A glTF buffer's URI that is not a path relative to the `.gltf`
+    /// (remote, `file:`, absolute, a drive letter, a bad escape): only
+    /// files given beside the scan are read.
+    #[error(
+        "{file}: buffer {buffer} refers to '{uri}', {reason}; only files beside the .gltf are \
+         read (a relative reference such as \"scene.bin\"): re-export the scan with its \
+         buffers beside it, or as one .glb"
+    )]
+    ExternalUri {
         file: String,
         buffer: usize,
         uri: String,
+        /// Why it is refused ("a remote URI", ...).
+        reason: String,
     },
 }
 

@@ -1,11 +1,13 @@
-//! glTF 2.0 (`.gltf` with data-URI buffers, `.glb`): every triangle
-//! primitive the default scene draws, placed by the node hierarchy.
+//! glTF 2.0 (`.gltf` with data-URI buffers or buffers in separate files,
+//! `.glb`): every triangle primitive the default scene draws, placed by the
+//! node hierarchy.
 //!
 //! The `gltf` crate parses and validates the JSON; the accessor bytes are
 //! read here with checked offsets instead of its reader, whose slicing
 //! assumes a well-formed file (a hostile scan must give an error, not a
-//! panic). Buffers come only from the file itself: the core never opens
-//! other files or fetches URIs.
+//! panic). Buffers come from the file itself or from the [`ExternalFiles`]
+//! given with it (listed by [`external_refs`]): the core never opens other
+//! files or fetches URIs.
 
 use std::borrow::Cow;
 
@@ -17,6 +19,7 @@ use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
 use gltf::{Accessor, Document, Mesh, Node};
 
+use super::external::{relative_path, ExternalFiles, ExternalRef};
 use super::import::{Parsed, Welder};
 use super::MeshError;
 
@@ -26,7 +29,13 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
     GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
 );
 
-pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+/// The scan, and the paths of the external files it read (each once, in
+/// buffer order).
+pub(super) fn parse(
+    bytes: &[u8],
+    file: &str,
+    external: &ExternalFiles,
+) -> Result<(Parsed, Vec<String>), MeshError> {
     let not_gltf = |e: &dyn std::fmt::Display| {
         MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}"))
     };
@@ -48,16 +57,18 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     })?;
     // Compressed geometry cannot be read without its decoder; its accessors
     // hold no data, which the validation would report accessor by accessor.
-    if let Some(ext) = root
-        .extensions_required
-        .iter()
-        .find(|e| COMPRESSION_EXTENSIONS.contains(&e.as_str()))
-    {
+    if let Some(ext) = compression(&root) {
+        let what = if ext.contains("draco") {
+            "Draco"
+        } else {
+            "meshopt"
+        };
         return Err(MeshError::invalid(
             file,
             format!(
-                "its meshes are compressed ({ext}), which this program does not decode; export \
-                 the scan without mesh compression (Blender reads it and exports it uncompressed)"
+                "its meshes are compressed ({ext}), which is not supported: this program does \
+                 not decode {what}; export the scan without {what} compression (Blender imports \
+                 it and exports it uncompressed)"
             ),
         ));
     }
@@ -79,7 +90,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     check_position_accessors(&root, file)?;
     fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
-    let buffers = load_buffers(&gltf, blob, file)?;
+    let (buffers, read) = load_buffers(&gltf, blob, file, external)?;
     let mut scene = SceneReader {
         file,
         buffers,
@@ -129,11 +140,78 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             scene.skipped_primitives
         ));
     }
-    Ok(Parsed {
+    let parsed = Parsed {
         vertices: scene.welder.vertices,
         triangles: scene.triangles,
         warnings,
-    })
+    };
+    Ok((parsed, read))
+}
+
+/// The external files the glTF in `bytes` refers to, one per buffer stored
+/// in a separate file, so that a caller can fetch them before the import.
+/// A reference that is not a relative path is an error
+/// ([`MeshError::ExternalUri`]); a file that cannot be parsed lists none
+/// (its import names the problem).
+pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>, MeshError> {
+    // Only `buffers[].uri` is read: a file the schema would refuse still
+    // lists what it needs.
+    #[derive(serde::Deserialize)]
+    struct Buffers {
+        #[serde(default)]
+        buffers: Vec<Buffer>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Buffer {
+        uri: Option<String>,
+    }
+    let json = if bytes.starts_with(b"glTF") {
+        match split_glb(bytes, file) {
+            Ok((json, _)) => json,
+            Err(_) => return Ok(Vec::new()),
+        }
+    } else {
+        bytes
+    };
+    let Ok(root) = serde_json::from_slice::<Buffers>(json) else {
+        return Ok(Vec::new());
+    };
+    root.buffers
+        .into_iter()
+        .enumerate()
+        .filter_map(|(buffer, b)| b.uri.map(|uri| (buffer, uri)))
+        .filter(|(_, uri)| !uri.starts_with("data:"))
+        .map(|(buffer, uri)| {
+            let path = relative_path(&uri, file, buffer)?;
+            Ok(ExternalRef { buffer, uri, path })
+        })
+        .collect()
+}
+
+/// The compression extension a file's meshes need decoded: one it
+/// requires, or one it uses where a POSITION accessor has no data of its
+/// own (an exporter that left `extensionsRequired` out).
+fn compression(root: &gltf::json::Root) -> Option<&'static str> {
+    let named = |list: &[String]| {
+        COMPRESSION_EXTENSIONS
+            .into_iter()
+            .find(|c| list.iter().any(|e| e == c))
+    };
+    let no_data = || {
+        root.meshes
+            .iter()
+            .flat_map(|m| &m.primitives)
+            .filter_map(|p| {
+                p.attributes
+                    .get(&gltf::json::validation::Checked::Valid(Semantic::Positions))
+            })
+            .any(|a| {
+                root.accessors
+                    .get(a.value())
+                    .is_some_and(|a| a.buffer_view.is_none())
+            })
+    };
+    named(&root.extensions_required).or_else(|| named(&root.extensions_used).filter(|_| no_data()))
 }
 
 /// Extensions that compress a glTF's geometry (its accessors then hold
@@ -275,14 +353,22 @@ fn fill_position_bounds(root: &mut gltf::json::Root) {
     }
 }
 
+/// The bytes of each buffer.
+type Buffers<'a> = Vec<Cow<'a, [u8]>>;
+
+/// The bytes of each buffer, and the paths of the external files read.
 fn load_buffers<'a>(
     gltf: &Document,
     blob: Option<&'a [u8]>,
     file: &str,
-) -> Result<Vec<Cow<'a, [u8]>>, MeshError> {
-    gltf.buffers()
+    external: &'a ExternalFiles,
+) -> Result<(Buffers<'a>, Vec<String>), MeshError> {
+    let mut read: Vec<String> = Vec::new();
+    let buffers = gltf
+        .buffers()
         .map(|buffer| {
             let index = buffer.index();
+            let mut from = String::new();
             let data: Cow<[u8]> = match buffer.source() {
                 gltf::buffer::Source::Bin => Cow::Borrowed(blob.ok_or_else(|| {
                     MeshError::invalid(
@@ -302,18 +388,29 @@ fn load_buffers<'a>(
                     })?)
                 }
                 gltf::buffer::Source::Uri(uri) => {
-                    return Err(MeshError::ExternalBuffer {
-                        file: file.into(),
-                        buffer: index,
-                        uri: uri.into(),
-                    })
+                    let path = relative_path(uri, file, index)?;
+                    let (_, bytes) =
+                        external
+                            .find(&path)
+                            .ok_or_else(|| MeshError::MissingExternalFile {
+                                file: file.into(),
+                                buffer: index,
+                                uri: uri.into(),
+                                path: path.clone(),
+                            })?;
+                    from = format!(" (file '{path}')");
+                    if !read.contains(&path) {
+                        read.push(path);
+                    }
+                    Cow::Borrowed(bytes)
                 }
             };
             if data.len() < buffer.length() {
                 return Err(MeshError::invalid(
                     file,
                     format!(
-                        "buffer {index} holds {} bytes but declares byteLength {} (truncated file?)",
+                        "buffer {index}{from} holds {} bytes but declares byteLength {} \
+                         (truncated file?)",
                         data.len(),
                         buffer.length()
                     ),
@@ -321,7 +418,8 @@ fn load_buffers<'a>(
             }
             Ok(data)
         })
-        .collect()
+        .collect::<Result<Buffers, MeshError>>()?;
+    Ok((buffers, read))
 }
 
 fn local_transform(node: &Node) -> DMat4 {
@@ -619,6 +717,11 @@ mod tests {
     use super::*;
     use base64::engine::general_purpose::STANDARD;
 
+    /// A file without external files.
+    fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+        super::parse(bytes, file, &ExternalFiles::new()).map(|(p, _)| p)
+    }
+
     fn triangle_gltf(extra_node: &str, uri: &str) -> String {
         format!(
             r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
@@ -673,6 +776,139 @@ mod tests {
             .to_string();
         assert!(
             e.contains("holds 3 bytes but declares byteLength 36"),
+            "{e}"
+        );
+    }
+
+    fn triangle_bytes() -> Vec<u8> {
+        [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect()
+    }
+
+    #[test]
+    fn external_buffers_are_read_from_the_files_given() {
+        let files = ExternalFiles::new().with("scan.bin", triangle_bytes());
+        let json = triangle_gltf("", "scan.bin");
+        let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2]]);
+        assert_eq!(read, ["scan.bin"]);
+        // The same bytes as a data URI read the same vertices.
+        let embedded = parse(triangle_gltf("", &triangle_uri()).as_bytes(), "t.gltf").unwrap();
+        assert_eq!(p.vertices, embedded.vertices);
+    }
+
+    #[test]
+    fn percent_encoded_uris_name_the_decoded_file() {
+        // A browser gives file names only: matched by the last component.
+        let files = ExternalFiles::new().with("my scan.bin", triangle_bytes());
+        for uri in ["my%20scan.bin", "./buffers/my%20scan.bin"] {
+            let json = triangle_gltf("", uri);
+            let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
+            assert_eq!(p.triangles.len(), 1, "{uri}");
+            assert_eq!(read, [uri.trim_start_matches("./").replace("%20", " ")]);
+        }
+    }
+
+    #[test]
+    fn a_missing_external_file_is_named_with_its_buffer() {
+        let other = ExternalFiles::new().with("other.bin", triangle_bytes());
+        let e = super::parse(
+            triangle_gltf("", "my%20scan.bin").as_bytes(),
+            "t.gltf",
+            &other,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e,
+            MeshError::MissingExternalFile {
+                file: "t.gltf".into(),
+                buffer: 0,
+                uri: "my%20scan.bin".into(),
+                path: "my scan.bin".into(),
+            }
+        );
+        let e = e.to_string();
+        assert!(
+            e.starts_with("t.gltf: buffer 0 ")
+                && e.contains("'my scan.bin'")
+                && e.contains("next to t.gltf")
+                && e.contains("select both files together"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn remote_and_absolute_uris_are_refused() {
+        let files = ExternalFiles::new().with("scan.bin", triangle_bytes());
+        for uri in [
+            "https://example.com/scan.bin",
+            "file:///tmp/scan.bin",
+            "/tmp/scan.bin",
+        ] {
+            let json = triangle_gltf("", uri);
+            let e = super::parse(json.as_bytes(), "t.gltf", &files)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("t.gltf: buffer 0 refers to ") && e.contains(&format!("'{uri}'")),
+                "{e}"
+            );
+            // Listed the same way, before any file is read.
+            let listed = external_refs(json.as_bytes(), "t.gltf")
+                .unwrap_err()
+                .to_string();
+            assert_eq!(listed, e);
+        }
+    }
+
+    #[test]
+    fn a_short_external_file_is_truncated() {
+        let files = ExternalFiles::new().with("scan.bin", vec![0u8; 10]);
+        let e = super::parse(triangle_gltf("", "scan.bin").as_bytes(), "t.gltf", &files)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "t.gltf: buffer 0 (file 'scan.bin') holds 10 bytes but declares byteLength 36 \
+             (truncated file?)"
+        );
+    }
+
+    #[test]
+    fn external_refs_list_the_separate_buffers() {
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":36,"uri":"{}"}},
+            {{"byteLength":4,"uri":"a%20b.bin"}},{{"byteLength":4}},{{"byteLength":4,"uri":"a%20b.bin"}}]}}"#,
+            triangle_uri()
+        );
+        let listed = external_refs(json.as_bytes(), "t.gltf").unwrap();
+        let a_b = |buffer| ExternalRef {
+            buffer,
+            uri: "a%20b.bin".into(),
+            path: "a b.bin".into(),
+        };
+        assert_eq!(listed, [a_b(1), a_b(3)]);
+        assert_eq!(listed[0].file_name(), "a b.bin");
+        // What cannot be parsed lists nothing: its import names the fault.
+        assert_eq!(external_refs(b"{not json", "t.gltf").unwrap(), []);
+        assert_eq!(external_refs(b"glTF\x02", "t.glb").unwrap(), []);
+    }
+
+    /// An exporter that lists Draco as used but not required: the
+    /// accessors without data are still named as compressed.
+    #[test]
+    fn draco_used_but_not_required_is_named() {
+        let json = r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],
+            "meshes":[{"primitives":[{"attributes":{"POSITION":0},
+              "extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],
+            "accessors":[{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+            "bufferViews":[{"buffer":0,"byteLength":4}],"buffers":[{"byteLength":4,"uri":"d.bin"}]}"#;
+        let e = parse(json.as_bytes(), "d.gltf").unwrap_err().to_string();
+        assert!(
+            e.contains("compressed (KHR_draco_mesh_compression), which is not supported")
+                && e.contains("without Draco compression"),
             "{e}"
         );
     }

@@ -4,6 +4,7 @@
 use glam::DVec3;
 
 use super::{cloud, gltf, obj, pcd, ply, stl, xyz};
+use super::{ExternalFiles, ExternalRef};
 use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, ScanUnits, TriMesh, UpAxis};
 
 /// What a format parser hands to the shared steps: positions in the file's
@@ -109,11 +110,38 @@ fn looks_like_obj(text: &[u8]) -> bool {
 /// `file` names the scan in messages and selects the format by extension
 /// (content sniffing otherwise). Units and up axis default to the format's
 /// convention ([`MeshFormat::default_units`]); degenerate triangles are
-/// dropped with a warning, everything else wrong is an error.
+/// dropped with a warning, everything else wrong is an error. A `.gltf`
+/// whose buffers are separate files needs [`import_mesh_with`].
 pub fn import_mesh(
     bytes: &[u8],
     file: &str,
     options: &ImportOptions,
+) -> Result<ImportedMesh, MeshError> {
+    import_mesh_with(bytes, file, options, &ExternalFiles::new())
+}
+
+/// The external files a scan needs besides its own bytes, so that they can
+/// be read before [`import_mesh_with`]: a glTF's buffers stored in separate
+/// files (`.gltf` or `.glb`), by their decoded relative paths. Other
+/// formats need none. A reference that is not relative to the scan's folder
+/// (remote, absolute) is an error naming the buffer and the URI.
+pub fn external_files_needed(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>, MeshError> {
+    match detect_format(bytes, file) {
+        Some(MeshFormat::Gltf | MeshFormat::Glb) => gltf::external_refs(bytes, file),
+        _ => Ok(Vec::new()),
+    }
+}
+
+/// [`import_mesh`] of a scan with the external files it refers to (a
+/// `.gltf`'s buffers in `.bin` files, [`external_files_needed`]), given as
+/// bytes by name; the paths of those it read are in
+/// [`ImportedMesh::external_files`]. A file it needs and was not given is
+/// [`MeshError::MissingExternalFile`].
+pub fn import_mesh_with(
+    bytes: &[u8],
+    file: &str,
+    options: &ImportOptions,
+    external: &ExternalFiles,
 ) -> Result<ImportedMesh, MeshError> {
     check_scan_size(bytes.len(), file)?;
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
@@ -127,11 +155,16 @@ pub fn import_mesh(
     }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
+    let mut external_files = Vec::new();
     let parsed = match format {
         MeshFormat::Obj => obj::parse(bytes, file)?,
         MeshFormat::Ply => ply::parse(bytes, file)?,
         MeshFormat::Stl => stl::parse(bytes, file)?,
-        MeshFormat::Gltf | MeshFormat::Glb => gltf::parse(bytes, file)?,
+        MeshFormat::Gltf | MeshFormat::Glb => {
+            let (parsed, read) = gltf::parse(bytes, file, external)?;
+            external_files = read;
+            parsed
+        }
         MeshFormat::Xyz => Parsed {
             vertices: xyz::parse(bytes, file)?,
             ..Parsed::default()
@@ -170,6 +203,7 @@ pub fn import_mesh(
         up_axis,
         warnings,
         cloud: None,
+        external_files,
     })
 }
 
@@ -215,6 +249,7 @@ fn import_cloud(
         up_axis,
         warnings,
         cloud: Some(info),
+        external_files: Vec::new(),
     })
 }
 

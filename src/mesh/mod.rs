@@ -6,7 +6,9 @@
 //! Each format has its own parser file that reads the file's own units and
 //! axes; [`import_mesh`] sniffs the format, validates (finite coordinates,
 //! indices in range), drops degenerate triangles with a warning, and applies
-//! the scan units and up axis.
+//! the scan units and up axis. A `.gltf` whose buffers are separate files
+//! names them ([`external_files_needed`]); the caller hands them over as
+//! bytes by name ([`ExternalFiles`], [`import_mesh_with`]).
 
 use std::{fmt, str::FromStr};
 
@@ -16,6 +18,7 @@ use serde::{Deserialize, Serialize};
 pub(crate) mod buckets;
 mod cloud;
 mod error;
+mod external;
 mod gltf;
 mod import;
 mod obj;
@@ -27,7 +30,8 @@ mod xyz;
 
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
-pub use import::{detect_format, import_mesh};
+pub use external::{ExternalFiles, ExternalRef};
+pub use import::{detect_format, external_files_needed, import_mesh, import_mesh_with};
 pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
 /// Largest scan file read (bytes). A 20 M triangle binary STL is 1 GB; a
@@ -244,6 +248,10 @@ pub struct ImportedMesh {
     pub warnings: Vec<String>,
     /// For a point cloud, how it was meshed.
     pub cloud: Option<CloudInfo>,
+    /// The external files the scan was read from besides its own bytes (a
+    /// `.gltf`'s buffers), by the relative paths it names them with, each
+    /// once.
+    pub external_files: Vec<String>,
 }
 
 impl ImportedMesh {

@@ -4,7 +4,7 @@
 //! checks G-code and previews it). Part of [`crate::wasm`]: they only
 //! convert types; every decision is made by [`crate::job`] and the core.
 //!
-//! Length: about 800 lines of bindings, each a few lines of conversion.
+//! Length: about 860 lines of bindings, each a few lines of conversion.
 
 use glam::DVec3;
 use serde::Serialize;
@@ -19,7 +19,7 @@ use super::{
 use crate::demo::{self, parts::DemoPart};
 use crate::fiducials::{find_fiducials_in, Fiducial};
 use crate::job::{self, InputFile, PreparedScan, RegistrationSettings};
-use crate::mesh::{ImportOptions, ImportedMesh, Topology};
+use crate::mesh::{ExternalFiles, ImportOptions, ImportedMesh, Topology};
 use crate::params::Nozzle;
 use crate::pipeline::{self, DrawnPath, Plan, PlanSettings, SurfacePath};
 use crate::placement;
@@ -34,6 +34,10 @@ use crate::svg::Placement;
 /// staged steps that [`job::prepare_scan`] runs in one call; the page shows
 /// progress between them: [`ScanBuffer::import_scan`], [`ScanImport::register`],
 /// [`ScanImport::index`].
+///
+/// A `.gltf` whose buffers are separate files ([`ScanBuffer::external_files`]
+/// lists them) gets each as a ScanBuffer of its own, written the same way
+/// and handed over with [`ScanBuffer::add_external_file`] before the import.
 #[wasm_bindgen]
 pub struct ScanBuffer {
     name: String,
@@ -43,6 +47,20 @@ pub struct ScanBuffer {
     /// long single call in its baseline tier (no on-stack replacement for
     /// wasm), where hashing a large file at once took 16 times longer.
     sha256: Sha256,
+    /// The files given with the scan, by name, and their SHA-256s.
+    external: ExternalFiles,
+    external_sha256: Vec<[u8; 32]>,
+}
+
+/// A file a `.gltf` needs besides itself, as the page is told of it.
+#[derive(Serialize)]
+struct ExternalView<'a> {
+    buffer: usize,
+    uri: &'a str,
+    /// Decoded, relative to the `.gltf`.
+    path: &'a str,
+    /// Its last component: the name of the file to select.
+    file_name: &'a str,
 }
 
 #[wasm_bindgen]
@@ -71,6 +89,8 @@ impl ScanBuffer {
             size,
             bytes,
             sha256: Sha256::new(),
+            external: ExternalFiles::new(),
+            external_sha256: Vec::new(),
         })
     }
 
@@ -103,23 +123,57 @@ impl ScanBuffer {
         self.bytes.len()
     }
 
+    /// The files the scan needs besides itself, once it is written whole
+    /// (a `.gltf`'s buffers in separate files,
+    /// [`crate::mesh::external_files_needed`]): `[{buffer, uri, path,
+    /// file_name}]`, none for other formats; a remote or absolute buffer
+    /// URI is an error (kind `mesh`) naming the buffer and the URI.
+    #[wasm_bindgen(js_name = externalFiles)]
+    pub fn external_files(&self) -> Result<JsValue, JsValue> {
+        self.check_whole()?;
+        let refs = crate::mesh::external_files_needed(&self.bytes, &self.name)
+            .map_err(|e| core_err(e.into()))?;
+        let views: Vec<ExternalView> = refs
+            .iter()
+            .map(|r| ExternalView {
+                buffer: r.buffer,
+                uri: &r.uri,
+                path: &r.path,
+                file_name: r.file_name(),
+            })
+            .collect();
+        Ok(to_js(&views)?)
+    }
+
+    /// Hands over `file`, a file the scan names (written whole into its own
+    /// ScanBuffer, named as the browser names it), for the import. Refused
+    /// (kind `limit`) when the scan and its files together pass the page's
+    /// limit.
+    #[wasm_bindgen(js_name = addExternalFile)]
+    pub fn add_external_file(&mut self, file: ScanBuffer) -> Result<(), JsValue> {
+        file.check_whole()?;
+        let total = self.size + self.external.iter().map(|(_, b)| b.len()).sum::<usize>();
+        check_scan_size(
+            &format!("{} with {}", self.name, file.name),
+            (total + file.size) as f64,
+        )?;
+        self.external_sha256.push(file.sha256.finalize().into());
+        self.external.add(file.name, file.bytes);
+        Ok(())
+    }
+
     /// Imports the bytes ([`pipeline::load_scan`]) with `scan`
     /// (ImportOptions); the bytes are freed once read, before the next step
     /// allocates the search structure.
     #[wasm_bindgen(js_name = importScan)]
     pub fn import_scan(self, scan: JsValue) -> Result<ScanImport, JsValue> {
-        if self.bytes.len() != self.size {
-            return Err(JsError::new(&format!(
-                "{}: only {} of {} bytes were read; open the file again",
-                self.name,
-                self.bytes.len(),
-                self.size
-            ))
-            .into());
-        }
+        self.check_whole()?;
         let options: ImportOptions = from_js("scan settings", scan)?;
-        let imported = pipeline::load_scan(&self.bytes, &self.name, &options).map_err(core_err)?;
-        let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize());
+        let imported = pipeline::load_scan_with(&self.bytes, &self.name, &options, &self.external)
+            .map_err(core_err)?;
+        let external = InputFile::external_of(&imported, &self.external, &self.external_sha256);
+        let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize())
+            .with_external_files(external);
         Ok(ScanImport {
             file,
             imported,
@@ -130,6 +184,20 @@ impl ScanBuffer {
 }
 
 impl ScanBuffer {
+    /// Ok once every byte of the file was written.
+    fn check_whole(&self) -> Result<(), JsValue> {
+        if self.bytes.len() != self.size {
+            return Err(JsError::new(&format!(
+                "{}: only {} of {} bytes were read; open the file again",
+                self.name,
+                self.bytes.len(),
+                self.size
+            ))
+            .into());
+        }
+        Ok(())
+    }
+
     /// A demo part's scan as the binary PLY `pcpp demo --part` writes.
     fn full(part: DemoPart) -> ScanBuffer {
         let bytes = demo::to_binary_ply(&part.mesh());
@@ -140,6 +208,8 @@ impl ScanBuffer {
             size: bytes.len(),
             bytes,
             sha256,
+            external: ExternalFiles::new(),
+            external_sha256: Vec::new(),
         }
     }
 }
@@ -354,6 +424,20 @@ impl Session {
         Ok(Session::from_prepared(scan, None))
     }
 
+    /// [`Session::new`] of a scan written into `buffer`, with the files it
+    /// names ([`ScanBuffer::add_external_file`]): the staged steps in one
+    /// call.
+    #[wasm_bindgen(js_name = fromScanBuffer)]
+    pub fn from_scan_buffer(
+        buffer: ScanBuffer,
+        scan: JsValue,
+        registration: JsValue,
+    ) -> Result<Session, JsValue> {
+        let mut import = buffer.import_scan(scan)?;
+        import.register(registration)?;
+        import.index()
+    }
+
     /// Vertices of the registered mesh, printer frame, xyz f32 (for drawing).
     #[wasm_bindgen(js_name = meshPositions)]
     pub fn mesh_positions(&self) -> Vec<f32> {
@@ -400,6 +484,7 @@ impl Session {
         to_js(&ScanView {
             name: &s.file.name,
             bytes: s.file.bytes,
+            external_files: &s.file.external_files,
             format: s.format,
             units: s.units,
             triangles: s.triangle_count(),

@@ -7,7 +7,7 @@ use pcpp::fiducials::find_fiducials_sized;
 use pcpp::registration::register;
 
 use crate::args::{FiducialsArgs, RegisterArgs};
-use crate::files::{file_name, in_file, read_scan, to_json};
+use crate::files::{file_name, in_file, read_external, read_scan, to_json};
 use crate::progress::{thousands, Progress};
 use crate::settings::import_options;
 use crate::{CliResult, Failure};
@@ -18,9 +18,11 @@ pub fn cmd_fiducials(a: &FiducialsArgs, progress: &Progress) -> CliResult<()> {
     progress.step(format!("reading scan {}...", path.display()));
     let bytes = read_scan(path, "scan")?;
     let name = file_name(path);
+    // A .gltf's buffers in separate files, from its folder.
+    let external = read_external(path, &name, bytes.as_ref())?;
     progress.step(format!("importing {name}..."));
-    let imported = pcpp::pipeline::load_scan(bytes.as_ref(), &name, &options)
-        .map_err(|e| Failure::Input(in_file(path, &name, &e.to_string())))?;
+    let imported = pcpp::pipeline::load_scan_with(bytes.as_ref(), &name, &options, &external.files)
+        .map_err(|e| Failure::Input(external.explain(in_file(path, &name, &e.to_string()), &e)))?;
     if let Some(cloud) = &imported.cloud {
         progress.note(&cloud.to_string());
     }

@@ -5,6 +5,8 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use pcpp::mesh::{ExternalFiles, MeshError};
+
 use crate::{CliResult, Failure};
 
 pub fn read_bytes(path: &Path, what: &str) -> CliResult<Vec<u8>> {
@@ -54,6 +56,71 @@ pub fn read_scan(path: &Path, what: &str) -> CliResult<ScanBytes> {
     file.read_to_end(&mut bytes)
         .map_err(|e| cannot_read(path, what, e))?;
     Ok(ScanBytes::Read(bytes))
+}
+
+/// The external files a scan names (a `.gltf`'s `.bin` buffers,
+/// [`pcpp::mesh::external_files_needed`]), read from the scan's folder,
+/// and those that are not there.
+pub struct ExternalInputs {
+    pub files: ExternalFiles,
+    /// (the path the scan names, where it was looked for).
+    missing: Vec<(String, PathBuf)>,
+}
+
+impl ExternalInputs {
+    /// The library's message for `e`, with where a missing external file
+    /// was looked for.
+    pub fn explain(&self, message: String, e: &pcpp::Error) -> String {
+        let pcpp::Error::Mesh(MeshError::MissingExternalFile { path, .. }) = e else {
+            return message;
+        };
+        match self.missing.iter().find(|(p, _)| p == path) {
+            Some((_, looked)) => format!("{message} (not found: {})", looked.display()),
+            None => message,
+        }
+    }
+}
+
+/// Reads the external files the scan at `scan_path` (its bytes `bytes`,
+/// `name` in the library's messages) names, relative to its folder. One
+/// that is not there is left out: the import then names it, unless it
+/// stops first for a reason of its own (a compressed mesh).
+pub fn read_external(scan_path: &Path, name: &str, bytes: &[u8]) -> CliResult<ExternalInputs> {
+    let needed = pcpp::mesh::external_files_needed(bytes, name)
+        .map_err(|e| Failure::Input(in_file(scan_path, name, &e.to_string())))?;
+    let dir = match scan_path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut out = ExternalInputs {
+        files: ExternalFiles::new(),
+        missing: Vec::new(),
+    };
+    let mut seen: Vec<&str> = Vec::new();
+    for r in &needed {
+        if seen.contains(&r.path.as_str()) {
+            continue;
+        }
+        seen.push(&r.path);
+        let path = dir.join(&r.path);
+        match std::fs::metadata(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                out.missing.push((r.path.clone(), path));
+            }
+            _ => {
+                let bytes = read_scan(&path, "external file").map_err(|f| match f {
+                    Failure::Input(m) => Failure::Input(format!(
+                        "{m} (buffer {} of {})",
+                        r.buffer,
+                        scan_path.display()
+                    )),
+                    other => other,
+                })?;
+                out.files.add(r.path.clone(), bytes);
+            }
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(target_os = "linux")]

@@ -9,7 +9,9 @@ use pcpp::registration::{Registration, RegistrationError, RegistrationMethod};
 use pcpp::Error;
 
 use crate::args::{CompareArgs, JobArgs, PlanArgs, ScanArgs};
-use crate::files::{file_name, in_file, read_bytes, read_scan, to_json, write_one, Staged};
+use crate::files::{
+    file_name, in_file, read_bytes, read_external, read_scan, to_json, write_one, Staged,
+};
 use crate::progress::{thousands, Progress};
 use crate::settings::job_settings;
 use crate::{CliResult, Failure, VERSION};
@@ -45,16 +47,25 @@ pub fn load_scan(
     progress.step(format!("reading scan {}...", scan_path.display()));
     let scan = read_scan(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
+    // A .gltf's buffers in separate files, from its folder.
+    let mut external = read_external(scan_path, &scan_name, scan.as_ref())?;
     progress.step(format!("importing and indexing {scan_name}..."));
-    let prepared =
-        job::prepare_scan_owned(scan, &scan_name, &settings.scan, &settings.registration).map_err(
-            |e| match e {
-                Error::Registration(r) => {
-                    Failure::Input(format!("registration of {}: {r}", scan_path.display()))
-                }
-                other => Failure::Input(in_file(scan_path, &scan_name, &other.to_string())),
-            },
-        )?;
+    let files = std::mem::take(&mut external.files);
+    let prepared = job::prepare_scan_owned_with(
+        scan,
+        &scan_name,
+        files,
+        &settings.scan,
+        &settings.registration,
+    )
+    .map_err(|e| match e {
+        Error::Registration(r) => {
+            Failure::Input(format!("registration of {}: {r}", scan_path.display()))
+        }
+        other => Failure::Input(
+            external.explain(in_file(scan_path, &scan_name, &other.to_string()), &other),
+        ),
+    })?;
     progress.note(&format!(
         "scan: {} triangles",
         thousands(prepared.triangle_count())
