@@ -1385,3 +1385,27 @@ fn a_gltf_without_its_bin_names_the_file_it_looked_for() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A reader that stops early (`pcpp fiducials ... | head -1`) ends the
+/// command quietly, as it ends any Unix tool, instead of a panic with a
+/// backtrace ("failed printing to stdout: Broken pipe", exit 101).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_reader_that_closes_the_pipe_ends_the_command_without_a_panic() {
+    use std::process::Stdio;
+    let scan = demo_file("demo-test-part.ply");
+    for _ in 0..3 {
+        let mut child = Command::new(BIN)
+            .args(["fiducials", "--scan", s(&scan)])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the read end before the command writes its JSON.
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let err = stderr(&o);
+        assert!(!err.contains("panicked"), "{err}");
+        assert_ne!(code(&o), 101, "{err}");
+    }
+}

@@ -89,6 +89,16 @@ mod native {
     }
 
     pub fn run() -> ExitCode {
+        // A reader that stops early (`pcpp fiducials ... | head -1`) ends
+        // this command as it ends any Unix tool, by SIGPIPE, instead of a
+        // panic in println! (Rust ignores SIGPIPE by default). Output files
+        // are renamed into place before anything is printed about them.
+        #[cfg(target_os = "linux")]
+        // SAFETY: sets the default disposition of one signal at the start
+        // of main, before any thread is spawned.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
         // Help and version (exit 0, stdout) and usage errors (exit 2,
         // stderr) are clap's.
         let cli = Cli::parse();
