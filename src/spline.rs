@@ -427,11 +427,7 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
     }
     // Where t is vertical, V is the neighbour's (spec section 5).
     for &j in &vertical {
-        let from = (0..j)
-            .rev()
-            .chain(j + 1..out.len())
-            .find(|k| vertical.binary_search(k).is_err());
-        if let Some(k) = from {
+        if let Some(k) = neighbour_outside(j, &vertical, out.len()) {
             out[j].v = out[k].v;
         }
     }
@@ -453,11 +449,7 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
         };
     }
     for &j in &cusps {
-        let from = (0..j)
-            .rev()
-            .chain(j + 1..out.len())
-            .find(|k| cusps.binary_search(k).is_err());
-        if let Some(k) = from {
+        if let Some(k) = neighbour_outside(j, &cusps, out.len()) {
             let g = out[k];
             out[j] = LocalGeometry {
                 curvature_3d: out[j].curvature_3d,
@@ -466,6 +458,16 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
         }
     }
     out
+}
+
+/// The nearest point before `j` not in `listed` (sorted), else the nearest
+/// after it, among `n` points: the one a point whose own geometry is
+/// unusable borrows from (the one it arrives from, first).
+fn neighbour_outside(j: usize, listed: &[usize], n: usize) -> Option<usize> {
+    (0..j)
+        .rev()
+        .chain(j + 1..n)
+        .find(|k| listed.binary_search(k).is_err())
 }
 
 /// |C'(u)| at most this share of its largest value along the spline marks

@@ -529,6 +529,19 @@ fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
     }
 }
 
+/// Every planner on a level plate 40 mm square at z = 5 (`pcpp compare`)
+/// with the drawing `svg`, a 40 mm square document laid onto the plate
+/// (its y runs down), and the settings used.
+fn compare_on_a_level_plate(svg: &[u8]) -> (Vec<pipeline::Plan>, PlanSettings) {
+    let xs = range(0.0, 40.0, 8);
+    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
+    let drawn = pipeline::load_path(svg, "level.svg").unwrap();
+    let mut settings = PlanSettings::default();
+    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
+    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
+    (plans, settings)
+}
+
 /// A drawn stroke that runs out and straight back along itself (a spike, as
 /// real drawings have: a pin's lead traced out and back), on a level
 /// plate: the spline stops at the far end, where its direction and
@@ -538,17 +551,11 @@ fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
 /// plate none sees a slope.
 #[test]
 fn a_stroke_that_turns_straight_back_plans_like_any_other_on_a_level_plate() {
-    let xs = range(0.0, 40.0, 8);
-    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
     let svg =
         br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
         <path d="M 12.413 10.9 L 12.4134 12.4 L 12.413 10.9" fill="none" stroke="black"/>
     </svg>"#;
-    let drawn = pipeline::load_path(svg, "spike.svg").unwrap();
-    // The SVG's y runs down: its 40 mm square laid onto the plate.
-    let mut settings = PlanSettings::default();
-    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
-    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
+    let (plans, settings) = compare_on_a_level_plate(svg);
     let reach = settings.nozzle.outer_diameter_mm + settings.nozzle.inner_diameter_mm;
     for plan in &plans {
         for piece in &plan.pieces {
@@ -581,19 +588,14 @@ fn a_stroke_that_turns_straight_back_plans_like_any_other_on_a_level_plate() {
 /// 1.5 mm had been reported there for `constant`).
 #[test]
 fn the_filament_is_measured_on_the_normal_line_only() {
-    let xs = range(0.0, 40.0, 8);
-    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
         <path d="M 5 5 L 20 5 L 20 6 L 5 6 L 5 7.5 L 20 7.5 L 20 9.5 L 5 9.5" fill="none" stroke="black"/>
         <path d="M 5 15 C 30 15 30 16 5 16 C 30 16.8 30 17.6 5 18.4" fill="none" stroke="black"/>
         <circle cx="25" cy="25" r="0.6" fill="none" stroke="black"/>
         <path d="M 5 30 h 1 v 1 h -1 v 1 h 1 v 1 h -1 v 1 h 1" fill="none" stroke="black"/>
     </svg>"#;
-    let drawn = pipeline::load_path(svg, "hairpins.svg").unwrap();
-    let mut settings = PlanSettings::default();
-    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
+    let (plans, settings) = compare_on_a_level_plate(svg);
     let d = settings.nozzle.inner_diameter_mm;
-    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
     for plan in &plans {
         for piece in &plan.pieces {
             for (j, q) in piece.quality.iter().enumerate() {
@@ -620,8 +622,6 @@ fn the_filament_is_measured_on_the_normal_line_only() {
 /// the curve touches the plane without a change of sign, had been missed).
 #[test]
 fn on_a_level_plate_nothing_descends_and_even_lays_the_filament_at_d() {
-    let xs = range(0.0, 40.0, 8);
-    let s = Surface::new(height_field(&xs, &xs, |_, _| 5.0)).unwrap();
     // Corners of 150 degrees and more, as logos have them, and curves.
     let svg =
         br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
@@ -629,11 +629,8 @@ fn on_a_level_plate_nothing_descends_and_even_lays_the_filament_at_d() {
         <path d="M 15 5 C 30 5 30 12 15 12 L 22 8.5" fill="none" stroke="black"/>
         <path d="M 5 20 L 20 20 L 20 21 L 5 21 L 5 22.5 L 20 22.5" fill="none" stroke="black"/>
     </svg>"#;
-    let drawn = pipeline::load_path(svg, "corners.svg").unwrap();
-    let mut settings = PlanSettings::default();
-    settings.placement.offset_mm = DVec2::new(0.0, 40.0);
+    let (plans, settings) = compare_on_a_level_plate(svg);
     let d = settings.nozzle.inner_diameter_mm;
-    let plans = pipeline::compare(&s, &drawn.subpaths, &settings).unwrap();
     for plan in &plans {
         for piece in &plan.pieces {
             for (j, (t, a)) in piece.toolpath.iter().zip(&piece.surface_path).enumerate() {
