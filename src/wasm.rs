@@ -26,11 +26,13 @@ use crate::planners::PlannerKind;
 use crate::sampling::{try_sample_subpath, MAX_SAMPLES};
 use crate::svg::Placement;
 
+mod scan;
 mod session;
 mod view;
 
+pub use scan::{ScanBuffer, ScanImport};
 use session::LoadedPath;
-pub use session::{ScanBuffer, ScanImport, Session};
+pub use session::Session;
 pub use view::{PreviewTimeline, Viewer};
 
 /// Largest scan file the page reads: 512 MiB. The core reads up to
