@@ -528,52 +528,11 @@ fn svg_numbers(text: &str) -> impl Iterator<Item = f64> + '_ {
 }
 
 /// The matrix [a b c d e f] (SVG's `matrix(a b c d e f)`) of a transform
-/// list, composed in f64; `None` when it does not parse or is not finite.
+/// list, composed in f64 by svgtypes (the parser usvg itself reads SVG's
+/// types with); `None` when it does not parse or is not finite.
 fn compose_transform(text: &str) -> Option<[f64; 6]> {
-    let mul = |m: [f64; 6], n: [f64; 6]| {
-        [
-            m[0] * n[0] + m[2] * n[1],
-            m[1] * n[0] + m[3] * n[1],
-            m[0] * n[2] + m[2] * n[3],
-            m[1] * n[2] + m[3] * n[3],
-            m[0] * n[4] + m[2] * n[5] + m[4],
-            m[1] * n[4] + m[3] * n[5] + m[5],
-        ]
-    };
-    let translate = |x: f64, y: f64| [1.0, 0.0, 0.0, 1.0, x, y];
-    let mut m = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
-    let mut rest = text.trim_start_matches(|c: char| c.is_whitespace() || c == ',');
-    while !rest.is_empty() {
-        let open = rest.find('(')?;
-        let close = rest.find(')')?;
-        if close < open {
-            return None;
-        }
-        let name = rest[..open].trim();
-        let args: Vec<f64> = svg_numbers(&rest[open + 1..close]).collect();
-        let rad = |deg: f64| deg.to_radians();
-        let step = match (name, args.as_slice()) {
-            ("matrix", &[a, b, c, d, e, f]) => [a, b, c, d, e, f],
-            ("translate", &[x]) => translate(x, 0.0),
-            ("translate", &[x, y]) => translate(x, y),
-            ("scale", &[k]) => [k, 0.0, 0.0, k, 0.0, 0.0],
-            ("scale", &[x, y]) => [x, 0.0, 0.0, y, 0.0, 0.0],
-            ("rotate", &[a]) => {
-                let (sin, cos) = rad(a).sin_cos();
-                [cos, sin, -sin, cos, 0.0, 0.0]
-            }
-            ("rotate", &[a, cx, cy]) => {
-                let (sin, cos) = rad(a).sin_cos();
-                let r = [cos, sin, -sin, cos, 0.0, 0.0];
-                mul(mul(translate(cx, cy), r), translate(-cx, -cy))
-            }
-            ("skewX", &[a]) => [1.0, 0.0, rad(a).tan(), 1.0, 0.0, 0.0],
-            ("skewY", &[a]) => [1.0, rad(a).tan(), 0.0, 1.0, 0.0, 0.0],
-            _ => return None,
-        };
-        m = mul(m, step);
-        rest = rest[close + 1..].trim_start_matches(|c: char| c.is_whitespace() || c == ',');
-    }
+    let t: svgtypes::Transform = text.parse().ok()?;
+    let m = [t.a, t.b, t.c, t.d, t.e, t.f];
     m.iter().all(|c| c.is_finite()).then_some(m)
 }
 
