@@ -224,8 +224,18 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         .map_err(|e| parse_err(format!("not UTF-8 text ({e}); SVG is an XML text file")))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
 
-    let (text, undeclared) = declare_prefixes(text);
-    let prepared = prepare(&text).map_err(parse_err)?;
+    // A document that uses an editor's prefix without declaring it is read
+    // again with the declarations added (only when the first parse fails).
+    let (prepared, undeclared) = match prepare(text) {
+        Ok(prepared) => (prepared, Vec::new()),
+        Err(e) => {
+            let (declared_text, undeclared) = declare_prefixes(text);
+            if undeclared.is_empty() {
+                return Err(parse_err(e));
+            }
+            (prepare(&declared_text).map_err(parse_err)?, undeclared)
+        }
+    };
     let mut notes = prepared.notes;
     if !undeclared.is_empty() {
         notes.push(format!(
