@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 
 use base64::Engine as _;
 use glam::DQuat;
+use pcpp::demo::glb_container as glb;
 use pcpp::mesh::{
     detect_format, import_mesh, ImportOptions, ImportedMesh, MeshError, MeshFormat, ScanUnits,
     TriMesh, UpAxis,
@@ -358,29 +359,6 @@ impl GltfBuilder {
     fn glb(&self, rest: &str) -> Vec<u8> {
         glb(self.json(rest, None).as_bytes(), &self.bin)
     }
-}
-
-fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
-    let mut json = json.to_vec();
-    while json.len() & 3 != 0 {
-        json.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while bin.len() & 3 != 0 {
-        bin.push(0);
-    }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
-    let mut b = Vec::with_capacity(total);
-    b.extend_from_slice(b"glTF");
-    b.extend_from_slice(&2u32.to_le_bytes());
-    b.extend_from_slice(&(total as u32).to_le_bytes());
-    b.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    b.extend_from_slice(b"JSON");
-    b.extend_from_slice(&json);
-    b.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    b.extend_from_slice(b"BIN\0");
-    b.extend_from_slice(&bin);
-    b
 }
 
 const ONE_NODE: &str = r#""scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}]"#;

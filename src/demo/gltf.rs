@@ -59,21 +59,27 @@ pub fn to_gltf_separate(mesh: &TriMesh, bin_uri: &str) -> (Vec<u8>, Vec<u8>) {
 /// The same glTF as [`to_gltf_separate`] as one `.glb`.
 pub fn to_glb(mesh: &TriMesh) -> Vec<u8> {
     let bin = buffer(mesh);
-    let mut json = json(mesh, bin.len(), None).into_bytes();
-    // Chunks are padded to 4 bytes: JSON with spaces, BIN with zeros.
-    json.resize(json.len().next_multiple_of(4), b' ');
+    glb_container(json(mesh, bin.len(), None).as_bytes(), &bin)
+}
+
+/// A `.glb` holding the glTF JSON `json` and the binary chunk `bin`, each
+/// chunk padded to 4 bytes as the format asks (JSON with spaces, BIN with
+/// zeros).
+pub fn glb_container(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let json_chunk = json.len().next_multiple_of(4);
     let bin_chunk = bin.len().next_multiple_of(4);
-    let total = 12 + 8 + json.len() + 8 + bin_chunk;
+    let total = 12 + 8 + json_chunk + 8 + bin_chunk;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
     out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(&(json_chunk as u32).to_le_bytes());
     out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
+    out.extend_from_slice(json);
+    out.resize(out.len() + json_chunk - json.len(), b' ');
     out.extend_from_slice(&(bin_chunk as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    out.extend_from_slice(bin);
     out.resize(total, 0);
     out
 }

@@ -6,7 +6,7 @@ pub mod parts;
 pub mod test_part;
 pub mod workloads;
 
-pub use gltf::{to_glb, to_gltf_separate};
+pub use gltf::{glb_container, to_glb, to_gltf_separate};
 
 use crate::mesh::TriMesh;
 
