@@ -1156,9 +1156,14 @@ fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
     );
     scan.add_external_file(written("block scan.bin", &bin))
         .unwrap_or_else(|e| panic!("{e:?}"));
-    let mut session =
-        pcpp::wasm::Session::from_scan_buffer(scan, js(&settings.scan), js(&settings.registration))
-            .unwrap_or_else(|e| panic!("{e:?}"));
+    // The page's staged steps (web/worker.js).
+    let mut import = scan
+        .import_scan(js(&settings.scan))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    import
+        .register(js(&settings.registration))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = import.index().unwrap_or_else(|e| panic!("{e:?}"));
     let info = json(session.info().unwrap());
     let want = job::InputFile::new("block scan.bin", &bin);
     assert_eq!(info["external_files"][0]["name"], "block scan.bin");

@@ -7,7 +7,6 @@ use glam::DVec3;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
-use super::scan::ScanBuffer;
 use super::{
     arr, check_samples, core_err, from_js, gcode_text, js_err, kind_err, profile, set, set_array,
     to_js, vec3, HoleView, PickView, RegistrationView, ScanView, TypedArray, PAGE_MAX_DRAWN_MOVES,
@@ -171,20 +170,6 @@ impl Session {
         let registration: RegistrationSettings = from_js("registration settings", registration)?;
         let scan = job::prepare_scan(bytes, name, &scan, &registration).map_err(core_err)?;
         Ok(Session::from_prepared(scan, None))
-    }
-
-    /// [`Session::new`] of a scan written into `buffer`, with the files it
-    /// names ([`ScanBuffer::add_external_file`]): the staged steps in one
-    /// call.
-    #[wasm_bindgen(js_name = fromScanBuffer)]
-    pub fn from_scan_buffer(
-        buffer: ScanBuffer,
-        scan: JsValue,
-        registration: JsValue,
-    ) -> Result<Session, JsValue> {
-        let mut import = buffer.import_scan(scan)?;
-        import.register(registration)?;
-        import.index()
     }
 
     /// Vertices of the registered mesh, printer frame, xyz f32 (for drawing).
