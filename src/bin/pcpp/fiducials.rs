@@ -19,10 +19,10 @@ pub fn cmd_fiducials(a: &FiducialsArgs, progress: &Progress) -> CliResult<()> {
     let bytes = read_scan(path, "scan")?;
     let name = file_name(path);
     // A .gltf's buffers in separate files, from its folder.
-    let external = read_external(path, &name, bytes.as_ref())?;
+    let (files, missing) = read_external(path, &name, bytes.as_ref())?;
     progress.step(format!("importing {name}..."));
-    let imported = pcpp::pipeline::load_scan_with(bytes.as_ref(), &name, &options, &external.files)
-        .map_err(|e| Failure::Input(external.explain(in_file(path, &name, &e.to_string()), &e)))?;
+    let imported = pcpp::pipeline::load_scan_with(bytes.as_ref(), &name, &options, &files)
+        .map_err(|e| Failure::Input(missing.explain(in_file(path, &name, &e.to_string()), &e)))?;
     if let Some(cloud) = &imported.cloud {
         progress.note(&cloud.to_string());
     }

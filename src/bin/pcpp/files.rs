@@ -58,23 +58,18 @@ pub fn read_scan(path: &Path, what: &str) -> CliResult<ScanBytes> {
     Ok(ScanBytes::Read(bytes))
 }
 
-/// The external files a scan names (a `.gltf`'s `.bin` buffers,
-/// [`pcpp::mesh::external_files_needed`]), read from the scan's folder,
-/// and those that are not there.
-pub struct ExternalInputs {
-    pub files: ExternalFiles,
-    /// (the path the scan names, where it was looked for).
-    missing: Vec<(String, PathBuf)>,
-}
+/// The external files a scan names that are not in its folder: (the path
+/// the scan names, where it was looked for).
+pub struct Missing(Vec<(String, PathBuf)>);
 
-impl ExternalInputs {
+impl Missing {
     /// The library's message for `e`, with where a missing external file
     /// was looked for.
     pub fn explain(&self, message: String, e: &pcpp::Error) -> String {
         let pcpp::Error::Mesh(MeshError::MissingExternalFile { path, .. }) = e else {
             return message;
         };
-        match self.missing.iter().find(|(p, _)| p == path) {
+        match self.0.iter().find(|(p, _)| p == path) {
             Some((_, looked)) => format!("{message} (not found: {})", looked.display()),
             None => message,
         }
@@ -82,20 +77,23 @@ impl ExternalInputs {
 }
 
 /// Reads the external files the scan at `scan_path` (its bytes `bytes`,
-/// `name` in the library's messages) names, relative to its folder. One
-/// that is not there is left out: the import then names it, unless it
+/// `name` in the library's messages) names ([`pcpp::mesh::external_files_needed`],
+/// a `.gltf`'s `.bin` buffers), relative to its folder. One that is not
+/// there is left out, in [`Missing`]: the import then names it, unless it
 /// stops first for a reason of its own (a compressed mesh).
-pub fn read_external(scan_path: &Path, name: &str, bytes: &[u8]) -> CliResult<ExternalInputs> {
+pub fn read_external(
+    scan_path: &Path,
+    name: &str,
+    bytes: &[u8],
+) -> CliResult<(ExternalFiles, Missing)> {
     let needed = pcpp::mesh::external_files_needed(bytes, name)
         .map_err(|e| Failure::Input(in_file(scan_path, name, &e.to_string())))?;
     let dir = match scan_path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut out = ExternalInputs {
-        files: ExternalFiles::new(),
-        missing: Vec::new(),
-    };
+    let mut files = ExternalFiles::new();
+    let mut missing = Vec::new();
     let mut seen: Vec<&str> = Vec::new();
     for r in &needed {
         if seen.contains(&r.path.as_str()) {
@@ -105,7 +103,7 @@ pub fn read_external(scan_path: &Path, name: &str, bytes: &[u8]) -> CliResult<Ex
         let path = dir.join(&r.path);
         match std::fs::metadata(&path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                out.missing.push((r.path.clone(), path));
+                missing.push((r.path.clone(), path));
             }
             _ => {
                 let bytes = read_scan(&path, "external file").map_err(|f| match f {
@@ -116,11 +114,11 @@ pub fn read_external(scan_path: &Path, name: &str, bytes: &[u8]) -> CliResult<Ex
                     )),
                     other => other,
                 })?;
-                out.files.add(r.path.clone(), bytes);
+                files.add(r.path.clone(), bytes);
             }
         }
     }
-    Ok(out)
+    Ok((files, Missing(missing)))
 }
 
 #[cfg(target_os = "linux")]

@@ -48,9 +48,8 @@ pub fn load_scan(
     let scan = read_scan(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
     // A .gltf's buffers in separate files, from its folder.
-    let mut external = read_external(scan_path, &scan_name, scan.as_ref())?;
+    let (files, missing) = read_external(scan_path, &scan_name, scan.as_ref())?;
     progress.step(format!("importing and indexing {scan_name}..."));
-    let files = std::mem::take(&mut external.files);
     let prepared = job::prepare_scan_owned_with(
         scan,
         &scan_name,
@@ -63,7 +62,7 @@ pub fn load_scan(
             Failure::Input(format!("registration of {}: {r}", scan_path.display()))
         }
         other => Failure::Input(
-            external.explain(in_file(scan_path, &scan_name, &other.to_string()), &other),
+            missing.explain(in_file(scan_path, &scan_name, &other.to_string()), &other),
         ),
     })?;
     progress.note(&format!(
