@@ -49,14 +49,6 @@ impl ExternalFiles {
         self
     }
 
-    pub fn len(&self) -> usize {
-        self.files.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.files.is_empty()
-    }
-
     /// The files as given, in order: (name, bytes).
     pub fn iter(&self) -> impl Iterator<Item = (&str, &[u8])> {
         self.files.iter().map(|(n, b)| (n.as_str(), (**b).as_ref()))
