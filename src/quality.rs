@@ -91,7 +91,7 @@ const ON_PLANE_MM: f64 = 1e-9;
 /// How many neighbours either side are searched for the crossing of the
 /// filament curve with the normal line; F_j lies at most do/2 + d behind
 /// T*_j, a few samples at d/2 spacing.
-const SEARCH: usize = 8;
+pub(crate) const SEARCH: usize = 8;
 
 /// Predicts the quality along one subpath planned as `toolpath`.
 pub fn predict(
@@ -102,13 +102,27 @@ pub fn predict(
     nozzle: &Nozzle,
     process: &Process,
 ) -> Vec<PointQuality> {
-    let d = nozzle.inner_diameter_mm;
     let r = 0.5 * nozzle.outer_diameter_mm;
-    let tol = process.tolerance_mm;
     let contact: Vec<bool> = toolpath
         .iter()
         .map(|&t| surface.disk_contact(t, r).is_some())
         .collect();
+    predict_given_contact(ta, geometry, toolpath, &contact, nozzle, process)
+}
+
+/// [`predict`] where it is known which points the tip disk touches the
+/// surface at (`contact`, one per point): a planner that has cleared its
+/// points by tol already knows there is no contact anywhere.
+pub(crate) fn predict_given_contact(
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    toolpath: &[DVec3],
+    contact: &[bool],
+    nozzle: &Nozzle,
+    process: &Process,
+) -> Vec<PointQuality> {
+    let d = nozzle.inner_diameter_mm;
+    let tol = process.tolerance_mm;
     // c(t) runs through the F_j of the points without contact only
     // (Algorithm 5 sets F_j <- [ ] at a contact, spec section 7): the
     // simulated filament does not pass where the nozzle hits the surface.

@@ -654,3 +654,55 @@ fn on_a_level_plate_nothing_descends_and_even_lays_the_filament_at_d() {
         }
     }
 }
+
+/// Along the foot of a wall, 0.2 mm from it: the tip's disk (do/2 plus tol)
+/// would reach into the wall. Stepping sideways by about 0.36 mm keeps the
+/// nozzle low, and its filament, measured from the surface point as
+/// section 7 does, is sqrt(w^2 + d^2) = 0.70 mm, within tol of d; rising
+/// over the 2 mm wall floats it. `even` searched only 0.2 mm sideways and
+/// rose (the stepped block under a logo: `pcpp-guarded`, which pushes away
+/// from the wall, printed better); it now searches out to the offset whose
+/// filament is still good, sqrt((d + tol)^2 - d^2), and takes the smallest
+/// that clears.
+#[test]
+fn regression_even_rose_over_a_wall_it_could_step_away_from() {
+    let mut xs = range(0.0, 10.0, 100);
+    xs.push(5.001);
+    xs.sort_by(f64::total_cmp);
+    let s = Surface::new(height_field(&xs, &range(0.0, 20.0, 40), |x, _| {
+        if x > 5.0005 {
+            2.0
+        } else {
+            0.0
+        }
+    }))
+    .unwrap();
+    let settings = PlanSettings::default();
+    let d = settings.nozzle.inner_diameter_mm;
+    let tol = settings.process.tolerance_mm;
+    let plan = pipeline::plan(
+        &s,
+        &[line(DVec2::new(4.8, 4.0), DVec2::new(4.8, 16.0))],
+        &settings,
+    )
+    .unwrap();
+    assert_eq!(plan.motion.touching_moves, 0);
+    let piece = &plan.pieces[0];
+    let n = piece.toolpath.len();
+    for j in n / 4..3 * n / 4 {
+        let (t, a) = (piece.toolpath[j], piece.surface_path[j]);
+        assert!(
+            (t.z - (a.z + d)).abs() < 1e-9,
+            "point {j} rose to {:.3} mm over the floor",
+            t.z - a.z
+        );
+        let away = a.x - t.x;
+        assert!(
+            away > 0.3 && away < 0.37,
+            "point {j}: {away:.4} mm from the path"
+        );
+        assert_eq!(piece.quality[j].defect, Defect::Good, "point {j}");
+        let e = piece.quality[j].error_mm.unwrap();
+        assert!(e.abs() <= tol, "point {j}: e = {e}");
+    }
+}

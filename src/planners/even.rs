@@ -18,15 +18,29 @@
 //!    such slopes the horizontal difference moves F_j along a nearly level
 //!    surface, which changes D_j by at most (do - d)/2 sin(3 deg), 0.008 mm
 //!    for the paper's tip.
-//! 2. Where the normal turns fast (steps, creases), N_j swings F_j back and
-//!    forth along the path. The tip's position along the path is made to
-//!    advance by at least [`MIN_ADVANCE`] of the sample spacing at every
-//!    step: the least-squares closest such positions to the targets
-//!    (isotonic regression, pool-adjacent-violators, O(n)).
+//! 2. Where the normal turns fast (valleys, creases) or the drawing turns
+//!    sharply, N_j swings F_j back along the path. The tip's position along
+//!    the path is made to advance by at least [`MIN_ADVANCE`] of the sample
+//!    spacing at every step, and where the targets fall back no such tool
+//!    path meets them all. Three compromises, each nondecreasing: the
+//!    least-squares closest positions (isotonic regression,
+//!    pool-adjacent-violators, O(n)), which pools the points on both sides
+//!    of the fall; the points before the fall kept and those after it
+//!    pushed on; those after it kept and those before it held back. Which
+//!    prints best depends on the surface (the pooled points of a sharp
+//!    valley all float; pushing on floats the ascent's first points, holding
+//!    back flattens the descent's last ones), so every stretch where the
+//!    least-squares fit leaves a defect within reach is planned with each,
+//!    and keeps the one section 7 predicts the fewest defects for, then the
+//!    least error: the planner is measured by the same code as the paper's
+//!    planners, and the rule is the same on every part.
 //! 3. Where the tip at its target would come within tol of the surface
-//!    (steep ascents, narrow valleys, the foot of a step), it is raised to
-//!    the lowest height that keeps tol ([`Clearance::rise_needed`]): no
-//!    sideways push, so it never leaves the path.
+//!    (steep ascents, narrow valleys, the foot of a step), it stays back
+//!    where that costs less than rising, else it is raised to the lowest
+//!    height that keeps tol ([`Clearance::rise_needed`]) or, where that
+//!    costs less, stepped sideways by at most [`lateral_reach`] (the offset
+//!    whose filament, measured from Ta_j, is still within tol of d; beside
+//!    a wall it clears with no rise).
 //!    Under section 7's model no other position does better on a straight
 //!    ascent: with the tip as low as the clearance allows, D_j does not
 //!    depend on where along the slope the tip sits.
@@ -35,12 +49,15 @@
 //! ([`crate::motion::insert_waypoints`], applied to every guarded planner).
 //! The same constants serve every part: nothing here is tuned per part.
 
+use std::ops::Range;
+
 use glam::DVec3;
 
 use super::PlannedPoints;
 use crate::motion::{Clearance, PLANNING_MARGIN_MM};
 use crate::parallel;
 use crate::params::{Nozzle, Process};
+use crate::quality::{predict_given_contact, Defect, PointQuality};
 use crate::spline::LocalGeometry;
 use crate::surface::Surface;
 
@@ -73,10 +90,18 @@ fn model_back_offset(nozzle: &Nozzle, g: &LocalGeometry) -> f64 {
     }
 }
 
-/// How far sideways (across the path, downhill) the tip may step where it
-/// would otherwise have to rise, and in how many steps it is searched.
-pub const LATERAL_MAX_MM: f64 = 0.2;
+/// The sideways search (across the path, either way) where the tip would
+/// otherwise have to rise: in this many steps out to [`lateral_reach`],
+/// then narrowed to the smallest offset that clears in this many halvings.
 const LATERAL_STEPS: usize = 4;
+const LATERAL_HALVINGS: usize = 6;
+
+/// How far sideways the tip may go: the offset w whose filament, measured
+/// from Ta_j as section 7 does, is sqrt(w^2 + d^2) = d + tol thick, the
+/// most that still counts as good. Beyond it a rise is no worse.
+fn lateral_reach(d: f64, tol: f64) -> f64 {
+    ((d + tol) * (d + tol) - d * d).max(0.0).sqrt()
+}
 
 /// The step of the search for a place behind the target that clears (the
 /// slide goes back at most do).
@@ -90,6 +115,12 @@ const MIN_CHUNK: usize = 256;
 /// filament starts at the back of the tip, so a start ahead of Ta_0 would
 /// leave Ta_0 without filament (section 7 finds no crossing there).
 const START_BEHIND_MM: f64 = 1e-4;
+
+/// Around a stretch where the places must be fitted (see [`plan`]), the
+/// points whose predicted filament the choice of fit can change: the
+/// filament curve's crossing is searched this many samples either side
+/// (section 7), and the cubic spline through the F_j settles within a few.
+const REACH: usize = crate::quality::SEARCH;
 
 pub(super) fn plan(
     surface: &Surface,
@@ -114,9 +145,8 @@ pub(super) fn plan(
         height.push(f.z);
     }
     // Progress: the tip's place along the path, w_j = u_j + shift_j, must
-    // advance by MIN_ADVANCE of each step (`advance`, summed in `floor`);
-    // the closest such places in least squares are the nondecreasing fit
-    // to w_j - floor_j, plus floor_j.
+    // advance by MIN_ADVANCE of each step (`advance`, summed in `floor`):
+    // the places minus `floor` must not decrease.
     let mut u = Vec::with_capacity(n);
     let mut advance = vec![0.0; n];
     let mut floor = Vec::with_capacity(n);
@@ -132,111 +162,354 @@ pub(super) fn plan(
         floor.push(least);
     }
     let lowered: Vec<f64> = (0..n).map(|j| u[j] + shift[j] - floor[j]).collect();
-    let target: Vec<f64> = isotonic(&lowered)
-        .into_iter()
-        .zip(&floor)
-        .map(|(w, f)| w + f)
-        .collect();
-    let c = Clearance::new(nozzle, process.tolerance_mm).with_margin(PLANNING_MARGIN_MM);
-    let at =
-        |j: usize, w: f64, z: f64| DVec3::new(ta[j].x, ta[j].y, z) + (w - u[j]) * geometry[j].v;
-    // Where a target is too close to the surface, the tip may stay back at
-    // its height instead of rising (up to do behind, as far forward as
-    // clears): before a step up this keeps the nozzle on the floor until
-    // the step rather than lifting it early into the air. Staying back by
-    // D on a slope of angle a moves the back of the tip D sin(a) further
-    // from the surface, rising by e moves it e cos(a): the tip stays back
-    // only where that costs less than half the rise, so a plain slope is
-    // still handled by rising.
-    // (Each point on its own: on every core natively.)
-    let steps = (nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
-    let furthest = steps as f64 * SLIDE_STEP_MM;
-    // With each cap, the rise the target itself needs when the query found
-    // it whole (see below).
-    let (low_cap, target_rise): (Vec<Option<f64>>, Vec<Option<f64>>) =
-        parallel::map(n, MIN_CHUNK, |j| {
-            let a = geometry[j].slope_rad;
-            let worth =
-                |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
-            // The rise matters only until it makes the whole slide worth
-            // trying (`worth` grows with the rise): the query stops there.
-            let rise = c.rise_until(surface, at(j, target[j], height[j]), |r| worth(furthest, r));
-            if rise == 0.0 {
-                return (Some(target[j]), None);
-            }
-            // Where the slide is not worth it, the query did not stop early
-            // and `rise` is the rise needed, to the last bit: a point left
-            // at its target is raised by it below without asking again.
-            let whole = (!worth(furthest, rise)).then_some(rise);
-            let cap = (1..=steps)
-                .map(|k| k as f64 * SLIDE_STEP_MM)
-                .take_while(|&back| worth(back, rise))
-                .map(|back| target[j] - back)
-                .find(|&w| c.is_clear(surface, at(j, w, height[j]), at(j, w, height[j])));
-            (cap, whole)
-        })
-        .into_iter()
-        .unzip();
-    // Backward: every point at most its cap and at least one advance
-    // behind the next; a point that cannot stay low within the slide is
-    // raised where progress puts it.
-    let mut w = vec![0.0; n];
-    for j in (0..n).rev() {
-        let next = if j + 1 < n {
-            w[j + 1] - advance[j + 1]
-        } else {
-            f64::INFINITY
-        };
-        match low_cap[j] {
-            Some(cap) if cap.min(next) >= target[j] - nozzle.outer_diameter_mm => {
-                w[j] = cap.min(next);
-            }
-            _ => w[j] = target[j].min(next),
-        }
-    }
-    // Each point raised on its own (on every core natively), then taken in
-    // order: (the tool-path point, how far it was raised).
-    let placed: Vec<(DVec3, f64)> = parallel::map(n, MIN_CHUNK, |j| {
-        let t = at(j, w[j], height[j]);
-        // Raise to the lowest height that keeps tol, where staying back
-        // did not clear (or progress moved the point off its cap); on a
-        // slope across the path a small step sideways, downhill, may need
-        // much less rise (section 7 measures the filament's distance from
-        // Ta_j, so a sideways offset w and a rise e give about
-        // sqrt(w^2 + (d + e cos a)^2)). A point at its cap was found
-        // clear when the cap was chosen.
-        if low_cap[j] == Some(w[j]) {
-            return (t, 0.0);
-        }
-        // The same point as the target's own query (the same bits of w, so
-        // of t) when that query found the rise needed whole.
-        let lift = match target_rise[j] {
-            Some(rise) if w[j].to_bits() == target[j].to_bits() => rise,
-            _ => c.rise_needed(surface, t),
-        };
-        if lift.is_nan() || lift <= 0.0 {
-            return (t, 0.0);
-        }
-        let (mut t, rise) = sideways(surface, &c, t, lift, &geometry[j], d);
-        if rise > 0.0 {
-            t.z += rise;
-        }
-        (t, rise)
-    });
-    let mut out = PlannedPoints {
-        toolpath: Vec::with_capacity(n),
-        ..Default::default()
+    let placer = Placer {
+        surface,
+        ta,
+        geometry,
+        u: &u,
+        height: &height,
+        advance: &advance,
+        nozzle,
+        clearance: Clearance::new(nozzle, process.tolerance_mm).with_margin(PLANNING_MARGIN_MM),
     };
-    for (j, (t, lift)) in placed.into_iter().enumerate() {
-        if lift > 0.0 {
-            out.lifted.push((j, lift));
+    let mut memo = Memo::default();
+    // Where the targets fall back, three nondecreasing compromises (module
+    // docs, item 2), tried where the first leaves a defect.
+    let fits = [
+        isotonic(&lowered),
+        clamp_forward(&lowered),
+        clamp_backward(&lowered),
+    ];
+    let targets: Vec<Vec<f64>> = fits
+        .iter()
+        .map(|f| f.iter().zip(&floor).map(|(w, fl)| w + fl).collect())
+        .collect();
+    let stretches = refitted(&lowered, &fits);
+    if stretches.is_empty() {
+        // Every fit is the targets themselves.
+        return placer.place(&targets[0], &mut memo).into_planned();
+    }
+    // The least-squares fit first, its filament predicted along the whole
+    // piece; the other fits are tried only on the stretches where it leaves
+    // a defect within reach.
+    let first = placer.place(&targets[0], &mut memo);
+    let predicted = first.predict(0..n, ta, geometry, nozzle, process);
+    let reach = |r: &Range<usize>| r.start.saturating_sub(REACH)..(r.end + REACH).min(n);
+    let open: Vec<Range<usize>> = stretches
+        .into_iter()
+        .filter(|r| predicted[reach(r)].iter().any(|q| q.defect != Defect::Good))
+        .collect();
+    if open.is_empty() {
+        return first.into_planned();
+    }
+    // Each other fit on those stretches, the least-squares one elsewhere.
+    let mut tried = vec![first];
+    for fit in &targets[1..] {
+        let mut t = targets[0].clone();
+        for r in &open {
+            t[r.clone()].copy_from_slice(&fit[r.clone()]);
         }
-        if !t.is_finite() {
-            out.uncleared.push(j);
+        tried.push(placer.place(&t, &mut memo));
+    }
+    // Each stretch takes the fit with the fewest defects among the points
+    // it can change, then the least error (predicted over a window around
+    // them, so that the filament curve there is the same for every fit).
+    let mut chosen = targets[0].clone();
+    for r in &open {
+        let core = reach(r);
+        let window = r.start.saturating_sub(2 * REACH)..(r.end + 2 * REACH).min(n);
+        let inner = core.start - window.start..core.end - window.start;
+        let score = |p: &Placed| {
+            p.predict(window.clone(), ta, geometry, nozzle, process)[inner.clone()]
+                .iter()
+                .fold((0usize, 0.0), |(bad, err), q| {
+                    (
+                        bad + usize::from(q.defect != Defect::Good),
+                        err + q.error_mm.map_or(0.0, f64::abs),
+                    )
+                })
+        };
+        let mut best = (0, score(&tried[0]));
+        for (k, p) in tried.iter().enumerate().skip(1) {
+            let s = score(p);
+            if s < best.1 {
+                best = (k, s);
+            }
         }
-        out.toolpath.push(t);
+        chosen[r.clone()].copy_from_slice(&targets[best.0][r.clone()]);
+    }
+    placer.place(&chosen, &mut memo).into_planned()
+}
+
+/// The stretches where some fit moves a place off its target (one choice
+/// each).
+fn refitted(lowered: &[f64], fits: &[Vec<f64>]) -> Vec<Range<usize>> {
+    let mut out: Vec<Range<usize>> = Vec::new();
+    for j in 0..lowered.len() {
+        if fits.iter().all(|f| f[j].to_bits() == lowered[j].to_bits()) {
+            continue;
+        }
+        match out.last_mut() {
+            Some(r) if j == r.end => r.end = j + 1,
+            _ => out.push(j..j + 1),
+        }
     }
     out
+}
+
+/// The sequence raised where it falls back: each value at least the one
+/// before (the points after a fall are pushed on).
+fn clamp_forward(y: &[f64]) -> Vec<f64> {
+    let mut out = y.to_vec();
+    for j in 1..out.len() {
+        out[j] = out[j].max(out[j - 1]);
+    }
+    out
+}
+
+/// The sequence lowered where it falls back: each value at most the one
+/// after (the points before a fall are held back).
+fn clamp_backward(y: &[f64]) -> Vec<f64> {
+    let mut out = y.to_vec();
+    for j in (0..out.len().saturating_sub(1)).rev() {
+        out[j] = out[j].min(out[j + 1]);
+    }
+    out
+}
+
+/// What the placement of one set of targets found: the tool-path points
+/// and how far each was raised.
+struct Placed {
+    points: Vec<DVec3>,
+    lifts: Vec<f64>,
+}
+
+impl Placed {
+    /// Section 7's prediction for the points in `range`, as if the piece
+    /// were those points alone. No placed point touches the surface (each
+    /// keeps tol), so the contact test is left out; a point that could not
+    /// be placed (not finite) counts as a contact.
+    fn predict(
+        &self,
+        range: Range<usize>,
+        ta: &[DVec3],
+        geometry: &[LocalGeometry],
+        nozzle: &Nozzle,
+        process: &Process,
+    ) -> Vec<PointQuality> {
+        let points = &self.points[range.clone()];
+        let lost: Vec<bool> = points.iter().map(|p| !p.is_finite()).collect();
+        predict_given_contact(
+            &ta[range.clone()],
+            &geometry[range],
+            points,
+            &lost,
+            nozzle,
+            process,
+        )
+    }
+
+    fn into_planned(self) -> PlannedPoints {
+        let mut out = PlannedPoints {
+            toolpath: Vec::with_capacity(self.points.len()),
+            ..Default::default()
+        };
+        for (j, (t, lift)) in self.points.into_iter().zip(self.lifts).enumerate() {
+            if lift > 0.0 {
+                out.lifted.push((j, lift));
+            }
+            if !t.is_finite() {
+                out.uncleared.push(j);
+            }
+            out.toolpath.push(t);
+        }
+        out
+    }
+}
+
+/// The point queries' answers, kept across the fits: each depends only on
+/// the point and its target place (the caps) or on the place it gets too
+/// (the raised point), so a place two fits share is asked once. The first
+/// placement fills the arrays; the others' few different places go to the
+/// maps.
+#[derive(Default)]
+struct Memo {
+    caps: Vec<(u64, Cap)>,
+    caps_more: std::collections::HashMap<(usize, u64), Cap>,
+    raised: Vec<((u64, u64), (DVec3, f64))>,
+    raised_more: std::collections::HashMap<(usize, (u64, u64)), (DVec3, f64)>,
+}
+
+/// A point's cap (the furthest place forward, at most its target, where
+/// the tip clears at the target's height, if staying back is worth it)
+/// and the rise its target needs where that query found it whole.
+type Cap = (Option<f64>, Option<f64>);
+
+impl Memo {
+    /// The answers of `ask` for every point at `key(j)`, asking only those
+    /// not known (on every core natively, in order).
+    fn fill<K: Copy + Eq + std::hash::Hash + Send + Sync, V: Copy + Send>(
+        base: &mut Vec<(K, V)>,
+        more: &mut std::collections::HashMap<(usize, K), V>,
+        n: usize,
+        key: impl Fn(usize) -> K + Sync,
+        ask: impl Fn(usize) -> V + Sync,
+    ) -> Vec<V> {
+        if base.is_empty() {
+            *base = parallel::map(n, MIN_CHUNK, |j| (key(j), ask(j)));
+            return base.iter().map(|&(_, v)| v).collect();
+        }
+        let missing: Vec<usize> = (0..n)
+            .filter(|&j| base[j].0 != key(j) && !more.contains_key(&(j, key(j))))
+            .collect();
+        let found = parallel::map(missing.len(), MIN_CHUNK, |i| ask(missing[i]));
+        for (&j, v) in missing.iter().zip(found) {
+            more.insert((j, key(j)), v);
+        }
+        (0..n)
+            .map(|j| {
+                let k = key(j);
+                if base[j].0 == k {
+                    base[j].1
+                } else {
+                    more[&(j, k)]
+                }
+            })
+            .collect()
+    }
+}
+
+/// Places the tool path for given target places: the part of `even` that
+/// asks the surface.
+struct Placer<'a> {
+    surface: &'a Surface,
+    ta: &'a [DVec3],
+    geometry: &'a [LocalGeometry],
+    u: &'a [f64],
+    height: &'a [f64],
+    advance: &'a [f64],
+    nozzle: &'a Nozzle,
+    clearance: Clearance,
+}
+
+impl Placer<'_> {
+    /// The tip at place `w` along the path of point j, at height `z`.
+    fn at(&self, j: usize, w: f64, z: f64) -> DVec3 {
+        let a = self.ta[j];
+        DVec3::new(a.x, a.y, z) + (w - self.u[j]) * self.geometry[j].v
+    }
+
+    /// The tool path for the places `target` (nondecreasing after the
+    /// advance floor): each point kept low where it clears, staying back
+    /// where that costs less than rising, and raised (or stepped sideways)
+    /// to keep tol.
+    fn place(&self, target: &[f64], memo: &mut Memo) -> Placed {
+        let n = target.len();
+        let (surface, c, height) = (self.surface, &self.clearance, self.height);
+        // Where a target is too close to the surface, the tip may stay
+        // back at its height instead of rising (up to do behind, as far
+        // forward as clears): before a step up this keeps the nozzle on
+        // the floor until the step rather than lifting it early into the
+        // air. Staying back by D on a slope of angle a moves the back of
+        // the tip D sin(a) further from the surface, rising by e moves it
+        // e cos(a): the tip stays back only where that costs less than
+        // half the rise, so a plain slope is still handled by rising.
+        let steps = (self.nozzle.outer_diameter_mm / SLIDE_STEP_MM).ceil() as usize;
+        let furthest = steps as f64 * SLIDE_STEP_MM;
+        // With each cap, the rise the target itself needs when the query
+        // found it whole (see below).
+        let caps = Memo::fill(
+            &mut memo.caps,
+            &mut memo.caps_more,
+            n,
+            |j| target[j].to_bits(),
+            |j| {
+                let a = self.geometry[j].slope_rad;
+                let worth =
+                    |back: f64, rise: f64| back * libm::sin(a).abs() < 0.5 * rise * libm::cos(a);
+                // The rise matters only until it makes the whole slide
+                // worth trying (`worth` grows with the rise): the query
+                // stops there.
+                let rise = c.rise_until(surface, self.at(j, target[j], height[j]), |r| {
+                    worth(furthest, r)
+                });
+                if rise == 0.0 {
+                    return (Some(target[j]), None);
+                }
+                // Where the slide is not worth it, the query did not stop
+                // early and `rise` is the rise needed, to the last bit: a
+                // point left at its target is raised by it below without
+                // asking again.
+                let whole = (!worth(furthest, rise)).then_some(rise);
+                let cap = (1..=steps)
+                    .map(|k| k as f64 * SLIDE_STEP_MM)
+                    .take_while(|&back| worth(back, rise))
+                    .map(|back| target[j] - back)
+                    .find(|&w| {
+                        let t = self.at(j, w, height[j]);
+                        c.is_clear(surface, t, t)
+                    });
+                (cap, whole)
+            },
+        );
+        // Backward: every point at most its cap and at least one advance
+        // behind the next; a point that cannot stay low within the slide
+        // is raised where progress puts it.
+        let mut w = vec![0.0; n];
+        for j in (0..n).rev() {
+            let next = if j + 1 < n {
+                w[j + 1] - self.advance[j + 1]
+            } else {
+                f64::INFINITY
+            };
+            match caps[j].0 {
+                Some(cap) if cap.min(next) >= target[j] - self.nozzle.outer_diameter_mm => {
+                    w[j] = cap.min(next);
+                }
+                _ => w[j] = target[j].min(next),
+            }
+        }
+        // Each point raised on its own: (the tool-path point, how far it
+        // was raised).
+        let d = self.nozzle.inner_diameter_mm;
+        let raised = Memo::fill(
+            &mut memo.raised,
+            &mut memo.raised_more,
+            n,
+            |j| (w[j].to_bits(), target[j].to_bits()),
+            |j| {
+                let (low_cap, target_rise) = caps[j];
+                let t = self.at(j, w[j], height[j]);
+                // Raise to the lowest height that keeps tol, where staying
+                // back did not clear (or progress moved the point off its
+                // cap); on a slope across the path a small step sideways
+                // may need much less rise (section 7 measures the
+                // filament's distance from Ta_j, so a sideways offset w and
+                // a rise e give about sqrt(w^2 + (d + e cos a)^2)). A point
+                // at its cap was found clear when the cap was chosen.
+                if low_cap == Some(w[j]) {
+                    return (t, 0.0);
+                }
+                // The same point as the target's own query (the same bits
+                // of w, so of t) when that query found the rise needed
+                // whole.
+                let lift = match target_rise {
+                    Some(rise) if w[j].to_bits() == target[j].to_bits() => rise,
+                    _ => c.rise_needed(surface, t),
+                };
+                if lift.is_nan() || lift <= 0.0 {
+                    return (t, 0.0);
+                }
+                let (mut t, rise) = sideways(surface, c, t, lift, &self.geometry[j], d);
+                if rise > 0.0 {
+                    t.z += rise;
+                }
+                (t, rise)
+            },
+        );
+        let (points, lifts) = raised.into_iter().unzip();
+        Placed { points, lifts }
+    }
 }
 
 /// The nondecreasing sequence closest to `y` in least squares
@@ -264,12 +537,13 @@ fn isotonic(y: &[f64]) -> Vec<f64> {
 }
 
 /// Where the tip `t` that must rise by `lift` (positive) to keep tol goes:
-/// itself, or a small step sideways (across the path, either way, up to
-/// [`LATERAL_MAX_MM`]) where that costs less, with the rise needed there
+/// itself, or a step sideways (across the path, either way, up to
+/// [`lateral_reach`]) where that costs less, with the rise needed there
 /// ((point, rise)). The cost of a sideways offset w and a rise e is the
 /// change of the filament's thickness measured from Ta_j on a slope of
 /// `g.slope_rad` (see `plan`), for the thickness `d`; the first of equal
-/// costs is kept.
+/// costs is kept. Where a step clears with no rise, the offset is narrowed
+/// to the smallest that clears between it and the step before.
 fn sideways(
     surface: &Surface,
     c: &Clearance,
@@ -281,9 +555,11 @@ fn sideways(
     let side = DVec3::new(-g.v.y, g.v.x, 0.0);
     let cos_a = libm::cos(g.slope_rad);
     let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+    let reach = lateral_reach(d, c.tol_mm);
+    let offset = |k: usize| reach * k as f64 / LATERAL_STEPS as f64;
     let mut best = (cost(0.0, lift), t, lift);
     for k in 1..=LATERAL_STEPS {
-        let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+        let w = offset(k);
         for sgn in [-1.0, 1.0] {
             // Off the path (w > 0) the cost grows with the rise e: e and
             // cos a are not negative, so d + e cos a is at least d, each
@@ -301,6 +577,19 @@ fn sideways(
             let cq = cost(w, e);
             if cq < best.0 {
                 best = (cq, q, e);
+                if e == 0.0 {
+                    let (mut near, mut far) = (offset(k - 1), w);
+                    for _ in 0..LATERAL_HALVINGS {
+                        let mid = 0.5 * (near + far);
+                        let p = t + sgn * mid * side;
+                        if c.is_clear(surface, p, p) {
+                            far = mid;
+                        } else {
+                            near = mid;
+                        }
+                    }
+                    best = (cost(far, 0.0), t + sgn * far * side, 0.0);
+                }
             }
         }
     }
@@ -311,8 +600,8 @@ fn sideways(
 mod tests {
     use super::*;
 
-    /// `sideways` as it was before it left out the queries that could not
-    /// change its answer: every offset asked.
+    /// `sideways` without leaving out the queries that cannot change its
+    /// answer: every offset asked.
     fn sideways_asking_all(
         surface: &Surface,
         c: &Clearance,
@@ -324,15 +613,30 @@ mod tests {
         let side = DVec3::new(-g.v.y, g.v.x, 0.0);
         let cos_a = libm::cos(g.slope_rad);
         let cost = |w: f64, e: f64| ((w * w + (d + e * cos_a).powi(2)).sqrt() - d).abs();
+        let reach = lateral_reach(d, c.tol_mm);
+        let offset = |k: usize| reach * k as f64 / LATERAL_STEPS as f64;
         let mut best = (cost(0.0, lift), t, lift);
         for k in 1..=LATERAL_STEPS {
-            let w = LATERAL_MAX_MM * k as f64 / LATERAL_STEPS as f64;
+            let w = offset(k);
             for sgn in [-1.0, 1.0] {
                 let q = t + sgn * w * side;
-                let e = c.rise_until(surface, q, |e| cost(w, e) >= best.0);
+                let e = c.rise_needed(surface, q);
                 let cq = cost(w, e);
                 if cq < best.0 {
                     best = (cq, q, e);
+                    if e == 0.0 {
+                        let (mut near, mut far) = (offset(k - 1), w);
+                        for _ in 0..LATERAL_HALVINGS {
+                            let mid = 0.5 * (near + far);
+                            let p = t + sgn * mid * side;
+                            if c.rise_needed(surface, p) == 0.0 {
+                                far = mid;
+                            } else {
+                                near = mid;
+                            }
+                        }
+                        best = (cost(far, 0.0), t + sgn * far * side, 0.0);
+                    }
                 }
             }
         }
@@ -388,6 +692,36 @@ mod tests {
         }
         // Enough tips needed a rise, and enough of them went sideways.
         assert!(lifted > 200 && moved > 50, "{lifted} lifted, {moved} moved");
+    }
+
+    #[test]
+    fn clamps_keep_one_side_of_a_fall() {
+        let y = [0.0, 1.0, 2.0, 0.5, 1.5, 3.0];
+        assert_eq!(clamp_forward(&y), vec![0.0, 1.0, 2.0, 2.0, 2.0, 3.0]);
+        assert_eq!(clamp_backward(&y), vec![0.0, 0.5, 0.5, 0.5, 1.5, 3.0]);
+        for f in [clamp_forward(&y), clamp_backward(&y), isotonic(&y)] {
+            assert!(f.windows(2).all(|w| w[0] <= w[1]), "{f:?}");
+        }
+        // Where nothing falls, every fit is the sequence itself, bit for
+        // bit, and there is nothing to choose.
+        let up = [0.0, 0.1, 0.30000000000000004, 0.7];
+        let fits = [isotonic(&up), clamp_forward(&up), clamp_backward(&up)];
+        assert!(fits.iter().all(|f| f == &up));
+        assert!(refitted(&up, &fits).is_empty());
+        let fits = [isotonic(&y), clamp_forward(&y), clamp_backward(&y)];
+        assert_eq!(refitted(&y, &fits), vec![1..5]);
+        // Two falls apart are two stretches, each chosen on its own.
+        let two = [0.0, 2.0, 1.0, 3.0, 4.0, 5.0, 7.0, 6.0, 8.0];
+        let fits = [isotonic(&two), clamp_forward(&two), clamp_backward(&two)];
+        assert_eq!(refitted(&two, &fits), vec![1..3, 6..8]);
+    }
+
+    #[test]
+    fn lateral_reach_keeps_the_filament_within_tol() {
+        let (d, tol) = (0.603, 0.1);
+        let w = lateral_reach(d, tol);
+        assert!(((w * w + d * d).sqrt() - (d + tol)).abs() < 1e-12);
+        assert_eq!(lateral_reach(d, 0.0), 0.0);
     }
 
     #[test]
