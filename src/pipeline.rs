@@ -397,14 +397,17 @@ fn plan_stage(
         for &j in &planned.uncleared {
             uncleared.push((k, j, planned.toolpath[j]));
         }
-        let quality = predict(
-            surface,
-            &piece.ta,
-            &piece.geometry,
-            &planned.toolpath,
-            nozzle,
-            process,
-        );
+        let quality = match planned.quality {
+            Some(q) => q,
+            None => predict(
+                surface,
+                &piece.ta,
+                &piece.geometry,
+                &planned.toolpath,
+                nozzle,
+                process,
+            ),
+        };
         pieces.push(PlannedPiece {
             source: piece.source.clone(),
             surface_path: piece.ta.clone(),

@@ -94,7 +94,7 @@ fn model_back_offset(nozzle: &Nozzle, g: &LocalGeometry) -> f64 {
 /// otherwise have to rise: in this many steps out to [`lateral_reach`],
 /// then narrowed to the smallest offset that clears in this many halvings.
 const LATERAL_STEPS: usize = 4;
-const LATERAL_HALVINGS: usize = 6;
+const LATERAL_HALVINGS: usize = 4;
 
 /// How far sideways the tip may go: the offset w whose filament, measured
 /// from Ta_j as section 7 does, is sqrt(w^2 + d^2) = d + tol thick, the
@@ -187,20 +187,22 @@ pub(super) fn plan(
     let stretches = refitted(&lowered, &fits);
     if stretches.is_empty() {
         // Every fit is the targets themselves.
-        return placer.place(&targets[0], &mut memo).into_planned();
+        let placed = placer.place(&targets[0], &mut memo);
+        let quality = placed.predict(0..n, surface, ta, geometry, nozzle, process);
+        return placed.into_planned(quality);
     }
     // The least-squares fit first, its filament predicted along the whole
     // piece; the other fits are tried only on the stretches where it leaves
     // a defect within reach.
     let first = placer.place(&targets[0], &mut memo);
-    let predicted = first.predict(0..n, ta, geometry, nozzle, process);
+    let predicted = first.predict(0..n, surface, ta, geometry, nozzle, process);
     let reach = |r: &Range<usize>| r.start.saturating_sub(REACH)..(r.end + REACH).min(n);
     let open: Vec<Range<usize>> = stretches
         .into_iter()
         .filter(|r| predicted[reach(r)].iter().any(|q| q.defect != Defect::Good))
         .collect();
     if open.is_empty() {
-        return first.into_planned();
+        return first.into_planned(predicted);
     }
     // Each other fit on those stretches, the least-squares one elsewhere.
     let mut tried = vec![first];
@@ -220,7 +222,7 @@ pub(super) fn plan(
         let window = r.start.saturating_sub(2 * REACH)..(r.end + 2 * REACH).min(n);
         let inner = core.start - window.start..core.end - window.start;
         let score = |p: &Placed| {
-            p.predict(window.clone(), ta, geometry, nozzle, process)[inner.clone()]
+            p.predict(window.clone(), surface, ta, geometry, nozzle, process)[inner.clone()]
                 .iter()
                 .fold((0usize, 0.0), |(bad, err), q| {
                     (
@@ -238,7 +240,9 @@ pub(super) fn plan(
         }
         chosen[r.clone()].copy_from_slice(&targets[best.0][r.clone()]);
     }
-    placer.place(&chosen, &mut memo).into_planned()
+    let placed = placer.place(&chosen, &mut memo);
+    let quality = placed.predict(0..n, surface, ta, geometry, nozzle, process);
+    placed.into_planned(quality)
 }
 
 /// The stretches where some fit moves a place off its target (one choice
@@ -278,7 +282,8 @@ fn clamp_backward(y: &[f64]) -> Vec<f64> {
 }
 
 /// What the placement of one set of targets found: the tool-path points
-/// and how far each was raised.
+/// and how far each was raised (NaN where the query could not tell whether
+/// the point clears).
 struct Placed {
     points: Vec<DVec3>,
     lifts: Vec<f64>,
@@ -286,32 +291,43 @@ struct Placed {
 
 impl Placed {
     /// Section 7's prediction for the points in `range`, as if the piece
-    /// were those points alone. No placed point touches the surface (each
-    /// keeps tol), so the contact test is left out; a point that could not
-    /// be placed (not finite) counts as a contact.
+    /// were those points alone: [`crate::quality::predict`]'s, to the last
+    /// bit. A point placed where the nozzle keeps tol from the surface has
+    /// no contact (the tip disk is tol away from it), so the contact test
+    /// is asked only of the others.
     fn predict(
         &self,
         range: Range<usize>,
+        surface: &Surface,
         ta: &[DVec3],
         geometry: &[LocalGeometry],
         nozzle: &Nozzle,
         process: &Process,
     ) -> Vec<PointQuality> {
-        let points = &self.points[range.clone()];
-        let lost: Vec<bool> = points.iter().map(|p| !p.is_finite()).collect();
+        let radius = 0.5 * nozzle.outer_diameter_mm;
+        let contact: Vec<bool> = range
+            .clone()
+            .map(|j| {
+                let t = self.points[j];
+                (self.lifts[j].is_nan() || !t.is_finite())
+                    && surface.disk_contact(t, radius).is_some()
+            })
+            .collect();
         predict_given_contact(
             &ta[range.clone()],
-            &geometry[range],
-            points,
-            &lost,
+            &geometry[range.clone()],
+            &self.points[range],
+            &contact,
             nozzle,
             process,
         )
     }
 
-    fn into_planned(self) -> PlannedPoints {
+    /// The planned points, with their predicted `quality`.
+    fn into_planned(self, quality: Vec<PointQuality>) -> PlannedPoints {
         let mut out = PlannedPoints {
             toolpath: Vec::with_capacity(self.points.len()),
+            quality: Some(quality),
             ..Default::default()
         };
         for (j, (t, lift)) in self.points.into_iter().zip(self.lifts).enumerate() {
@@ -497,8 +513,10 @@ impl Placer<'_> {
                     Some(rise) if w[j].to_bits() == target[j].to_bits() => rise,
                     _ => c.rise_needed(surface, t),
                 };
+                // (NaN: the query could not tell; kept as the mark of a
+                // point not known to clear.)
                 if lift.is_nan() || lift <= 0.0 {
-                    return (t, 0.0);
+                    return (t, if lift.is_nan() { lift } else { 0.0 });
                 }
                 let (mut t, rise) = sideways(surface, c, t, lift, &self.geometry[j], d);
                 if rise > 0.0 {

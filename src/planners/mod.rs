@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::motion::{Clearance, PLANNING_MARGIN_MM};
 use crate::params::{Nozzle, Process};
+use crate::quality::PointQuality;
 use crate::spline::LocalGeometry;
 use crate::surface::Surface;
 
@@ -98,6 +99,10 @@ pub struct PlannedPoints {
     pub lifted: Vec<(usize, f64)>,
     /// Points the guarded planner could not clear.
     pub uncleared: Vec<usize>,
+    /// The planner's own section 7 prediction for these points, where it
+    /// made one to plan them (`even`): what [`crate::quality::predict`]
+    /// gives, to the last bit, without asking it again.
+    pub quality: Option<Vec<PointQuality>>,
 }
 
 /// M_j of eq. 8-9: the forward shift on descents, from the profile curvature.
