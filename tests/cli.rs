@@ -924,6 +924,38 @@ fn regression_a_check_that_checked_no_move_passed() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A dispensing program in relative moves (G91) that starts wherever the
+/// head was jogged to: no move can be placed in the scan's frame. The
+/// check printed "0 moves checked ...: no move passes near the scan; no
+/// move comes closer than tol" and exited 0 (found by running real
+/// programs through it); a check that could not look must not pass.
+#[test]
+fn regression_check_passed_a_program_none_of_whose_moves_it_could_check() {
+    let dir = temp_dir("check-relative");
+    let g = dir.join("relative.gcode");
+    std::fs::write(
+        &g,
+        "G21\nG91\nG1 X1 Y0 Z-2 F300\nG1 X5 Y0 Z0\nG1 X0 Y5 Z0\nG1 X0 Y0 Z2\n",
+    )
+    .unwrap();
+    let report = dir.join("check.json");
+    let o = check_on_demo(&g, Some(&report));
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("0 moves checked") && err.contains("4 move(s) could not be checked"),
+        "{err}"
+    );
+    assert!(
+        err.contains("not shown to keep tol") && err.contains("G92"),
+        "{err}"
+    );
+    assert!(!err.contains("no move comes closer"), "{err}");
+    let v: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(v["unchecked_lines"].as_array().unwrap().len(), 4, "{v}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A hand-made program that climbs the region-1 block's wall in one
 /// straight move (issue 11's example): exit 1, naming the line.
 #[test]

@@ -63,7 +63,11 @@ export function onCheck(m) {
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
   verdict.textContent = c.clear
     ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
-    : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
+    : sum.touching_moves === 0
+      ? `not shown clear: ${c.unchecked_lines.length} move(s) could not be checked (the file does not `
+        + `give where they start or end, and they come lower than tol above the scan's top); none of `
+        + `the ${sum.moves} checked moves comes closer than tol; ${against}`
+      : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];
   const p = (text, id, cls) => details.push(el('p', text, cls, id));

@@ -35,15 +35,15 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     progress.warn(&prepared.warnings);
     progress.warn(&check.notes);
     let sum = &check.summary;
-    let clear = sum
-        .min_clearance_mm
-        .map_or("no move passes near the scan".to_string(), |c| {
-            format!(
-                "min clearance {c:.3} mm{}",
-                sum.min_clearance_line
-                    .map_or(String::new(), |l| format!(" (line {l})"))
-            )
-        });
+    let clear =
+        sum.min_clearance_mm
+            .map_or("no placed move passes near the scan".to_string(), |c| {
+                format!(
+                    "min clearance {c:.3} mm{}",
+                    sum.min_clearance_line
+                        .map_or(String::new(), |l| format!(" (line {l})"))
+                )
+            });
     let head = format!(
         "{}: {} moves checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
         gcode_path.display(),
@@ -54,18 +54,37 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     );
     if check.is_clear() {
         println!("{head}; no move comes closer than tol");
-        if !check.unchecked_lines.is_empty() {
-            println!(
-                "{} move(s) not checked: their position is not in the file (see the warning)",
-                check.unchecked_lines.len()
-            );
-        }
         return Ok(());
+    }
+    if sum.touching_moves == 0 {
+        let lines = &check.unchecked_lines;
+        return Err(Failure::Input(format!(
+            "{head}; none of those comes closer than tol, but {} move(s) could not be checked \
+             (lines {}{}): the file does not give where they start or end, and they come lower \
+             than tol above the scan's top, so the program is not shown to keep tol; give the \
+             position before them (absolute G90 moves from a known point, or G92), or check \
+             the program from where it starts printing",
+            lines.len(),
+            lines
+                .iter()
+                .take(10)
+                .map(|l| l.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            if lines.len() > 10 { ", ..." } else { "" }
+        )));
     }
     let mut s = format!(
         "{head}; {} move(s) come closer than tol:",
         sum.touching_moves
     );
+    if !check.unchecked_lines.is_empty() {
+        let _ = write!(
+            s,
+            " (and {} move(s) could not be checked, see the warning)",
+            check.unchecked_lines.len()
+        );
+    }
     for t in &sum.touching {
         let _ = write!(s, "\n  {t}");
     }
