@@ -170,7 +170,8 @@ pub fn registration_for(
 const AUTO_CANDIDATES: usize = 6;
 
 /// Tries every ordered choice of the best hole candidates against P and
-/// keeps the one with the lowest RMS: the user need not order the holes.
+/// keeps the one with the lowest RMS among those that keep the scan upright
+/// (any, if none does): the user need not order the holes.
 fn best_auto_match(
     found: &[Fiducial],
     printer: &[DVec3],
@@ -200,7 +201,10 @@ fn best_auto_match(
     let mut used = vec![false; cands.len()];
     permute(&cands, k, &mut used, &mut chosen, &mut |scan| {
         if let Ok(r) = register(scan, printer, method) {
-            if best.as_ref().is_none_or(|b| r.rms_mm < b.rms_mm) {
+            // An upright fit before an upside-down one (three dots in the
+            // other order around their triangle fit a half turn as well).
+            let key = |r: &Registration| (r.is_upside_down(), r.rms_mm);
+            if best.as_ref().is_none_or(|b| key(&r) < key(b)) {
                 best = Some(r);
             }
         }
@@ -383,9 +387,14 @@ pub struct MotionReport {
     /// The largest sideways offset of a tool-path point from the drawn
     /// path (mm).
     pub max_sideways_mm: f64,
-    /// Whether G-code with moves closer than tol was written because the
-    /// user accepted the risk.
+    /// Whether the G-code was written only because the user accepted the
+    /// risk: moves closer than tol, or one of `accepted_risks`.
     pub risk_accepted: bool,
+    /// What else G-code would have been refused for, written because the
+    /// risk was accepted: a registration far off or upside down, a whole
+    /// object's point cloud, points the planner could not clear.
+    #[serde(default)]
+    pub accepted_risks: Vec<String>,
 }
 
 impl MotionReport {
@@ -417,6 +426,12 @@ impl MotionReport {
             "; {} waypoint(s) added (+{:.3} mm)",
             self.waypoints, self.extra_length_mm
         ));
+        if !self.accepted_risks.is_empty() {
+            s.push_str(&format!(
+                "; WARNING: written only because the risk was accepted: {}",
+                self.accepted_risks.join("; ")
+            ));
+        }
         s
     }
 }
@@ -800,24 +815,43 @@ pub fn run_on(
 }
 
 /// The refusal of G-code on a registration whose fiducials miss their
-/// printer points by more than the nozzle's inner diameter d (RMS), unless
-/// the user accepts the risk: the scan is then not where the printer is,
-/// so neither where the path lands nor the clearance checked along the
-/// moves holds. (The paper's own fiducials leave 0.1-0.3 mm.)
+/// printer points by more than the nozzle's inner diameter d (RMS), or
+/// that turns the scan upside down, unless the user accepts the risk: the
+/// scan is then not where the printer is (or the nozzle would come to its
+/// underside), so neither where the path lands nor the clearance checked
+/// along the moves holds. (The paper's own fiducials leave 0.1-0.3 mm.)
 pub fn refuse_bad_registration(
     registration: &Registration,
     nozzle: &crate::params::Nozzle,
     accept_risk: bool,
 ) -> Result<()> {
-    let d = nozzle.inner_diameter_mm;
-    if accept_risk || registration.rms_mm <= d {
-        return Ok(());
+    match registration_risk(registration, nozzle) {
+        Some(e) if !accept_risk => Err(Error::Registration(e)),
+        _ => Ok(()),
     }
-    Err(Error::Registration(RegistrationError::TooFarOff {
-        rms_mm: registration.rms_mm,
-        residuals_mm: registration.residuals_mm.clone(),
-        d_mm: d,
-    }))
+}
+
+/// What is wrong with a registration that G-code is refused on: its
+/// fiducials miss their printer points by more than d (RMS), or it turns
+/// the scan upside down.
+fn registration_risk(
+    registration: &Registration,
+    nozzle: &crate::params::Nozzle,
+) -> Option<RegistrationError> {
+    let d = nozzle.inner_diameter_mm;
+    if registration.rms_mm > d {
+        return Some(RegistrationError::TooFarOff {
+            rms_mm: registration.rms_mm,
+            residuals_mm: registration.residuals_mm.clone(),
+            d_mm: d,
+        });
+    }
+    registration
+        .is_upside_down()
+        .then(|| RegistrationError::UpsideDown {
+            tilt_deg: registration.up_tilt_deg(),
+            rms_mm: registration.rms_mm,
+        })
 }
 
 /// The refusal of G-code on a point cloud some of whose points lie under
@@ -885,6 +919,34 @@ pub fn write_outputs(
     refuse_whole_object_cloud(scan, accept_risk)?;
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
+    // What the G-code would have been refused for but for the accepted
+    // risk, known before it is written: said in its header (one line, so
+    // the header's length does not change) and in the report.
+    let mut risks = Vec::new();
+    match registration_risk(&scan.registration, &settings.nozzle) {
+        Some(RegistrationError::UpsideDown { tilt_deg, .. }) => risks.push(format!(
+            "the registration turns the scan upside down (its up axis {tilt_deg:.1} deg from +Z)"
+        )),
+        Some(RegistrationError::TooFarOff { rms_mm, d_mm, .. }) => risks.push(format!(
+            "the registration leaves the fiducials {rms_mm:.3} mm RMS from the printer points \
+             (more than d = {d_mm} mm)"
+        )),
+        _ => {}
+    }
+    if let Some(c) = scan.cloud.filter(|c| c.hidden > 0) {
+        risks.push(format!(
+            "the scan is a whole object's point cloud ({} of its {} points lie under its top and \
+             were left out): between its points the real surface may be higher",
+            c.hidden, c.points
+        ));
+    }
+    if !plan.uncleared.is_empty() {
+        risks.push(format!(
+            "the nozzle still touches the surface at {} planned point(s)",
+            plan.uncleared.len()
+        ));
+    }
+    report.motion.accepted_risks = risks;
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
     let job = |header| GcodeJob {
         toolpaths: &toolpaths,
@@ -921,7 +983,8 @@ pub fn write_outputs(
             summary: checked,
         })));
     }
-    report.motion.risk_accepted = checked.touching_moves > 0;
+    report.motion.risk_accepted =
+        checked.touching_moves > 0 || !report.motion.accepted_risks.is_empty();
     report.motion.program = checked;
     // The final header on the moves already written.
     let header = provenance(&report);

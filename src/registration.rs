@@ -136,6 +136,21 @@ impl Registration {
         self.residuals_mm.iter().copied().fold(0.0, f64::max)
     }
 
+    /// How far G tips the scan's up axis (its +Z as imported, after the
+    /// up-axis choice) from the printer's +Z, degrees: 0 upright, 180
+    /// upside down.
+    pub fn up_tilt_deg(&self) -> f64 {
+        let up = DMat3::from_mat4(self.matrix) * DVec3::Z;
+        libm::acos((up.z / up.length()).clamp(-1.0, 1.0)).to_degrees()
+    }
+
+    /// Whether G turns the scan's up axis below the horizon: the nozzle,
+    /// coming from above, would then meet the scan's underside
+    /// ([`UPSIDE_DOWN_DEG`]).
+    pub fn is_upside_down(&self) -> bool {
+        self.up_tilt_deg() > UPSIDE_DOWN_DEG
+    }
+
     /// The rotation angle of G, degrees (for reports).
     pub fn rotation_deg(&self) -> f64 {
         let r = DMat3::from_mat4(self.matrix);
@@ -143,6 +158,15 @@ impl Registration {
         libm::acos(c).to_degrees()
     }
 }
+
+/// A registration that tips the scan's up axis more than this from the
+/// printer's +Z turns it upside down. A scan is taken from above, and
+/// the part lies on the bed as it did under the scanner, give or take a
+/// tilt; past 90 degrees the side the nozzle comes to is the side the
+/// scanner did not see. With three fiducials (the paper's case) the
+/// printer points listed in the other winding order are fitted exactly by
+/// a half turn, residuals 0, so the residuals cannot tell; this can.
+pub const UPSIDE_DOWN_DEG: f64 = 90.0;
 
 /// Which of the two fiducial sets a point belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -222,6 +246,19 @@ pub enum RegistrationError {
         residuals_mm: Vec<f64>,
         d_mm: f64,
     },
+    /// The fit turns the scan upside down ([`Registration::is_upside_down`]):
+    /// the nozzle would come to the side the scanner did not see, so G-code
+    /// on it is refused unless the risk is accepted
+    /// (`job::refuse_bad_registration`).
+    #[error(
+        "the registration turns the scan upside down: its up axis ends {tilt_deg:.1} deg from \
+         the printer's +Z (rms {rms_mm:.3} mm), so the path would be planned on the side the \
+         scanner did not see; with three fiducials, printer points listed in the other order \
+         around the triangle fit a half turn as well as the right order (residuals near 0): \
+         list the printer points in the same order as the scan's fiducials, or check the scan's \
+         up axis (--up-axis); no G-code written"
+    )]
+    UpsideDown { tilt_deg: f64, rms_mm: f64 },
 }
 
 fn list_1_based(indices: &[usize]) -> String {
@@ -342,13 +379,22 @@ pub fn register(
         fiducials: scan.len(),
         rms_mm,
     };
-    Ok(Registration {
+    let mut registration = Registration {
         matrix,
         residuals_mm,
         rms_mm,
         notes,
         status,
-    })
+    };
+    if registration.is_upside_down() {
+        registration.notes.push(format!(
+            "the registration turns the scan upside down (its up axis ends {:.1} deg from the \
+             printer's +Z): are the printer points in the same order as the scan's fiducials? \
+             G-code on it is refused unless the risk is accepted",
+            registration.up_tilt_deg()
+        ));
+    }
+    Ok(registration)
 }
 
 fn check_finite(set: PointSet, pts: &[DVec3]) -> Result<(), RegistrationError> {

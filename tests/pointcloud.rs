@@ -390,6 +390,26 @@ fn a_whole_objects_cloud_is_meshed_from_above_and_its_gcode_needs_the_risk_accep
     );
 
     let out = run_on(&scan, svg, "line.svg", &settings, &profile, true).unwrap();
+    // The acceptance is said where the operator reads it: the program's
+    // header and the report (they had said nothing: the header's safe
+    // motion line read as a clean plan's, `risk_accepted` was false).
+    assert!(out.report.motion.risk_accepted);
+    assert!(
+        out.report.motion.accepted_risks[0].contains("whole object's point cloud"),
+        "{:?}",
+        out.report.motion.accepted_risks
+    );
+    let header: Vec<&str> = out
+        .gcode
+        .lines()
+        .take_while(|l| l.starts_with(';'))
+        .collect();
+    assert!(
+        header.iter().any(|l| l.contains("safe motion")
+            && l.contains("WARNING: written only because the risk was accepted")
+            && l.contains("whole object's point cloud")),
+        "{header:#?}"
+    );
     let mut truth = truth;
     for v in &mut truth.vertices {
         *v = m.transform_point3(*v);

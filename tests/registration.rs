@@ -681,3 +681,127 @@ fn real_dots_rank_first_among_noise_holes_and_a_ragged_border() {
         big[0]
     );
 }
+
+/// Three fiducials with the printer points listed the other way round
+/// their triangle (an easy slip when jogging to them) are fitted exactly by
+/// a half turn: rms 0, and G-code was written on the scan's underside
+/// (found by exploratory runs: 713 moves of the demo part's program hit the
+/// upright part, the worst 4.4 mm deep). Now refused, naming the cause;
+/// written with the risk accepted and said in its header; the same points
+/// in the right order plan as before, and "auto" takes the upright match
+/// of the holes when a half turn fits as well.
+#[test]
+fn regression_printer_points_in_the_other_order_turned_the_scan_upside_down() {
+    use pcpp::demo;
+    use pcpp::gcode::MachineProfile;
+    use pcpp::job::{prepare_scan, run_on, FiducialSource, RegistrationSettings};
+    use pcpp::mesh::ImportOptions;
+    use pcpp::pipeline::PlanSettings;
+    use pcpp::svg::Placement;
+
+    let scan_bytes = demo::demo_scan_bytes();
+    let svg = demo::test_part::test_part_svg();
+    let profile = MachineProfile::builtin("marlin").unwrap();
+    let scan_points = vec![
+        DVec3::new(4.0, 4.0, 5.0),
+        DVec3::new(4.0, 76.0, 5.0),
+        DVec3::new(76.0, 4.0, 5.0),
+    ];
+    let shift = DVec3::new(10.0, 10.0, 0.0);
+    let right: Vec<DVec3> = scan_points.iter().map(|p| *p + shift).collect();
+    let wrong = vec![right[0], right[2], right[1]];
+    let prepare = |fiducials: FiducialSource, printer: &[DVec3]| {
+        let registration = RegistrationSettings {
+            fiducials,
+            printer_points: printer.to_vec(),
+            ..Default::default()
+        };
+        prepare_scan(
+            &scan_bytes,
+            demo::DEMO_SCAN_NAME,
+            &ImportOptions::DEFAULT,
+            &registration,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let settings = PlanSettings {
+        placement: Placement {
+            offset_mm: pcpp::DVec2::new(10.0, 90.0),
+            ..Placement::IDENTITY
+        },
+        ..Default::default()
+    };
+
+    let flipped = prepare(FiducialSource::Points(scan_points.clone()), &wrong);
+    let reg = &flipped.registration;
+    assert!(reg.rms_mm < 1e-9, "{}", reg.rms_mm);
+    assert!(reg.is_upside_down() && reg.up_tilt_deg() > 179.0);
+    assert!(
+        reg.notes.iter().any(|n| n.contains("upside down")),
+        "{:?}",
+        reg.notes
+    );
+    let e = run_on(
+        &flipped,
+        svg.as_bytes(),
+        "lines.svg",
+        &settings,
+        &profile,
+        false,
+    )
+    .err()
+    .expect("G-code written on an upside-down registration");
+    assert!(
+        matches!(
+            e,
+            pcpp::Error::Registration(RegistrationError::UpsideDown { .. })
+        ),
+        "{e}"
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("upside down") && msg.contains("same order"),
+        "{msg}"
+    );
+    let out = run_on(
+        &flipped,
+        svg.as_bytes(),
+        "lines.svg",
+        &settings,
+        &profile,
+        true,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(out.report.motion.risk_accepted);
+    assert!(
+        out.gcode
+            .lines()
+            .any(|l| l.starts_with(';') && l.contains("turns the scan upside down")),
+        "the header does not say the risk was accepted"
+    );
+
+    let upright = prepare(FiducialSource::Points(scan_points), &right);
+    assert!(!upright.registration.is_upside_down());
+    assert!(upright.registration.up_tilt_deg() < 1e-6);
+    run_on(
+        &upright,
+        svg.as_bytes(),
+        "lines.svg",
+        &settings,
+        &profile,
+        false,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+
+    let auto = prepare(FiducialSource::Auto, &wrong);
+    assert!(
+        auto.registration.rms_mm < 0.05,
+        "{}",
+        auto.registration.rms_mm
+    );
+    assert!(
+        !auto.registration.is_upside_down(),
+        "auto chose a half turn: {:?}",
+        auto.registration.matrix
+    );
+}

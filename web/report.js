@@ -156,7 +156,10 @@ function showMotion(summary) {
     ['backward moves', String(m.backward_moves), 'motion-backward'],
     ['max sideways offset', `${fmt(m.max_sideways_mm)} mm`],
   ];
-  if (m.risk_accepted) rows.push(['risk', 'accepted: G-code with moves closer than tol', 'motion-risk', 'bad']);
+  if (m.risk_accepted) {
+    const risks = [...(touching ? ['G-code with moves closer than tol'] : []), ...(m.accepted_risks || [])];
+    rows.push(['risk', `accepted: ${risks.join('; ')}`, 'motion-risk', 'bad']);
+  }
   const body = $('motion-table').tBodies[0];
   body.replaceChildren(...rows.map(([k, v, id, cls]) => {
     const tr = el('tr');
