@@ -174,7 +174,17 @@ pub fn surface_path(
     if pieces.is_empty() {
         let (slo, shi) = surface.bbox();
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
-        return Err(Error::Plan(if !any_line && !dots.is_empty() {
+        let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
+        return Err(Error::Plan(if any_sample && edge_on(foot, tall) {
+            format!(
+                "no part of the path lies over the scan's surface: the scan is seen edge-on \
+                 from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame), so there is \
+                 almost nothing for the nozzle to come down on; if the scan lies on its side in \
+                 the file, choose its up axis (--up-axis y or z, the page's up axis; glTF files \
+                 are +Y up) or register it onto the bed",
+                foot.x, foot.y, tall
+            )
+        } else if !any_line && !dots.is_empty() {
             format!(
                 "nothing to print at the nozzle's scale: every path of the drawing ({} of them: \
                  '{}'{}) is a dot or a shape shorter than the samples' spacing of {spacing:.4} mm \
@@ -186,7 +196,7 @@ pub fn surface_path(
         } else if any_sample && inside {
             format!(
                 "no part of the path lies over the scan's surface: the path spans x \
-                 {:.3}..{:.3}, y {:.3}..{:.3} mm, inside the scan's extent (x {:.3}..{:.3}, y \
+                 {:.3}..{:.3}, y {:.3}..{:.3} mm, over the scan's extent (x {:.3}..{:.3}, y \
                  {:.3}..{:.3} mm, printer frame) but over its holes or gaps (a bore of the part, \
                  a point cloud's dropouts); move the drawing onto the surface (the placement \
                  offset), and for a point cloud a larger maximum edge (--max-edge) closes wider \
@@ -207,6 +217,17 @@ pub fn surface_path(
     }
     Ok(SurfacePath { pieces, warnings })
 }
+
+/// Whether a scan `foot` wide (its footprint in printer XY) and `tall` high
+/// is seen edge-on from above: a side of its footprint under a
+/// fiftieth of its height (a flat film or plate seen from its edge, as a
+/// file with another up axis gives it).
+pub fn edge_on(foot: DVec2, tall: f64) -> bool {
+    foot.min_element() < EDGE_ON_SHARE * tall
+}
+
+/// See [`edge_on`].
+pub const EDGE_ON_SHARE: f64 = 0.02;
 
 /// One planned piece: Ta, its geometry, T* and the predicted quality.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

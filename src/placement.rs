@@ -225,6 +225,10 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
 /// How much of the footprint a drawing may fill when it is scaled to fit.
 pub const FIT_SHARE: f64 = 0.9;
 
+/// A footprint side this small beside the other is not fitted to
+/// ([`centre_drawing`]).
+pub const FLAT_SIDE_SHARE: f64 = 1e-3;
+
 /// The placement that puts the middle of the drawing's bounding box (as
 /// `current` turns and scales it) on the middle of a scan's footprint
 /// `footprint` (printer XY). With `fit`, a drawing larger than
@@ -256,7 +260,12 @@ pub fn centre_drawing(
     let size = hi - lo;
     let mut scale = 1.0;
     for k in 0..2 {
-        if size[k] > room[k] && room[k] > 0.0 {
+        // A side of the footprint that is nothing beside the other (a scan
+        // seen edge-on: a film or plate in a file with another up axis) is
+        // not fitted to: the drawing would shrink to a line; planning then
+        // says the scan is edge-on.
+        let flat = room[k] <= FLAT_SIDE_SHARE * room.max_element();
+        if size[k] > room[k] && room[k] > 0.0 && !flat {
             scale = f64::min(scale, room[k] / size[k]);
         }
     }
@@ -492,7 +501,13 @@ mod tests {
         assert!(note.unwrap().contains("kept at its scale"));
         let (lo, hi) = extent(&p.apply_subpath(&square));
         assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
-        let (_, note) = centre_drawing(&[square], footprint, &current, false).unwrap();
+        let (_, note) = centre_drawing(&[square.clone()], footprint, &current, false).unwrap();
         assert!(note.is_none());
+        // A scan seen edge-on (a vertical plane, 1000 x 0 mm from above):
+        // the drawing is not shrunk to its zero side ("scaled by 0.000"),
+        // only to the other.
+        let edge = (DVec2::new(-500.0, 0.0), DVec2::new(500.0, 0.0));
+        let (p, _) = centre_drawing(&[square], edge, &Placement::IDENTITY, true).unwrap();
+        assert_eq!(p.scale, 1.0);
     }
 }

@@ -736,3 +736,43 @@ fn even_reports_the_prediction_section_7_makes_of_its_points() {
         }
     }
 }
+
+/// A scan that stands on its edge in the printer frame (a Y-up glTF plane
+/// read as Z-up, a film exported lying in the YZ plane): the drawing was
+/// "scaled by 0.000 to fit" its 0 mm side and planning blamed the drawing
+/// ("inside the scan's extent ... over its holes": neither true). Now the
+/// drawing keeps its scale and the error names the scan's up axis.
+#[test]
+fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
+    let mesh = TriMesh {
+        vertices: vec![
+            DVec3::new(-50.0, 0.0, 0.0),
+            DVec3::new(50.0, 0.0, 0.0),
+            DVec3::new(50.0, 0.0, 80.0),
+            DVec3::new(-50.0, 0.0, 80.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    let s = Surface::new(mesh).unwrap();
+    let (lo, hi) = s.bbox();
+    let drawn = [line(DVec2::new(0.0, 0.0), DVec2::new(20.0, 10.0))];
+    let (placement, _) = pcpp::placement::centre_drawing(
+        &drawn,
+        (lo.truncate(), hi.truncate()),
+        &pcpp::svg::Placement::IDENTITY,
+        true,
+    )
+    .unwrap();
+    assert_eq!(placement.scale, 1.0);
+    let settings = PlanSettings {
+        placement,
+        ..PlanSettings::default()
+    };
+    let e = pipeline::plan(&s, &drawn, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("edge-on") && e.contains("--up-axis") && !e.contains("holes"),
+        "{e}"
+    );
+}
