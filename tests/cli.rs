@@ -1441,3 +1441,24 @@ fn a_reader_that_closes_the_pipe_ends_the_command_without_a_panic() {
         assert_ne!(code(&o), 101, "{err}");
     }
 }
+
+// ------------------------------------------------ outputs and flag values
+
+/// `pcpp check` named the program twice in one error: "error:
+/// cura_like.gcode: cura_like.gcode, line 23: arcs (G2 ...) are not
+/// supported" (the reader's message starts with the file's name).
+#[test]
+fn regression_check_named_the_gcode_file_twice() {
+    let dir = temp_dir("check-name-once");
+    let g = dir.join("arcs.gcode");
+    std::fs::write(&g, "G21\nG90\nG1 X10 Y16 Z20\nG2 X20 Y16 I5 J0\n").unwrap();
+    let o = check_on_demo(&g, None);
+    assert_eq!(code(&o), 1);
+    let err = stderr(&o);
+    assert!(
+        err.starts_with(&format!("error: {}, line 4: arcs", g.display())),
+        "{err}"
+    );
+    assert_eq!(err.matches("arcs.gcode").count(), 1, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

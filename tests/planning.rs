@@ -462,7 +462,7 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("inside the scan's extent") && e.contains("holes or gaps"),
+        e.contains("over the scan's extent") && e.contains("holes or gaps"),
         "{e}"
     );
     // Off the scan altogether: the placement is what to check.

@@ -203,9 +203,14 @@ pub fn file_name(path: &Path) -> String {
 /// Puts the path in front of a library message. The library names files by
 /// the name it was given; where a message starts with that name, the path
 /// replaces it, and the library's `name:12: ...` line form reads
-/// "dir/scan.obj, line 12: ...".
+/// "dir/scan.obj, line 12: ..." (the G-code reader's `name, line 12: ...`
+/// already does).
 pub fn in_file(path: &Path, name: &str, message: &str) -> String {
-    let Some(rest) = message.strip_prefix(name).and_then(|r| r.strip_prefix(':')) else {
+    let rest = message.strip_prefix(name);
+    if let Some(line) = rest.filter(|r| r.starts_with(", line ")) {
+        return format!("{}{line}", path.display());
+    }
+    let Some(rest) = rest.and_then(|r| r.strip_prefix(':')) else {
         return format!("{}: {message}", path.display());
     };
     let line = rest
@@ -307,6 +312,16 @@ mod tests {
         assert_eq!(
             in_file(p, "scan.obj", "the path misses"),
             "dir/scan.obj: the path misses"
+        );
+        // The G-code reader's form, named once.
+        let g = Path::new("dir/p.gcode");
+        assert_eq!(
+            in_file(g, "p.gcode", "p.gcode, line 4: arcs"),
+            "dir/p.gcode, line 4: arcs"
+        );
+        assert_eq!(
+            in_file(g, "p.gcode", "p.gcode, more"),
+            "dir/p.gcode: p.gcode, more"
         );
     }
 
