@@ -1444,6 +1444,100 @@ fn a_reader_that_closes_the_pipe_ends_the_command_without_a_panic() {
 
 // ------------------------------------------------ outputs and flag values
 
+/// `--place 1e308,0` was taken, and the plan's error printed the drawing's
+/// span as a 309-digit number. Placements and points now have bounds, as
+/// --tol and --speed have: a usage error naming the flag.
+#[test]
+fn regression_a_placement_of_1e308_printed_a_309_digit_number() {
+    let (scan, svg) = (
+        demo_file(demo::DEMO_SCAN_NAME),
+        demo_file(demo::DEMO_PATH_NAME),
+    );
+    let job = |flag: &'static str, value: &'static str| -> Vec<String> {
+        ["plan", "--scan", s(&scan), "--path", s(&svg), "-o"]
+            .iter()
+            .map(|a| a.to_string())
+            .chain(["never.gcode".into(), flag.into(), value.into()])
+            .collect()
+    };
+    let far = "1e300,0,0;0,10,0;0,0,10";
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (job("--place", "1e308,0"), "--place"),
+        (job("--place", "0,2e6"), "--place"),
+        (job("--place", "0,0,1e308"), "--place"),
+        (job("--place", "0,0,0,1e308"), "--place"),
+        (job("--place", "centre,0,1e-300"), "--place"),
+        (job("--place-scan", "bed,1e308,0,0"), "--place-scan"),
+        (job("--place-scan", "bed,0,0,0,1e308"), "--place-scan"),
+        (
+            [
+                "register",
+                "--scan-points",
+                far,
+                "--printer-points",
+                TABLE_S1_PRINTER,
+            ]
+            .map(String::from)
+            .to_vec(),
+            "--scan-points",
+        ),
+        (
+            [
+                "register",
+                "--scan-points",
+                TABLE_S1_SCAN,
+                "--printer-points",
+                far,
+            ]
+            .map(String::from)
+            .to_vec(),
+            "--printer-points",
+        ),
+    ];
+    for (args, flag) in &cases {
+        let o = Command::new(BIN).args(args).output().unwrap();
+        let err = stderr(&o);
+        assert_eq!(code(&o), 2, "{args:?}: {err}");
+        assert!(err.contains(flag), "{args:?}: {err}");
+        let longest = err
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0);
+        assert!(longest < 12, "{args:?}: {err}");
+    }
+    assert!(!Path::new("never.gcode").exists());
+}
+
+/// `--max-edge 0` (or -1) on a point cloud failed with exit 1 naming the
+/// scan file ("ground.xyz: the maximum edge length must be a positive
+/// number of mm"); every other bad number is a usage error naming its
+/// flag, and so is this one now.
+#[test]
+fn regression_max_edge_0_named_the_scan_instead_of_the_flag() {
+    let dir = temp_dir("max-edge");
+    let cloud = dir.join("ground.xyz");
+    let mut text = String::new();
+    for i in 0..20 {
+        for j in 0..20 {
+            text += &format!("{} {} 1\n", i as f64 * 2.0, j as f64 * 2.0);
+        }
+    }
+    std::fs::write(&cloud, text).unwrap();
+    for value in ["0", "-1", "1e300"] {
+        let o = pcpp(&["fiducials", "--scan", s(&cloud), "--max-edge", value]);
+        let err = stderr(&o);
+        assert_eq!(code(&o), 2, "{value}: {err}");
+        assert!(
+            err.contains("--max-edge") && !err.contains("ground.xyz"),
+            "{value}: {err}"
+        );
+    }
+    let o = pcpp(&["fiducials", "--scan", s(&cloud), "--max-edge", "5"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `pcpp check` named the program twice in one error: "error:
 /// cura_like.gcode: cura_like.gcode, line 23: arcs (G2 ...) are not
 /// supported" (the reader's message starts with the file's name).

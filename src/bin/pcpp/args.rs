@@ -26,7 +26,8 @@ use pcpp::planners::PlannerKind;
 use pcpp::registration::RegistrationMethod;
 
 use crate::values::{
-    dot_diameter, fiducials, number, place, place_scan, points, PlaceArg, PlaceScanArg, Points,
+    dot_diameter, fiducials, max_edge, number, place, place_scan, printer_points, scan_points,
+    PlaceArg, PlaceScanArg, Points,
 };
 
 const EXIT_STATUS: &str = "\
@@ -232,7 +233,7 @@ pub struct RegisterArgs {
     #[arg(
         long,
         value_name = "x,y,z;...",
-        value_parser = points,
+        value_parser = scan_points,
         allow_hyphen_values = true
     )]
     pub scan_points: Points,
@@ -241,7 +242,7 @@ pub struct RegisterArgs {
     #[arg(
         long,
         value_name = "x,y,z;...",
-        value_parser = points,
+        value_parser = printer_points,
         allow_hyphen_values = true
     )]
     pub printer_points: Points,
@@ -361,7 +362,7 @@ pub struct ScanArgs {
 
     /// Point clouds: the longest edge (in XY) of a triangle of the meshed
     /// cloud; longer gaps stay holes [default: 3 x the median point spacing]
-    #[arg(long, value_name = "MM", value_parser = number, allow_hyphen_values = true)]
+    #[arg(long, value_name = "MM", value_parser = max_edge, allow_hyphen_values = true)]
     pub max_edge: Option<f64>,
 }
 
@@ -444,7 +445,7 @@ pub struct RegistrationArgs {
     #[arg(
         long,
         value_name = "x,y,z;...",
-        value_parser = points,
+        value_parser = printer_points,
         allow_hyphen_values = true,
         requires = "fiducials"
     )]
