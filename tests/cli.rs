@@ -1444,6 +1444,219 @@ fn a_reader_that_closes_the_pipe_ends_the_command_without_a_panic() {
 
 // ------------------------------------------------ outputs and flag values
 
+/// `pcpp` run in `dir`, so that relative spellings (`./x`, `a/../x`) are
+/// the user's.
+fn pcpp_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(BIN)
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `-o` and `--report` naming a file the command reads replaced it, exit
+/// 0: `plan --scan teapot.obj ... -o teapot.obj` left G-code where the
+/// scan was, `--report drawing.svg` JSON where the drawing was, `check
+/// --gcode out.gcode --report out.gcode` JSON where the program was; and
+/// `-o X --report X` failed with "cannot write X: No such file or
+/// directory" but left X holding the report (both were staged as one
+/// temporary file). Found by exploratory runs. Any spelling of one file
+/// (`./x`, `a/../x`, a symbolic or hard link) is now refused before
+/// anything is read: a usage error naming both flags, and every file
+/// stays as it was.
+#[test]
+fn regression_an_output_named_like_an_input_replaced_it() {
+    let dir = temp_dir("output-is-input");
+    std::fs::copy(demo_file(demo::DEMO_SCAN_NAME), dir.join("scan.ply")).unwrap();
+    std::fs::copy(demo_file(demo::DEMO_PATH_NAME), dir.join("drawing.svg")).unwrap();
+    std::fs::copy(demo_file("demo-even.gcode"), dir.join("prog.gcode")).unwrap();
+    let marlin = MachineProfile::builtin("marlin").unwrap();
+    std::fs::write(
+        dir.join("machine.json"),
+        serde_json::to_string(&marlin).unwrap(),
+    )
+    .unwrap();
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("scan.ply", dir.join("link.ply")).unwrap();
+        std::fs::hard_link(dir.join("drawing.svg"), dir.join("hard.svg")).unwrap();
+    }
+    let before: Vec<(String, Vec<u8>)> = listing(&dir)
+        .into_iter()
+        .filter(|n| n != "sub")
+        .map(|n| {
+            let bytes = std::fs::read(dir.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect();
+    let plan = |flags: &[&'static str]| -> Vec<&'static str> {
+        let mut v = vec![
+            "plan",
+            "--scan",
+            "scan.ply",
+            "--path",
+            "drawing.svg",
+            "--place",
+            "0,80",
+        ];
+        v.extend(flags);
+        v
+    };
+    let check = |flags: &[&'static str]| -> Vec<&'static str> {
+        let mut v = vec!["check", "--scan", "scan.ply", "--gcode", "prog.gcode"];
+        v.extend(flags);
+        v
+    };
+    let mut cases: Vec<(Vec<&str>, [&str; 3])> = vec![
+        (plan(&["-o", "scan.ply"]), ["-o", "--scan", "scan.ply"]),
+        (plan(&["-o", "./scan.ply"]), ["-o", "--scan", "./scan.ply"]),
+        (
+            plan(&["-o", "sub/../scan.ply"]),
+            ["-o", "--scan", "sub/../scan.ply"],
+        ),
+        (
+            plan(&["-o", "out.gcode", "--report", "drawing.svg"]),
+            ["--report", "--path", "drawing.svg"],
+        ),
+        (
+            plan(&["-o", "out.gcode", "--report", "out.gcode"]),
+            ["--report", "-o", "out.gcode"],
+        ),
+        (
+            plan(&["-o", "out.gcode", "--report", "sub/../out.gcode"]),
+            ["--report", "-o", "sub/../out.gcode"],
+        ),
+        (
+            plan(&["-o", "machine.json", "--profile", "machine.json"]),
+            ["-o", "--profile", "machine.json"],
+        ),
+        (
+            check(&["--report", "prog.gcode"]),
+            ["--report", "--gcode", "prog.gcode"],
+        ),
+        (
+            check(&["--report", "./scan.ply"]),
+            ["--report", "--scan", "./scan.ply"],
+        ),
+        (
+            vec![
+                "compare",
+                "--scan",
+                "scan.ply",
+                "--path",
+                "drawing.svg",
+                "--place",
+                "0,80",
+                "--report",
+                "drawing.svg",
+            ],
+            ["--report", "--path", "drawing.svg"],
+        ),
+    ];
+    #[cfg(unix)]
+    cases.extend([
+        (plan(&["-o", "link.ply"]), ["-o", "--scan", "link.ply"]),
+        (
+            plan(&["-o", "out.gcode", "--report", "hard.svg"]),
+            ["--report", "--path", "hard.svg"],
+        ),
+    ]);
+    for (args, [flag, other, path]) in &cases {
+        let o = pcpp_in(&dir, args);
+        let err = stderr(&o);
+        assert_eq!(code(&o), 2, "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("{flag} {path} and {other} ")) && err.contains("the same file"),
+            "{args:?}: {err}"
+        );
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    let after: Vec<(String, Vec<u8>)> = listing(&dir)
+        .into_iter()
+        .filter(|n| n != "sub")
+        .map(|n| {
+            let bytes = std::fs::read(dir.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect();
+    assert!(before == after, "files changed: {:?}", listing(&dir));
+
+    // A `.gltf`'s buffer is read too.
+    let (dir, gltf, bin) = separate_gltf("output-is-gltf-buffer");
+    let bin_bytes = std::fs::read(&bin).unwrap();
+    let o = plan_on(
+        &gltf,
+        &dir.join("block.svg"),
+        &["--place", "0,40", "-o", s(&bin)],
+    );
+    let err = stderr(&o);
+    assert_eq!(code(&o), 2, "{err}");
+    assert!(
+        err.contains(&format!("-o {} and ", bin.display())) && err.contains("--scan"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&bin).unwrap(), bin_bytes);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `-o nodir/out.gcode` planned the whole job, then failed with "cannot
+/// write nodir/out.gcode: No such file or directory". The folder is now
+/// checked before anything is read (here the scan does not exist either:
+/// the folder is named first), and the message says what is missing.
+#[test]
+fn regression_a_missing_output_folder_was_found_only_after_planning() {
+    let dir = temp_dir("no-output-folder");
+    let gcode = dir.join("prog.gcode");
+    std::fs::write(&gcode, "G1 X1 Y1 Z20\n").unwrap();
+    let (scan, svg) = (dir.join("missing.ply"), demo_file(demo::DEMO_PATH_NAME));
+    let nodir = dir.join("nodir");
+    let inside = |name: &str| nodir.join(name).to_str().unwrap().to_string();
+    let (out, report) = (inside("out.gcode"), inside("out.json"));
+    for args in [
+        vec!["plan", "--scan", s(&scan), "--path", s(&svg), "-o", &out],
+        vec![
+            "plan",
+            "--scan",
+            s(&scan),
+            "--path",
+            s(&svg),
+            "-o",
+            s(&gcode),
+            "--report",
+            &report,
+        ],
+        vec![
+            "compare",
+            "--scan",
+            s(&scan),
+            "--path",
+            s(&svg),
+            "--report",
+            &report,
+        ],
+        vec![
+            "check",
+            "--scan",
+            s(&scan),
+            "--gcode",
+            s(&gcode),
+            "--report",
+            &report,
+        ],
+    ] {
+        let o = pcpp(&args);
+        let err = stderr(&o);
+        assert_eq!(code(&o), 1, "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("the folder {} does not exist", nodir.display())),
+            "{args:?}: {err}"
+        );
+    }
+    assert_eq!(listing(&dir), ["prog.gcode"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `--place 1e308,0` was taken, and the plan's error printed the drawing's
 /// span as a 309-digit number. Placements and points now have bounds, as
 /// --tol and --speed have: a usage error naming the flag.

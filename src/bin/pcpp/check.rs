@@ -7,17 +7,28 @@ use pcpp::job;
 
 use crate::args::CheckArgs;
 use crate::files::{file_name, in_file, read_text, to_json, write_one};
+use crate::outputs::{Flagged, Outputs};
 use crate::plan::load_scan;
 use crate::progress::Progress;
 use crate::settings::check_settings;
 use crate::{CliResult, Failure};
 
 pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
+    let read = [
+        Some(Flagged::new("--scan", &a.scan.scan)),
+        Some(Flagged::new("--gcode", &a.gcode)),
+        a.machine
+            .profile
+            .as_deref()
+            .map(|p| Flagged::new("--profile", p)),
+    ];
+    let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
+    let outputs = Outputs::check("check", report, read.into_iter().flatten())?;
     let (settings, _profile) =
         check_settings("check", &a.scan, &a.nozzle, &a.registration, &a.machine)?;
     let gcode_path = &a.gcode;
     let text = read_text(gcode_path, "gcode")?;
-    let prepared = load_scan(&a.scan, &settings, progress)?;
+    let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
     let check = job::check_gcode(

@@ -8,6 +8,7 @@ use pcpp::registration::register;
 
 use crate::args::{FiducialsArgs, RegisterArgs};
 use crate::files::{file_name, in_file, read_external, read_scan, to_json};
+use crate::outputs::Outputs;
 use crate::progress::{thousands, Progress};
 use crate::settings::import_options;
 use crate::{CliResult, Failure};
@@ -18,8 +19,9 @@ pub fn cmd_fiducials(a: &FiducialsArgs, progress: &Progress) -> CliResult<()> {
     progress.step(format!("reading scan {}...", path.display()));
     let bytes = read_scan(path, "scan")?;
     let name = file_name(path);
-    // A .gltf's buffers in separate files, from its folder.
-    let (files, missing) = read_external(path, &name, bytes.as_ref())?;
+    // A .gltf's buffers in separate files, from its folder. The JSON goes
+    // to stdout: no output file to keep them from.
+    let (files, missing) = read_external(path, &name, bytes.as_ref(), &Outputs::default())?;
     progress.step(format!("importing {name}..."));
     let imported = pcpp::pipeline::load_scan_with(bytes.as_ref(), &name, &options, &files)
         .map_err(|e| Failure::Input(missing.explain(in_file(path, &name, &e.to_string()), &e)))?;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use pcpp::mesh::{ExternalFiles, MeshError};
 
+use crate::outputs::Outputs;
 use crate::{CliResult, Failure};
 
 pub fn read_bytes(path: &Path, what: &str) -> CliResult<Vec<u8>> {
@@ -80,11 +81,13 @@ impl Missing {
 /// `name` in the library's messages) names ([`pcpp::mesh::external_files_needed`],
 /// a `.gltf`'s `.bin` buffers), relative to its folder. One that is not
 /// there is left out, in [`Missing`]: the import then names it, unless it
-/// stops first for a reason of its own (a compressed mesh).
+/// stops first for a reason of its own (a compressed mesh). One that is
+/// also an output of the command is refused before it is read.
 pub fn read_external(
     scan_path: &Path,
     name: &str,
     bytes: &[u8],
+    outputs: &Outputs,
 ) -> CliResult<(ExternalFiles, Missing)> {
     let needed = pcpp::mesh::external_files_needed(bytes, name)
         .map_err(|e| Failure::Input(in_file(scan_path, name, &e.to_string())))?;
@@ -101,6 +104,14 @@ pub fn read_external(
         }
         seen.push(&r.path);
         let path = dir.join(&r.path);
+        outputs.refuse_read(&path, || {
+            format!(
+                "{} (buffer {} of --scan {})",
+                path.display(),
+                r.buffer,
+                scan_path.display()
+            )
+        })?;
         match std::fs::metadata(&path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 missing.push((r.path.clone(), path));

@@ -12,7 +12,9 @@
 //! values, `settings.rs` turns them into the library's settings; one module
 //! per command (`plan.rs` holds `plan` and `compare`, which share reading
 //! the inputs; `fiducials.rs` holds `fiducials` and `register`); `files.rs`
-//! reads and writes, `progress.rs` draws progress on a terminal.
+//! reads and writes, `outputs.rs` checks the outputs before anything is
+//! read (not an input, not each other, in a folder that exists),
+//! `progress.rs` draws progress on a terminal.
 //!
 //! The CLI is native only: on wasm32 (built there only because the
 //! integration tests name the binary) it is an empty `main`, and its
@@ -30,6 +32,8 @@ mod demo;
 mod fiducials;
 #[cfg(not(target_arch = "wasm32"))]
 mod files;
+#[cfg(not(target_arch = "wasm32"))]
+mod outputs;
 #[cfg(not(target_arch = "wasm32"))]
 mod plan;
 #[cfg(not(target_arch = "wasm32"))]

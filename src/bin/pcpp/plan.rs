@@ -8,10 +8,11 @@ use pcpp::job::{self, FiducialSource, InputFile, JobSettings, PreparedScan};
 use pcpp::registration::{Registration, RegistrationError, RegistrationMethod};
 use pcpp::Error;
 
-use crate::args::{CompareArgs, JobArgs, PlanArgs, ScanArgs};
+use crate::args::{CompareArgs, JobArgs, MachineArgs, PlanArgs, ScanArgs};
 use crate::files::{
     file_name, in_file, read_bytes, read_external, read_scan, to_json, write_one, Staged,
 };
+use crate::outputs::{Flagged, Outputs};
 use crate::progress::{thousands, Progress};
 use crate::settings::job_settings;
 use crate::{CliResult, Failure, VERSION};
@@ -25,8 +26,27 @@ pub struct Inputs {
     pub prepared: PreparedScan,
 }
 
-fn load_inputs(a: &JobArgs, settings: &JobSettings, progress: &Progress) -> CliResult<Inputs> {
-    let prepared = load_scan(&a.scan, settings, progress)?;
+/// The files `plan` and `compare` read, for [`Outputs::check`].
+fn job_inputs<'a>(a: &'a JobArgs, machine: &'a MachineArgs) -> impl Iterator<Item = Flagged<'a>> {
+    [
+        Some(Flagged::new("--scan", &a.scan.scan)),
+        Some(Flagged::new("--path", &a.path)),
+        machine
+            .profile
+            .as_deref()
+            .map(|p| Flagged::new("--profile", p)),
+    ]
+    .into_iter()
+    .flatten()
+}
+
+fn load_inputs(
+    a: &JobArgs,
+    settings: &JobSettings,
+    outputs: &Outputs,
+    progress: &Progress,
+) -> CliResult<Inputs> {
+    let prepared = load_scan(&a.scan, settings, outputs, progress)?;
     let svg = read_bytes(&a.path, "path")?;
     Ok(Inputs {
         svg_name: file_name(&a.path),
@@ -37,10 +57,12 @@ fn load_inputs(a: &JobArgs, settings: &JobSettings, progress: &Progress) -> CliR
     })
 }
 
-/// Reads, registers and indexes `--scan`.
+/// Reads, registers and indexes `--scan` (its external files refused
+/// where one is also an output).
 pub fn load_scan(
     a: &ScanArgs,
     settings: &JobSettings,
+    outputs: &Outputs,
     progress: &Progress,
 ) -> CliResult<PreparedScan> {
     let scan_path = &a.scan;
@@ -48,7 +70,7 @@ pub fn load_scan(
     let scan = read_scan(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
     // A .gltf's buffers in separate files, from its folder.
-    let (files, missing) = read_external(scan_path, &scan_name, scan.as_ref())?;
+    let (files, missing) = read_external(scan_path, &scan_name, scan.as_ref(), outputs)?;
     progress.step(format!("importing and indexing {scan_name}..."));
     let prepared = job::prepare_scan_owned_with(
         scan,
@@ -153,9 +175,18 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
 }
 
 pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
-    let (mut settings, profile) = job_settings("plan", &a.job, a.planner, &a.machine)?;
     let out: &Path = &a.output;
-    let inputs = load_inputs(&a.job, &settings, progress)?;
+    let written = [
+        Some(Flagged::new("-o", out)),
+        a.report.as_deref().map(|r| Flagged::new("--report", r)),
+    ];
+    let outputs = Outputs::check(
+        "plan",
+        written.into_iter().flatten(),
+        job_inputs(&a.job, &a.machine),
+    )?;
+    let (mut settings, profile) = job_settings("plan", &a.job, a.planner, &a.machine)?;
+    let inputs = load_inputs(&a.job, &settings, &outputs, progress)?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step(format!("planning ({})...", settings.plan.planner));
     let output = job::run_on(
@@ -227,9 +258,11 @@ pub fn comparison_json(
 }
 
 pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
+    let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
+    let outputs = Outputs::check("compare", report, job_inputs(&a.job, &a.machine))?;
     // The planner flag is plan's; compare plans with all of them.
     let (mut settings, _profile) = job_settings("compare", &a.job, Default::default(), &a.machine)?;
-    let inputs = load_inputs(&a.job, &settings, progress)?;
+    let inputs = load_inputs(&a.job, &settings, &outputs, progress)?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step("planning with all five planners...");
     let comparison = job::compare_on(
