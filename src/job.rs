@@ -1047,6 +1047,7 @@ pub fn check_gcode(
         .with_tolerance_mm(tol_mm)
         .validate()?;
     let program = crate::gcode::read_gcode(text, file)?;
+    let frame_notes = header_mismatch(text, scan);
     let clearance = Clearance::new(nozzle, tol_mm);
     let summary = check_moves(
         &scan.surface,
@@ -1070,7 +1071,7 @@ pub fn check_gcode(
              the moves span x {:.3}..{:.3}, y {:.3}..{:.3} mm, the scan x {:.3}..{:.3}, y \
              {:.3}..{:.3} mm; the program and the scan are not in one frame: place or register \
              the scan as it was when the program was planned (a pcpp program's header says how, \
-             e.g. placed on the bed: --place-scan bed)",
+             e.g. placed on the bed: --place-scan bed){}",
             program.moves.len(),
             lo.x,
             hi.x,
@@ -1079,7 +1080,11 @@ pub fn check_gcode(
             slo.x,
             shi.x,
             slo.y,
-            shi.y
+            shi.y,
+            frame_notes
+                .iter()
+                .map(|n| format!("; {n}"))
+                .collect::<String>()
         )));
     }
     // Above the highest point by tol the nozzle clears everything, wherever
@@ -1152,6 +1157,8 @@ pub fn check_gcode(
             }
         ));
     }
+    // What the program's header says against this scan, first.
+    notes.splice(0..0, frame_notes);
     Ok(GcodeCheck {
         file: InputFile::new(file, text.as_bytes()),
         lines: program.lines,
@@ -1162,6 +1169,72 @@ pub fn check_gcode(
         outer_diameter_mm: nozzle.outer_diameter_mm,
         moves: program.moves,
     })
+}
+
+/// What a pcpp program's own header says it was planned on, against the
+/// scan it is checked with: another scan file (its SHA-256), or the scan
+/// in another frame (the registration or placement G, as the header
+/// writes it to 6 decimals). The check itself stands either way; these
+/// say why its moves may miss or hit the part (a program planned on a
+/// scan placed on the bed, checked against the scan placed another way,
+/// showed only collisions). Other tools' programs have no such header.
+fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
+    let mut notes = Vec::new();
+    // The leading comment block: `; key: value` (`'` for Aerotech).
+    let header = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| l.starts_with(';') || l.starts_with('\''))
+        .map(|l| l[1..].trim());
+    for line in header {
+        if let Some(v) = line.strip_prefix("scan file: ") {
+            let planned = v
+                .split("sha256 ")
+                .nth(1)
+                .map(|h| h.trim_end_matches(')').trim());
+            if let Some(h) = planned.filter(|h| *h != scan.file.sha256) {
+                notes.push(format!(
+                    "the program was planned on another scan file: its header names {} (sha256 \
+                     {}...), this check's scan is {} (sha256 {}...): its moves may not fit this \
+                     scan",
+                    v.split(" (").next().unwrap_or(v),
+                    &h[..h.len().min(12)],
+                    scan.file.name,
+                    &scan.file.sha256[..scan.file.sha256.len().min(12)]
+                ));
+            }
+        } else if let Some(v) = line.strip_prefix("registration: ") {
+            let Some((status, g)) = v.rsplit_once("; G [") else {
+                continue;
+            };
+            let numbers: Vec<f64> = g
+                .trim_end_matches(']')
+                .split([';', ' '])
+                .filter(|t| !t.is_empty())
+                .filter_map(|t| t.parse().ok())
+                .collect();
+            if numbers.len() != 16 {
+                continue;
+            }
+            let ours = scan.registration.matrix_row_major();
+            let off = numbers
+                .iter()
+                .zip(ours.iter().flatten())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            // Written to 6 decimals: more than their rounding is another
+            // frame.
+            if off > 1e-5 {
+                notes.push(format!(
+                    "the program was planned with the scan in another frame: its header says \
+                     \"{status}\", G differing from this check's by up to {off:.3}; place or \
+                     register the scan as it was then (this check's scan is {})",
+                    scan.registration.status
+                ));
+            }
+        }
+    }
+    notes
 }
 
 /// Plans from bytes: the CLI's `plan` and the page's Plan button.

@@ -486,3 +486,65 @@ fn the_reader_catches_what_it_is_meant_to_catch() {
     );
     assert_eq!(back.print_moves()[0].feed, Some(300.0));
 }
+
+/// A pcpp program checked against a scan other than the one it was planned
+/// on, or against its scan in another frame (placed on the bed when it
+/// was planned as scanned): the check found only collisions and did not
+/// say why, though the program's header names the scan's SHA-256 and the
+/// registration it was planned with. Now the notes say so; the program
+/// checked as it was planned gets neither note.
+#[test]
+fn regression_check_did_not_compare_the_programs_header_with_its_scan() {
+    use pcpp::demo;
+    use pcpp::job::{check_gcode, prepare_scan, FiducialSource, RegistrationSettings};
+    use pcpp::mesh::ImportOptions;
+
+    let golden = include_str!("golden/demo-marlin.gcode");
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let prepare = |bytes: &[u8], name: &str, registration: &RegistrationSettings| {
+        prepare_scan(bytes, name, &ImportOptions::DEFAULT, registration).unwrap()
+    };
+    let notes = |scan| {
+        check_gcode(scan, golden, "demo.gcode", &nozzle, 0.1)
+            .unwrap()
+            .notes
+    };
+    let ply = demo::demo_scan_bytes();
+    let as_planned = prepare(&ply, demo::DEMO_SCAN_NAME, &RegistrationSettings::default());
+    let n = notes(&as_planned);
+    assert!(
+        !n.iter()
+            .any(|n| n.contains("another frame") || n.contains("another scan")),
+        "{n:?}"
+    );
+
+    // The same scan registered 2 mm and 3 mm over from where it was.
+    let fiducials = demo::test_part::FIDUCIALS_MM.to_vec();
+    let shifted = RegistrationSettings {
+        fiducials: FiducialSource::Points(fiducials.clone()),
+        printer_points: fiducials
+            .iter()
+            .map(|p| *p + DVec3::new(2.0, 3.0, 0.0))
+            .collect(),
+        ..Default::default()
+    };
+    let moved = prepare(&ply, demo::DEMO_SCAN_NAME, &shifted);
+    let n = notes(&moved);
+    assert!(
+        n.iter().any(|n| n.contains("another frame")
+            && n.contains("taken as it is")
+            && n.contains("up to 3.000")
+            && n.contains("place or register the scan")),
+        "{n:?}"
+    );
+
+    let obj = demo::workloads::to_obj(&demo::test_part::test_part());
+    let other = prepare(obj.as_bytes(), "part.obj", &RegistrationSettings::default());
+    let n = notes(&other);
+    assert!(
+        n.iter().any(|n| n.contains("another scan file")
+            && n.contains(demo::DEMO_SCAN_NAME)
+            && n.contains("part.obj")),
+        "{n:?}"
+    );
+}
