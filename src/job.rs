@@ -767,13 +767,13 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         "path".into(),
         format!(
             "{} piece(s), {} points, {:.3} mm, height change {:.3} mm, max inclination {:.1} deg, \
-             min radius {:.3} mm, print time {:.1} s",
+             min radius {}, print time {:.1} s",
             st.subpaths,
             st.points,
             st.length_mm,
             st.height_change_mm,
             st.max_inclination_deg,
-            st.min_radius_mm,
+            st.min_radius_text(),
             st.print_time_s
         ),
     ));

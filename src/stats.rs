@@ -25,6 +25,19 @@ pub struct PathStats {
     pub print_time_s: f64,
 }
 
+impl PathStats {
+    /// The smallest radius of curvature as the summaries print it: in mm,
+    /// or "none (straight)" for a path of straight lines (inf, which read
+    /// as "min radius inf mm").
+    pub fn min_radius_text(&self) -> String {
+        if self.min_radius_mm.is_finite() {
+            format!("{:.3} mm", self.min_radius_mm)
+        } else {
+            "none (straight)".into()
+        }
+    }
+}
+
 /// Statistics over subpaths given as (T*, geometry of Ta) pairs.
 pub fn path_stats<'a>(
     subpaths: impl IntoIterator<Item = (&'a [DVec3], &'a [LocalGeometry])>,
@@ -83,6 +96,16 @@ mod tests {
         assert!((s.max_inclination_deg - 45.0).abs() < 1e-6);
         // Straight: infinite, not the 1e11 mm of the spline's rounding.
         assert_eq!(s.min_radius_mm, f64::INFINITY);
+        // Said as such, not "inf mm" (the G-code header printed that).
+        assert_eq!(s.min_radius_text(), "none (straight)");
+        assert_eq!(
+            PathStats {
+                min_radius_mm: 0.1454,
+                ..s
+            }
+            .min_radius_text(),
+            "0.145 mm"
+        );
         assert!((s.print_time_s - s.length_mm / 5.0).abs() < 1e-12);
     }
 }
