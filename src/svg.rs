@@ -1,9 +1,10 @@
 //! SVG drawn paths (spec "Inputs", T2D): every subpath of every painted
 //! shape, flattened finely, in millimetres with y up.
 //!
-//! Length: about 1,400 lines before its tests, in one file on purpose: the
-//! usvg tree walk, the f64 re-reading of path data and the flattening of
-//! curves share the transform and unit state of each element.
+//! Length: about 2,200 lines before its tests, in one file on purpose: the
+//! usvg tree walk, the f64 re-reading of path data, the flattening of
+//! curves and their dashes share the transform and unit state of each
+//! element.
 //!
 //! ## Features
 //! - Every shape (`path` with all commands, `line`, `polyline`, `polygon`,
@@ -19,10 +20,25 @@
 //!   nozzle), to a chord error of at most [`FLATTEN_TOLERANCE_MM`].
 //! - Corners (tangent discontinuities) are marked so sampling can keep them
 //!   (spec section 3, Decision).
+//! - Dashed strokes (`stroke-dasharray`, `stroke-dashoffset`) are cut into
+//!   their dashes as SVG draws them, each dash a subpath, with a note;
+//!   patterns that draw no dashes print solid, with a note.
+//! - Path data is read up to its first error, as SVG viewers draw it, with
+//!   a note naming the element, the character and the text there.
 //!
 //! ## Limitations
 //! - Text is not converted to paths (no fonts are loaded); images, markers
 //!   and clip/mask/pattern content are not printed. Each is reported as a note.
+//! - A stroke is printed along its centre line whatever its width (a note
+//!   names the widest past [`WIDE_STROKE_MM`]).
+//! - A root `viewBox` of zero width or height is refused (SVG draws nothing
+//!   for it); a negative or unreadable one, and a percentage `width` or
+//!   `height`, are read as usvg reads them, with a note on the scale taken.
+//! - Shapes only defined in `symbol`s or `defs` draw where a `use` refers to
+//!   them; a file of nothing else (an icon sprite sheet) is an error that
+//!   says so.
+//! - A degenerate dash pattern is noticed when written in an attribute or a
+//!   `style` (one set in a stylesheet prints solid without a note).
 //! - External files are never opened (`use` of another file, `image` hrefs).
 //! - Compressed `.svgz` must be unzipped first.
 
@@ -55,6 +71,14 @@ pub const MAX_POINTS: usize = 4_000_000;
 
 /// CSS pixels are 1/96 in; usvg reports everything in them.
 pub const MM_PER_PX: f64 = 25.4 / 96.0;
+
+/// Strokes drawn wider than this (mm) get a note: they are printed along
+/// their centre lines, one trace of the nozzle's width. Twice the default
+/// tip's outer diameter ([`crate::params::Nozzle::DEFAULT`], 0.908 mm).
+pub const WIDE_STROKE_MM: f64 = 2.0 * crate::params::Nozzle::DEFAULT.outer_diameter_mm;
+
+/// Elements a note names before it says "and N more".
+const MAX_NAMED: usize = 3;
 
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
 
@@ -236,6 +260,19 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             (prepare(&declared_text).map_err(parse_err)?, undeclared)
         }
     };
+    if let Some(vb) = &prepared.empty_viewbox {
+        // SVG draws nothing for a zero-size viewBox (a viewer shows an empty
+        // page) and nothing tells the drawing's scale: refused, not guessed.
+        return Err(SvgError::NothingPrintable {
+            file: file.to_string(),
+            reason: format!(
+                "the root <svg>'s viewBox=\"{vb}\" has a zero width or height, with which SVG \
+                 draws nothing (a viewer shows an empty page): give the viewBox the drawing's \
+                 extent in user units (x y width height), or remove it to take user units as \
+                 CSS px"
+            ),
+        });
+    }
     let mut notes = prepared.notes;
     if !undeclared.is_empty() {
         notes.push(format!(
@@ -260,7 +297,30 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     };
     let tree = usvg::Tree::from_str(&prepared.text, &options)
         .map_err(|e| parse_err(format!("not a usable SVG: {e}")))?;
-
+    if !prepared.percent_size.is_empty() {
+        // usvg takes a percentage of the viewBox's size in px; with no
+        // viewBox the page is the drawing's extent and user units are px.
+        let assumed = if prepared.has_viewbox {
+            let size = tree.size();
+            format!(
+                "the page was taken as {:.1} x {:.1} mm, that percentage of the viewBox's size \
+                 read as CSS px (96 per inch)",
+                f64::from(size.width()) * MM_PER_PX,
+                f64::from(size.height()) * MM_PER_PX,
+            )
+        } else {
+            format!("user units were taken as CSS px (1 unit = {MM_PER_PX:.4} mm)")
+        };
+        let one = match prepared.percent_size.len() {
+            1 => "is a percentage",
+            _ => "are percentages",
+        };
+        notes.push(format!(
+            "the root <svg>'s {} {one} of a window the file does not have: {assumed}, which sets \
+             the drawing's scale; give width and height in mm (e.g. width=\"40mm\") to set it",
+            prepared.percent_size.join(" and "),
+        ));
+    }
     let mut out = Vec::new();
     let mut budget = MAX_POINTS;
     let mut unpainted = 0usize;
@@ -287,6 +347,13 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     }
 
     let (mut filled_only, mut first_filled) = (0usize, None::<String>);
+    // Shapes whose path data stops at an error, by shape index (once for
+    // all `use` instances of one).
+    let mut data_errors: std::collections::BTreeSet<usize> = Default::default();
+    // (shapes, pieces, the first) dashed; (shape, pattern, why) printed solid.
+    let mut dashed = (0usize, 0usize, None::<String>);
+    let mut solid: Vec<(String, String, String)> = Vec::new();
+    let mut widest: Option<(f64, String)> = None;
     let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
     while let Some(node) = stack.pop() {
         let path = match node {
@@ -337,19 +404,50 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
 
         let to_mm = DAffine2::from_scale(DVec2::new(MM_PER_PX, -MM_PER_PX))
             * affine_from_usvg(path.abs_transform());
+        if let Some(i) = shape_index {
+            if shape.is_some_and(|s| s.d_read.as_ref().is_some_and(|r| r.error.is_some())) {
+                data_errors.insert(i);
+            }
+        }
         let stretch = max_stretch(to_mm.matrix2);
         if !(stretch.is_finite() && stretch > 0.0) {
             continue;
         }
+        if let Some(stroke) = path.stroke() {
+            let width_mm = f64::from(stroke.width().get()) * stretch;
+            if width_mm > widest.as_ref().map_or(WIDE_STROKE_MM, |w| w.0) {
+                widest = Some((width_mm, label.clone()));
+            }
+        }
+        let mut dashes = match path.stroke() {
+            Some(stroke) => match stroke.dasharray() {
+                Some(array) => Dashes::new(array, stroke.dashoffset())
+                    .map_err(|why| {
+                        let written = shape.and_then(|s| s.dasharray.clone());
+                        solid.push((
+                            label.clone(),
+                            written.unwrap_or_else(|| pattern(array)),
+                            why,
+                        ));
+                    })
+                    .ok(),
+                None => {
+                    // usvg drops a pattern SVG draws solid: say so.
+                    let written = shape.and_then(|s| s.dasharray.as_deref());
+                    if let Some((w, why)) = written.and_then(|w| Some((w, solid_dash_reason(w)?))) {
+                        solid.push((label.clone(), w.to_string(), why.to_string()));
+                    }
+                    None
+                }
+            },
+            None => None,
+        };
+
         let tol_local = FLATTEN_TOLERANCE_MM / stretch;
+        let mut flats = Vec::with_capacity(local.len());
         for sub in &local {
             match flatten_subpath(sub, &to_mm, tol_local, cos_corner, &mut budget) {
-                Ok(Some((points, corner, closed))) => out.push(Subpath2 {
-                    points,
-                    corner,
-                    closed,
-                    source: label.clone(),
-                }),
+                Ok(Some(flat)) => flats.push(flat),
                 Ok(None) => non_finite += 1,
                 Err(()) => {
                     return Err(SvgError::TooComplex {
@@ -361,6 +459,104 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 }
             }
         }
+        if let Some(d) = &dashes {
+            let length: f64 = flats
+                .iter()
+                .flat_map(|f| f.0.windows(2).map(|w| w[0].distance(w[1])))
+                .sum();
+            let count = length / d.period * (d.array.len() / 2) as f64 + flats.len() as f64;
+            if count.is_nan() || count > dash_limit(budget) {
+                solid.push((
+                    label.clone(),
+                    shape
+                        .and_then(|s| s.dasharray.clone())
+                        .unwrap_or_else(|| pattern(&d.array)),
+                    format!(
+                        "a pattern repeating every {:.2e} mm, which would cut it into more \
+                         than {:.0} dashes",
+                        d.period * stretch,
+                        dash_limit(budget)
+                    ),
+                ));
+                dashes = None;
+            }
+        }
+        let pieces: Vec<Flat> = match &dashes {
+            Some(d) => {
+                let pieces: Vec<Flat> = flats.iter().flat_map(|f| d.cut(f)).collect();
+                // Two new ends per dash; the count above bounds them.
+                budget = budget.saturating_sub(2 * pieces.len());
+                dashed.0 += 1;
+                dashed.1 += pieces.len();
+                dashed.2.get_or_insert_with(|| label.clone());
+                pieces
+            }
+            None => flats,
+        };
+        for piece in pieces {
+            match into_mm(piece, &to_mm) {
+                Some((points, corner, closed)) => out.push(Subpath2 {
+                    points,
+                    corner,
+                    closed,
+                    source: label.clone(),
+                }),
+                None => non_finite += 1,
+            }
+        }
+    }
+
+    // Paths usvg left out because their data fails before drawing anything.
+    for (i, s) in prepared.shapes.iter().enumerate() {
+        if s.rendered
+            && s.d_read
+                .as_ref()
+                .is_some_and(|r| r.error.is_some() && !r.draws)
+        {
+            data_errors.insert(i);
+        }
+    }
+    if !data_errors.is_empty() {
+        let listed: Vec<String> = data_errors
+            .iter()
+            .take(MAX_NAMED)
+            .filter_map(|&i| {
+                let s = prepared.shapes.get(i)?;
+                let read = s.d_read.as_ref()?;
+                let (at, excerpt) = read.error.as_ref()?;
+                let place = if excerpt.is_empty() {
+                    "where the data ends inside a command".to_string()
+                } else {
+                    format!("'{excerpt}'")
+                };
+                let commas = if excerpt.starts_with(',') {
+                    ", two commas in a row (SVG allows one between numbers)"
+                } else {
+                    ""
+                };
+                let drawn = if read.draws {
+                    ""
+                } else {
+                    ", before it draws anything"
+                };
+                Some(format!(
+                    "'{}' at character {at}: {place}{commas}{drawn}",
+                    s.label
+                ))
+            })
+            .collect();
+        let more = data_errors.len().saturating_sub(listed.len());
+        notes.push(format!(
+            "{} path(s) have an error in their path data ({}{}): each is printed only up to \
+             the command holding it, as SVG viewers draw it; correct the path data there",
+            data_errors.len(),
+            listed.join("; "),
+            if more > 0 {
+                format!("; and {more} more")
+            } else {
+                String::new()
+            }
+        ));
     }
 
     if unpainted > 0 {
@@ -380,20 +576,84 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
              serpentine) to print it"
         ));
     }
+    if let Some(first) = &dashed.2 {
+        notes.push(format!(
+            "{} shape(s) have dashed strokes (the first: '{first}'): each dash is printed as its \
+             own piece ({} pieces), as SVG draws them; remove stroke-dasharray to print a solid \
+             line",
+            dashed.0, dashed.1
+        ));
+    }
+    if let Some((first, written, why)) = solid.first() {
+        notes.push(format!(
+            "{} dashed shape(s) printed as solid lines (the first: '{first}', \
+             stroke-dasharray=\"{written}\": {why}); give the dashes a length above zero, or \
+             remove stroke-dasharray",
+            solid.len()
+        ));
+    }
+    if let Some((width_mm, widest)) = &widest {
+        notes.push(format!(
+            "strokes are printed along their centre lines, one nozzle's trace wide; the widest, \
+             '{widest}', is drawn {width_mm:.2} mm wide: to print a trace that wide, draw it as \
+             strokes side by side (e.g. a serpentine)"
+        ));
+    }
     if non_finite > 0 {
         notes.push(format!(
             "{non_finite} subpath(s) dropped: their coordinates overflow in mm"
         ));
     }
     if out.is_empty() {
-        let detail = if notes.is_empty() {
-            "the document contains no shapes".to_string()
+        let unused = &prepared.unused;
+        let reason = if unused.shapes > 0 {
+            let first = unused.ids.first().map_or("its-id", String::as_str);
+            let named: Vec<String> = unused
+                .ids
+                .iter()
+                .take(MAX_NAMED)
+                .map(|id| format!("'{id}'"))
+                .collect();
+            let more = if unused.ids.len() > named.len() {
+                ", ..."
+            } else {
+                ""
+            };
+            let within = if unused.symbols > 0 {
+                format!(
+                    "{} <symbol>(s) ({}{more})",
+                    unused.symbols,
+                    named.join(", ")
+                )
+            } else if named.is_empty() {
+                "<defs>".to_string()
+            } else {
+                format!("<defs> ({}{more})", named.join(", "))
+            };
+            let note = if notes.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", notes.join("; "))
+            };
+            format!(
+                "the document's {} shape(s) sit inside {within}, which are drawn only where a \
+                 <use> refers to them, and none does (an icon sprite sheet?): open the one icon's \
+                 own SVG, or add <use href=\"#{first}\"/> after the <defs> to print that one{note}",
+                unused.shapes
+            )
+        } else if notes.is_empty() {
+            "no visible shape with a stroke or fill (the document contains no shapes)".to_string()
+        } else if !data_errors.is_empty() {
+            format!("no shape is left to draw ({})", notes.join("; "))
         } else {
-            notes.join("; ")
+            format!(
+                "no visible shape with a stroke or fill ({})",
+                notes.join("; ")
+            )
         };
         return Err(SvgError::NothingPrintable {
             file: file.to_string(),
-            reason: format!("no visible shape with a stroke or fill ({detail})"),
+            reason,
         });
     }
     Ok(SvgImport {
@@ -420,6 +680,26 @@ struct ShapeInfo {
     kind: ShapeKind,
     /// The raw `d` of a `path`, re-read in f64 (usvg keeps f32 and coarse arcs).
     d: Option<String>,
+    /// How far usvg reads that `d` (svgtypes, the parser it reads it with).
+    d_read: Option<PathDataRead>,
+    /// The `stroke-dasharray` the shape has or inherits, as written in an
+    /// attribute or a `style` (not from a stylesheet): tells a pattern usvg
+    /// dropped (it then draws the stroke solid) from no pattern at all.
+    dasharray: Option<String>,
+    /// Drawn where it stands or through a `use`, not only defined (inside
+    /// `defs`, `symbol`, `clipPath`, `mask` or `pattern`).
+    rendered: bool,
+}
+
+/// Shapes defined in `symbol`s or `defs` that no `use` draws (an icon
+/// sprite sheet): named when they are all the document has.
+#[derive(Debug, Default)]
+struct UnusedDefinitions {
+    shapes: usize,
+    /// Ids of the `symbol`s (else of the defined elements) holding them, in
+    /// document order, and whether any of them is a `symbol`.
+    ids: Vec<String>,
+    symbols: usize,
 }
 
 struct Prepared {
@@ -432,6 +712,166 @@ struct Prepared {
     ids: HashMap<String, usize>,
     copy_prefix: String,
     notes: Vec<String>,
+    unused: UnusedDefinitions,
+    /// The root's size, from [`RootSize`].
+    empty_viewbox: Option<String>,
+    has_viewbox: bool,
+    percent_size: Vec<String>,
+}
+
+/// Elements whose content is only drawn where something refers to it.
+const DEFINITION_CONTAINERS: [&str; 6] =
+    ["defs", "symbol", "clipPath", "mask", "pattern", "marker"];
+
+/// How far usvg reads a path's data: like browsers, it draws the path up to
+/// the command holding the first error and drops the rest.
+#[derive(Debug, Clone)]
+struct PathDataRead {
+    /// Segments (commands, and implicit repeats) read before the end or
+    /// the error; the f64 re-reading keeps to the same number.
+    segments: usize,
+    /// Some of them draw (more than movetos).
+    draws: bool,
+    /// Where the data stops at an error: the character (1-based, as
+    /// svgtypes counts) and the text from there, shortened.
+    error: Option<(usize, String)>,
+}
+
+/// Characters of path data quoted in a note.
+const EXCERPT_CHARS: usize = 16;
+
+fn read_path_data(d: &str) -> PathDataRead {
+    let mut read = PathDataRead {
+        segments: 0,
+        draws: false,
+        error: None,
+    };
+    for seg in svgtypes::PathParser::from(d) {
+        match seg {
+            Ok(seg) => {
+                read.segments += 1;
+                read.draws |= !matches!(
+                    seg,
+                    svgtypes::PathSegment::MoveTo { .. } | svgtypes::PathSegment::ClosePath { .. }
+                );
+            }
+            Err(e) => {
+                let at = match e {
+                    svgtypes::Error::UnexpectedData(at)
+                    | svgtypes::Error::InvalidNumber(at)
+                    | svgtypes::Error::InvalidChar(_, at)
+                    | svgtypes::Error::InvalidString(_, at) => at,
+                    // The data ends inside a command.
+                    _ => d.chars().count() + 1,
+                };
+                // (Path data may span lines: quoted on one.)
+                let mut excerpt: String = d
+                    .chars()
+                    .skip(at.saturating_sub(1))
+                    .take(EXCERPT_CHARS + 1)
+                    .map(|c| {
+                        if c.is_whitespace() || c.is_control() {
+                            ' '
+                        } else {
+                            c
+                        }
+                    })
+                    .collect();
+                if excerpt.chars().count() > EXCERPT_CHARS {
+                    excerpt = excerpt.chars().take(EXCERPT_CHARS).collect::<String>() + "...";
+                }
+                read.error = Some((at, excerpt));
+                break;
+            }
+        }
+    }
+    read
+}
+
+/// The `stroke-dasharray` an element has or inherits from its ancestors,
+/// from a `style` declaration (which wins) or the attribute.
+fn written_dasharray(node: roxmltree::Node) -> Option<String> {
+    node.ancestors().filter(|n| n.is_element()).find_map(|n| {
+        let declared = n.attribute("style").and_then(|style| {
+            style.split(';').find_map(|decl| {
+                let (name, value) = decl.split_once(':')?;
+                (name.trim() == "stroke-dasharray").then(|| value.trim().to_string())
+            })
+        });
+        declared.or_else(|| {
+            n.attribute("stroke-dasharray")
+                .map(|v| v.trim().to_string())
+        })
+    })
+}
+
+/// Why a written dash pattern draws a solid line in SVG (SVG 1.1 11.4,
+/// 'stroke-dasharray': a negative value is an error, a zero sum draws the
+/// stroke as if none were given), or None if it does not.
+fn solid_dash_reason(written: &str) -> Option<&'static str> {
+    if written.is_empty() || written == "none" || written == "inherit" {
+        return None;
+    }
+    let values: Vec<f64> = svgtypes::LengthListParser::from(written)
+        .map_while(Result::ok)
+        .map(|l| l.number)
+        .collect();
+    if values.iter().any(|v| *v < 0.0) {
+        Some("a negative length, which SVG takes as no pattern")
+    } else if values.iter().all(|v| *v == 0.0) {
+        Some("no length at all, which SVG draws as a solid line")
+    } else {
+        None
+    }
+}
+
+/// What the root `<svg>`'s size attributes leave to assumption.
+#[derive(Debug, Default)]
+struct RootSize {
+    /// The `viewBox` when its width or height is zero: SVG draws nothing.
+    empty_viewbox: Option<String>,
+    /// usvg maps a `viewBox` (a valid one: positive sizes).
+    has_viewbox: bool,
+    /// `width`/`height` written as percentages (of a window the file does
+    /// not have), e.g. `width="100%"`.
+    percent: Vec<String>,
+    notes: Vec<String>,
+}
+
+fn root_size(root: roxmltree::Node) -> RootSize {
+    let mut size = RootSize::default();
+    if let Some(vb) = root.attribute("viewBox") {
+        let numbers: Vec<f64> = svg_numbers(vb).take(4).collect();
+        match vb.parse::<svgtypes::ViewBox>() {
+            // usvg keeps the viewBox in f32: a size that rounds to 0 is 0.
+            Ok(v) if (v.w as f32) > 0.0 && (v.h as f32) > 0.0 => size.has_viewbox = true,
+            Ok(_) => size.empty_viewbox = Some(vb.to_string()),
+            Err(svgtypes::ViewBoxError::InvalidSize) if numbers.iter().all(|n| *n >= 0.0) => {
+                size.empty_viewbox = Some(vb.to_string())
+            }
+            // SVG 1.1 7.7: a negative width or height is an error that
+            // disables the attribute; viewers then draw in px, as usvg does.
+            Err(e) => size.notes.push(format!(
+                "the root <svg>'s viewBox=\"{vb}\" is not valid ({}), which makes SVG ignore it: \
+                 ignored, so user units were taken as CSS px (1 unit = {MM_PER_PX:.4} mm); give \
+                 the viewBox the drawing's extent (x y width height, both sizes above 0) or \
+                 remove it",
+                match e {
+                    svgtypes::ViewBoxError::InvalidSize => "a negative width or height",
+                    svgtypes::ViewBoxError::InvalidNumber => "it is not four numbers",
+                }
+            )),
+        }
+    }
+    size.percent = ["width", "height"]
+        .into_iter()
+        .filter_map(|name| {
+            let value = root.attribute(name)?;
+            let length = value.parse::<svgtypes::Length>().ok()?;
+            (length.unit == svgtypes::LengthUnit::Percent).then(|| format!("{name}=\"{value}\""))
+        })
+        .collect();
+    size
 }
 
 /// Attributes that define a shape's geometry (SVG 1.1 chapters 8 and 9).
@@ -727,6 +1167,8 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     let mut index = 0usize;
     let mut texts = 0usize;
     let mut markers = 0usize;
+    let mut unused = UnusedDefinitions::default();
+    let mut unused_seen: HashSet<&str> = HashSet::new();
     for node in root.descendants().filter(|n| n.is_element() && is_svg(n)) {
         let name = node.tag_name().name();
         // Nodes expanded from DTD entities point into the DTD: no edits there.
@@ -786,14 +1228,54 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         let d = (kind == ShapeKind::Path)
             .then(|| node.attribute("d").map(str::to_string))
             .flatten();
-        let shape = shapes.len();
-        shapes.push(ShapeInfo { label, kind, d });
-        if let Some((id, _)) = key {
-            ids.insert(id, shape);
-        }
         let under_use = node
             .ancestors()
             .any(|a| a.attribute("id").is_some_and(|id| referenced.contains(id)));
+        let container = node.ancestors().skip(1).find(|a| {
+            a.is_element() && is_svg(a) && DEFINITION_CONTAINERS.contains(&a.tag_name().name())
+        });
+        let rendered = container.is_none() || under_use;
+        if let (Some(c), false) = (container, under_use) {
+            // A shape of a clip path, mask or pattern draws through what
+            // uses it; one in a symbol or defs only through a `use`.
+            let defined = node.ancestors().skip(1).all(|a| {
+                !(a.is_element()
+                    && is_svg(&a)
+                    && matches!(
+                        a.tag_name().name(),
+                        "clipPath" | "mask" | "pattern" | "marker"
+                    ))
+            });
+            if defined {
+                unused.shapes += 1;
+                let symbol = node
+                    .ancestors()
+                    .find(|a| a.is_element() && is_svg(a) && a.tag_name().name() == "symbol");
+                let named = symbol.or_else(|| {
+                    node.ancestors()
+                        .take_while(|a| a.id() != c.id())
+                        .find(|a| a.attribute("id").is_some_and(|id| !id.is_empty()))
+                });
+                if let Some(id) = named.and_then(|n| n.attribute("id")) {
+                    if unused_seen.insert(id) {
+                        unused.ids.push(id.to_string());
+                        unused.symbols += usize::from(symbol.is_some());
+                    }
+                }
+            }
+        }
+        let shape = shapes.len();
+        shapes.push(ShapeInfo {
+            label,
+            kind,
+            d_read: d.as_deref().map(read_path_data),
+            d,
+            dasharray: written_dasharray(node),
+            rendered,
+        });
+        if let Some((id, _)) = key {
+            ids.insert(id, shape);
+        }
         if under_use {
             // Only un-namespaced geometry attributes: prefixed ones might
             // need declarations that do not reach the end of the document.
@@ -819,7 +1301,8 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         }
     }
 
-    let mut notes = Vec::new();
+    let root_size = root_size(root);
+    let mut notes = root_size.notes;
     if texts > 0 {
         notes.push(format!(
             "{texts} text element(s) skipped: text is not converted to paths (no fonts are loaded); \
@@ -851,6 +1334,10 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         ids,
         copy_prefix: format!("{prefix}copy-"),
         notes,
+        unused,
+        empty_viewbox: root_size.empty_viewbox,
+        has_viewbox: root_size.has_viewbox,
+        percent_size: root_size.percent,
     })
 }
 
@@ -1083,7 +1570,7 @@ fn from_tiny_skia(path: &tiny_skia_path::Path) -> Vec<LocalSubpath> {
 /// Exact geometry where usvg's is approximate, or None to use usvg's.
 fn exact_geometry(shape: &ShapeInfo, data: &tiny_skia_path::Path) -> Option<Vec<LocalSubpath>> {
     let subs = match shape.kind {
-        ShapeKind::Path => parse_path_data(shape.d.as_deref()?),
+        ShapeKind::Path => parse_path_data(shape.d.as_deref()?, shape.d_read.as_ref()?.segments)?,
         ShapeKind::Circle | ShapeKind::Ellipse => ellipse_from_usvg(data)?,
         ShapeKind::Rect => rounded_rect_from_usvg(data)?,
         ShapeKind::Other => return None,
@@ -1289,7 +1776,11 @@ impl PathData<'_> {
     }
 }
 
-fn parse_path_data(d: &str) -> Vec<LocalSubpath> {
+/// The first `segments` segments of path data (the number usvg reads, see
+/// [`read_path_data`]), or None if this reading stops before them: then
+/// usvg's own geometry is what is drawn.
+fn parse_path_data(d: &str, segments: usize) -> Option<Vec<LocalSubpath>> {
+    let mut read = 0usize;
     let mut p = PathData {
         s: d.as_bytes(),
         i: 0,
@@ -1301,7 +1792,7 @@ fn parse_path_data(d: &str) -> Vec<LocalSubpath> {
     let mut last_quad_ctrl: Option<DVec2> = None;
     let mut started = false;
 
-    loop {
+    while read < segments {
         p.skip_separators();
         let Some(&c) = p.s.get(p.i) else { break };
         let command = if c.is_ascii_alphabetic() {
@@ -1385,8 +1876,9 @@ fn parse_path_data(d: &str) -> Vec<LocalSubpath> {
         }
         last_cubic_ctrl = cubic_ctrl;
         last_quad_ctrl = quad_ctrl;
+        read += 1;
     }
-    asm.finish()
+    (read == segments).then(|| asm.finish())
 }
 
 /// An SVG elliptical arc from end points to centre form (SVG 1.1
@@ -1480,7 +1972,9 @@ fn is_corner(a: DVec2, b: DVec2, cos_corner: f64) -> bool {
 
 type Flat = (Vec<DVec2>, Vec<bool>, bool);
 
-/// Ok(None): the coordinates overflowed; Err: over the point budget.
+/// The subpath flattened in its own user units (corners judged after the
+/// map to mm, which need not keep angles). Ok(None): nothing to flatten;
+/// Err: over the point budget.
 fn flatten_subpath(
     sub: &LocalSubpath,
     to_mm: &DAffine2,
@@ -1493,12 +1987,12 @@ fn flatten_subpath(
     };
     let lin = to_mm.matrix2;
     let segs: Vec<&Seg> = sub.segs.iter().filter(|s| !s.is_degenerate()).collect();
-    let mut points = vec![to_mm.transform_point2(first.start())];
+    let mut points = vec![first.start()];
     let mut corner = vec![true];
     if segs.is_empty() {
         // A dot (e.g. "M5 5 L5 5" with round caps): one point.
         *budget = budget.checked_sub(1).ok_or(())?;
-        return Ok(points[0].is_finite().then_some((points, corner, false)));
+        return Ok(Some((points, corner, false)));
     }
     for (i, seg) in segs.iter().enumerate() {
         if i > 0 {
@@ -1519,10 +2013,10 @@ fn flatten_subpath(
         *budget -= n;
         points.reserve(n);
         for k in 1..n {
-            points.push(to_mm.transform_point2(seg.eval(k as f64 / n as f64)));
+            points.push(seg.eval(k as f64 / n as f64));
             corner.push(false);
         }
-        points.push(to_mm.transform_point2(seg.end()));
+        points.push(seg.end());
         corner.push(false);
     }
     let n = points.len();
@@ -1542,10 +2036,181 @@ fn flatten_subpath(
         corner[0] = true;
         corner[n - 1] = true;
     }
-    if !points.iter().all(|p| p.is_finite()) {
-        return Ok(None);
-    }
     Ok(Some((points, corner, sub.closed)))
+}
+
+/// A flattened piece in mm, or None where the coordinates overflow there.
+fn into_mm((points, corner, closed): Flat, to_mm: &DAffine2) -> Option<Flat> {
+    let points: Vec<DVec2> = points.iter().map(|&p| to_mm.transform_point2(p)).collect();
+    points
+        .iter()
+        .all(|p| p.is_finite())
+        .then_some((points, corner, closed))
+}
+
+// ---------------------------------------------------------------------------
+// Dashes (SVG 1.1 11.4, 'stroke-dasharray' and 'stroke-dashoffset'): each
+// dash is a piece of its own, measured along the path in the element's
+// user units, as SVG measures them.
+
+/// A dash pattern as SVG writes one, "4 2".
+fn pattern(array: &[impl std::fmt::Display]) -> String {
+    array
+        .iter()
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Most dashes one shape may be cut into, as points (two ends each) out of
+/// the file's budget: a finer pattern is printed solid, with a note.
+fn dash_limit(budget: usize) -> f64 {
+    budget as f64 / 2.0
+}
+
+/// A pattern usvg resolved: lengths in user units, an even number of them
+/// (usvg repeats an odd list), none negative, a positive sum.
+#[derive(Debug, Clone, PartialEq)]
+struct Dashes {
+    array: Vec<f64>,
+    offset: f64,
+    period: f64,
+}
+
+impl Dashes {
+    /// The pattern, or why it prints solid.
+    fn new(array: &[f32], offset: f32) -> Result<Dashes, String> {
+        let array: Vec<f64> = array.iter().map(|&v| f64::from(v)).collect();
+        let period: f64 = array.iter().sum();
+        let offset = f64::from(offset);
+        if array.len() < 2
+            || !array.len().is_multiple_of(2)
+            || array.iter().any(|v| v.is_nan() || *v < 0.0)
+        {
+            return Err("a pattern with a negative length, which SVG takes as no pattern".into());
+        }
+        if !(period.is_finite() && period > 0.0) {
+            return Err("a pattern of no finite length".into());
+        }
+        if array.iter().step_by(2).all(|&on| on == 0.0) {
+            return Err("dashes of zero length only (dots), which a nozzle cannot draw".into());
+        }
+        if !offset.is_finite() {
+            return Err("a stroke-dashoffset that is not a finite number".into());
+        }
+        Ok(Dashes {
+            array,
+            offset,
+            period,
+        })
+    }
+
+    /// The dashes of one flattened subpath (local units), as tiny-skia's
+    /// port of Skia's dasher places them for resvg: the pattern starts
+    /// `offset` into itself at the subpath's start; on a closed subpath the
+    /// first dash is drawn last, continuing the last dash through the start
+    /// point when that one runs to the end. A drawn vertex inside a dash
+    /// keeps its corner flag; a dash's ends are corners (ends of an open
+    /// piece). Zero-length dashes draw nothing a nozzle can print: left out.
+    fn cut(&self, (points, corner, closed): &Flat) -> Vec<Flat> {
+        let mut along = Vec::with_capacity(points.len());
+        let mut total = 0.0;
+        along.push(0.0);
+        for w in points.windows(2) {
+            total += w[0].distance(w[1]);
+            along.push(total);
+        }
+        if !(total.is_finite() && total > 0.0) || points.len() < 2 {
+            return vec![(points.clone(), corner.clone(), *closed)];
+        }
+        // The point at arc length `s`, and the last vertex at or before it.
+        let at = |s: f64| -> (usize, DVec2) {
+            let i = along
+                .partition_point(|&a| a <= s)
+                .saturating_sub(1)
+                .min(points.len() - 2);
+            let len = along[i + 1] - along[i];
+            let t = if len > 0.0 {
+                ((s - along[i]) / len).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (i, points[i].lerp(points[i + 1], t))
+        };
+        // Appends the stretch [s0, s1] to a piece (its start only if the
+        // piece is empty).
+        let span = |s0: f64, s1: f64, piece: &mut Flat| {
+            let (i0, p0) = at(s0);
+            let (i1, p1) = at(s1);
+            if piece.0.is_empty() {
+                piece.0.push(p0);
+                piece.1.push(true);
+            }
+            for j in i0 + 1..=i1 {
+                if along[j] > s0 && along[j] < s1 {
+                    piece.0.push(points[j]);
+                    piece.1.push(corner[j]);
+                }
+            }
+            piece.0.push(p1);
+            piece.1.push(true);
+        };
+
+        let n = self.array.len();
+        let mut phase = self.offset.rem_euclid(self.period);
+        if phase >= self.period {
+            phase = 0.0;
+        }
+        let (mut index, mut len) = (0, self.array[0]);
+        for (i, &gap) in self.array.iter().enumerate() {
+            if phase > gap || (phase == gap && gap != 0.0) {
+                phase -= gap;
+            } else {
+                (index, len) = (i, gap - phase);
+                break;
+            }
+        }
+        let (first_index, first_len) = (index, len);
+
+        let mut pieces: Vec<Flat> = Vec::new();
+        let mut skip_first = *closed;
+        let mut distance = 0.0;
+        let mut ran_to_end = false;
+        while distance < total {
+            ran_to_end = false;
+            if index % 2 == 0 && !skip_first {
+                let end = (distance + len).min(total);
+                if end > distance {
+                    let mut piece = (Vec::new(), Vec::new(), false);
+                    span(distance, end, &mut piece);
+                    pieces.push(piece);
+                    ran_to_end = end >= total;
+                }
+            }
+            distance += len;
+            skip_first = false;
+            index = (index + 1) % n;
+            len = self.array[index];
+        }
+        if *closed && first_index % 2 == 0 && first_len > 0.0 {
+            let end = first_len.min(total);
+            match pieces.last_mut() {
+                Some(last) if ran_to_end => {
+                    // Through the start point: the drawn join there.
+                    if let Some(c) = last.1.last_mut() {
+                        *c = corner[0];
+                    }
+                    span(0.0, end, last);
+                }
+                _ => {
+                    let mut piece = (Vec::new(), Vec::new(), false);
+                    span(0.0, end, &mut piece);
+                    pieces.push(piece);
+                }
+            }
+        }
+        pieces
+    }
 }
 
 #[cfg(test)]
@@ -1670,9 +2335,15 @@ mod tests {
         assert!((arc.point(arc.theta0 + arc.dtheta) - DVec2::new(10.0, 0.0)).length() < 1e-12);
     }
 
+    /// Path data read as usvg reads it: up to the command holding the first
+    /// error.
+    fn path(d: &str) -> Vec<LocalSubpath> {
+        parse_path_data(d, read_path_data(d).segments).unwrap_or_default()
+    }
+
     #[test]
     fn path_data_packed_flags_and_numbers() {
-        let subs = parse_path_data("M0,0a5 5 0 01 10 0l-.5.5-1e1-0Z");
+        let subs = path("M0,0a5 5 0 01 10 0l-.5.5-1e1-0Z");
         assert_eq!(subs.len(), 1);
         assert!(subs[0].closed);
         assert_eq!(subs[0].segs.len(), 4);
@@ -1681,16 +2352,46 @@ mod tests {
 
     #[test]
     fn path_data_error_keeps_the_prefix() {
-        let subs = parse_path_data("M 0 0 L 10 0 L 10 x 20");
+        let subs = path("M 0 0 L 10 0 L 10 x 20");
         assert_eq!(subs.len(), 1);
         assert_eq!(subs[0].segs.len(), 1);
-        assert!(parse_path_data("L 1 1").is_empty());
-        assert!(parse_path_data("M 1e999 0 L 1 1").is_empty());
+        assert!(path("L 1 1").is_empty());
+        assert!(path("M 1e999 0 L 1 1").is_empty());
+        let read = read_path_data("M 0 0 L 10 0 L 10 x 20");
+        assert_eq!((read.segments, read.draws), (2, true));
+        assert_eq!(read.error, Some((19, "x 20".to_string())));
+        // The data ends inside a command: the place is its end.
+        let read = read_path_data("M 0 0 L 1");
+        assert_eq!((read.segments, read.draws), (1, false));
+        assert_eq!(read.error, Some((10, String::new())));
+    }
+
+    /// The f64 reading draws what usvg draws, up to the same command, on
+    /// separators SVG refuses ("1,,2", a comma after a command letter) as on
+    /// valid data.
+    #[test]
+    fn path_data_stops_where_usvg_stops() {
+        for d in [
+            "M2,10 L20,10 L25,,5 L38,10",
+            "M0 0 L,1 1 L2 2",
+            "M0 0 l1 1 , , 2 2",
+            "M0,0,L1,1 2,2",
+            "M0 0 L 5 5 Z 3 3",
+            "M0 0 H 1 2 3 V",
+            "M0 0 A 1 1 0 2 1 5 5",
+        ] {
+            let ours: usize = path(d).iter().map(|s| s.segs.len()).sum();
+            let usvg = svgtypes::SimplifyingPathParser::from(d)
+                .map_while(Result::ok)
+                .filter(|s| !matches!(s, svgtypes::SimplePathSegment::MoveTo { .. }))
+                .count();
+            assert_eq!(ours, usvg, "{d}");
+        }
     }
 
     #[test]
     fn drawing_after_close_restarts_at_the_start() {
-        let subs = parse_path_data("M 1 1 h 2 v 2 z l 5 0");
+        let subs = path("M 1 1 h 2 v 2 z l 5 0");
         assert_eq!(subs.len(), 2);
         assert_eq!(
             subs[1].segs[0],

@@ -848,3 +848,392 @@ fn a_path_needing_too_many_samples_names_the_count_and_the_units() {
         "{e}"
     );
 }
+
+// ---------------------------------------------------------------------------
+// What exploratory QA found changed silently (each now printed as drawn, or
+// told): dashes, path-data errors, icon sprites, the root's size.
+// ---------------------------------------------------------------------------
+
+/// The notes of a drawing that imports.
+fn notes_of(text: &str) -> (Vec<Subpath2>, Vec<String>) {
+    match import_svg_with_notes(text.as_bytes(), "qa.svg") {
+        Ok(i) => (i.subpaths, i.notes),
+        Err(e) => panic!("import failed: {e}\n{text}"),
+    }
+}
+
+/// The one note that contains `word`.
+fn note_with<'a>(notes: &'a [String], word: &str) -> &'a str {
+    let found: Vec<&String> = notes.iter().filter(|n| n.contains(word)).collect();
+    assert_eq!(found.len(), 1, "one note with {word:?}: {notes:?}");
+    found[0]
+}
+
+fn import_error(text: &str) -> String {
+    match import_svg(text.as_bytes(), "qa.svg") {
+        Ok(s) => panic!("expected an error, read {s:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const PAGE_40: &str = r#"width="40mm" height="20mm" viewBox="0 0 40 20""#;
+
+/// QA `dash.svg`: a 36 mm line with `stroke-dasharray="4 2"` was printed as
+/// one solid line. SVG draws six 4 mm dashes, each now its own piece, and a
+/// note says so; `stroke-dashoffset` shifts them as SVG shifts them.
+#[test]
+fn dashed_stroke_printed_solid() {
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<path id="trace" d="M2,10 H38" stroke="black" stroke-dasharray="4 2" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 6, "{subs:?}");
+    for (k, s) in subs.iter().enumerate() {
+        let x0 = 2.0 + 6.0 * k as f64;
+        assert_eq!(s.points.len(), 2, "{s:?}");
+        assert_near(s.points[0], v(x0, -10.0), 1e-5);
+        assert_near(s.points[1], v(x0 + 4.0, -10.0), 1e-5);
+        assert_eq!(s.corner, vec![true, true]);
+        assert!(!s.closed);
+        assert_eq!(s.source, "trace");
+    }
+    let note = note_with(&notes, "dash");
+    assert!(
+        note.starts_with("1 shape(s)")
+            && note.contains("'trace'")
+            && note.contains("6 pieces")
+            && note.contains("its own piece")
+            && note.contains("stroke-dasharray"),
+        "{note}"
+    );
+
+    // An offset of 1 starts the pattern 1 unit in: a first dash of 3, and a
+    // last of 1 cut by the end of the line.
+    let (subs, _) = notes_of(&doc(
+        PAGE_40,
+        r#"<path d="M2,10 H38" stroke="black" stroke-dasharray="4 2" stroke-dashoffset="1"/>"#,
+    ));
+    let spans: Vec<(f64, f64)> = subs
+        .iter()
+        .map(|s| (s.points[0].x, s.points[s.points.len() - 1].x))
+        .collect();
+    let want = [
+        (2.0, 5.0),
+        (7.0, 11.0),
+        (13.0, 17.0),
+        (19.0, 23.0),
+        (25.0, 29.0),
+        (31.0, 35.0),
+        (37.0, 38.0),
+    ];
+    assert_eq!(spans.len(), want.len(), "{spans:?}");
+    for (got, want) in spans.iter().zip(want) {
+        assert!(
+            (got.0 - want.0).abs() < 1e-5 && (got.1 - want.1).abs() < 1e-5,
+            "{spans:?}"
+        );
+    }
+}
+
+/// Dashes keep the drawn corners: a vertex inside a dash keeps its flag (a
+/// straight-through vertex is no corner, a right angle is), and a dash's
+/// own ends are corners (the ends of an open piece).
+#[test]
+fn dashes_keep_the_drawn_corners() {
+    let (subs, _) = notes_of(&doc(
+        MM,
+        r#"<path d="M0,0 H5 H10 V10" stroke="black" stroke-dasharray="6 2" fill="none"/>"#,
+    ));
+    // Dashes over [0, 6] and [8, 14] of the 20-unit path, then [16, 20].
+    assert_eq!(subs.len(), 3, "{subs:?}");
+    assert_eq!(subs[0].points.len(), 3);
+    assert_near(subs[0].points[1], v(5.0, 0.0), 1e-5);
+    assert_eq!(subs[0].corner, vec![true, false, true]);
+    assert_eq!(subs[1].points.len(), 3);
+    assert_near(subs[1].points[1], v(10.0, 0.0), 1e-5);
+    assert_eq!(subs[1].corner, vec![true, true, true]);
+    assert_near(subs[2].points[0], v(10.0, -6.0), 1e-5);
+}
+
+/// A dashed closed shape as SVG draws it: the first dash is left for the
+/// end, where it continues the last one through the start point (one
+/// piece, no corner at the start of a smooth circle).
+#[test]
+fn a_dashed_circle_joins_its_last_dash_to_its_first() {
+    let (subs, _) = notes_of(&doc(
+        MM,
+        r#"<circle cx="30" cy="20" r="5" stroke="black" stroke-dasharray="5 5" fill="none"/>"#,
+    ));
+    // Circumference 31.42: dashes over [10, 15], [20, 25] and [30, 36.42].
+    let tau = std::f64::consts::TAU;
+    assert_eq!(subs.len(), 3, "{subs:?}");
+    let lengths: Vec<f64> = subs.iter().map(|s| s.length_mm()).collect();
+    for (got, want) in lengths.iter().zip([5.0, 5.0, 5.0 + tau * 5.0 - 30.0]) {
+        assert!((got - want).abs() < 1e-3, "{lengths:?}");
+    }
+    for s in &subs {
+        assert!(!s.closed);
+        assert!(s.corner[0] && s.corner[s.corner.len() - 1]);
+        assert!(s.corner[1..s.corner.len() - 1].iter().all(|&c| !c), "{s:?}");
+        for p in &s.points {
+            assert!((p.distance(v(30.0, -20.0)) - 5.0).abs() < 1e-4, "{p}");
+        }
+    }
+    // The joined piece passes through the circle's start, (35, -20).
+    assert!(subs[2]
+        .points
+        .iter()
+        .any(|p| p.distance(v(35.0, -20.0)) < 1e-5));
+}
+
+/// Patterns that draw no dashes print the stroke solid, with a note naming
+/// the shape and its pattern: zero total length and a negative length
+/// (which SVG draws solid), and only zero-length dashes (dots).
+#[test]
+fn degenerate_dash_patterns_print_solid_with_a_note() {
+    for (pattern, why) in [
+        ("0 0", "solid"),
+        ("-1 2", "negative"),
+        ("0 3", "zero length"),
+    ] {
+        let (subs, notes) = notes_of(&doc(
+            PAGE_40,
+            &format!(r#"<path id="d" d="M2,10 H38" stroke="black" stroke-dasharray="{pattern}"/>"#),
+        ));
+        assert_eq!(subs.len(), 1, "{pattern}: {subs:?}");
+        assert!((subs[0].length_mm() - 36.0).abs() < 1e-5);
+        let note = note_with(&notes, "solid");
+        assert!(
+            note.contains("'d'") && note.contains(pattern) && note.contains(why),
+            "{pattern}: {note}"
+        );
+    }
+    // From a `style` attribute on a group, as Inkscape writes it.
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<g style="stroke-dasharray:0,0"><path d="M2,10 H38" stroke="black"/></g>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert!(note_with(&notes, "solid").contains("path #1"), "{notes:?}");
+    // `none` is no dash pattern at all: no note.
+    let (_, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<path d="M2,10 H38" stroke="black" style="stroke-dasharray:none"/>"#,
+    ));
+    assert!(notes.is_empty(), "{notes:?}");
+}
+
+/// QA `nan2.svg`: `L NaN 5` ended the path there without a word (18 of its
+/// 36 mm printed). SVG draws up to the error, so the same part is printed,
+/// and a note names the element, the character and the text there.
+#[test]
+fn path_data_error_truncates_the_path_silently() {
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<path d="M2,10 L20,10 L NaN 5 L38,10" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert!((subs[0].length_mm() - 18.0).abs() < 1e-5);
+    let note = note_with(&notes, "error");
+    assert!(
+        note.contains("'path #1'")
+            && note.contains("character 16")
+            && note.contains("NaN 5 L38,10")
+            && note.contains("path data"),
+        "{note}"
+    );
+}
+
+/// QA `nan2.svg` with the error first: the import said "the document
+/// contains no shapes", hiding the cause. It now names the path's error.
+#[test]
+fn path_data_error_before_anything_is_drawn_is_named_in_the_error() {
+    let e = import_error(&doc(
+        PAGE_40,
+        r#"<path id="trace" d="M2,10 L NaN 5 L38,10" stroke="black" fill="none"/>"#,
+    ));
+    assert!(
+        e.contains("nothing printable")
+            && e.contains("'trace'")
+            && e.contains("character 9")
+            && e.contains("NaN 5")
+            && !e.contains("contains no shapes"),
+        "{e}"
+    );
+}
+
+/// QA `typo.svg`: `L25,,5` was read as `L25,5` by the f64 re-reading
+/// (39.2 mm printed) while usvg, and browsers, stop at the second comma
+/// (SVG allows one between numbers). The print now stops where the drawing
+/// does, with the note.
+#[test]
+fn double_comma_in_path_data_read_unlike_svg() {
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<path d="M2,10 L20,10 L25,,5 L38,10" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert!((subs[0].length_mm() - 18.0).abs() < 1e-5, "{subs:?}");
+    let note = note_with(&notes, "error");
+    assert!(
+        note.contains("character 18") && note.contains("two commas"),
+        "{note}"
+    );
+}
+
+/// QA `feather-sprite.svg` (287 `<symbol>`s, no `<use>`): the error said
+/// the document contains no shapes. It now says where they are, why they
+/// draw nothing, and how to print one.
+#[test]
+fn icon_sprite_reported_as_containing_no_shapes() {
+    let e = import_error(&doc(
+        "",
+        r#"<defs><symbol id="activity" viewBox="0 0 24 24"><polyline points="22 12 18 12 15 21 9 3 6 12 2 12"></polyline></symbol>
+           <symbol id="airplay" viewBox="0 0 24 24"><path d="M5 17H4a2 2 0 0 1-2-2V5"></path><polygon points="12 15 17 21 7 21 12 15"></polygon></symbol>
+           <symbol id="alert-circle" viewBox="0 0 24 24"><circle cx="12" cy="12" r="10"></circle></symbol>
+           <symbol id="anchor" viewBox="0 0 24 24"><circle cx="12" cy="5" r="3"></circle></symbol></defs>"#,
+    ));
+    assert!(
+        e.contains("5 shape(s)")
+            && e.contains("4 <symbol>")
+            && e.contains("'activity', 'airplay', 'alert-circle'")
+            && e.contains("<use")
+            && e.contains("href=\"#activity\"")
+            && e.contains("sprite")
+            && !e.contains("contains no shapes"),
+        "{e}"
+    );
+    // A used symbol is printed as before.
+    let subs = import(&doc(
+        MM,
+        r##"<defs><symbol id="dash"><path d="M0 0 H10" stroke="black"/></symbol></defs><use href="#dash"/>"##,
+    ));
+    assert_eq!(subs.len(), 1);
+}
+
+/// QA `vb0.svg`: `viewBox="0 0 0 0"` was ignored and user units taken as
+/// px, printing 9.5 mm where the page is 40 mm wide. SVG draws nothing for a
+/// zero-size viewBox (a viewer shows an empty page), and no scale can be
+/// trusted, so the import refuses it, naming the attribute and the fix,
+/// rather than print at a guessed size.
+#[test]
+fn zero_viewbox_ignored_silently() {
+    for vb in ["0 0 0 0", "0 0 40 0"] {
+        let e = import_error(&doc(
+            &format!(r#"width="40mm" height="20mm" viewBox="{vb}""#),
+            r#"<path d="M2,10 H38" stroke="black"/>"#,
+        ));
+        assert!(
+            e.contains(&format!("viewBox=\"{vb}\"")) && e.contains("zero") && e.contains("remove"),
+            "{e}"
+        );
+    }
+}
+
+/// A negative viewBox size is an error that makes SVG ignore the attribute
+/// (viewers then draw the content in px), so it is followed, as usvg does,
+/// with a note saying what was assumed.
+#[test]
+fn negative_or_unreadable_viewbox_is_ignored_with_a_note() {
+    for vb in ["0 0 -40 20", "0 0 40"] {
+        let (subs, notes) = notes_of(&doc(
+            &format!(r#"width="40mm" height="20mm" viewBox="{vb}""#),
+            r#"<path d="M2,10 H38" stroke="black"/>"#,
+        ));
+        assert!((subs[0].length_mm() - 36.0 * 25.4 / 96.0).abs() < 1e-5);
+        let note = note_with(&notes, "viewBox");
+        assert!(
+            note.contains(&format!("\"{vb}\"")) && note.contains("ignored") && note.contains("px"),
+            "{note}"
+        );
+    }
+}
+
+/// `width="100%"` falls back to the viewBox's size in px: the note says what
+/// page size was taken, so a wrong scale is not silent.
+#[test]
+fn percentage_width_falls_back_to_px_silently() {
+    let (subs, notes) = notes_of(&doc(
+        r#"width="100%" height="100%" viewBox="0 0 40 20""#,
+        r#"<path d="M2,10 H38" stroke="black"/>"#,
+    ));
+    let px = 25.4 / 96.0;
+    assert!((subs[0].length_mm() - 36.0 * px).abs() < 1e-5);
+    let note = note_with(&notes, "%");
+    assert!(
+        note.contains("width=\"100%\"")
+            && note.contains("height=\"100%\"")
+            && note.contains("10.6 x 5.3 mm")
+            && note.contains("mm"),
+        "{note}"
+    );
+}
+
+/// A stroke far wider than a nozzle's trace is printed along its centre
+/// line: the note names the widest and its width in mm.
+#[test]
+fn wide_stroke_printed_as_its_centre_line_silently() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<path id="thin" d="M0,0 H10" stroke="black" stroke-width="0.3"/>
+           <path id="wide" d="M0,5 H10" stroke="black" stroke-width="12"/>"#,
+    ));
+    assert_eq!(subs.len(), 2);
+    let note = note_with(&notes, "wide");
+    assert!(
+        note.contains("'wide'") && note.contains("12.00 mm") && note.contains("centre line"),
+        "{note}"
+    );
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r#"<path d="M0,0 H10" stroke="black" stroke-width="0.5"/>"#,
+    ));
+    assert!(notes.is_empty(), "{notes:?}");
+}
+
+/// Hostile path data and dash patterns: an error or a sane result, never a
+/// panic, a hang or an unbounded allocation.
+#[test]
+fn hostile_dashes_and_path_data_do_not_panic() {
+    let long_garbage = format!("M0 0 L1 1 {}", "\u{e9}\u{1F600},,".repeat(10_000));
+    let cases = [
+        r#"<path d="M0 0 H90000" stroke="black" stroke-dasharray="1e-30 1e-30"/>"#.to_string(),
+        r#"<path d="M0 0 H90000" stroke="black" stroke-dasharray="1e-3"/>"#.to_string(),
+        r#"<path d="M0 0 H10" stroke="black" stroke-dasharray="1e38 1e38" stroke-dashoffset="-1e38"/>"#.to_string(),
+        r#"<path d="M0 0 H10" stroke="black" stroke-dasharray="1 2" stroke-dashoffset="NaN"/>"#.to_string(),
+        r#"<path d="M0 0 H10" stroke="black" stroke-dasharray="3e38 3e38 3e38"/>"#.to_string(),
+        r#"<path d="M0 0 H10" stroke="black" stroke-dasharray="1, ,2 x"/>"#.to_string(),
+        r#"<path d="M 1e38 0 L -1e38 0" stroke="black" stroke-dasharray="1 1"/>"#.to_string(),
+        r#"<path d="M0 0 Z" stroke="black" stroke-dasharray="1 1"/>"#.to_string(),
+        r#"<circle r="3" stroke="black" stroke-dasharray="0.000001 100"/>"#.to_string(),
+        format!(r#"<path d="{long_garbage}" stroke="black"/>"#),
+        r#"<path d="M0 0 L 1 \u{e9} 2" stroke="black"/>"#.to_string(),
+        r#"<path d="M0 0 L 1" stroke="black"/>"#.to_string(),
+        r#"<path d="Z" stroke="black"/>"#.to_string(),
+        r#"<path d=",,," stroke="black"/>"#.to_string(),
+    ];
+    for body in &cases {
+        for size in [MM, r#"width="100%" viewBox="0 0 -1 1e-40""#] {
+            let start = std::time::Instant::now();
+            match import_svg_with_notes(doc(size, body).as_bytes(), "h.svg") {
+                Err(e) => assert!(e.to_string().starts_with("h.svg: "), "{e}"),
+                Ok(import) => {
+                    for s in import.subpaths {
+                        assert!(!s.points.is_empty() && s.points.len() == s.corner.len());
+                        assert!(s.points.iter().all(|p| p.is_finite()), "{body}: {s:?}");
+                    }
+                    assert!(
+                        import.notes.iter().all(|n| n.len() < 2000),
+                        "{:?}",
+                        import.notes
+                    );
+                }
+            }
+            assert!(
+                start.elapsed().as_secs() < 20,
+                "{body}: {:?}",
+                start.elapsed()
+            );
+        }
+    }
+}
