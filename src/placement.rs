@@ -501,7 +501,8 @@ mod tests {
         assert!(note.unwrap().contains("kept at its scale"));
         let (lo, hi) = extent(&p.apply_subpath(&square));
         assert!((0.5 * (lo + hi) - DVec2::new(30.0, 40.0)).length() < 1e-9);
-        let (_, note) = centre_drawing(&[square.clone()], footprint, &current, false).unwrap();
+        let (_, note) =
+            centre_drawing(std::slice::from_ref(&square), footprint, &current, false).unwrap();
         assert!(note.is_none());
         // A scan seen edge-on (a vertical plane, 1000 x 0 mm from above):
         // the drawing is not shrunk to its zero side ("scaled by 0.000"),
