@@ -217,6 +217,7 @@ pub(super) fn plan(
     // it can change, then the least error (predicted over a window around
     // them, so that the filament curve there is the same for every fit).
     let mut chosen = targets[0].clone();
+    let mut switched = false;
     for r in &open {
         let core = reach(r);
         let window = r.start.saturating_sub(2 * REACH)..(r.end + 2 * REACH).min(n);
@@ -239,6 +240,12 @@ pub(super) fn plan(
             }
         }
         chosen[r.clone()].copy_from_slice(&targets[best.0][r.clone()]);
+        switched |= best.0 != 0;
+    }
+    if !switched {
+        // The least-squares fit is kept everywhere: placed and predicted.
+        let mut tried = tried;
+        return tried.swap_remove(0).into_planned(predicted);
     }
     let placed = placer.place(&chosen, &mut memo);
     let quality = placed.predict(0..n, surface, ta, geometry, nozzle, process);
