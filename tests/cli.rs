@@ -1769,3 +1769,68 @@ fn regression_check_named_the_gcode_file_twice() {
     assert_eq!(err.matches("arcs.gcode").count(), 1, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Printer points listed the other way round their triangle: the plan is
+/// refused naming the scan and how to write it anyway (the library's
+/// refusal reached the CLI named after the drawing, without the
+/// --accept-risk hint the RMS refusal has).
+#[test]
+fn an_upside_down_registration_is_refused_naming_the_scan() {
+    let dir = temp_dir("upside-down");
+    let out = dir.join("out.gcode");
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let o = plan_on(
+        &scan,
+        &demo_file(demo::DEMO_PATH_NAME),
+        &[
+            "--fiducials",
+            "4,4,5;4,76,5;76,4,5",
+            "--printer-points",
+            "14,14,5;86,14,5;14,86,5",
+            "--place",
+            "centre",
+            "-o",
+            s(&out),
+        ],
+    );
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(&format!(
+            "error: {}: the registration turns the scan upside down",
+            s(&scan)
+        )) && err.contains("same order")
+            && err.contains("--accept-risk"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A scan in the wrong units leaves nothing to print; the import's own
+/// hint ("the scan is only 0.008 x ... mm, read in mm: check its units")
+/// was printed only after a plan that succeeded, so the error blamed the
+/// drawing's units alone (assimp's regr_3429812.obj, a 0.0075 mm quad).
+#[test]
+fn regression_the_scans_units_hint_was_lost_when_planning_failed() {
+    let dir = temp_dir("tiny-scan");
+    let scan = dir.join("tiny.obj");
+    std::fs::write(
+        &scan,
+        "v 0 0 0\nv 0.0075 0 0\nv 0.0075 0.003 0.004\nv 0 0.003 0.004\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let o = plan_on(
+        &scan,
+        &demo_file("antenna-spiral.svg"),
+        &["--place", "centre", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("tiny.obj: the scan is only") && err.contains("--scan-units m"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

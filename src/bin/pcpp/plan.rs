@@ -142,7 +142,11 @@ fn centre_on_scan(
 }
 
 /// Errors of planning on a prepared scan: the drawn path's file is named.
-fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
+/// What the scan's import and registration noticed is said first: it may
+/// be the cause (a scan read in the wrong units leaves nothing to print).
+fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
+    progress.warn(&inputs.prepared.warnings);
+    progress.warn(&inputs.prepared.registration.notes);
     match e {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
         e @ Error::OutsideVolume { .. } => Failure::Input(format!(
@@ -150,7 +154,9 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
             inputs.scan_path.display()
         )),
         Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
-        Error::Registration(r @ RegistrationError::TooFarOff { .. }) => Failure::Input(format!(
+        Error::Registration(
+            r @ (RegistrationError::TooFarOff { .. } | RegistrationError::UpsideDown { .. }),
+        ) => Failure::Input(format!(
             "{}: {r} (--accept-risk writes it anyway)",
             inputs.scan_path.display()
         )),
@@ -161,6 +167,9 @@ fn plan_failure(inputs: &Inputs, e: Error) -> Failure {
             "{}: {m} (--accept-risk writes it anyway)",
             inputs.svg_path.display()
         )),
+        Error::Plan(m) if m.contains("seen edge-on") => {
+            Failure::Input(format!("{}: {m}", inputs.scan_path.display()))
+        }
         Error::Plan(m) if m.contains("misses the scan") => Failure::Input(format!(
             "{} on {}: {m}",
             inputs.svg_path.display(),
@@ -197,7 +206,7 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
         &profile,
         a.accept_risk,
     )
-    .map_err(|e| plan_failure(&inputs, e))?;
+    .map_err(|e| plan_failure(&inputs, e, progress))?;
 
     progress.step("writing...");
     let mut staged = Staged::default();
@@ -222,8 +231,10 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
     );
     let _ = writeln!(
         s,
-        "path: height change {:.3} mm, max inclination {:.1} deg, min radius {:.3} mm",
-        st.height_change_mm, st.max_inclination_deg, st.min_radius_mm
+        "path: height change {:.3} mm, max inclination {:.1} deg, min radius {}",
+        st.height_change_mm,
+        st.max_inclination_deg,
+        st.min_radius_text()
     );
     if settings.registration.fiducials != FiducialSource::None {
         let _ = writeln!(
@@ -271,7 +282,7 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
         &inputs.svg_name,
         &settings.plan,
     )
-    .map_err(|e| plan_failure(&inputs, e))?;
+    .map_err(|e| plan_failure(&inputs, e, progress))?;
     let rows = comparison.rows;
     if let Some(r) = &a.report {
         let files = [
