@@ -294,6 +294,12 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'whole-object') {
     title = 'The scan is a point cloud of a whole object: no G-code';
     message += '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
+  } else if (m.kind === 'registration') {
+    // Refused at planning: fiducials far off their printer points, or the
+    // scan turned upside down (printer points in the other order).
+    title = 'The registration puts the scan where the part is not: no G-code';
+    message += '\nCheck the printer points (their order and values); to write it anyway, tick '
+      + '"write G-code even where the nozzle may touch" (Nozzle and process).';
   }
   // A plan refused for its motion still compared the planners on the
   // settings that failed: the table shows why.
