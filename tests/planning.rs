@@ -356,6 +356,21 @@ fn even_beats_the_papers_planners_on_every_part() {
             );
         }
         let even = by(PlannerKind::Even);
+        // `even` predicts its own points' filament while it plans (to
+        // choose between its fits) and the plan reports that prediction:
+        // it must be section 7's, to the last bit, with the contact test
+        // asked of every point.
+        for piece in &even.pieces {
+            let again = pcpp::quality::predict(
+                &s,
+                &piece.surface_path,
+                &piece.geometry,
+                &piece.toolpath,
+                &settings.nozzle,
+                &settings.process,
+            );
+            assert!(again == piece.quality, "{part}: {}", piece.source);
+        }
         let q = &even.quality;
         assert_eq!(q.contact_pct, 0.0, "{part}");
         assert_eq!(even.motion.touching_moves, 0, "{part}");
@@ -704,36 +719,6 @@ fn regression_even_rose_over_a_wall_it_could_step_away_from() {
         assert_eq!(piece.quality[j].defect, Defect::Good, "point {j}");
         let e = piece.quality[j].error_mm.unwrap();
         assert!(e.abs() <= tol, "point {j}: e = {e}");
-    }
-}
-
-/// `even` predicts its own points' filament while it plans (to choose
-/// between its fits) and the plan reports that prediction instead of
-/// asking section 7 again; it must be section 7's, to the last bit, with
-/// the contact test asked of every point (`quality::predict`).
-#[test]
-fn even_reports_the_prediction_section_7_makes_of_its_points() {
-    use pcpp::demo::parts::DemoPart;
-    for part in DemoPart::ALL {
-        let s = Surface::new(part.mesh()).unwrap();
-        let drawn = pipeline::load_path(part.svg().as_bytes(), "part.svg").unwrap();
-        let settings = PlanSettings {
-            placement: part.placement(),
-            ..Default::default()
-        };
-        let plan = pipeline::plan(&s, &drawn.subpaths, &settings).unwrap();
-        assert_eq!(plan.planner, PlannerKind::Even);
-        for piece in &plan.pieces {
-            let again = pcpp::quality::predict(
-                &s,
-                &piece.surface_path,
-                &piece.geometry,
-                &piece.toolpath,
-                &settings.nozzle,
-                &settings.process,
-            );
-            assert!(again == piece.quality, "{part}: {}", piece.source);
-        }
     }
 }
 
