@@ -155,6 +155,9 @@ pub fn import_mesh_with(
     }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
+    if let Some(e) = binary_in_text(bytes, file, format) {
+        return Err(e);
+    }
     let mut external_files = Vec::new();
     let parsed = match format {
         MeshFormat::Obj => obj::parse(bytes, file)?,
@@ -180,10 +183,13 @@ pub fn import_mesh_with(
     };
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
-    // A PLY with vertices and no faces is a point cloud too.
+    // A PLY or OBJ with vertices and no faces is a point cloud too
+    // (Meshlab and CloudCompare write clouds as OBJ `v` lines).
     let cloud = match format {
         MeshFormat::Xyz | MeshFormat::Pcd => true,
-        MeshFormat::Ply => parsed.triangles.is_empty() && !parsed.vertices.is_empty(),
+        MeshFormat::Ply | MeshFormat::Obj => {
+            parsed.triangles.is_empty() && !parsed.vertices.is_empty()
+        }
         _ => false,
     };
     if cloud {
@@ -205,6 +211,39 @@ pub fn import_mesh_with(
         cloud: None,
         external_files,
     })
+}
+
+/// A file named as a text format (OBJ, XYZ) that holds binary data: an
+/// image or archive given the wrong name read as lines of nothing, "the
+/// mesh has no triangles". Said as what it is, with the kind of file its
+/// first bytes show where they are a common one.
+fn binary_in_text(bytes: &[u8], file: &str, format: MeshFormat) -> Option<MeshError> {
+    if !matches!(format, MeshFormat::Obj | MeshFormat::Xyz) {
+        return None;
+    }
+    let head = &bytes[..bytes.len().min(64 * 1024)];
+    let at = head.iter().position(|&b| b == 0)?;
+    let kind = [
+        (&b"\x89PNG"[..], "a PNG image"),
+        (&b"\xFF\xD8\xFF"[..], "a JPEG image"),
+        (&b"%PDF"[..], "a PDF document"),
+        (&b"PK\x03\x04"[..], "a ZIP archive"),
+        (&b"\x1F\x8B"[..], "gzip-compressed data (unpack it first)"),
+        (&b"glTF"[..], "a binary glTF (name it .glb)"),
+    ]
+    .iter()
+    .find(|(magic, _)| bytes.starts_with(magic))
+    .map_or(String::new(), |(_, k)| format!("; it looks like {k}"));
+    Some(MeshError::invalid(
+        file,
+        format!(
+            "not {} text: byte {at} is binary (0x00){kind}; open the scan's own file",
+            match format {
+                MeshFormat::Obj => "OBJ",
+                _ => "XYZ",
+            }
+        ),
+    ))
 }
 
 /// A point cloud into millimetres and printer axes, then meshed as a
