@@ -344,7 +344,7 @@ pub struct JobArgs {
 #[command(next_help_heading = "Scan")]
 pub struct ScanArgs {
     /// The scanned surface: a mesh (OBJ, PLY, STL, glTF, GLB) or a point
-    /// cloud (XYZ/CSV/TXT, vertex-only PLY, PCD)
+    /// cloud (XYZ/CSV/TXT, vertex-only PLY or OBJ, PCD)
     #[arg(long, value_name = "FILE", value_hint = ValueHint::FilePath)]
     pub scan: PathBuf,
 
