@@ -253,9 +253,9 @@ pub enum RegistrationError {
     #[error(
         "the registration turns the scan upside down: its up axis ends {tilt_deg:.1} deg from \
          the printer's +Z (rms {rms_mm:.3} mm), so the path would be planned on the side the \
-         scanner did not see; with three fiducials, printer points listed in the other order \
-         around the triangle fit a half turn as well as the right order (residuals near 0): \
-         list the printer points in the same order as the scan's fiducials, or check the scan's \
+         scanner did not see; fiducials that lie in a plane (three always do), with the printer \
+         points listed the other way round, fit a half turn as well as the right order \
+         (residuals near 0): list the printer points in the same order as the scan's fiducials, or check the scan's \
          up axis (--up-axis); no G-code written"
     )]
     UpsideDown { tilt_deg: f64, rms_mm: f64 },
