@@ -111,6 +111,9 @@ export function moveScan(change) {
     s.placement.x = round4(c.offset_mm[0]);
     s.placement.y = round4(c.offset_mm[1]);
     s.placement.rot = round4(c.rotation_deg);
+    // The fields show what is planned: a nudge of one moves the drawing
+    // from where it now is, not from where it was on the other bed.
+    ctx.writeForm();
   } catch (e) {
     showError('Could not move the drawing with the scan', e.message);
   }
