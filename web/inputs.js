@@ -202,6 +202,7 @@ export function loadDemo(part = settings.demoPart) {
   settings.fidPrinterText = demo.fidPrinterText;
   settings.pathSource = 'demo';
   settings.placement = demo.placement;
+  settings.fit = null;
   settings.scanUnits = '';
   settings.scanUp = '';
   settings.scanMaxEdge = '';

@@ -17,7 +17,9 @@ import {
   acceptScan, bindFiles, demoScanEntry, dropCentre, endRestoring, keep, loadDemo, restoreInputs,
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
-import { cancelCentre, centreRequest, initPlacement, onCentred, requestCentre } from './placement.js';
+import {
+  cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote,
+} from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanShown, syncPreviewButton,
 } from './preview.js';
@@ -407,6 +409,8 @@ async function start() {
   $('scan-name').textContent = state.scan.name;
   await restoreInputs();
   writeForm();
+  // The note of a fit kept from the last visit.
+  showFitNote();
   // For tests and the curious: read-only access to the page's state.
   window.pcpp = { state, get settings() { return settings; } };
   requestPlan();

@@ -7,7 +7,9 @@
 // worker's Session.centreDrawing); this module keeps the settings and the
 // elements in step.
 import { bedOf, carryDrawing, volumeFit } from '../pkg/pcpp.js';
-import { $, profile, settings, state } from './page.js';
+import {
+  $, num, profile, settings, state,
+} from './page.js';
 import { clearError, showError } from './status.js';
 
 // The scan placement the settings start with (and a new scan is read with).
@@ -134,9 +136,20 @@ export function cancelCentre() {
   state.centre = null;
 }
 
-// What a plan request carries: {token, fresh}, or null.
+// The scale the user gave the drawing: the one a scan is fitted from.
+// A scale the page chose to fit one scan would otherwise carry over to
+// every later scan and only ever shrink.
+function userScale() {
+  if (settings.fit) return settings.fit.userScale;
+  const v = num(settings.placement.scale);
+  return v > 0 && Number.isFinite(v) ? v : 1;
+}
+
+// What a plan request carries: {token, fresh, scale} (the scale to centre
+// from: 1 for a new drawing, else the user's), or null.
 export function centreRequest() {
-  return state.centre ? { ...state.centre } : null;
+  if (!state.centre) return null;
+  return { ...state.centre, scale: state.centre.fresh ? 1 : userScale() };
 }
 
 // The worker centred the drawing for the request `busy` (its token): taken
@@ -153,6 +166,10 @@ export function onCentred(m, busy) {
     rot: m.placement.rotation_deg,
     scale: m.placement.scale,
   };
+  // The core scales only down, only to fit: a scale other than the one
+  // sent is the page's choice, not the user's.
+  const from = busy.centre.scale;
+  s.fit = m.placement.scale !== from ? { userScale: from, note: m.note || '' } : null;
   // What was sent is what the worker plans: the request matches again.
   busy.job.plan.placement = m.placement;
   setNote(m.note || '');
@@ -160,10 +177,33 @@ export function onCentred(m, busy) {
   ctx.writeForm();
 }
 
+// The user moved or turned the drawing, or set its scale: nothing is
+// centred over it; the note stays while the scale is still the one the
+// page fitted (a move or turn leaves it so).
+export function userPlaced() {
+  cancelCentre();
+  showFitNote();
+}
+
 // The note under the drawing's placement (the core's, when it scaled the
-// drawing to fit); cleared when the user places it.
+// drawing to fit).
 export function setNote(text) {
   $('pl-note').textContent = text;
+}
+
+// The note of the page's fit of the drawing, or none while the scale is
+// the user's.
+export function showFitNote() {
+  setNote(settings.fit ? settings.fit.note : '');
+}
+
+// A fit kept in the browser's storage, checked: the user's scale a
+// positive number, the note text.
+export function sanitizeFit(fit) {
+  if (!fit || typeof fit !== 'object') return null;
+  const u = fit.userScale;
+  if (typeof u !== 'number' || !(u > 0) || !Number.isFinite(u)) return null;
+  return { userScale: u, note: typeof fit.note === 'string' ? fit.note : '' };
 }
 
 // Banner, the placement panel and the header's status, for the scan on

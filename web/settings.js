@@ -8,8 +8,8 @@ import {
 import { fmtPoints, pointsEdited } from './fiducials.js';
 import { $, hooks, num, settings, state } from './page.js';
 import {
-  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, sanitizeScanPlace, scanPlacementFor, setNote,
-  showScanPlacement,
+  SCAN_PLACE_DEFAULT, moveScan, requestCentre, sanitizeFit, sanitizeScanPlace, scanPlacementFor,
+  showScanPlacement, userPlaced,
 } from './placement.js';
 
 const STORE_KEY = 'pcpp.settings.v1';
@@ -54,6 +54,11 @@ export function demoUiSettings(part = 'test-part') {
     hilbert: { order: 3, size_mm: 20 },
     monopole: { height_mm: 20, base_mm: 15, feed_mm: 5 },
     placement: { x: pl.offset_mm[0], y: pl.offset_mm[1], rot: pl.rotation_deg, scale: pl.scale },
+    // The page's fit of the drawing to the scan: null while the scale is
+    // the user's, else {userScale, note}: the page scaled the drawing from
+    // the user's scale down to `placement.scale` to fit the scan, as the
+    // core's note says. The next scan is fitted from the user's scale.
+    fit: null,
     nozzle: { id: d.plan.nozzle.inner_diameter_mm, od: d.plan.nozzle.outer_diameter_mm },
     process: {
       tol: d.plan.process.tolerance_mm,
@@ -89,6 +94,7 @@ export function loadSettings() {
   if (!demoParts().some((p) => p.name === base.demoPart)) base.demoPart = 'test-part';
   if (!planners().includes(base.planner)) base.planner = demoUiSettings().planner;
   base.scanPlace = sanitizeScanPlace(base.scanPlace);
+  base.fit = sanitizeFit(base.fit);
   return base;
 }
 
@@ -214,9 +220,9 @@ const FIELDS = [
   ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, 'typed'],
   ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, 'typed'],
   ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'typed'],
-  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'typed'],
+  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); settings.fit = null; }, 'typed'],
   ['pl-rot-range', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'live'],
-  ['pl-scale-range', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); }, 'live'],
+  ['pl-scale-range', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); settings.fit = null; }, 'live'],
   ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }, 'typed'],
   ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }, 'typed'],
   ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }, 'typed'],
@@ -284,11 +290,8 @@ export function bindForm() {
       // drawing with it.
       if (id === 'dialect') moveScan(() => set(value));
       else set(value);
-      if (/^pl-/.test(id)) {
-        // The user places the drawing: no centring over it.
-        cancelCentre();
-        setNote('');
-      }
+      // The user places the drawing: no centring over it.
+      if (/^pl-/.test(id)) userPlaced();
       if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
       const after = before ? pathCentre() : null;
       if (before && after) {

@@ -5,7 +5,7 @@
 import { Viewer } from '../pkg/pcpp.js';
 import { BEST, fmtPoints, safePoints } from './fiducials.js';
 import { $, fmt, hooks, num, settings, state } from './page.js';
-import { cancelCentre, setNote } from './placement.js';
+import { userPlaced } from './placement.js';
 import { saveSettings, syncVisibility, writeField, writeForm } from './settings.js';
 import { showError } from './status.js';
 
@@ -147,8 +147,7 @@ function movePlacementTo(x, y) {
   if (nx === num(settings.placement.x) && ny === num(settings.placement.y)) return;
   settings.placement.x = nx;
   settings.placement.y = ny;
-  cancelCentre();
-  setNote('');
+  userPlaced();
   writeField('pl-x');
   writeField('pl-y');
   state.interacting = true;

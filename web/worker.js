@@ -169,10 +169,9 @@ async function plan(m) {
     if (m.centre) {
       // A new scan or drawing: the drawing centred on the scan (the core's
       // centre_drawing), told to the page before planning, so it keeps the
-      // placement even if this plan fails.
-      // A new drawing starts at its own size.
-      if (m.centre.fresh) m.plan.placement.scale = 1;
-      const c = session.centreDrawing(m.plan.placement);
+      // placement even if this plan fails. It starts from the user's scale
+      // (1 for a new drawing), not from one fitted to another scan.
+      const c = session.centreDrawing({ ...m.plan.placement, scale: m.centre.scale });
       if (c) {
         m.plan.placement = c.placement;
         post({ type: 'centred', id, placement: c.placement, note: c.note });

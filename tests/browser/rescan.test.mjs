@@ -4,9 +4,13 @@
 // scale the page chose to fit one scan is not kept for the next: the
 // user's own scale is (found by exploratory QA with real scans).
 import assert from 'node:assert/strict';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { test } from 'node:test';
-import { ROOT, openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
+import { after, before, test } from 'node:test';
+import {
+  ROOT, openPage, waitForPlan, waitIdle, waitKept, waitSettled, withPageServer,
+} from './helpers.mjs';
 
 const env = withPageServer();
 // The Stanford bunny (tests/data/realworld/SOURCES.md): y up, about 10 mm
@@ -14,6 +18,28 @@ const env = withPageServer();
 const BUNNY = join(ROOT, 'tests/data/realworld/mesh/stanford-bunny.ply');
 // assimp's spider (same SOURCES.md): about 6 x 8 mm.
 const SPIDER = join(ROOT, 'tests/data/realworld/mesh/Spider_binary.stl');
+
+let dir;
+before(() => { dir = mkdtempSync(join(tmpdir(), 'pcpp-rescan-')); });
+after(() => { if (dir) rmSync(dir, { recursive: true, force: true }); });
+
+// A flat 100 x 100 mm plate on the marlin bed: the demo drawing (68 x 50
+// mm) fits on it at its own size.
+function plate() {
+  const path = join(dir, 'plate.obj');
+  writeFileSync(path, 'v 10 10 0\nv 110 10 0\nv 110 110 0\nv 10 110 0\nf 1 2 3\nf 1 3 4\n');
+  return path;
+}
+
+// Opens a scan and waits until it is read and its plan done (planned or
+// refused: the spider lies outside the bed as it is).
+async function openScan(page, path, name) {
+  await page.setInputFiles('#scan-input', path);
+  await page.waitForFunction((n) => window.pcpp.state.info && window.pcpp.state.info.name === n
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, name, { timeout: 120_000 });
+}
+
+const scale = (page) => page.evaluate(() => window.pcpp.settings.placement.scale);
 
 // The placement fields as typed, the settings and the plan on screen's.
 const placements = (page) => page.evaluate(() => {
@@ -61,6 +87,60 @@ test('another dialect moves the scan to its bed: the offset fields show the offs
   const nudged = await placements(page);
   assert.ok(Math.abs(nudged.planned[1] - grbl.planned[1] - 1) < 1e-9, JSON.stringify([grbl, nudged]));
   assert.equal(nudged.planned[0], grbl.planned[0]);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a scale the page chose to fit one scan is not kept for the next, nor across "Centre on scan" and a reload: the user\'s is', async () => {
+  const platePath = plate();
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  assert.equal(await scale(page), 1);
+
+  // The spider: the demo drawing shrunk to fit it, with the core's note.
+  await openScan(page, SPIDER, 'Spider_binary.stl');
+  const spider = await scale(page);
+  assert.ok(spider < 0.15, `${spider}`);
+  assert.match(await page.textContent('#pl-note'), /scaled by 0\.\d+ to fit/);
+
+  // The plate is larger: the drawing at the user's scale again, no note.
+  await openScan(page, platePath, 'plate.obj');
+  await waitSettled(page);
+  assert.equal(await scale(page), 1);
+  assert.equal(await page.inputValue('#pl-scale'), '1');
+  assert.equal(await page.textContent('#pl-note'), '');
+
+  // The spider again, then "Centre on scan" twice: fitted from the user's
+  // scale each time, the same scale.
+  await openScan(page, SPIDER, 'Spider_binary.stl');
+  assert.equal(await scale(page), spider);
+  for (const k of [1, 2]) {
+    await page.click('#center-btn');
+    await page.waitForTimeout(100);
+    await waitIdle(page);
+    assert.equal(await scale(page), spider, `centred ${k} time(s)`);
+  }
+
+  // Across a reload: the plate after it still gets the user's scale.
+  await waitKept(page);
+  await page.reload();
+  await page.waitForFunction(() => window.pcpp && window.pcpp.state.info
+    && window.pcpp.state.info.name === 'Spider_binary.stl' && !window.pcpp.state.busy, null, { timeout: 120_000 });
+  assert.equal(await scale(page), spider);
+  assert.match(await page.textContent('#pl-note'), /scaled by 0\.\d+ to fit/);
+  await openScan(page, platePath, 'plate.obj');
+  await waitSettled(page);
+  assert.equal(await scale(page), 1);
+
+  // A scale the user types is theirs: fitted down for the spider, back for
+  // the plate.
+  await page.fill('#pl-scale', '0.5');
+  await waitSettled(page);
+  await openScan(page, SPIDER, 'Spider_binary.stl');
+  assert.ok(Math.abs(await scale(page) - spider) < 1e-12);
+  await openScan(page, platePath, 'plate.obj');
+  await waitSettled(page);
+  assert.equal(await scale(page), 0.5);
   assert.deepEqual(problems, []);
   await context.close();
 });
