@@ -308,6 +308,10 @@ export function bindForm() {
       if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
         requestCentre(true);
       }
+      // Read in other units or turned up another way, the scan is another
+      // scan for the drawing: where it lay and the scale fitted to the
+      // misread scan say nothing of this one.
+      if (id === 'scan-units' || id === 'scan-up') requestCentre();
       if (mode === 'live') {
         state.interacting = true;
         hooks.planNow();

@@ -144,3 +144,42 @@ test('a scale the page chose to fit one scan is not kept for the next, nor acros
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+test('new units or up axis for the scan centre the drawing again from the user\'s scale, with a note for the scan as now read', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  // Read in mm (the file's default), the bunny is 10 mm across: the demo
+  // drawing is shrunk to fit it.
+  await openScan(page, BUNNY, 'stanford-bunny.ply');
+  const small = await scale(page);
+  assert.ok(small < 0.2, `${small}`);
+  assert.match(await page.textContent('#pl-note'), /footprint \(9\.\d x 9\.\d mm\)/);
+
+  // In cm it is 10 times as large: the drawing fits at its own size, on
+  // the middle of the footprint, and the note of the 10 mm scan is gone.
+  await page.selectOption('#scan-units', 'cm');
+  await page.waitForFunction(() => window.pcpp.state.info.units === 'cm' && !window.pcpp.state.busy
+    && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  assert.equal(await scale(page), 1);
+  assert.equal(await page.inputValue('#pl-scale'), '1');
+  assert.equal(await page.textContent('#pl-note'), '');
+
+  // Up +Y turns it: centred again on its footprint as now read.
+  const bbox = await page.evaluate(() => JSON.stringify(window.pcpp.state.info.bbox_mm));
+  await page.selectOption('#scan-up', 'y');
+  await page.waitForFunction((b) => JSON.stringify(window.pcpp.state.info.bbox_mm) !== b
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, bbox, { timeout: 120_000 });
+  await page.click('#place-bed-btn');
+  await waitSettled(page);
+  assert.equal(await scale(page), 1);
+  const r = await page.evaluate(() => {
+    const j = JSON.parse(window.pcpp.state.lastPlan.reportJson);
+    const pts = j.toolpath.flat();
+    const mid = (k) => (Math.min(...pts.map((p) => p[k])) + Math.max(...pts.map((p) => p[k]))) / 2;
+    const [lo, hi] = j.mesh.bbox_mm;
+    return { path: [mid(0), mid(1)], scan: [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2] };
+  });
+  for (const k of [0, 1]) assert.ok(Math.abs(r.path[k] - r.scan[k]) < 3, JSON.stringify(r));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
