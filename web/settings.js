@@ -284,7 +284,12 @@ export function bindForm() {
     // the antenna; keep its centre where the user placed it.
     const antennaField = /^(sp|hb|mp)-/.test(id);
     const handler = () => {
-      const before = antennaField ? pathCentre() : null;
+      // An antenna's size is physical: one the page shrank to fit the scan
+      // is fitted again at its new size from the user's scale (kept
+      // shrunk, an 8 mm loop was printed at 83 %, under the note of the
+      // 20 mm one).
+      const refit = antennaField && !!settings.fit;
+      const before = antennaField && !refit ? pathCentre() : null;
       const value = el.type === 'checkbox' ? el.checked : el.value;
       // A new profile has its own bed: a scan placed on it moves, and the
       // drawing with it.
@@ -311,7 +316,7 @@ export function bindForm() {
       // Read in other units or turned up another way, the scan is another
       // scan for the drawing: where it lay and the scale fitted to the
       // misread scan say nothing of this one.
-      if (id === 'scan-units' || id === 'scan-up') requestCentre();
+      if (id === 'scan-units' || id === 'scan-up' || refit) requestCentre();
       if (mode === 'live') {
         state.interacting = true;
         hooks.planNow();

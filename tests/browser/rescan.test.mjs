@@ -183,3 +183,40 @@ test('new units or up axis for the scan centre the drawing again from the user\'
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The drawing's size in the note, mm.
+const noteSize = (note) => {
+  const m = /the drawing \((\d+\.\d) x (\d+\.\d) mm\) is larger than the scan's footprint/.exec(note);
+  return m ? [Number(m[1]), Number(m[2])] : null;
+};
+
+test('a built-in antenna shrunk to fit the scan is fitted again from its own size when its size changes, the note about the antenna as it now is', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await bunnyOnBed(page);
+  // The Hilbert loop at its default 20 mm does not fit the 10 mm bunny.
+  await page.selectOption('#path-source', 'hilbert');
+  await waitSettled(page);
+  const fitted = await scale(page);
+  assert.ok(fitted < 0.5, `${fitted}`);
+  const size20 = noteSize(await page.textContent('#pl-note'));
+  assert.ok(size20, await page.textContent('#pl-note'));
+
+  // 30 mm: fitted again from its own size, the note of the 30 mm loop.
+  await page.fill('#hb-size', '30');
+  await page.dispatchEvent('#hb-size', 'change');
+  await waitSettled(page);
+  const size30 = noteSize(await page.textContent('#pl-note'));
+  assert.ok(size30 && Math.abs(size30[0] - 1.5 * size20[0]) < 0.2, `${size20} -> ${size30}`);
+  assert.ok(Math.abs(await scale(page) - fitted / 1.5) < 1e-3, `${fitted} -> ${await scale(page)}`);
+
+  // 6 mm fits: planned at its own size, the note gone.
+  await page.fill('#hb-size', '6');
+  await page.dispatchEvent('#hb-size', 'change');
+  await waitSettled(page);
+  assert.equal(await scale(page), 1);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.placement.scale), 1);
+  assert.equal(await page.textContent('#pl-note'), '');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
