@@ -100,7 +100,9 @@ async function openSvg(file) {
     showError(`Could not read ${file.name}`, e.message);
     return;
   }
-  state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes };
+  // The path source it replaces, taken back if it cannot be read.
+  const was = state.pendingSvg ? state.pendingSvg.pathSource : settings.pathSource;
+  state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes, pathSource: was };
   settings.pathSource = 'file';
   // A new drawing lands on the scan.
   requestCentre(true);

@@ -30,7 +30,9 @@ import {
 import {
   clearError, endProgress, laterProgress, setStatus, showError, showProgress,
 } from './status.js';
-import { bindView, onPick, requestDraw, setPicking, updateMarkers } from './view.js';
+import {
+  bindView, onPick, requestDraw, setPicking, updateDragOffset, updateMarkers,
+} from './view.js';
 
 const decoder = new TextDecoder();
 
@@ -124,6 +126,43 @@ function runPlan() {
   }, transfer);
 }
 
+// What a plan is planned from, as one string: the scan, the drawing, the
+// settings the core reads and the profile (null when a setting is not
+// valid). A plan whose inputs equal the current ones is still good.
+function currentInputs() {
+  try {
+    const { dialect, file } = profile();
+    return JSON.stringify([state.scan.key, currentSvg().key, jobSettings(state.scan), dialect, file || null,
+      !!settings.acceptRisk]);
+  } catch {
+    return null;
+  }
+}
+
+// The status line of a plan offered for download.
+function plannedStatus(plan) {
+  const touching = plan.summary.motion.program.touching_moves;
+  return touching > 0
+    ? [`planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}: ${touching} move(s) touch the part; `
+      + 'the G-code downloads only after a confirmation', true]
+    : [`planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}`, false];
+}
+
+// After a request that failed without changing anything the plan on
+// screen was planned from (a file that could not be read, the previous
+// one kept): that plan is current again, offered as before.
+function restorePlan() {
+  const plan = state.lastPlan;
+  if (!plan || !plan.inputs || state.queued || currentInputs() !== plan.inputs) return false;
+  const c = state.lastComparison;
+  if (c && c.gen === plan.gen) c.gen = state.gen;
+  plan.gen = state.gen;
+  offerDownloads(plan);
+  setStatus(...plannedStatus(plan));
+  updateDragOffset();
+  return true;
+}
+
 function finish() {
   state.busy = null;
   endProgress();
@@ -148,6 +187,9 @@ function keptPlan(m, busy) {
     placement: m.summary.settings.placement,
     gen: busy.gen,
     compared: !!m.comparison,
+    scanName: busy.scan.name,
+    // Only a plan of the settings as they are now knows its inputs.
+    inputs: busy.gen === state.gen ? currentInputs() : null,
   };
 }
 
@@ -213,11 +255,7 @@ function onWorkerMessage(e) {
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
-        const touching = m.summary.motion.program.touching_moves;
-        setStatus(touching > 0
-          ? `planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}: ${touching} move(s) touch the part; `
-            + 'the G-code downloads only after a confirmation'
-          : `planned ${busy.svg.name} on ${state.scan.name} with ${busy.planner}`, touching > 0);
+        setStatus(...plannedStatus(state.lastPlan));
       } else {
         // Shown while the user goes on changing things; not offered.
         setStatus('settings changed: re-planning…', true);
@@ -280,14 +318,17 @@ function onPlanError(m, busy) {
     }
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
     title = `Could not read the SVG ${state.pendingSvg.name}`;
+    // Back to the path planned before it (an antenna, the demo, or the
+    // previous file), where it was.
+    const was = state.pendingSvg.pathSource;
     state.pendingSvg = null;
-    // The drawing stays where it was.
     cancelCentre();
-    if (!state.svgFile) settings.pathSource = 'demo';
+    settings.pathSource = was === 'file' && !state.svgFile ? 'demo' : was || 'demo';
+    saveSettings();
     writeForm();
-    message += state.svgFile
+    message += settings.pathSource === 'file'
       ? `\nStill using the previous SVG, ${state.svgFile.name}.`
-      : '\nBack to the demo paths.';
+      : `\nStill using ${$('path-source').selectedOptions[0].textContent}.`;
   } else if (m.kind === 'limit') {
     title = 'The path is too long for the page';
   } else if (m.kind === 'touching') {
@@ -310,6 +351,7 @@ function onPlanError(m, busy) {
     showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm);
   }
   showError(title, message);
+  if (busy.gen === state.gen && restorePlan()) return;
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.
   hideDownloads();

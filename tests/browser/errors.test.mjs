@@ -23,10 +23,15 @@ after(() => {
 
 const file = (name, text) => ({ name, mimeType: 'application/octet-stream', buffer: Buffer.from(text) });
 
-test('a corrupt scan shows the error, keeps the previous plan, offers no download', async () => {
+// A file that could not be read changes nothing the plan on screen was
+// planned from: it stays offered, as planned (it had been hidden and said
+// 'plan failed' for a PNG renamed .obj; found by exploratory QA).
+test('a corrupt scan shows the error and keeps the previous plan, its download and its status', async () => {
   const { page, context } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
   const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /^planned demo-test-part-lines\.svg on demo-test-part\.ply with even$/);
 
   await page.setInputFiles('#scan-input', file('broken.stl', 'solid broken\nfacet normal 0 0 1\n outer loop\n  vertex 1 2\n'));
   await page.waitForSelector('#error-panel:not([hidden])');
@@ -36,15 +41,16 @@ test('a corrupt scan shows the error, keeps the previous plan, offers no downloa
   assert.match(title, /broken\.stl/);
   assert.match(message, /broken\.stl/);
   assert.match(message, /demo-test-part\.ply/); // still using the previous scan
-  assert.equal(await page.isHidden('#dl-gcode'), true);
-  assert.equal(await page.isHidden('#dl-report'), true);
-  // The previous plan stays on screen and in memory.
+  // The previous plan stays on screen and in memory, offered as before.
   assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), before);
   assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
+  assert.equal(await page.textContent('#plan-status'), status);
+  assert.equal(await page.isVisible('#dl-report'), true);
   const px = await viewPixels(page);
   assert.ok(px.mesh > 1000 && px.good > 100, JSON.stringify(px));
+  assert.equal((await download(page, 'dl-gcode')).bytes.toString('utf8'), before);
 
-  // Planning again uses the previous scan and offers the G-code again.
+  // Planning again uses the previous scan and gives the same G-code.
   await page.click('#plan-btn');
   await waitForPlan(page);
   const again = await download(page, 'dl-gcode');
@@ -59,8 +65,22 @@ test('a corrupt SVG names the file and falls back; bad settings name the paramet
   await page.waitForSelector('#error-panel:not([hidden])');
   await waitIdle(page);
   assert.match(await page.textContent('#error-title'), /nonsense\.svg/);
-  assert.equal(await page.isHidden('#dl-gcode'), true);
   assert.equal(await page.inputValue('#path-source'), 'demo');
+  // The demo's plan still stands: offered.
+  assert.equal(await page.isVisible('#dl-gcode'), true);
+  assert.match(await page.textContent('#plan-status'), /^planned demo-test-part-lines\.svg/);
+
+  // Over an antenna: back to the antenna, its plan still offered.
+  await page.selectOption('#path-source', 'spiral');
+  await waitSettled(page);
+  const spiral = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  await page.setInputFiles('#svg-input', file('nonsense2.svg', '<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 L'));
+  await page.waitForFunction(() => /nonsense2\.svg/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Still using antenna: spiral\./);
+  assert.equal(await page.inputValue('#path-source'), 'spiral');
+  assert.equal(await page.isVisible('#antenna-spiral'), true);
+  assert.equal((await download(page, 'dl-gcode')).bytes.toString('utf8'), spiral);
 
   await page.fill('#nz-od', '0.1'); // smaller than the inner diameter
   await page.dispatchEvent('#nz-od', 'change');

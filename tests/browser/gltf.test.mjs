@@ -145,8 +145,8 @@ test('a .gltf dropped with its .bin loads; alone it is refused naming the .bin, 
   await waitForPlan(page);
   const before = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
 
-  // Selected alone: refused, naming the .bin; the demo and its plan stay
-  // (no download is offered after a failure, as for any bad scan).
+  // Selected alone: refused, naming the .bin; the demo and its plan stay,
+  // still offered (nothing it was planned from changed).
   const alone = join(dir, 'ridge.gltf');
   writeFileSync(alone, gltf);
   await page.setInputFiles('#scan-input', alone);
@@ -160,6 +160,7 @@ test('a .gltf dropped with its .bin loads; alone it is refused naming the .bin, 
   assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
   assert.equal(await page.evaluate(() => window.pcpp.state.scan.name), 'demo-test-part.ply');
   assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), before);
+  assert.equal((await download(page, 'dl-gcode')).bytes.toString('utf8'), before);
   await page.click('#plan-btn');
   await waitForPlan(page);
   assert.equal((await download(page, 'dl-gcode')).bytes.toString('utf8'), before);
