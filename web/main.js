@@ -21,9 +21,11 @@ import {
   cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote,
 } from './placement.js';
 import {
-  bindPreview, onPreview, previewCheckShown, previewClick, previewPlanShown, syncPreviewButton,
+  bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
 } from './preview.js';
-import { showComparison, showErrorPlot, showPlan, showScan } from './report.js';
+import {
+  clearPlan, showComparison, showErrorPlot, showPlan, showScan,
+} from './report.js';
 import {
   bindForm, currentSvg, jobSettings, loadSettings, saveSettings, writeForm,
 } from './settings.js';
@@ -31,7 +33,7 @@ import {
   clearError, endProgress, laterProgress, setStatus, showError, showProgress,
 } from './status.js';
 import {
-  bindView, onPick, requestDraw, setPicking, updateDragOffset, updateMarkers,
+  bindView, drawPlanPaths, onPick, requestDraw, setPicking, updateDragOffset, updateMarkers,
 } from './view.js';
 
 const decoder = new TextDecoder();
@@ -163,6 +165,24 @@ function restorePlan() {
   return true;
 }
 
+// The mesh a request plans on: the scan and how it is read and placed
+// (as the worker keys its session).
+const meshOf = (busy) => JSON.stringify([busy.scan.key, busy.job.scan, busy.job.registration]);
+
+// A scan read for the request `busy` (another file, or the same in another
+// frame: units, up axis, registration, placement on the bed): a plan on
+// screen planned on another mesh goes, its figures and paths not shown as
+// this scan's; the next plan fills them.
+function dropPlan(busy) {
+  if (!state.lastPlan || state.lastPlan.mesh === meshOf(busy)) return;
+  state.lastPlan = null;
+  state.lastComparison = null;
+  hideDownloads();
+  clearPlan();
+  previewPlanDropped();
+  if (state.viewShows === 'plan') drawPlanPaths();
+}
+
 function finish() {
   state.busy = null;
   endProgress();
@@ -188,6 +208,7 @@ function keptPlan(m, busy) {
     gen: busy.gen,
     compared: !!m.comparison,
     scanName: busy.scan.name,
+    mesh: meshOf(busy),
     // Only a plan of the settings as they are now knows its inputs.
     inputs: busy.gen === state.gen ? currentInputs() : null,
   };
@@ -230,6 +251,7 @@ function onWorkerMessage(e) {
       if (state.pendingScan && state.pendingScan.key === m.key) {
         acceptScan(m.info);
       }
+      dropPlan(busy);
       state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);
       break;
@@ -315,6 +337,7 @@ function onPlanError(m, busy) {
       // Readable but not registered: it stays loaded until the fiducials fit.
       acceptScan();
       $('scan-name').textContent = state.scan.name;
+      dropPlan(busy);
     }
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
     title = `Could not read the SVG ${state.pendingSvg.name}`;

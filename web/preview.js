@@ -284,6 +284,17 @@ export function previewPlanShown() {
   }
 }
 
+// The plan on screen was dropped (a new scan): its preview goes with it.
+export function previewPlanDropped() {
+  if (pv.source !== 'plan' || (!pv.data && !pv.pending)) return;
+  pv.pending = null;
+  dropData();
+  setTime(0);
+  syncControls();
+  setStatus(pv.on ? 'No plan for this scan yet.' : '');
+  if (state.viewShows === 'preview') drawPlanPaths();
+}
+
 // A G-code file was checked (or failed): it can be previewed.
 export function previewCheckShown() {
   syncControls();

@@ -72,6 +72,19 @@ export function showPlan(plan) {
   if (!state.interacting || view.defects.length < 20000) showErrorPlot();
 }
 
+// No plan on screen (the last one was for another scan, or another frame
+// of this one): its tables, warnings and plot emptied, not shown under the
+// new scan's name.
+export function clearPlan() {
+  for (const id of ['compare-table', 'motion-table', 'stats-table']) $(id).tBodies[0].replaceChildren();
+  $('compare-table').classList.remove('stale');
+  for (const id of ['motion-touches', 'warnings', 'plot-legend']) $(id).replaceChildren();
+  $('plot-note').textContent = '';
+  $('plan-time').textContent = '';
+  const plot = $('plot');
+  plot.getContext('2d').clearRect(0, 0, plot.width, plot.height);
+}
+
 // The plot of the plan on screen: every planner's errors (the last
 // comparison, if it was made for this plan), or one planner's coloured by
 // defect. During a drag only the plan being dragged is drawn.

@@ -7,7 +7,7 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
 import {
-  download, openPage, startProbe, stopProbe, viewPixels, waitForPlan, waitIdle, waitKept, waitSettled,
+  ROOT, download, openPage, startProbe, stopProbe, viewPixels, waitForPlan, waitIdle, waitKept, waitSettled,
   withPageServer,
 } from './helpers.mjs';
 
@@ -248,6 +248,45 @@ test('a path too long for the page names the limit; past the core\'s limit the c
   await waitSettled(page);
   assert.equal(await page.isHidden('#error-panel'), true);
   assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), good);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A new scan's plan that fails leaves nothing of the previous scan's plan
+// on screen as if it were this scan's: no quality, statistics or warnings
+// of the demo part under the bunny's name, no demo path drawn beside the
+// bunny (found by exploratory QA).
+test('after a new scan whose plan fails, nothing of the previous scan\'s plan is shown as this scan\'s', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const panels = () => page.evaluate(() => {
+    const text = (sel) => document.querySelector(sel).textContent.trim();
+    return {
+      compare: text('#compare-table tbody'),
+      motion: text('#motion-table tbody'),
+      touches: text('#motion-touches'),
+      stats: text('#stats-table tbody'),
+      warnings: text('#warnings'),
+    };
+  });
+  const demo = await panels();
+  assert.match(demo.stats, /placement/);
+
+  // The bunny as it is lies outside the bed: its plan fails.
+  await page.setInputFiles('#scan-input', join(ROOT, 'tests/data/realworld/mesh/stanford-bunny.ply'));
+  await page.waitForFunction(() => window.pcpp.state.info.name === 'stanford-bunny.ply'
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan), null);
+  const now = await panels();
+  assert.deepEqual({ ...now, compare: '' }, { compare: '', motion: '', touches: '', stats: '', warnings: '' });
+  // The planners compared, if shown, are the bunny's.
+  assert.notEqual(now.compare, demo.compare);
+  assert.doesNotMatch(await page.textContent('#plan-status'), /previous plan/);
+  // The bunny is drawn; no path is.
+  const px = await viewPixels(page);
+  assert.ok(px.mesh > 1000, JSON.stringify(px));
+  assert.equal(px.good + px.defect + px.ta, 0, JSON.stringify(px));
   assert.deepEqual(problems, []);
   await context.close();
 });
