@@ -4,7 +4,7 @@
 // program's moves drawn in the 3-D view on request.
 import { checkGcodeSize } from '../pkg/pcpp.js';
 import {
-  $, cell, el, fmt, fmtPoint, hooks, num, settings, state,
+  $, cell, el, fmt, fmtPoint, hooks, num, pageText, settings, state,
 } from './page.js';
 import { showError } from './status.js';
 import { drawPlanPaths, setViewShows } from './view.js';
@@ -103,7 +103,7 @@ export function onCheck(m) {
   }
   if (c.notes.length) {
     const ul = el('ul', undefined, 'warnings small', 'check-notes');
-    ul.append(...c.notes.map((n) => el('li', n)));
+    ul.append(...c.notes.map((n) => el('li', pageText(n))));
     details.push(ul);
   }
   $('check-details').replaceChildren(...details);

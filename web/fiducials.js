@@ -5,7 +5,9 @@
 // printer points P; the registration's residual per fiducial and its RMS.
 // The registration itself runs in the core (the worker's Session).
 import { parsePoints } from '../pkg/pcpp.js';
-import { $, fmt, settings, state } from './page.js';
+import {
+  $, fmt, pageText, settings, state,
+} from './page.js';
 
 // How many of the best candidates are listed.
 export const BEST = 8;
@@ -82,7 +84,7 @@ export function showFiducials() {
     res.append(p);
     for (const n of r.notes) {
       const q = document.createElement('p');
-      q.textContent = n;
+      q.textContent = pageText(n);
       res.append(q);
     }
   }

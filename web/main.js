@@ -18,7 +18,7 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote,
+  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -373,7 +373,12 @@ function onPlanError(m, busy) {
     state.lastComparison = { rows: m.comparison, series: null, gen: busy.gen };
     showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm);
   }
-  showError(title, message);
+  // A scan outside the build volume, with the banner on screen offering to
+  // place it: the banner says it, with its button; a red panel repeating
+  // it would only bury it.
+  const offered = m.stage === 'plan' && bannerOffers(message);
+  if (offered) clearError();
+  else showError(title, message);
   if (busy.gen === state.gen && restorePlan()) return;
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.
@@ -382,7 +387,8 @@ function onPlanError(m, busy) {
     state.viewer.setPathOffset(0, 0, 0);
     requestDraw();
   }
-  setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+  if (offered) setStatus('no G-code: the scan lies outside the build volume (see above)', true);
+  else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 
 function cancelPlan() {

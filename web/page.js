@@ -54,6 +54,30 @@ export function profile() {
     : { dialect: settings.dialect, file: undefined, name: settings.dialect };
 }
 
+// The core's messages are shared with the command line, and some say how
+// to fix a problem with a flag. Where the page has a control for it, the
+// page names the control instead (a flag means nothing in the page). A
+// message the core words otherwise is shown as it is.
+const PAGE_WORDS = [
+  [/ \(--place-scan bed; in the page, ('Place on the bed')\)/g, ' ($1)'],
+  [/\(--place centre,ROT,SCALE; the page's scale\) is kept as given/g, '(typed in Scale) is planned as typed'],
+  [/\(--place centre, or the page's drawing placement, puts the drawing on the scan's footprint\)/g,
+    "('Centre on scan' puts the drawing on the scan's footprint)"],
+  [/\(--up-axis y or z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
+  [/\(--up-axis\)/g, '(Up axis)'],
+  [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
+  [/\(--max-edge\)/g, '(Cloud max edge)'],
+  [/\(--accept-risk; in the page, (the box '[^']*')\)/g, '($1)'],
+  [/keep it next to \S+ \(command line\) or select both files together \(page\)/g, 'select both files together'],
+  [/e\.g\. placed on the bed: --place-scan bed\)/g, "e.g. placed on the bed: 'Place on the bed')"],
+];
+
+export function pageText(text) {
+  let t = String(text);
+  for (const [from, to] of PAGE_WORDS) t = t.replace(from, to);
+  return t;
+}
+
 export const num = (v) => (v === null || v === '' || v === undefined ? NaN : Number(v));
 
 export const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '∞' : v.toFixed(d));

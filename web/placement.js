@@ -8,7 +8,7 @@
 // elements in step.
 import { bedOf, carryDrawing, volumeFit } from '../pkg/pcpp.js';
 import {
-  $, num, profile, settings, state,
+  $, num, pageText, profile, settings, state,
 } from './page.js';
 import { clearError, showError } from './status.js';
 
@@ -28,6 +28,8 @@ const FIELDS = [
 let ctx = null;
 let centreTokens = 0;
 const beds = new Map(); // profile key -> its bed (wasm bedOf)
+// The core's sentence the banner shows, while it is shown.
+let banner = null;
 
 const finite = (v) => typeof v === 'number' && Number.isFinite(v);
 
@@ -188,7 +190,7 @@ export function userPlaced() {
 // The note under the drawing's placement (the core's, when it scaled the
 // drawing to fit).
 export function setNote(text) {
-  $('pl-note').textContent = text;
+  $('pl-note').textContent = pageText(text);
 }
 
 // The note of the page's fit of the drawing, or none while the scale is
@@ -232,19 +234,27 @@ export function showScanPlacement() {
   }
   const outside = !!fit && !fit.inside;
   $('place-banner').hidden = !(outside && !on && s.fidSource === 'none' && !state.pendingScan);
-  $('place-banner-text').textContent = outside ? capital(fit.message) : '';
+  banner = !$('place-banner').hidden && outside ? fit.message : null;
+  $('place-banner-text').textContent = outside ? pageText(capital(fit.message)) : '';
   $('scan-place').hidden = !on;
   if (on) {
     $('bed-name').textContent = `profile ${profile().name}`;
     const note = $('bed-note');
     const shown = info && info.registration.status.kind === 'placed-on-bed';
-    note.textContent = shown && outside ? capital(fit.message) : '';
+    note.textContent = shown && outside ? pageText(capital(fit.message)) : '';
     note.classList.toggle('bad-note', shown && outside);
   }
   writeFields(null);
 }
 
 const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
+
+// Whether the banner on screen offers the fix for the planning error
+// `message` (the core's sentence on the scan outside the build volume is
+// part of it): the banner says it better, with its button.
+export function bannerOffers(message) {
+  return !!banner && String(message).includes(banner);
+}
 
 // The fields from the settings (except the one being typed in).
 function writeFields(except) {

@@ -4,7 +4,7 @@
 import { clearanceCapAboveTolMm } from '../pkg/pcpp.js';
 import { showFiducials } from './fiducials.js';
 import {
-  $, cell, el, fmt, fmtPoint, state, swatch,
+  $, cell, el, fmt, fmtPoint, pageText, state, swatch,
 } from './page.js';
 import { showScanPlacement } from './placement.js';
 import { drawPlot, plannerColor } from './plot.js';
@@ -66,7 +66,7 @@ export function showPlan(plan) {
     tr.append(el('td', k), el('td', String(v), '', id));
     return tr;
   }));
-  $('warnings').replaceChildren(...summary.warnings.map((w) => el('li', w)));
+  $('warnings').replaceChildren(...summary.warnings.map((w) => el('li', pageText(w))));
   showMotion(summary);
   // A long path's plot waits for the end of a drag.
   if (!state.interacting || view.defects.length < 20000) showErrorPlot();

@@ -1,10 +1,10 @@
 // The page's error panel, status line and progress of a plan: what every
 // other module reports through.
-import { $, state } from './page.js';
+import { $, pageText, state } from './page.js';
 
 export function showError(title, message) {
   $('error-title').textContent = title;
-  $('error-message').textContent = message;
+  $('error-message').textContent = pageText(message);
   $('error-panel').hidden = false;
 }
 

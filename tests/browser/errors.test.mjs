@@ -290,3 +290,37 @@ test('after a new scan whose plan fails, nothing of the previous scan\'s plan is
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The first contact with most real scans: out of the bed as they are. The
+// banner says so and offers the fix; a red 'Planning failed' repeating it
+// word for word, with command-line flags, only buried it (found by
+// exploratory QA). No page message names a flag where the page has its
+// own control.
+test('a scan outside the bed: the banner offers the fix, no red error repeats it, no command-line flags', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', join(ROOT, 'tests/data/realworld/mesh/stanford-bunny.ply'));
+  await page.waitForFunction(() => window.pcpp.state.info.name === 'stanford-bunny.ply'
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  assert.equal(await page.isVisible('#place-banner'), true);
+  const banner = await page.textContent('#place-banner-text');
+  assert.match(banner, /^The scan lies outside the build volume of profile marlin \(x 0\.\.220/);
+  assert.match(banner, /place it on the bed \('Place on the bed'\)/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  const status = await page.textContent('#plan-status');
+  assert.ok(status.length < 100, status);
+  assert.match(status, /outside the build volume/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  // The drawing was scaled to fit: the core's note, in the page's words.
+  const note = await page.textContent('#pl-note');
+  assert.match(note, /scaled by 0\.\d+ to fit/);
+  for (const text of [banner, status, note]) assert.doesNotMatch(text, /--[a-z]/, text);
+
+  // Placed on the bed: planned, banner and status as usual.
+  await page.click('#place-bed-btn');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#place-banner'), true);
+  assert.match(await page.textContent('#plan-status'), /^planned demo-test-part-lines\.svg on stanford-bunny\.ply/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});

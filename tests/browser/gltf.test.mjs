@@ -156,6 +156,8 @@ test('a .gltf dropped with its .bin loads; alone it is refused naming the .bin, 
   const message = await page.textContent('#error-message');
   assert.match(message, /^ridge\.gltf: buffer 0 is stored in the external file 'ridge\.bin', which was not given/);
   assert.match(message, /Select ridge\.gltf together with ridge\.bin/);
+  // The page's advice only, not the command line's.
+  assert.doesNotMatch(message, /command line|\(page\)/);
   assert.match(message, /Still using the previous scan, demo-test-part\.ply\./);
   assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
   assert.equal(await page.evaluate(() => window.pcpp.state.scan.name), 'demo-test-part.ply');
