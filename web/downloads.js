@@ -2,6 +2,13 @@
 // the two clicks a G-code that touches the part needs.
 import { $, state } from './page.js';
 
+// A press on a download link that ends the edit of a field re-planning on
+// change: the field's change hides the link under the pointer and the
+// click is lost. The press is kept ({id, at, replanned}) and the link is
+// clicked for the user once the plan for the new value is offered.
+let press = null;
+const PRESS_KEPT_MS = 30_000;
+
 const GCODE_LABEL = 'Download G-code';
 const RISKY_LABEL = 'Download G-code (the nozzle touches the part)…';
 const CONFIRM_LABEL = 'Download anyway (the nozzle touches the part)';
@@ -51,6 +58,31 @@ export function offerDownloads(plan) {
     linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
   }
   linkBytes($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
+  const p = press;
+  if (p && p.replanned) {
+    press = null;
+    // A touching plan's G-code still needs its own two clicks.
+    const risky = p.id === 'dl-gcode' && state.risky;
+    if (!risky && performance.now() - p.at < PRESS_KEPT_MS) $(p.id).click();
+  }
+}
+
+// Something the plan depends on changed (downloads hidden): whether it was
+// the press on a link that ended a field's edit. Returns true if so.
+export function pressReplans() {
+  if (press && !press.replanned && performance.now() - press.at < 1000) press.replanned = true;
+  else if (press && !press.replanned) press = null;
+  return !!press;
+}
+
+// Whether a download follows the plan being made.
+export function downloadFollows() {
+  return !!(press && press.replanned);
+}
+
+// The plan for the new value failed or was cancelled: no download follows.
+export function dropPress() {
+  press = null;
 }
 
 // The first click on a touching plan's G-code asks for the second.
@@ -66,6 +98,17 @@ export function onGcodeClick(e) {
 
 
 export function bindDownloads() {
+  for (const id of ['dl-gcode', 'dl-report']) {
+    const a = $(id);
+    a.addEventListener('mousedown', (e) => {
+      if (e.button === 0) press = { id, at: performance.now(), replanned: false };
+    });
+    a.addEventListener('click', () => { press = null; });
+  }
+  // A press that did not end an edit ends with its own click (or none).
+  window.addEventListener('mouseup', () => setTimeout(() => {
+    if (press && !press.replanned) press = null;
+  }, 0), true);
   $('dl-gcode').addEventListener('click', onGcodeClick);
   $('dl-gcode').addEventListener('keydown', (e) => {
     // A touching plan's button has no link until confirmed: keys click it.

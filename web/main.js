@@ -10,7 +10,9 @@
 // share. Text from files and errors is set with textContent.
 import { pageLimits, version } from '../pkg/pcpp.js';
 import { onCheck, syncCheckButton } from './check.js';
-import { bindDownloads, hideDownloads, offerDownloads } from './downloads.js';
+import {
+  bindDownloads, downloadFollows, dropPress, hideDownloads, offerDownloads, pressReplans,
+} from './downloads.js';
 import { initFiducials } from './fiducials.js';
 import { loadWasm, startWorker } from './engine.js';
 import {
@@ -45,7 +47,8 @@ const decoder = new TextDecoder();
 function markChanged() {
   state.gen++;
   hideDownloads();
-  if (state.lastPlan) setStatus('settings changed: re-planning…', true);
+  if (pressReplans()) setStatus('re-planning for the new value: the download follows', true);
+  else if (state.lastPlan) setStatus('settings changed: re-planning…', true);
 }
 
 function schedulePlan(delay) {
@@ -280,7 +283,8 @@ function onWorkerMessage(e) {
         setStatus(...plannedStatus(state.lastPlan));
       } else {
         // Shown while the user goes on changing things; not offered.
-        setStatus('settings changed: re-planning…', true);
+        setStatus(downloadFollows() ? 're-planning for the new value: the download follows'
+          : 'settings changed: re-planning…', true);
       }
       if (m.comparison) showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm);
       else $('compare-table').classList.add('stale');
@@ -301,6 +305,7 @@ function onWorkerMessage(e) {
 }
 
 function onPlanError(m, busy) {
+  dropPress();
   let title = 'Planning failed';
   let message = m.message;
   if (m.kind === 'crash') {
@@ -399,6 +404,7 @@ function cancelPlan() {
   state.queued = false;
   endProgress();
   hideDownloads();
+  dropPress();
   setStatus('cancelled', true);
 }
 

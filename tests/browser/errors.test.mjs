@@ -324,3 +324,24 @@ test('a scan outside the bed: the banner offers the fix, no red error repeats it
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// Pressing Download ends the edit of a field that re-plans on change: the
+// re-plan hid the link under the pointer and the click downloaded nothing
+// (found by exploratory QA). It now downloads the plan for the new value,
+// once planned.
+test('a click on Download that ends the edit of a field downloads the plan for the new value', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.selectOption('#path-source', 'hilbert');
+  await waitSettled(page);
+  await page.click('#hb-size');
+  await page.fill('#hb-size', '12');
+  const [dl] = await Promise.all([page.waitForEvent('download', { timeout: 30_000 }), page.click('#dl-gcode')]);
+  const { readFileSync } = await import('node:fs');
+  const got = readFileSync(await dl.path(), 'utf8');
+  await waitSettled(page);
+  assert.equal(await page.inputValue('#hb-size'), '12');
+  assert.equal(got, await page.evaluate(() => window.pcpp.state.lastPlan.gcode), 'the G-code of the plan for 12 mm');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
