@@ -49,6 +49,13 @@ function openFiles(files) {
   if (rest.length === 0) return;
   const scan = rest.find((f) => GLTF_FILE.test(f.name)) || rest.find((f) => SCAN_FILE.test(f.name)) || rest[0];
   openScan(scan, rest.filter((f) => f !== scan));
+  // The page reads one scan: the others selected with it are not read
+  // (only the files a scan names are).
+  const others = rest.filter((f) => f !== scan && SCAN_FILE.test(f.name));
+  if (others.length) {
+    $('scan-note').textContent = `${others.length + 1} scans selected at once: ${scan.name} was opened, `
+      + `${others.map((f) => f.name).join(', ')} ${others.length > 1 ? 'were' : 'was'} not (open one scan at a time).`;
+  }
 }
 
 // `external`: the files opened with it (Files), for those it names.
@@ -67,6 +74,7 @@ function openScan(file, external) {
   const entry = {
     key: `file-${state.nextKey++}`, name: file.name, size: file.size, blob: file, external,
   };
+  $('scan-note').textContent = '';
   state.pendingScan = entry;
   // The demo's fiducials belong to the demo part: a new scan is read
   // unregistered until the user sets its fiducials (the settings change
@@ -215,6 +223,7 @@ export function loadDemo(part = settings.demoPart) {
   state.pendingScan = null;
   state.scan = demoScanEntry(settings.demoPart);
   $('scan-name').textContent = state.scan.name;
+  $('scan-note').textContent = '';
   state.svgFile = null;
   state.pendingSvg = null;
   keep('scan', null);

@@ -9,7 +9,9 @@ import { closeSync, ftruncateSync, mkdtempSync, openSync, rmSync, writeFileSync,
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { download, openPage, waitForPlan, waitIdle, waitKept, waitSettled, withPageServer } from './helpers.mjs';
+import {
+  ROOT, download, openPage, waitForPlan, waitIdle, waitKept, waitSettled, withPageServer,
+} from './helpers.mjs';
 
 const env = withPageServer();
 const MIB = 1 << 20;
@@ -214,6 +216,28 @@ test('the last scan and SVG are reopened after a reload; a scan the page closed 
   await waitSettled(page);
   assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
   assert.equal(await page.inputValue('#path-source'), 'demo');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// Two scans selected at once: one is read, and the page says which, and
+// that the other is not (it had silently used the first; found by
+// exploratory QA).
+test('several scans selected at once: the page says which one it reads', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  const mesh = (name) => join(ROOT, 'tests/data/realworld/mesh', name);
+  await page.setInputFiles('#scan-input', [mesh('stanford-bunny.ply'), mesh('Spider_binary.stl')]);
+  await page.waitForFunction(() => window.pcpp.state.info.name !== 'demo-test-part.ply'
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  const name = await page.textContent('#scan-name');
+  const other = name === 'stanford-bunny.ply' ? 'Spider_binary.stl' : 'stanford-bunny.ply';
+  const note = await page.textContent('#scan-note');
+  assert.equal(note, `2 scans selected at once: ${name} was opened, ${other} was not (open one scan at a time).`);
+  // The next scan opened alone: no note.
+  await page.setInputFiles('#scan-input', mesh('Spider_binary.stl'));
+  assert.equal(await page.textContent('#scan-note'), '');
+  await waitIdle(page);
   assert.deepEqual(problems, []);
   await context.close();
 });
