@@ -43,7 +43,7 @@ function showCheckError(name, message) {
   $('check-verdict').textContent = `could not check ${name}`;
   $('check-verdict').className = 'verdict bad';
   $('check-details').replaceChildren();
-  showError(`Could not check ${name}`, message);
+  showError(`Could not check ${name}`, message, name);
 }
 
 export function onCheck(m) {

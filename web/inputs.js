@@ -66,7 +66,7 @@ function openScan(file, external) {
     checkScanSize(file.name, file.size);
   } catch (e) {
     showError(`Could not open the scan ${file.name}`,
-      `${e.message}\nStill using ${state.scan ? state.scan.name : 'no scan'}.`);
+      `${e.message}\nStill using ${state.scan ? state.scan.name : 'no scan'}.`, file.name);
     return;
   }
   // The File itself goes to the worker, which reads it into wasm memory:
@@ -97,7 +97,7 @@ async function openSvg(file) {
   try {
     checkSvgSize(file.name, file.size);
   } catch (e) {
-    showError(`Could not open the SVG ${file.name}`, e.message);
+    showError(`Could not open the SVG ${file.name}`, e.message, file.name);
     return;
   }
   let bytes;
@@ -134,7 +134,7 @@ async function openProfile(file) {
     name = checkProfile(text, file.name);
   } catch (e) {
     showError(`Could not use the machine profile ${file.name}`,
-      `${e.message}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`);
+      `${e.message}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`, file.name);
     return;
   }
   clearError();
@@ -257,6 +257,9 @@ export function acceptScan(info) {
   if (scan.unregistered) {
     delete scan.unregistered;
     settings.fidSource = 'none';
+    // The demo part's printer points with it: shown, they looked like a
+    // registration of the new scan.
+    settings.fidPrinterText = '';
     saveSettings();
     writeForm();
   }

@@ -308,6 +308,7 @@ function onPlanError(m, busy) {
   dropPress();
   let title = 'Planning failed';
   let message = m.message;
+  let file; // the file the title names
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -327,7 +328,8 @@ function onPlanError(m, busy) {
   } else if (m.stage === 'scan' && (m.kind === 'mesh' || m.kind === 'limit' || m.kind === 'other')
     && state.pendingScan && busy.scan === state.pendingScan) {
     // The file could not be read: keep working with the previous scan.
-    title = `Could not read the scan ${state.pendingScan.name}`;
+    file = state.pendingScan.name;
+    title = `Could not read the scan ${file}`;
     if (state.pendingScan.restored) {
       endRestoring();
       keep('scan', null);
@@ -337,7 +339,8 @@ function onPlanError(m, busy) {
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
   } else if (m.stage === 'scan') {
-    title = m.kind === 'mesh' ? 'Could not read the scan' : 'Registration failed';
+    // (The registration's messages start 'registration needs ...'.)
+    title = m.kind === 'mesh' ? 'Could not read the scan' : `Could not register ${busy.scan.name}`;
     if (state.pendingScan && busy.scan === state.pendingScan) {
       // Readable but not registered: it stays loaded until the fiducials fit.
       acceptScan();
@@ -345,7 +348,8 @@ function onPlanError(m, busy) {
       dropPlan(busy);
     }
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
-    title = `Could not read the SVG ${state.pendingSvg.name}`;
+    file = state.pendingSvg.name;
+    title = `Could not read the SVG ${file}`;
     // Back to the path planned before it (an antenna, the demo, or the
     // previous file), where it was.
     const was = state.pendingSvg.pathSource;
@@ -383,7 +387,7 @@ function onPlanError(m, busy) {
   // it would only bury it.
   const offered = m.stage === 'plan' && bannerOffers(message);
   if (offered) clearError();
-  else showError(title, message);
+  else showError(title, message, file);
   if (busy.gen === state.gen && restorePlan()) return;
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.

@@ -2,9 +2,12 @@
 // other module reports through.
 import { $, pageText, state } from './page.js';
 
-export function showError(title, message) {
+// `file`: the file the title names; the core's message starting with its
+// name does not say it a second time.
+export function showError(title, message, file) {
+  const m = String(message);
   $('error-title').textContent = title;
-  $('error-message').textContent = pageText(message);
+  $('error-message').textContent = pageText(file && m.startsWith(`${file}: `) ? m.slice(file.length + 2) : m);
   $('error-panel').hidden = false;
 }
 

@@ -39,7 +39,7 @@ test('a corrupt scan shows the error and keeps the previous plan, its download a
   const message = await page.textContent('#error-message');
   const title = await page.textContent('#error-title');
   assert.match(title, /broken\.stl/);
-  assert.match(message, /broken\.stl/);
+  assert.doesNotMatch(message, /^broken\.stl: /); // named once, in the title
   assert.match(message, /demo-test-part\.ply/); // still using the previous scan
   // The previous plan stays on screen and in memory, offered as before.
   assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.gcode), before);
@@ -104,6 +104,15 @@ test('fiducial residuals are shown and an RMS above d/2 is highlighted', async (
   await waitIdle(page);
   const rms = Number.parseFloat(await page.textContent('#rms'));
   assert.ok(rms > 0.3015, `${rms}`);
+
+  // Two points: the title says what could not be done, the core's message
+  // why (it read 'Registration failed registration needs ...').
+  await page.fill('#fid-printer', '4, 4, 5\n76, 4, 5');
+  await page.waitForFunction(() => /^Could not register/.test(document.getElementById('error-title').textContent)
+    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'Could not register demo-test-part.ply');
+  assert.match(await page.textContent('#error-message'), /^registration needs at least 3 fiducials, got 2/);
   await context.close();
 });
 
@@ -315,6 +324,11 @@ test('a scan outside the bed: the banner offers the fix, no red error repeats it
   const note = await page.textContent('#pl-note');
   assert.match(note, /scaled by 0\.\d+ to fit/);
   for (const text of [banner, status, note]) assert.doesNotMatch(text, /--[a-z]/, text);
+
+  // Read unregistered: the demo part's printer points are not shown as if
+  // they registered it.
+  assert.equal(await page.inputValue('#fid-source'), 'none');
+  assert.equal(await page.inputValue('#fid-printer'), '');
 
   // Placed on the bed: planned, banner and status as usual.
   await page.click('#place-bed-btn');
