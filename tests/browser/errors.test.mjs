@@ -172,11 +172,15 @@ const TRACK_SVG = `<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="
 </svg>
 `;
 
-// The values of every setting field of the page.
+// The values of every setting field of the page. A number field's text is
+// compared as the number it holds: Chromium may write the same double with
+// another number of digits ('19.9999994436899820' before a reload,
+// '19.999999443689983' after it, one CI run in several).
 const formValues = (page) => page.evaluate(() => Object.fromEntries(
   [...document.querySelectorAll('.side input, .side select, .side textarea')]
     .filter((el) => el.id && el.type !== 'file')
-    .map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]),
+    .map((el) => [el.id, el.type === 'checkbox' ? el.checked
+      : el.type === 'number' && el.value !== '' ? String(Number(el.value)) : el.value]),
 ));
 
 test('a failed plan keeps the inputs and settings, also across a reload; fixing the setting plans them', async () => {
