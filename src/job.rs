@@ -1142,19 +1142,9 @@ pub fn check_gcode(
     if !unchecked_lines.is_empty() {
         notes.push(format!(
             "{} move(s) could not be checked: the file does not give where they start or end \
-             and they come lower than tol above the scan's top (lines {}{})",
+             and they come lower than tol above the scan's top (lines {})",
             unchecked_lines.len(),
-            unchecked_lines
-                .iter()
-                .take(10)
-                .map(|l| l.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            if unchecked_lines.len() > 10 {
-                ", ..."
-            } else {
-                ""
-            }
+            line_list(&unchecked_lines)
         ));
     }
     // What the program's header says against this scan, first.
@@ -1169,6 +1159,21 @@ pub fn check_gcode(
         outer_diameter_mm: nozzle.outer_diameter_mm,
         moves: program.moves,
     })
+}
+
+/// G-code line numbers as a message lists them: the first ten, then
+/// "...".
+pub fn line_list(lines: &[usize]) -> String {
+    let mut s = lines
+        .iter()
+        .take(10)
+        .map(|l| l.to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    if lines.len() > 10 {
+        s.push_str(", ...");
+    }
+    s
 }
 
 /// What a pcpp program's own header says it was planned on, against the

@@ -71,18 +71,12 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         let lines = &check.unchecked_lines;
         return Err(Failure::Input(format!(
             "{head}; none of those comes closer than tol, but {} move(s) could not be checked \
-             (lines {}{}): the file does not give where they start or end, and they come lower \
+             (lines {}): the file does not give where they start or end, and they come lower \
              than tol above the scan's top, so the program is not shown to keep tol; give the \
              position before them (absolute G90 moves from a known point, or G92), or check \
              the program from where it starts printing",
             lines.len(),
-            lines
-                .iter()
-                .take(10)
-                .map(|l| l.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            if lines.len() > 10 { ", ..." } else { "" }
+            job::line_list(lines)
         )));
     }
     let mut s = format!(
