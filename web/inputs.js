@@ -5,7 +5,7 @@ import { checkProfile, checkScanSize, checkSvgSize } from '../pkg/pcpp.js';
 import { checkGcodeFile, drawCheckedMoves } from './check.js';
 import { $, hooks, settings, state } from './page.js';
 import {
-  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, setNote, showScanPlacement,
+  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, setNote, showScanPlacement, userPlacements,
 } from './placement.js';
 import {
   demoInfo, demoUiSettings, saveSettings, syncProfileOption, writeForm,
@@ -100,6 +100,10 @@ async function openSvg(file) {
     showError(`Could not open the SVG ${file.name}`, e.message, file.name);
     return;
   }
+  // The user may place the drawing while its bytes are read (type in
+  // Offset X right after choosing the file): that placement stands, it is
+  // not centred over (a typed 20 became the centre's 19.99999944).
+  const placed = userPlacements();
   let bytes;
   try {
     // Bytes go to wasm as a Uint8Array, never through a JS string.
@@ -112,8 +116,8 @@ async function openSvg(file) {
   const was = state.pendingSvg ? state.pendingSvg.pathSource : settings.pathSource;
   state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes, pathSource: was };
   settings.pathSource = 'file';
-  // A new drawing lands on the scan.
-  requestCentre(true);
+  // A new drawing lands on the scan, unless the user placed it meanwhile.
+  if (userPlacements() === placed) requestCentre(true);
   saveSettings();
   writeForm();
   hooks.schedulePlan(0);

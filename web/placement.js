@@ -179,10 +179,16 @@ export function onCentred(m, busy) {
   ctx.writeForm();
 }
 
+// How many times the user placed the drawing: a drawing read meanwhile is
+// not centred over their placement (inputs.js).
+let placedByUser = 0;
+export const userPlacements = () => placedByUser;
+
 // The user moved or turned the drawing, or set its scale: nothing is
 // centred over it; the note stays while the scale is still the one the
 // page fitted (a move or turn leaves it so).
 export function userPlaced() {
+  placedByUser++;
   cancelCentre();
   showFitNote();
 }

@@ -233,13 +233,41 @@ const FIELDS = [
   ['accept-risk', () => settings.acceptRisk, (v) => { settings.acceptRisk = v; }],
 ];
 
-export function writeForm() {
-  for (const [id, get] of FIELDS) {
-    const el = $(id);
-    const v = get();
-    if (el.type === 'checkbox') el.checked = !!v;
-    else el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+// A setting as its field's text.
+const fieldText = (v) => (v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v));
+
+// Fields the page changed while the user was in them, not yet rewritten.
+// A field with the caret is not rewritten: writing it drops the user's
+// selection, so what they type next is added to the page's number (a
+// drawing centred while Offset X was selected for typing read
+// '19.99999944368998' + '20'). It is written when the user leaves it,
+// unless they typed in it since: then it holds their value.
+const unsynced = new Set();
+
+// Whether `el` is a field the user may be typing in now.
+const typingIn = (el) => el === document.activeElement
+  && (el.tagName === 'TEXTAREA' || (el.tagName === 'INPUT' && !['checkbox', 'range'].includes(el.type)));
+
+// Writes field `id` (element `el`) from the setting `v`, except under the
+// user's cursor (see `unsynced`).
+function putField(id, el, v) {
+  if (el.type === 'checkbox') {
+    el.checked = !!v;
+    return;
   }
+  const text = fieldText(v);
+  if (el.value === text) {
+    unsynced.delete(id);
+  } else if (typingIn(el)) {
+    unsynced.add(id);
+  } else {
+    el.value = text;
+    unsynced.delete(id);
+  }
+}
+
+export function writeForm() {
+  for (const [id, get] of FIELDS) putField(id, $(id), get());
   syncGauge();
   syncVisibility();
 }
@@ -271,19 +299,18 @@ const PAIRS = { 'pl-rot': 'pl-rot-range', 'pl-rot-range': 'pl-rot', 'pl-scale': 
 // would rewrite "1." as "1" under the user's cursor).
 export function writeField(id) {
   const f = FIELDS.find((x) => x[0] === id);
-  if (!f) return;
-  const el = $(id);
-  const v = f[1]();
-  el.value = v === null || v === undefined || (typeof v === 'number' && Number.isNaN(v)) ? '' : String(v);
+  if (f) putField(id, $(id), f[1]());
 }
 
 export function bindForm() {
-  for (const [id, , set, mode] of FIELDS) {
+  for (const [id, get, set, mode] of FIELDS) {
     const el = $(id);
     // Antenna SVGs measure from their page's corner, so a new size moves
     // the antenna; keep its centre where the user placed it.
     const antennaField = /^(sp|hb|mp)-/.test(id);
     const handler = () => {
+      // Typed in: the field holds the user's value, not one to write.
+      unsynced.delete(id);
       // An antenna's size is physical: one the page shrank to fit the scan
       // is fitted again at its new size from the user's scale (kept
       // shrunk, an 8 mm loop was printed at 83 %, under the note of the
@@ -325,6 +352,10 @@ export function bindForm() {
       }
     };
     el.addEventListener(mode || el.tagName === 'TEXTAREA' ? 'input' : 'change', handler);
+    // Left without typing: the page's value it was not written with.
+    el.addEventListener('blur', () => {
+      if (unsynced.delete(id)) el.value = fieldText(get());
+    });
     if (mode === 'live') {
       // The slider is let go: plan once more with the comparison.
       el.addEventListener('change', () => hooks.endInteraction());

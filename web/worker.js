@@ -150,6 +150,24 @@ async function loadScan(m) {
     [positions.buffer, indices.buffer]);
 }
 
+// The centred placement as the page shows it in its fields and plans it.
+// The core's numbers carry the drawing's import noise: usvg holds an SVG's
+// mm-to-px scale in f32, so every coordinate comes in 1 + 2.8e-8 times too
+// large (a 40 mm track's box centre at 20.00000056 mm), and centred on the
+// demo part's middle (40 mm) it lay at 19.99999944368998 mm, shown with all
+// its digits where the user would type 20. Offsets are kept to 1e-4 mm (as
+// a drawing carried with its scan, placement.js), a scale the core fitted
+// to 6 significant digits; a scale it kept (`sent`) and the rotation are
+// the user's, untouched.
+function shownPlacement(p, sent) {
+  const mm = (v) => Math.round(v * 1e4) / 1e4 + 0; // + 0: no -0 in a field
+  return {
+    offset_mm: [mm(p.offset_mm[0]), mm(p.offset_mm[1])],
+    rotation_deg: p.rotation_deg,
+    scale: p.scale === sent ? p.scale : Number(p.scale.toPrecision(6)),
+  };
+}
+
 async function plan(m) {
   const { id } = m;
   const key = JSON.stringify([m.scan.key, m.scanSettings, m.registration]);
@@ -173,8 +191,9 @@ async function plan(m) {
       // (1 for a new drawing), not from one fitted to another scan.
       const c = session.centreDrawing({ ...m.plan.placement, scale: m.centre.scale });
       if (c) {
-        m.plan.placement = c.placement;
-        post({ type: 'centred', id, placement: c.placement, note: c.note });
+        const placement = shownPlacement(c.placement, m.centre.scale);
+        m.plan.placement = placement;
+        post({ type: 'centred', id, placement, note: c.note });
       }
     }
     progress(id, 'plan', m.compare ? 'planning and comparing every planner' : 'planning');

@@ -172,15 +172,16 @@ const TRACK_SVG = `<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="
 </svg>
 `;
 
-// The values of every setting field of the page. A number field's text is
-// compared as the number it holds: Chromium may write the same double with
-// another number of digits ('19.9999994436899820' before a reload,
-// '19.999999443689983' after it, one CI run in several).
+// The values of every setting field of the page, as their text: what the
+// user typed is what they see again. (One CI run read Offset X as
+// '19.9999994436899820' before the reload and '19.999999443689983' after
+// it: the page had written its centring of track.svg, 19.99999944368998,
+// into the field Playwright had selected to type in, and the typed '20'
+// went after it; typed.test.mjs pins that.)
 const formValues = (page) => page.evaluate(() => Object.fromEntries(
   [...document.querySelectorAll('.side input, .side select, .side textarea')]
     .filter((el) => el.id && el.type !== 'file')
-    .map((el) => [el.id, el.type === 'checkbox' ? el.checked
-      : el.type === 'number' && el.value !== '' ? String(Number(el.value)) : el.value]),
+    .map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]),
 ));
 
 test('a failed plan keeps the inputs and settings, also across a reload; fixing the setting plans them', async () => {
