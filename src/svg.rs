@@ -1,7 +1,7 @@
 //! SVG drawn paths (spec "Inputs", T2D): every subpath of every painted
 //! shape, flattened finely, in millimetres with y up.
 //!
-//! Length: about 2,200 lines before its tests, in one file on purpose: the
+//! Length: about 2,400 lines before its tests, in one file on purpose: the
 //! usvg tree walk, the f64 re-reading of path data, the flattening of
 //! curves and their dashes share the transform and unit state of each
 //! element.
@@ -25,6 +25,10 @@
 //!   patterns that draw no dashes print solid, with a note.
 //! - Path data is read up to its first error, as SVG viewers draw it, with
 //!   a note naming the element, the character and the text there.
+//! - A `polyline`'s or `polygon`'s `points` likewise: x,y pairs up to the
+//!   first word that is not a number, a lone last x dropped, nothing drawn
+//!   with fewer than 2 points; a note names the file, the element, the word
+//!   or the odd count of numbers, and the points kept.
 //!
 //! ## Limitations
 //! - Text is not converted to paths (no fonts are loaded); images, markers
@@ -350,6 +354,8 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // Shapes whose path data stops at an error, by shape index (once for
     // all `use` instances of one).
     let mut data_errors: std::collections::BTreeSet<usize> = Default::default();
+    // Likewise polylines and polygons whose points are not drawn whole.
+    let mut points_errors: std::collections::BTreeSet<usize> = Default::default();
     // (shapes, pieces, the first) dashed; (shape, pattern, why) printed solid.
     let mut dashed = (0usize, 0usize, None::<String>);
     let mut solid: Vec<(String, String, String)> = Vec::new();
@@ -407,6 +413,9 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         if let Some(i) = shape_index {
             if shape.is_some_and(|s| s.d_read.as_ref().is_some_and(|r| r.error.is_some())) {
                 data_errors.insert(i);
+            }
+            if shape.is_some_and(|s| s.points_read.as_ref().is_some_and(|r| !r.1.is_whole())) {
+                points_errors.insert(i);
             }
         }
         let stretch = max_stretch(to_mm.matrix2);
@@ -515,6 +524,10 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         {
             data_errors.insert(i);
         }
+        // usvg leaves out a polyline or polygon of fewer than 2 points.
+        if s.rendered && s.points_read.as_ref().is_some_and(|r| !r.1.draws()) {
+            points_errors.insert(i);
+        }
     }
     if !data_errors.is_empty() {
         let listed: Vec<String> = data_errors
@@ -557,6 +570,38 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 String::new()
             }
         ));
+    }
+
+    // The note names the file (its warnings are listed with the scan's in
+    // the report); an error quoting it, which names the file itself, gets
+    // it without.
+    let mut points_note = None;
+    if !points_errors.is_empty() {
+        let listed: Vec<String> = points_errors
+            .iter()
+            .take(MAX_NAMED)
+            .filter_map(|&i| {
+                let (element, read) = prepared.shapes.get(i)?.points_read.as_ref()?;
+                Some(points_problem(element, read))
+            })
+            .collect();
+        let more = points_errors.len().saturating_sub(listed.len());
+        let note = |file: &str| {
+            format!(
+                "{} polyline/polygon(s){file} have points SVG draws only in part or not at all \
+                 ({}{}): each is printed up to its last whole x,y pair before the problem, as \
+                 SVG viewers draw it; correct the points attribute there",
+                points_errors.len(),
+                listed.join("; "),
+                if more > 0 {
+                    format!("; and {more} more")
+                } else {
+                    String::new()
+                }
+            )
+        };
+        points_note = Some((notes.len(), note("")));
+        notes.push(note(&format!(" in {file}")));
     }
 
     if unpainted > 0 {
@@ -605,6 +650,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         ));
     }
     if out.is_empty() {
+        let mut notes = notes.clone();
+        if let Some((at, without_file)) = points_note {
+            if let Some(note) = notes.get_mut(at) {
+                *note = without_file;
+            }
+        }
         let unused = &prepared.unused;
         let reason = if unused.shapes > 0 {
             let first = unused.ids.first().map_or("its-id", String::as_str);
@@ -643,7 +694,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             )
         } else if notes.is_empty() {
             "no visible shape with a stroke or fill (the document contains no shapes)".to_string()
-        } else if !data_errors.is_empty() {
+        } else if !(data_errors.is_empty() && points_errors.is_empty()) {
             format!("no shape is left to draw ({})", notes.join("; "))
         } else {
             format!(
@@ -682,6 +733,9 @@ struct ShapeInfo {
     d: Option<String>,
     /// How far usvg reads that `d` (svgtypes, the parser it reads it with).
     d_read: Option<PathDataRead>,
+    /// How far usvg reads the `points` of a `polyline` or `polygon`, and the
+    /// element as a note names it (its kind and id, or its label).
+    points_read: Option<(String, PointsRead)>,
     /// The `stroke-dasharray` the shape has or inherits, as written in an
     /// attribute or a `style` (not from a stylesheet): tells a pattern usvg
     /// dropped (it then draws the stroke solid) from no pattern at all.
@@ -786,6 +840,117 @@ fn read_path_data(d: &str) -> PathDataRead {
         }
     }
     read
+}
+
+/// How far usvg reads a `polyline`'s or `polygon`'s `points`: svgtypes'
+/// `PointsParser` takes x,y pairs up to the first text that is not a number
+/// and drops a lone x at the end (as browsers do, SVG 2 "error handling":
+/// render up to the error), and usvg draws nothing with fewer than 2 points.
+#[derive(Debug, Clone, PartialEq)]
+struct PointsRead {
+    /// Numbers read before the end or the error.
+    numbers: usize,
+    /// The last of them (an x with no y when `numbers` is odd) and the
+    /// first point, for the note.
+    last: f64,
+    first: (f64, f64),
+    /// Where the reading stops at text that is not a number: the character
+    /// (1-based, as svgtypes counts) and the word there ("" for a comma).
+    error: Option<(usize, String)>,
+}
+
+impl PointsRead {
+    /// The points usvg keeps.
+    fn points(&self) -> usize {
+        self.numbers / 2
+    }
+
+    fn draws(&self) -> bool {
+        self.points() >= 2
+    }
+
+    /// Drawn as written: nothing dropped and enough to draw.
+    fn is_whole(&self) -> bool {
+        self.error.is_none() && self.numbers.is_multiple_of(2) && self.draws()
+    }
+}
+
+/// Reads `points` number by number with svgtypes' `NumberListParser`: the
+/// same `parse_list_number` calls, in the same order, as the
+/// `PointsParser` usvg draws with, so the count is usvg's, with the place
+/// of the error.
+fn read_points(points: &str) -> PointsRead {
+    let mut read = PointsRead {
+        numbers: 0,
+        last: 0.0,
+        first: (0.0, 0.0),
+        error: None,
+    };
+    for n in svgtypes::NumberListParser::from(points) {
+        match n {
+            Ok(v) => {
+                match read.numbers {
+                    0 => read.first.0 = v,
+                    1 => read.first.1 = v,
+                    _ => {}
+                }
+                read.numbers += 1;
+                read.last = v;
+            }
+            Err(e) => {
+                let at = match e {
+                    svgtypes::Error::InvalidNumber(at) => at,
+                    _ => points.chars().count() + 1,
+                };
+                let rest: String = points.chars().skip(at.saturating_sub(1)).collect();
+                // Trailing separators ("1,2 3,4, ") lose nothing: no note.
+                if rest.chars().all(|c| c.is_whitespace() || c == ',') {
+                    break;
+                }
+                let mut word: String = rest
+                    .chars()
+                    .take_while(|&c| !(c.is_whitespace() || c == ','))
+                    .take(EXCERPT_CHARS + 1)
+                    .collect();
+                if word.chars().count() > EXCERPT_CHARS {
+                    word = word.chars().take(EXCERPT_CHARS).collect::<String>() + "...";
+                }
+                read.error = Some((at, word));
+                break;
+            }
+        }
+    }
+    read
+}
+
+/// The part of the points note on one element: what stops the reading and
+/// what is left of it.
+fn points_problem(element: &str, read: &PointsRead) -> String {
+    let kept = match read.points() {
+        0 => "no point kept: not printed".to_string(),
+        1 => "1 point kept, 2 are needed to draw: not printed".to_string(),
+        n => format!("{n} points kept"),
+    };
+    match &read.error {
+        Some((at, word)) if word.is_empty() => format!(
+            "{element} at character {at}: two commas in a row (SVG allows one between \
+             numbers); {kept}"
+        ),
+        Some((at, word)) => {
+            format!("{element} at character {at}: '{word}' is not a number; {kept}")
+        }
+        None if !read.numbers.is_multiple_of(2) => format!(
+            "{element}: {} number{}, an odd count (the last, {}, is an x with no y); {kept}",
+            read.numbers,
+            if read.numbers == 1 { "" } else { "s" },
+            read.last
+        ),
+        None if read.numbers == 0 => format!("{element}: no points; not printed"),
+        None => format!(
+            "{element}: only 1 point ({}, {}); 2 are needed to draw: not printed",
+            read.first.0, read.first.1
+        ),
+    }
 }
 
 /// The `stroke-dasharray` an element has or inherits from its ancestors,
@@ -1224,7 +1389,9 @@ fn prepare(text: &str) -> Result<Prepared, String> {
                 }
             }
         };
-        let label = key.as_ref().map_or(fallback_label, |k| k.1.clone());
+        let label = key
+            .as_ref()
+            .map_or_else(|| fallback_label.clone(), |k| k.1.clone());
         let d = (kind == ShapeKind::Path)
             .then(|| node.attribute("d").map(str::to_string))
             .flatten();
@@ -1264,11 +1431,23 @@ fn prepare(text: &str) -> Result<Prepared, String> {
                 }
             }
         }
+        let points_read = matches!(name, "polyline" | "polygon")
+            .then(|| node.attribute("points"))
+            .flatten()
+            .map(|points| {
+                let element = if label == fallback_label {
+                    format!("'{label}'")
+                } else {
+                    format!("{name} '{label}'")
+                };
+                (element, read_points(points))
+            });
         let shape = shapes.len();
         shapes.push(ShapeInfo {
             label,
             kind,
             d_read: d.as_deref().map(read_path_data),
+            points_read,
             d,
             dasharray: written_dasharray(node),
             rendered,
@@ -2387,6 +2566,51 @@ mod tests {
                 .count();
             assert_eq!(ours, usvg, "{d}");
         }
+    }
+
+    /// The points note counts what usvg draws: the pairs svgtypes'
+    /// `PointsParser` (usvg's reader) yields, valid, tricky and broken.
+    #[test]
+    fn points_stop_where_usvg_stops() {
+        for points in [
+            "",
+            " ",
+            "0,0 10,0 10,x 20,20",
+            "0,0 10,0 10,10 20",
+            "+1e1-2E-1 1.5.5-.5,20",
+            "1-2-3-4",
+            "1e+1,2e-0 .5.5 3.",
+            "1,2,,3,4",
+            "1 2 3 4,",
+            "1 2 3 4 , ,",
+            "1 2 1e 4",
+            "1 2 1em 4",
+            "1 2 3 4\u{a0}",
+            "1 2 NaN 4",
+            "1 2 inf 4",
+            "1,2;3,4",
+            "\u{e9}1 2",
+            "1 2 \u{1F600} 3 4",
+            "-",
+            ",1 2 3 4",
+        ] {
+            let read = read_points(points);
+            let usvg = svgtypes::PointsParser::from(points).count();
+            assert_eq!(read.points(), usvg, "{points:?}");
+            if let Some((at, word)) = &read.error {
+                // The character svgtypes names is where the word starts.
+                let from: String = points.chars().skip(at - 1).collect();
+                assert!(from.starts_with(word.as_str()), "{points:?}: {at} {word:?}");
+            }
+        }
+        assert_eq!(
+            read_points("0,0 10,0 10,x 20,20").error,
+            Some((13, "x".to_string()))
+        );
+        assert_eq!(read_points("1,2,,3,4").error, Some((5, String::new())));
+        assert!(read_points("1 2 3 4 , ,").is_whole());
+        assert!(read_points("+1e1-2E-1 1.5.5-.5,20").is_whole());
+        assert_eq!(read_points("1 2 1e 4").error, Some((5, "1e".to_string())));
     }
 
     #[test]

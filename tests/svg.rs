@@ -1081,6 +1081,123 @@ fn double_comma_in_path_data_read_unlike_svg() {
     );
 }
 
+/// A `<polyline>` whose `points` hold a word (`10,x`) was printed up to it
+/// without a word: 2 of its 5 points. SVG draws up to the error, so the same
+/// part is printed, and a note names the file, the element, the character,
+/// the word and the points kept.
+#[test]
+fn polyline_points_error_truncated_silently() {
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<polyline points="0,0 10,0 10,x 20,20 30,30" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert_eq!(subs[0].points.len(), 2, "{subs:?}");
+    assert_near(subs[0].points[1], v(10.0, 0.0), 1e-5);
+    let note = note_with(&notes, "points");
+    assert!(
+        note.starts_with("1 polyline/polygon(s) in qa.svg ")
+            && note.contains("'polyline #1' at character 13: 'x' is not a number; 2 points kept"),
+        "{note}"
+    );
+}
+
+/// `points="0,0 10,0 10,10 20"`: the lone 20 (an x with no y) was dropped
+/// without a word. It still is, as SVG drops it, with a note giving the odd
+/// count and the points kept; an id names the element with its kind.
+#[test]
+fn odd_coordinate_count_in_points_dropped_silently() {
+    let (subs, notes) = notes_of(&doc(
+        PAGE_40,
+        r#"<polygon id="tri" points="0,0 10,0 10,10 20" stroke="black" fill="none"/>"#,
+    ));
+    assert_eq!(subs.len(), 1);
+    assert!(subs[0].closed);
+    assert_eq!(subs[0].points.len(), 4, "{subs:?}");
+    let note = note_with(&notes, "points");
+    assert!(
+        note.contains("polygon 'tri': 7 numbers, an odd count (the last, 20, is an x with no y); 3 points kept"),
+        "{note}"
+    );
+}
+
+/// `points` that leave fewer than 2 points draw nothing: beside another
+/// shape the element vanished without a word; alone, the error said the
+/// document "contains no shapes". Both now say why, once per element, and
+/// the error names the file once.
+#[test]
+fn points_too_few_to_draw_are_named() {
+    let cases = [
+        ("", "'polyline #1': no points; not printed"),
+        ("  ", "'polyline #1': no points; not printed"),
+        ("5,5", "'polyline #1': only 1 point (5, 5); 2 are needed to draw: not printed"),
+        ("a,b", "'polyline #1' at character 1: 'a' is not a number; no point kept: not printed"),
+        ("1,2 3", "'polyline #1': 3 numbers, an odd count (the last, 3, is an x with no y); 1 point kept, 2 are needed to draw: not printed"),
+        ("1,2,,3,4", "'polyline #1' at character 5: two commas in a row (SVG allows one between numbers); 1 point kept, 2 are needed to draw: not printed"),
+    ];
+    for (points, expected) in cases {
+        let alone = format!(r#"<polyline points="{points}" stroke="black" fill="none"/>"#);
+        let e = import_error(&doc(PAGE_40, &alone));
+        assert!(
+            e.starts_with("qa.svg: nothing printable: no shape is left to draw (1 polyline")
+                && e.contains(expected)
+                && e.matches("qa.svg").count() == 1,
+            "{points:?}: {e}"
+        );
+        let beside = format!(r#"{alone}<line x1="0" y1="5" x2="10" y2="5" stroke="black"/>"#);
+        let (subs, notes) = notes_of(&doc(PAGE_40, &beside));
+        assert_eq!(subs.len(), 1, "{points:?}");
+        let note = note_with(&notes, "points");
+        assert!(note.contains(expected), "{points:?}: {note}");
+    }
+}
+
+/// Valid point lists in SVG's number syntax (commas and/or whitespace,
+/// signs, exponents, "1.5.5" as 1.5 and .5, "1-2" as 1 and -2, trailing
+/// separators) give no note and every point.
+#[test]
+fn tricky_but_valid_points_get_no_note() {
+    let cases: [(&str, &[(f64, f64)]); 7] = [
+        ("0,0 10,0 10,10", &[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)]),
+        (
+            "0 0,10 0\n\t10\r\n10 ",
+            &[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
+        ),
+        (
+            "  0,0,10,0 , 10 , 10,",
+            &[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
+        ),
+        (
+            "+1e1-2E-1 1.5.5-.5,20",
+            &[(10.0, -0.2), (1.5, 0.5), (-0.5, 20.0)],
+        ),
+        ("1-2-3-4", &[(1.0, -2.0), (-3.0, -4.0)]),
+        (
+            "1e+1,2e-0 .5.5 3.,4",
+            &[(10.0, 2.0), (0.5, 0.5), (3.0, 4.0)],
+        ),
+        (
+            "0,0 10,0 10,10 ,  ",
+            &[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
+        ),
+    ];
+    for (points, expected) in cases {
+        let text = doc(
+            PAGE_40,
+            &format!(r#"<polyline points="{points}" stroke="black" fill="none"/>"#),
+        );
+        let (subs, notes) = notes_of(&text);
+        assert!(notes.is_empty(), "{points:?}: {notes:?}");
+        assert_eq!(subs.len(), 1, "{points:?}");
+        let got = &subs[0].points;
+        assert_eq!(got.len(), expected.len(), "{points:?}: {got:?}");
+        for (&p, &(x, y)) in got.iter().zip(expected) {
+            // y up: SVG's y is negated.
+            assert_near(p, v(x, -y), 1e-5);
+        }
+    }
+}
+
 /// QA `feather-sprite.svg` (287 `<symbol>`s, no `<use>`): the error said
 /// the document contains no shapes. It now says where they are, why they
 /// draw nothing, and how to print one.
@@ -1211,6 +1328,10 @@ fn hostile_dashes_and_path_data_do_not_panic() {
         r#"<path d="M0 0 L 1" stroke="black"/>"#.to_string(),
         r#"<path d="Z" stroke="black"/>"#.to_string(),
         r#"<path d=",,," stroke="black"/>"#.to_string(),
+        format!(r#"<polyline points="{}x" stroke="black"/>"#, "1,".repeat(50_000)),
+        format!(r#"<polygon points="0 0 1 1 {long_garbage}" stroke="black"/>"#),
+        r#"<polygon points="\u{e9}" stroke="black"/>"#.to_string(),
+        r#"<polyline points="1e38,1e38 -1e38,-1e38 x" stroke="black"/>"#.to_string(),
     ];
     for body in &cases {
         for size in [MM, r#"width="100%" viewBox="0 0 -1 1e-40""#] {
