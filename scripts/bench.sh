@@ -219,8 +219,10 @@ out.push(`(a) The importer alone, in wasm the page's importScan (web/worker.js's
   `from the OBJ's bytes (hash, import, holes, index): ${f(wasm.obj_session_mb_s, 0)} MB/s in ` +
   `wasm, ${f(obj.bytes / 1e6 / objSessionS, 0)} MB/s natively.`);
 out.push('');
-out.push(`(b) Session.plan: the plan, its report and G-code, converted to JS; ` +
-  `the same job natively: W2 ${ms(w2JobS)}, W3 ${ms(w3JobS)}.`);
+out.push(`(b) Session.plan: the plan, its report and G-code, the G-code converted to JS, the ` +
+  `report kept and its JSON not written (the page writes it only for a download, as the CLI ` +
+  `only with --report; W3's is 35.6 MB); the same job natively (job::run_on): W2 ${ms(w2JobS)}, ` +
+  `W3 ${ms(w3JobS)}.`);
 out.push('');
 out.push(`(c) Peak resident set (VmHWM) of examples/peak_memory.rs, which prepares the scan as ` +
   `the CLI does (job::prepare_scan_owned: the file's bytes freed once read, then the mesh, its ` +

@@ -235,7 +235,7 @@ fn js<T: serde::Serialize>(v: &T) -> JsValue {
 #[wasm_bindgen_test]
 fn session_plans_the_golden_gcode_and_the_cli_report() {
     let settings = golden_settings();
-    let session = pcpp::wasm::Session::new(
+    let mut session = pcpp::wasm::Session::new(
         &demo::demo_scan_bytes(),
         demo::DEMO_SCAN_NAME,
         js(&settings.scan),
@@ -250,6 +250,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
             js(&settings.plan),
             "marlin",
             false,
+            None,
             None,
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
@@ -274,10 +275,69 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
             "marlin",
             false,
             None,
+            None,
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let g2 = js_sys::Reflect::get(&again, &"gcode".into()).unwrap();
     assert_ne!(g2.as_string().unwrap(), GOLDEN_MARLIN);
+}
+
+/// A plan that leaves its report for later: the same bytes when asked for,
+/// and only while no later such plan replaced it.
+#[wasm_bindgen_test]
+fn a_report_left_for_later_is_the_same_bytes_and_kept_until_the_next_plan() {
+    let settings = golden_settings();
+    let mut session = pcpp::wasm::Session::new(
+        &demo::demo_scan_bytes(),
+        demo::DEMO_SCAN_NAME,
+        js(&settings.scan),
+        js(&settings.registration),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let svg = test_part::test_part_svg();
+    let plan = |session: &mut pcpp::wasm::Session,
+                with_report: Option<bool>,
+                settings: &pcpp::pipeline::PlanSettings| {
+        session
+            .plan(
+                svg.as_bytes(),
+                demo::DEMO_PATH_NAME,
+                js(settings),
+                "marlin",
+                false,
+                None,
+                with_report,
+            )
+            .unwrap_or_else(|e| panic!("{e:?}"))
+    };
+    let get = |v: &JsValue, k: &str| js_sys::Reflect::get(v, &k.into()).unwrap();
+    let whole = plan(&mut session, Some(true), &settings.plan);
+    let expected = get(&whole, "report_json").as_string().unwrap();
+    let absent = |v: JsValue| v.is_null() || v.is_undefined();
+    assert!(absent(get(&whole, "report_id")));
+    let later = plan(&mut session, Some(false), &settings.plan);
+    assert!(absent(get(&later, "report_json")));
+    assert_eq!(get(&later, "gcode").as_string().unwrap(), GOLDEN_MARLIN);
+    let id = get(&later, "report_id").as_f64().unwrap() as u32;
+    let mut moved = settings.plan;
+    moved.placement.offset_mm.x += 1.0;
+    let next = plan(&mut session, Some(false), &moved);
+    let next_id = get(&next, "report_id").as_f64().unwrap() as u32;
+    assert_ne!(id, next_id);
+    // The first is gone, the second is the moved plan's.
+    let err = session
+        .report_json(id)
+        .expect_err("replaced by the next plan");
+    let message = js_sys::Reflect::get(&err, &"message".into()).unwrap();
+    assert!(message.as_string().unwrap().contains("no longer kept"));
+    let moved_report = String::from_utf8(session.report_json(next_id).unwrap()).unwrap();
+    assert_ne!(moved_report, expected);
+    // Asked again for the first settings: the bytes of the report written
+    // at once.
+    let again = plan(&mut session, Some(false), &settings.plan);
+    let again_id = get(&again, "report_id").as_f64().unwrap() as u32;
+    let bytes = session.report_json(again_id).unwrap();
+    assert_eq!(String::from_utf8(bytes).unwrap(), expected);
 }
 
 #[wasm_bindgen_test]
@@ -318,7 +378,7 @@ fn session_errors_name_the_cause_and_the_stage() {
     assert_eq!(kind.as_string().as_deref(), Some("registration"));
 
     // Unknown dialect and bad settings objects are errors, not panics.
-    let ok = pcpp::wasm::Session::new(
+    let mut ok = pcpp::wasm::Session::new(
         small_obj().as_bytes(),
         "sheet.obj",
         js(&none.scan),
@@ -327,7 +387,15 @@ fn session_errors_name_the_cause_and_the_stage() {
     .unwrap_or_else(|e| panic!("{e:?}"));
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M1 5 L9 5"/></svg>"#;
     assert!(ok
-        .plan(svg, "l.svg", js(&none.plan), "no-such-dialect", false, None)
+        .plan(
+            svg,
+            "l.svg",
+            js(&none.plan),
+            "no-such-dialect",
+            false,
+            None,
+            None
+        )
         .is_err());
     assert!(ok
         .plan(
@@ -336,6 +404,7 @@ fn session_errors_name_the_cause_and_the_stage() {
             JsValue::from_str("nonsense"),
             "marlin",
             false,
+            None,
             None
         )
         .is_err());
@@ -344,7 +413,7 @@ fn session_errors_name_the_cause_and_the_stage() {
 #[wasm_bindgen_test]
 fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
     let settings = golden_settings();
-    let session = pcpp::wasm::Session::new(
+    let mut session = pcpp::wasm::Session::new(
         &demo::demo_scan_bytes(),
         demo::DEMO_SCAN_NAME,
         js(&settings.scan),
@@ -370,6 +439,7 @@ fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
             &text,
             false,
             Some("my-printer.json".into()),
+            None,
         )
         .unwrap_or_else(|e| panic!("{e:?}"));
     let gcode = js_sys::Reflect::get(&out, &"gcode".into())
@@ -388,6 +458,7 @@ fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
             &bad,
             false,
             Some("bad.json".into()),
+            None,
         )
         .expect_err("a profile with a bad field must not plan");
     let message = js_sys::Reflect::get(&err, &"message".into())
@@ -511,7 +582,7 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
             )
             .unwrap();
             let out = session
-                .plan_live(js(&plan), "grbl", accept, None, step == 0)
+                .plan_live(js(&plan), "grbl", accept, None, step == 0, None)
                 .unwrap_or_else(|e| panic!("{e:?}"));
             // Compared without printing: a G-code file fills the screen.
             assert!(
@@ -637,14 +708,14 @@ fn a_failed_registration_keeps_the_import_and_bad_paths_keep_the_drawing() {
 
     // No drawing yet: an error, not a panic.
     assert!(session
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .is_err());
     let svg = test_part::test_part_svg();
     session
         .set_path(svg.as_bytes(), demo::DEMO_PATH_NAME)
         .unwrap();
     let first = session
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .unwrap();
     // A broken SVG names the file (kind svg) and the previous drawing stays.
     let err = session
@@ -654,7 +725,7 @@ fn a_failed_registration_keeps_the_import_and_bad_paths_keep_the_drawing() {
     assert_eq!(kind, "svg");
     assert!(message.contains("broken.svg"), "{message}");
     let again = session
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .unwrap();
     assert_eq!(
         bytes_text(&get(&again, "gcode")),
@@ -708,7 +779,7 @@ fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
     let mut plan = settings.plan;
     plan.placement.scale = 1000.0;
     let err = session
-        .plan_live(js(&plan), "marlin", false, None, false)
+        .plan_live(js(&plan), "marlin", false, None, false, None)
         .expect_err("past the page's sample limit");
     let (message, kind) = message_and_kind(&err);
     assert_eq!(kind, "limit", "{message}");
@@ -720,7 +791,7 @@ fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
     // per subpath: the core's own message (sampling.rs), as the CLI prints it.
     plan.placement.scale = 50_000.0;
     let err = session
-        .plan_live(js(&plan), "marlin", false, None, false)
+        .plan_live(js(&plan), "marlin", false, None, false, None)
         .expect_err("past the core's sample limit");
     let (message, _) = message_and_kind(&err);
     assert!(
@@ -804,7 +875,7 @@ fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
     let mut plan = settings.plan;
     plan.planner = PlannerKind::Slope;
     let err = session
-        .plan_live(js(&plan), "marlin", false, None, true)
+        .plan_live(js(&plan), "marlin", false, None, true, None)
         .expect_err("slope runs into the steps' walls");
     let (message, kind) = message_and_kind(&err);
     assert_eq!(kind, "touching");
@@ -834,14 +905,14 @@ fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
     }
     // Without the comparison, none is attached.
     let err = session
-        .plan_live(js(&plan), "marlin", false, None, false)
+        .plan_live(js(&plan), "marlin", false, None, false, None)
         .err()
         .unwrap();
     assert!(get(&err, "comparison").is_undefined());
 
     // Accepted: written, and said so in the summary and the G-code header.
     let out = session
-        .plan_live(js(&plan), "marlin", true, None, false)
+        .plan_live(js(&plan), "marlin", true, None, false, None)
         .unwrap_or_else(|e| panic!("{e:?}"));
     let summary = get(&out, "summary");
     let motion: job::MotionReport =
@@ -854,7 +925,7 @@ fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
 
     // The default planner clears the steps.
     let out = session
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .unwrap_or_else(|e| panic!("{e:?}"));
     let motion: job::MotionReport =
         serde_wasm_bindgen::from_value(get(&get(&out, "summary"), "motion")).unwrap();
@@ -1076,7 +1147,7 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
     assert!(centred["note"].is_null(), "{centred}");
     settings.plan.placement = serde_json::from_value(centred["placement"].clone()).unwrap();
     let out = placed
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .unwrap_or_else(|e| panic!("{e:?}"));
     let gcode = bytes_text(&get(&out, "gcode"));
     assert!(
@@ -1099,7 +1170,7 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
     settings.registration.scan_placement = pcpp::placement::ScanPlacement::on_bed(&marlin);
     let centre = pcpp::placement::Bed::of_profile(&marlin).centre_mm;
     settings.plan.placement.offset_mm = centre - pcpp::DVec2::new(6.0, 1.0);
-    let session = pcpp::wasm::Session::new(
+    let mut session = pcpp::wasm::Session::new(
         text.as_bytes(),
         "pebble.xyz",
         js(&settings.scan),
@@ -1108,7 +1179,15 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
     .unwrap_or_else(|e| panic!("{e:?}"));
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="12mm" height="2mm" viewBox="0 0 12 2"><path d="M0 1 H12" fill="none" stroke="black"/></svg>"#;
     let err = session
-        .plan(svg, "line.svg", js(&settings.plan), "marlin", false, None)
+        .plan(
+            svg,
+            "line.svg",
+            js(&settings.plan),
+            "marlin",
+            false,
+            None,
+            None,
+        )
         .expect_err("G-code written for a whole object's cloud");
     let (message, kind) = message_and_kind(&err);
     assert_eq!(kind, "whole-object", "{message}");
@@ -1117,7 +1196,15 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
         "{message}"
     );
     session
-        .plan(svg, "line.svg", js(&settings.plan), "marlin", true, None)
+        .plan(
+            svg,
+            "line.svg",
+            js(&settings.plan),
+            "marlin",
+            true,
+            None,
+            None,
+        )
         .unwrap_or_else(|e| panic!("{e:?}"));
 }
 
@@ -1172,7 +1259,7 @@ fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
         .set_path(part.svg().as_bytes(), "block.svg")
         .unwrap_or_else(|e| panic!("{e:?}"));
     let out = session
-        .plan_live(js(&settings.plan), "marlin", false, None, false)
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .unwrap_or_else(|e| panic!("{e:?}"));
     let files = pcpp::mesh::ExternalFiles::new().with("block scan.bin", bin.clone());
     let native = job::prepare_scan_owned_with(

@@ -1,6 +1,7 @@
 // The downloads: the G-code and the report as the planner wrote them, and
 // the two clicks a G-code that touches the part needs.
 import { $, state } from './page.js';
+import { showError } from './status.js';
 
 // A press on a download link that ends the edit of a field re-planning on
 // change: the field's change hides the link under the pointer and the
@@ -12,6 +13,13 @@ const PRESS_KEPT_MS = 30_000;
 const GCODE_LABEL = 'Download G-code';
 const RISKY_LABEL = 'Download G-code (the nozzle touches the part)…';
 const CONFIRM_LABEL = 'Download anyway (the nozzle touches the part)';
+const REPORT_LABEL = 'Download report';
+const WRITING_LABEL = 'Writing the report…';
+
+// The report offered {plan, name, writing}: the worker writes its JSON
+// when the link is first clicked (tens of MB for a large drawing, not
+// written at every re-plan).
+let reportOffer = null;
 
 export function hideDownloads() {
   const g = $('dl-gcode');
@@ -25,6 +33,10 @@ export function hideDownloads() {
   g.classList.remove('risky', 'armed');
   g.removeAttribute('tabindex');
   state.risky = null;
+  const r = $('dl-report');
+  r.textContent = REPORT_LABEL;
+  r.removeAttribute('tabindex');
+  reportOffer = null;
   $('risk-warning').hidden = true;
 }
 
@@ -57,7 +69,12 @@ export function offerDownloads(plan) {
   } else {
     linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
   }
-  linkBytes($('dl-report'), plan.reportBytes, 'application/json', `${stem}-${plan.planner}.json`);
+  // No link until the report is written: focusable and pressed as one.
+  const r = $('dl-report');
+  reportOffer = { plan, name: `${stem}-${plan.planner}.json`, writing: false };
+  r.download = reportOffer.name;
+  r.tabIndex = 0;
+  r.hidden = false;
   const p = press;
   if (p && p.replanned) {
     press = null;
@@ -97,6 +114,31 @@ export function onGcodeClick(e) {
 }
 
 
+// A click on the report before it is written: the worker writes it, then
+// the link downloads it (a later click downloads the same bytes).
+async function onReportClick(e) {
+  const r = $('dl-report');
+  if (r.getAttribute('href')) return;
+  e.preventDefault();
+  const offer = reportOffer;
+  if (!offer || offer.writing) return;
+  offer.writing = true;
+  r.textContent = WRITING_LABEL;
+  try {
+    const bytes = await offer.plan.reportBytes();
+    // Another plan offered meanwhile: its own report is asked for.
+    if (reportOffer !== offer) return;
+    linkBytes(r, bytes, 'application/json', offer.name);
+    r.textContent = REPORT_LABEL;
+    r.click();
+  } catch (err) {
+    if (reportOffer === offer) r.textContent = REPORT_LABEL;
+    showError('Could not write the report', String((err && err.message) || err));
+  } finally {
+    offer.writing = false;
+  }
+}
+
 export function bindDownloads() {
   for (const id of ['dl-gcode', 'dl-report']) {
     const a = $(id);
@@ -110,6 +152,13 @@ export function bindDownloads() {
     if (press && !press.replanned) press = null;
   }, 0), true);
   $('dl-gcode').addEventListener('click', onGcodeClick);
+  $('dl-report').addEventListener('click', onReportClick);
+  $('dl-report').addEventListener('keydown', (e) => {
+    if (e.key === 'Enter' || e.key === ' ') {
+      e.preventDefault();
+      $('dl-report').click();
+    }
+  });
   $('dl-gcode').addEventListener('keydown', (e) => {
     // A touching plan's button has no link until confirmed: keys click it.
     if ((e.key === 'Enter' || e.key === ' ') && state.risky && !$('dl-gcode').classList.contains('armed')) {

@@ -192,16 +192,45 @@ function finish() {
   if (state.queued) runPlan();
 }
 
+// The JSON report of the plan `reportId` from the worker that made it
+// (generation `worker`), written there now: a promise of its bytes.
+function askReport(reportId, worker) {
+  if (worker !== state.workerGen) {
+    return Promise.reject(new Error('the planner was restarted since this plan: plan again to get its report'));
+  }
+  const id = ++state.reportId;
+  return new Promise((resolve, reject) => {
+    state.reportAsks.set(id, { resolve, reject });
+    state.worker.postMessage({ type: 'report', id, reportId });
+  });
+}
+
+function onReport(m) {
+  const ask = state.reportAsks.get(m.id);
+  if (!ask) return;
+  state.reportAsks.delete(m.id);
+  if (m.error) ask.reject(new Error(m.error));
+  else ask.resolve(m.bytes);
+}
+
 // What the page keeps of a plan: the bytes to download (decoded to text
-// only when asked), what the tables show and the per-point arrays.
+// only when asked; the report written by the worker only when asked), what
+// the tables show and the per-point arrays.
 function keptPlan(m, busy) {
   let gcode = null;
-  let reportJson = null;
+  let report = null;
+  const worker = state.workerGen;
   return {
     gcodeBytes: m.gcode,
-    reportBytes: m.report,
+    // A promise of the report's bytes, asked once.
+    reportBytes() {
+      report ??= askReport(m.reportId, worker);
+      report.catch(() => { report = null; });
+      return report;
+    },
+    // A promise of the report's text.
+    async report() { return decoder.decode(await this.reportBytes()); },
     get gcode() { gcode ??= decoder.decode(m.gcode); return gcode; },
-    get reportJson() { reportJson ??= decoder.decode(m.report); return reportJson; },
     summary: m.summary,
     view: m.view,
     svgName: busy.svg.name,
@@ -231,6 +260,10 @@ function onWorkerMessage(e) {
   }
   if (m.type === 'preview') {
     onPreview(m);
+    return;
+  }
+  if (m.type === 'report') {
+    onReport(m);
     return;
   }
   if (!busy || m.id !== busy.id) {
@@ -415,6 +448,9 @@ function cancelPlan() {
 function restartWorker() {
   state.worker.terminate();
   state.worker = makeWorker();
+  // Its reports went with it.
+  for (const ask of state.reportAsks.values()) ask.reject(new Error('the planner was restarted: plan again to get the report'));
+  state.reportAsks.clear();
   if (state.checking) {
     // The new worker never got the check in flight.
     $('check-verdict').textContent = `${state.checking.name} was not checked: the planner was restarted; check it again`;
@@ -425,8 +461,9 @@ function restartWorker() {
 
 function makeWorker() {
   const w = startWorker(state.module);
-  // A new worker holds no scan and no drawing.
+  // A new worker holds no scan, no drawing and no report.
   state.sentSvgKey = null;
+  state.workerGen++;
   w.onmessage = onWorkerMessage;
   w.onerror = (e) => {
     showError('The planner stopped', e.message || 'the worker failed to load');

@@ -104,6 +104,11 @@ export const state = {
   gen: 0,
   planId: 0,
   lastPlan: null,
+  // Workers started so far: a plan's report is asked of the worker that
+  // made it (a restarted one holds none).
+  workerGen: 0,
+  reportId: 0, // the report request in flight counts up
+  reportAsks: new Map(), // request id -> {resolve, reject}
   // The last comparison of every planner {rows, series, gen} (series: the
   // per-point errors of each planner, for the plot; null after a failed plan).
   lastComparison: null,

@@ -198,14 +198,16 @@ async function plan(m) {
     }
     progress(id, 'plan', m.compare ? 'planning and comparing every planner' : 'planning');
     const t0 = performance.now();
-    const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare);
+    // The report's JSON is written only when the page asks for it (a
+    // download): tens of MB for a large drawing, at every re-plan.
+    const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare, false);
     const planMs = performance.now() - t0;
     const v = r.view;
-    const transfer = [r.gcode.buffer, r.report.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
+    const transfer = [r.gcode.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
       v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer];
     for (const sr of r.series || []) transfer.push(sr.error.buffer, sr.defects.buffer);
     post({
-      type: 'result', id, gcode: r.gcode, report: r.report, summary: r.summary, view: v,
+      type: 'result', id, gcode: r.gcode, reportId: r.reportId, summary: r.summary, view: v,
       comparison: r.comparison, series: r.series, planMs, memory: memoryBytes(),
     }, transfer);
     post({ type: 'done', id });
@@ -270,6 +272,15 @@ self.onmessage = (e) => {
     check(m);
   } else if (m.type === 'preview') {
     preview(m);
+  } else if (m.type === 'report') {
+    // The JSON report of the last plan (`reportId`), written now.
+    try {
+      if (!session) throw new Error('no plan to report: the planner holds no scan');
+      const bytes = session.reportJson(m.reportId);
+      post({ type: 'report', id: m.id, bytes }, [bytes.buffer]);
+    } catch (err) {
+      post({ type: 'report', id: m.id, error: errorOf(err).message });
+    }
   } else if (m.type === 'pick') {
     // The first surface point along the view's ray, on the session's scan.
     if (!session) {

@@ -44,14 +44,34 @@ pub struct Session {
     scan_bbox: (DVec3, DVec3),
     path: Option<LoadedPath>,
     cache: Option<PathCache>,
+    /// The report of the last plan that left its JSON for later
+    /// (`with_report` false): its number and the report, until the next such plan. The
+    /// JSON of a large drawing's report runs to tens of MB (35.6 MB for the
+    /// 100 k point raster W3), and a page that re-plans as the user drags
+    /// needs it only when the user downloads it.
+    kept_report: Option<(u32, job::Report)>,
 }
+
+/// Reports kept so far by every session of this wasm instance: a report's
+/// number, so one session's number never names another session's report.
+static REPORTS_KEPT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
 
 #[derive(Serialize)]
 struct PlanResult {
     gcode: String,
-    /// Pretty JSON, exactly what the CLI's `--report` writes.
-    report_json: String,
+    /// Pretty JSON, exactly what the CLI's `--report` writes (left out when
+    /// it was left for later, see [`Session::report_json`]).
+    report_json: Option<String>,
+    /// The report kept for [`Session::report_json`] instead.
+    report_id: Option<u32>,
     warnings: Vec<String>,
+}
+
+/// Pretty JSON and a final newline: what the CLI's `--report` writes.
+fn report_bytes(report: &job::Report) -> Result<Vec<u8>, JsValue> {
+    let mut json = serde_json::to_vec_pretty(report).map_err(js_err)?;
+    json.push(b'\n');
+    Ok(json)
 }
 
 /// What the page shows of a plan besides the per-point arrays.
@@ -72,6 +92,16 @@ struct PlanSummary<'a> {
 }
 
 impl Session {
+    /// Keeps `report` for [`Session::report_json`] in place of the last one
+    /// kept, and returns its number.
+    fn keep_report(&mut self, report: job::Report) -> u32 {
+        // The old report goes first: memory for one, not two.
+        self.kept_report = None;
+        let id = REPORTS_KEPT.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        self.kept_report = Some((id, report));
+        id
+    }
+
     /// `scan_bbox`: the import's bounds (scanner frame); without them they
     /// are found by taking the registered mesh back (G is rigid).
     pub(super) fn from_prepared(scan: PreparedScan, scan_bbox: Option<(DVec3, DVec3)>) -> Session {
@@ -92,6 +122,7 @@ impl Session {
             scan_bbox,
             path: None,
             cache: None,
+            kept_report: None,
         }
     }
 
@@ -267,28 +298,51 @@ impl Session {
     /// Plans `svg` on this scan ([`job::run_on`]) and writes G-code with the
     /// machine profile `dialect`: a built-in name or a profile's JSON text
     /// (`profile_file` then names the file in errors); returns
-    /// `{gcode, report_json, warnings}`.
+    /// `{gcode, report_json, warnings}`. With `with_report` false,
+    /// `report_json` is left out and `report_id` names the report kept for
+    /// [`Session::report_json`] (see [`Session::plan_live`]).
+    // A JS call's positional arguments, the last one optional.
+    #[allow(clippy::too_many_arguments)]
     pub fn plan(
-        &self,
+        &mut self,
         svg: &[u8],
         svg_name: &str,
         settings: JsValue,
         dialect: &str,
         accept_risk: bool,
         profile_file: Option<String>,
+        with_report: Option<bool>,
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
         let profile = profile(dialect, profile_file.as_deref())?;
         let out = job::run_on(&self.scan, svg, svg_name, &settings, &profile, accept_risk)
             .map_err(core_err)?;
-        // Pretty JSON and a final newline: what the CLI's `--report` writes.
-        let mut report_json = serde_json::to_string_pretty(&out.report).map_err(js_err)?;
-        report_json.push('\n');
+        let warnings = out.report.warnings.clone();
+        let (report_json, report_id) = if with_report.unwrap_or(true) {
+            (Some(report_bytes(&out.report)?), None)
+        } else {
+            (None, Some(self.keep_report(out.report)))
+        };
         Ok(to_js(&PlanResult {
             gcode: out.gcode,
-            report_json,
-            warnings: out.report.warnings,
+            report_json: report_json.map(|b| String::from_utf8(b).expect("JSON is UTF-8")),
+            report_id,
+            warnings,
         })?)
+    }
+
+    /// The JSON report (UTF-8 bytes, exactly what the CLI's `--report`
+    /// writes) of the plan `id` made with `with_report` false, while it is the
+    /// last such plan; an error otherwise.
+    #[wasm_bindgen(js_name = reportJson)]
+    pub fn report_json(&self, id: u32) -> Result<Vec<u8>, JsValue> {
+        match &self.kept_report {
+            Some((kept, report)) if *kept == id => report_bytes(report),
+            _ => Err(JsError::new(
+                "the report of that plan is no longer kept (a later plan replaced it): plan again",
+            )
+            .into()),
+        }
     }
 
     /// Reads the drawing the next plans use (an error, kind `svg`, names
@@ -345,7 +399,10 @@ impl Session {
     /// `motion` and its header line `motion_line`), `view` (see
     /// [`plan_arrays`]), `comparison` (`[job::ComparisonRow]`, every
     /// planner, or null) and `series` (per planner, see [`plan_series`],
-    /// or null).
+    /// or null). With `with_report` false, `report` is left out and `reportId`
+    /// names the report kept for [`Session::report_json`]: its JSON is
+    /// written only if asked for (a page re-planning as the user drags
+    /// would write tens of MB per plan of a large drawing for nothing).
     ///
     /// G-code whose moves come closer to the surface than tol is refused
     /// unless `accept_risk` (an `Error` of kind `touching`, see
@@ -360,6 +417,7 @@ impl Session {
         accept_risk: bool,
         profile_file: Option<String>,
         compare: bool,
+        with_report: Option<bool>,
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
         // As job::run_on: bad settings and profiles fail before any work.
@@ -425,11 +483,8 @@ impl Session {
                 return Err(err);
             }
         };
-        let mut report_json = serde_json::to_vec_pretty(&report).map_err(js_err)?;
-        report_json.push(b'\n');
         let out = js_sys::Object::new();
         set_array(&out, "gcode", gcode.as_bytes());
-        set_array(&out, "report", &report_json);
         let summary = PlanSummary {
             planner: plan.planner,
             settings: &settings,
@@ -444,6 +499,11 @@ impl Session {
         set(&out, "view", &plan_arrays(&plan).into());
         set(&out, "comparison", &comparison);
         set(&out, "series", &series);
+        if with_report.unwrap_or(true) {
+            set_array(&out, "report", &report_bytes(&report)?);
+        } else {
+            set(&out, "reportId", &self.keep_report(report).into());
+        }
         Ok(out.into())
     }
 

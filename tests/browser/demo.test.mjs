@@ -32,10 +32,20 @@ test('the demo plans on load, is drawn, and its G-code downloads', async () => {
   const text = gcode.bytes.toString('utf8');
   assert.match(text, /G1 /);
   assert.match(text, /demo-test-part\.ply/);
+  // The report is written by the worker when its link is pressed, not at
+  // every plan: no link before, the same bytes as the plan's own after,
+  // and the keyboard presses it too.
+  assert.equal(await page.getAttribute('#dl-report', 'href'), null);
+  assert.equal(await page.getAttribute('#dl-report', 'tabindex'), '0');
   const report = await download(page, 'dl-report');
+  assert.equal(report.name, 'demo-test-part-lines-even.json');
   const json = JSON.parse(report.bytes.toString('utf8'));
   assert.equal(json.planner, 'even');
   assert.equal(json.toolpath.length, 6);
+  assert.equal(report.bytes.toString('utf8'), await page.evaluate(() => window.pcpp.state.lastPlan.report()));
+  assert.ok(report.bytes.toString('utf8').endsWith('}\n'));
+  const again = await Promise.all([page.waitForEvent('download'), page.focus('#dl-report').then(() => page.keyboard.press('Enter'))]);
+  assert.equal(again[0].suggestedFilename(), 'demo-test-part-lines-even.json');
 
   mkdirSync(join(ROOT, 'target'), { recursive: true });
   await page.screenshot({ path: join(ROOT, 'target/screenshot-demo.png'), fullPage: true });
@@ -53,7 +63,7 @@ test('settings persist across reloads and a placement change re-plans', async ()
     return !s.busy && !s.queued && s.lastPlan && s.lastPlan.gcode !== g
       && !document.getElementById('dl-gcode').hidden;
   }, before, { timeout: 120_000 });
-  const json = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  const json = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.equal(json.settings.placement.offset_mm[0], 1.5);
   await page.reload();
   await waitForPlan(page);

@@ -127,6 +127,11 @@ test('cancel ends the worker; a dropped SVG then plans on a fresh one', async ()
   });
   assert.equal(await page.textContent('#plan-status'), 'cancelled');
   assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.isHidden('#dl-report'), true);
+  // The plan still on screen was made by the worker that ended: its report
+  // (written only when asked) is refused with the reason, not another's.
+  const refused = await page.evaluate(() => window.pcpp.state.lastPlan.report().then(() => 'written', (e) => e.message));
+  assert.match(refused, /^the planner was restarted since this plan: plan again/);
   // Drag and drop, as a user would drop a file on the page.
   await page.evaluate(() => {
     const svg = '<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80">'

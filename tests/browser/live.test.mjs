@@ -171,7 +171,7 @@ test('the rotation and scale sliders, typed nozzle sizes and arrow keys re-plan 
   assert.equal(await page.evaluate(() => window.pcpp.state.interacting), true);
   await page.dispatchEvent('#pl-rot-range', 'change');
   await waitSettled(page);
-  let report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  let report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.equal(report.settings.placement.rotation_deg, 12);
   assert.equal(await page.inputValue('#pl-rot'), '12'); // the number field follows
   assert.equal(await page.$eval('#compare-table', (e) => e.classList.contains('stale')), false);
@@ -185,14 +185,14 @@ test('the rotation and scale sliders, typed nozzle sizes and arrow keys re-plan 
     el.dispatchEvent(new Event('change', { bubbles: true }));
   });
   await waitSettled(page);
-  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.equal(report.settings.placement.scale, 0.8);
 
   // Typing a nozzle size re-plans without a change event or a click.
   await page.fill('#nz-id', '0.41');
   await page.fill('#nz-od', '0.72');
   await waitSettled(page);
-  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.deepEqual(report.settings.nozzle, { inner_diameter_mm: 0.41, outer_diameter_mm: 0.72 });
 
   // In move mode the arrow keys nudge the path: 0.5 mm, 5 mm with Shift.
@@ -202,7 +202,7 @@ test('the rotation and scale sliders, typed nozzle sizes and arrow keys re-plan 
   await page.keyboard.press('ArrowRight');
   await page.keyboard.press('Shift+ArrowUp');
   await waitSettled(page);
-  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.deepEqual(report.settings.placement.offset_mm, [at.x + 0.5, at.y + 5]);
 
   const probe = await stopProbe(page);

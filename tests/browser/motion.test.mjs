@@ -47,7 +47,7 @@ test('every planner is compared with its defects, backward moves, clearance and 
   assert.deepEqual(heads, ['planner', 'mean |e| mm', 'mean e− mm', 'mean e+ mm', 'contact', 'flattening',
     'floating', 'defects', 'backward', 'min clear mm', 'waypoints']);
   assert.deepEqual(Object.keys(rows), PLANNERS);
-  const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   assert.equal(report.planner, 'even');
   const tol = report.settings.process.tolerance_mm;
   // even, the default, never falls back along the drawn path and keeps tol.
@@ -250,7 +250,7 @@ test('the demo menu loads each generated part with its drawing and placement', a
     assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
     assert.equal(await page.textContent('#scan-name'), scan);
     assert.equal(await page.textContent('#svg-name'), `demo: ${part} drawing`);
-    const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+    const report = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
     assert.deepEqual(report.inputs.map((i) => i.name), [scan, path]);
     // The part's own placement, as `pcpp demo --part` plans it; only the
     // test part registers on fiducial holes.

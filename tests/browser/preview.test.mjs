@@ -95,7 +95,7 @@ test('the preview scrubs the plan\'s G-code: the nozzle moves, the line is the f
   assert.match(status, /^the plan's G-code demo-test-part-lines-even\.gcode: \d+ moves, .* at its feeds; 0 closer than tol \(0\.100 mm\), \d+ near/);
   const total = await page.evaluate(() => window.pcpp.state.preview.data.total);
   // The plan's print time is inside the program's time (travel and dwell added).
-  const printTime = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson)).stats.print_time_s;
+  const printTime = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report())).stats.print_time_s;
   assert.ok(total > printTime && total < printTime * 3, `${total} s against ${printTime} s printing`);
 
   // A print move that comes near (tol to tol + 0.1 mm) and one well clear.

@@ -172,8 +172,8 @@ test('new units or up axis for the scan centre the drawing again from the user\'
   await page.click('#place-bed-btn');
   await waitSettled(page);
   assert.equal(await scale(page), 1);
-  const r = await page.evaluate(() => {
-    const j = JSON.parse(window.pcpp.state.lastPlan.reportJson);
+  const r = await page.evaluate(async () => {
+    const j = JSON.parse(await window.pcpp.state.lastPlan.report());
     const pts = j.toolpath.flat();
     const mid = (k) => (Math.min(...pts.map((p) => p[k])) + Math.max(...pts.map((p) => p[k]))) / 2;
     const [lo, hi] = j.mesh.bbox_mm;

@@ -150,7 +150,7 @@ test('a built-in antenna plans on an uploaded scan, centred on it', async () => 
   // Centred on the 40 x 40 mm sheet.
   const x = Number(await page.inputValue('#pl-x'));
   const y = Number(await page.inputValue('#pl-y'));
-  const json = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.reportJson));
+  const json = JSON.parse(await page.evaluate(() => window.pcpp.state.lastPlan.report()));
   const xs = json.toolpath.flat().map((p) => p[0]);
   const ys = json.toolpath.flat().map((p) => p[1]);
   const mid = (v) => (Math.min(...v) + Math.max(...v)) / 2;
