@@ -14,6 +14,12 @@
 //! - Physical units (`width="80mm"`, `in`, `cm`, `pt`, `px` at 96 dpi) and the
 //!   viewBox become millimetres; y is flipped (SVG y points down, printer y
 //!   up), so `y_mm = -y_svg_mm`.
+//! - The map from user units to mm is f64: the root's size, viewBox,
+//!   `preserveAspectRatio` and `transform` as usvg reads them, and an
+//!   element's own transforms and its groups' as written (usvg holds them,
+//!   and its 3.7795276 px/mm, in f32, which made every drawing 1 + 2.8e-8
+//!   times too large). A drawing in whole or half units lands on exact mm:
+//!   4 units of a 40 mm page with `viewBox="0 0 40 40"` are 4.0 mm.
 //! - Exact geometry: path data is re-read in f64 and arcs, circles, ellipses
 //!   and rounded corners are flattened from their true ellipses (usvg itself
 //!   turns arcs into cubics with a 0.1 user-unit tolerance, far coarser than a
@@ -31,6 +37,13 @@
 //!   or the odd count of numbers, and the points kept.
 //!
 //! ## Limitations
+//! - Precision: a `path`'s data is read in f64, but the coordinates of the
+//!   other shapes are usvg's f32 numbers (about 6e-8 relative: 0.1 reads
+//!   0.100000001), and a shape placed by a `use`, a nested `svg` or a
+//!   transform set in CSS keeps usvg's f32 transforms below the root (the
+//!   root's own are f64 for it too). Where the f64 map and usvg's differ by
+//!   more than f32 rounding (1e-5 relative), usvg's is used: it is what is
+//!   drawn.
 //! - Text is not converted to paths (no fonts are loaded); images, markers
 //!   and clip/mask/pattern content are not printed. Each is reported as a note.
 //! - A stroke is printed along its centre line whatever its width (a note
@@ -335,10 +348,15 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // The hidden copies: their usvg geometry names the shape of each
     // id-less path usvg makes for a `use` instance.
     let mut fingerprints: Vec<(&tiny_skia_path::Path, usize)> = Vec::new();
+    // usvg's root transform (user units to px, in f32), read off the probe.
+    let mut usvg_root = None;
     let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
     while let Some(node) = stack.pop() {
         match node {
             usvg::Node::Group(g) => stack.extend(g.children().iter().rev()),
+            usvg::Node::Path(p) if p.id() == prepared.root_probe => {
+                usvg_root = Some(affine_from_usvg(p.abs_transform()));
+            }
             usvg::Node::Path(p) => {
                 if let Some(i) = p.id().strip_prefix(prepared.copy_prefix.as_str()) {
                     if let Ok(i) = i.parse::<usize>() {
@@ -349,6 +367,16 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             _ => {}
         }
     }
+
+    // usvg's f32 root transform undone and the f64 one put in its place, for
+    // shapes placed by usvg's transforms (`use` instances, nested `svg`s).
+    let root_fix = prepared
+        .user_to_mm
+        .zip(usvg_root)
+        .and_then(|(exact, usvg)| {
+            let det = usvg.matrix2.determinant();
+            (det.is_finite() && det != 0.0).then(|| exact * usvg.inverse())
+        });
 
     let (mut filled_only, mut first_filled) = (0usize, None::<String>);
     // Shapes whose path data stops at an error, by shape index (once for
@@ -408,8 +436,20 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             .and_then(|s| exact_geometry(s, path.data()))
             .unwrap_or_else(|| from_tiny_skia(path.data()));
 
-        let to_mm = DAffine2::from_scale(DVec2::new(MM_PER_PX, -MM_PER_PX))
+        let usvg_to_mm = DAffine2::from_scale(DVec2::new(MM_PER_PX, -MM_PER_PX))
             * affine_from_usvg(path.abs_transform());
+        // The element itself (not a `use` instance of it) has its written
+        // transforms composed in f64; any other shape usvg's, with the root
+        // transform taken in f64. Either is checked against usvg's own.
+        let own = shape.filter(|_| !id.is_empty()).and_then(|s| s.to_root);
+        let exact = match (prepared.user_to_mm, own) {
+            (Some(root), Some(own)) => Some(root * own),
+            _ => root_fix.map(|fix| fix * affine_from_usvg(path.abs_transform())),
+        };
+        let to_mm = exact
+            .map(|m| DAffine2::from_scale(DVec2::new(1.0, -1.0)) * m)
+            .filter(|m| agrees_to_f32(m, &usvg_to_mm))
+            .unwrap_or(usvg_to_mm);
         if let Some(i) = shape_index {
             if shape.is_some_and(|s| s.d_read.as_ref().is_some_and(|r| r.error.is_some())) {
                 data_errors.insert(i);
@@ -743,6 +783,9 @@ struct ShapeInfo {
     /// Drawn where it stands or through a `use`, not only defined (inside
     /// `defs`, `symbol`, `clipPath`, `mask` or `pattern`).
     rendered: bool,
+    /// Its user units to the root's where it stands, from
+    /// [`transform_to_root`].
+    to_root: Option<DAffine2>,
 }
 
 /// Shapes defined in `symbol`s or `defs` that no `use` draws (an icon
@@ -767,6 +810,11 @@ struct Prepared {
     copy_prefix: String,
     notes: Vec<String>,
     unused: UnusedDefinitions,
+    /// The root's user units to mm (y down), from [`root_user_to_mm`].
+    user_to_mm: Option<DAffine2>,
+    /// Id of a hidden, untransformed path at the root: its usvg transform
+    /// is usvg's own (f32) root transform.
+    root_probe: String,
     /// The root's size, from [`RootSize`].
     empty_viewbox: Option<String>,
     has_viewbox: bool,
@@ -1037,6 +1085,118 @@ fn root_size(root: roxmltree::Node) -> RootSize {
         })
         .collect();
     size
+}
+
+/// Millimetres in one unit of a CSS length at 96 px per inch (CSS
+/// Values 3), `None` for font-relative units and percentages.
+fn mm_per_unit(unit: svgtypes::LengthUnit) -> Option<f64> {
+    use svgtypes::LengthUnit as U;
+    match unit {
+        U::None | U::Px => Some(MM_PER_PX),
+        U::In => Some(25.4),
+        U::Cm => Some(10.0),
+        U::Mm => Some(1.0),
+        U::Pt => Some(25.4 / 72.0),
+        U::Pc => Some(25.4 / 6.0),
+        U::Em | U::Ex | U::Percent => None,
+    }
+}
+
+/// The document's map from root user units to mm (SVG's frame, y down),
+/// computed in f64 as usvg computes its root transform in f32 (its
+/// `resolve_svg_size`, `ViewBox::to_transform` and the root's own
+/// `transform` about the viewport's centre): usvg holds the mm-to-px scale
+/// (3.7795276 px/mm) and the viewBox scale in f32, which made every drawing
+/// 1 + 2.8e-8 times too large (4 mm read 4.000000111). Each scale is taken
+/// as (size / viewBox size) x mm per unit, so that a `width` equal to the
+/// viewBox width gives exactly 1 unit = 1 mm, cm, in, ... `None` where the
+/// size is font-relative (`em`, `ex`) or the root has a `transform-origin`:
+/// usvg's matrix is then used as it is.
+fn root_user_to_mm(root: roxmltree::Node) -> Option<DAffine2> {
+    let length = |name: &str| {
+        root.attribute(name)
+            .and_then(|v| v.parse::<svgtypes::Length>().ok())
+    };
+    let (width, height) = (length("width"), length("height"));
+    // (usvg keeps the viewBox in f32: a size that rounds to 0 is none.)
+    let view_box = root
+        .attribute("viewBox")
+        .and_then(|v| v.parse::<svgtypes::ViewBox>().ok())
+        .filter(|v| (v.w as f32) > 0.0 && (v.h as f32) > 0.0);
+    // mm per user unit along one axis, from `width` or `height` over the
+    // viewBox's size; a missing one is 100 %, a percentage one of the
+    // viewBox's size read as px.
+    let scale = |len: Option<svgtypes::Length>, vb: f64| match len {
+        None => Some(MM_PER_PX),
+        Some(l) if l.unit == svgtypes::LengthUnit::Percent => Some(l.number / 100.0 * MM_PER_PX),
+        Some(l) => Some(l.number / vb * mm_per_unit(l.unit)?),
+    };
+    let (view, size_mm) = match view_box {
+        Some(vb) => {
+            let (mut sx, mut sy) = (scale(width, vb.w)?, scale(height, vb.h)?);
+            // One of the two given: the other follows the viewBox's aspect.
+            match (width, height) {
+                (Some(_), None) => sy = sx,
+                (None, Some(_)) => sx = sy,
+                _ => {}
+            }
+            let size_mm = DVec2::new(sx * vb.w, sy * vb.h);
+            let aspect: svgtypes::AspectRatio = root
+                .attribute("preserveAspectRatio")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or_default();
+            use svgtypes::Align as A;
+            let (fx, fy) = match aspect.align {
+                A::None | A::XMinYMin => (0.0, 0.0),
+                A::XMidYMin => (0.5, 0.0),
+                A::XMaxYMin => (1.0, 0.0),
+                A::XMinYMid => (0.0, 0.5),
+                A::XMidYMid => (0.5, 0.5),
+                A::XMaxYMid => (1.0, 0.5),
+                A::XMinYMax => (0.0, 1.0),
+                A::XMidYMax => (0.5, 1.0),
+                A::XMaxYMax => (1.0, 1.0),
+            };
+            let (s0x, s0y) = (sx, sy);
+            if aspect.align != A::None {
+                let s = if aspect.slice { sx.max(sy) } else { sx.min(sy) };
+                (sx, sy) = (s, s);
+            }
+            // The room left beside the scaled viewBox, written so that it
+            // is exactly 0 along an axis whose scale was kept.
+            let tx = -vb.x * sx + fx * ((s0x - sx) * vb.w);
+            let ty = -vb.y * sy + fy * ((s0y - sy) * vb.h);
+            let view =
+                DAffine2::from_cols(DVec2::new(sx, 0.0), DVec2::new(0.0, sy), DVec2::new(tx, ty));
+            (view, Some(size_mm))
+        }
+        // No viewBox: user units are px, whatever the size (a percentage
+        // one is of usvg's default 100 x 100 px window).
+        None => {
+            let side = |len: Option<svgtypes::Length>| match len {
+                None => Some(100.0 * MM_PER_PX),
+                Some(l) if l.unit == svgtypes::LengthUnit::Percent => Some(l.number * MM_PER_PX),
+                Some(l) => Some(l.number * mm_per_unit(l.unit)?),
+            };
+            let size_mm = side(width).zip(side(height)).map(|(w, h)| DVec2::new(w, h));
+            (DAffine2::from_scale(DVec2::splat(MM_PER_PX)), size_mm)
+        }
+    };
+    let Some(transform) = root.attribute("transform") else {
+        return Some(view);
+    };
+    if root.has_attribute("transform-origin") {
+        return None;
+    }
+    // The root's own transform acts on the viewport (px) about its centre.
+    let [a, b, c, d, e, f] = compose_transform(transform)?;
+    let centre = 0.5 * size_mm?;
+    let t = DAffine2::from_cols(
+        DVec2::new(a, b),
+        DVec2::new(c, d),
+        DVec2::new(e, f) * MM_PER_PX,
+    );
+    Some(DAffine2::from_translation(centre) * t * DAffine2::from_translation(-centre) * view)
 }
 
 /// Attributes that define a shape's geometry (SVG 1.1 chapters 8 and 9).
@@ -1325,6 +1485,15 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         n.ancestors()
             .any(|a| a.is_element() && is_svg(&a) && a.tag_name().name() == "marker")
     };
+    // A stylesheet can set `transform` (usvg reads it as a presentation
+    // attribute): shapes are then placed by usvg's transforms alone.
+    let css_transform = root.descendants().any(|n| {
+        n.is_element()
+            && n.tag_name().name() == "style"
+            && n.descendants()
+                .filter_map(|t| t.text())
+                .any(|t| t.to_ascii_lowercase().contains("transform"))
+    });
     let mut shapes = Vec::new();
     let mut ids = HashMap::new();
     let mut copies = String::new();
@@ -1451,6 +1620,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             d,
             dasharray: written_dasharray(node),
             rendered,
+            to_root: transform_to_root(node, root, css_transform),
         });
         if let Some((id, _)) = key {
             ids.insert(id, shape);
@@ -1471,10 +1641,16 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             copies.push_str("/>");
         }
     }
-    if !copies.is_empty() {
-        let end = root.range().end;
-        if let Some(at) = text.get(..end).and_then(|t| t.rfind("</")) {
-            if at > root_start {
+    let root_probe = format!("{prefix}copy-root");
+    let end = root.range().end;
+    if let Some(at) = text.get(..end).and_then(|t| t.rfind("</")) {
+        if at > root_start {
+            edits.push((
+                at,
+                0,
+                format!("<path id=\"{root_probe}\" d=\"M0 0 L1 0\" visibility=\"hidden\"/>"),
+            ));
+            if !copies.is_empty() {
                 edits.push((at, 0, format!("<g visibility=\"hidden\">{copies}</g>")));
             }
         }
@@ -1514,10 +1690,44 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         copy_prefix: format!("{prefix}copy-"),
         notes,
         unused,
+        user_to_mm: root_user_to_mm(root),
+        root_probe,
         empty_viewbox: root_size.empty_viewbox,
         has_viewbox: root_size.has_viewbox,
         percent_size: root_size.percent,
     })
+}
+
+/// The map from a shape's user units to the root's where it stands (its
+/// own transform and those of the groups holding it), composed in f64 from
+/// the transforms as written: usvg composes them in f32. `None` when
+/// something else places it (a nested `svg`, a `symbol`, a `transform`
+/// given in CSS, a `transform-origin`): usvg's transforms are then used.
+fn transform_to_root(
+    node: roxmltree::Node,
+    root: roxmltree::Node,
+    css_transform: bool,
+) -> Option<DAffine2> {
+    if css_transform {
+        return None;
+    }
+    let mut m = DAffine2::IDENTITY;
+    for a in node.ancestors().take_while(|a| *a != root) {
+        let container = a == node
+            || (a.tag_name().namespace() == node.tag_name().namespace()
+                && matches!(a.tag_name().name(), "g" | "a" | "switch"));
+        let styled = a
+            .attribute("style")
+            .is_some_and(|s| s.to_ascii_lowercase().contains("transform"));
+        if !a.is_element() || !container || styled || a.has_attribute("transform-origin") {
+            return None;
+        }
+        if let Some(t) = a.attribute("transform") {
+            let [a, b, c, d, e, f] = compose_transform(t)?;
+            m = DAffine2::from_cols(DVec2::new(a, b), DVec2::new(c, d), DVec2::new(e, f)) * m;
+        }
+    }
+    Some(m)
 }
 
 /// Byte position just after the qualified tag name of the element whose
@@ -2131,6 +2341,20 @@ fn affine_from_usvg(t: usvg::Transform) -> DAffine2 {
         DVec2::new(f64::from(t.kx), f64::from(t.sy)),
         DVec2::new(f64::from(t.tx), f64::from(t.ty)),
     )
+}
+
+/// Whether a map composed in f64 is usvg's (composed in f32) up to f32's
+/// rounding: a guard against reading the document differently from usvg,
+/// which then has the last word. (A relative 1e-5 leaves room for the
+/// rounding of a few nested f32 products, about 6e-8 each, while a unit
+/// read wrongly is off by far more.)
+fn agrees_to_f32(exact: &DAffine2, usvg: &DAffine2) -> bool {
+    let stretch = max_stretch(usvg.matrix2);
+    let linear = (exact.matrix2 - usvg.matrix2).to_cols_array();
+    let moved = (exact.translation - usvg.translation).abs().max_element();
+    let reach =
+        stretch + exact.translation.abs().max_element() + usvg.translation.abs().max_element();
+    linear.iter().all(|d| d.abs() <= 1e-5 * stretch) && moved <= 1e-5 * reach
 }
 
 /// Largest singular value: how much the map can lengthen a local distance.

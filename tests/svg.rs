@@ -8,8 +8,10 @@ use pcpp::sampling::{sample_subpath, try_sample_subpath_marked};
 use pcpp::svg::{import_svg, import_svg_with_notes, Placement, Subpath2, SvgError};
 use pcpp::DVec2;
 
-// Coordinates carry usvg's f32 transforms (about 1e-7 relative): 1e-5 mm
-// is the tolerance for positions in a 100 mm drawing.
+// Shapes other than paths, and `use` instances, carry usvg's f32 numbers
+// (about 1e-7 relative): 1e-5 mm is the tolerance for positions in a
+// 100 mm drawing. The scale from user units to mm is f64 (the tests after
+// "user units to mm, in f64" compare exactly).
 const MM: &str = r#"width="100mm" height="100mm" viewBox="0 0 100 100""#;
 
 fn doc(size: &str, body: &str) -> String {
@@ -1357,4 +1359,209 @@ fn hostile_dashes_and_path_data_do_not_panic() {
             );
         }
     }
+}
+
+// ------------------------------------------------- user units to mm, in f64
+
+/// The drawing of the scale bug: a 32 mm line and its turn, 4 mm in from
+/// the corner of a 40 mm page.
+const SQUARE: &str = r#"<path d="M4 4 L36 4 L36 36" fill="none" stroke="black"/>"#;
+
+fn square_points(mm_per_unit: f64) -> Vec<DVec2> {
+    [(4.0, 4.0), (36.0, 4.0), (36.0, 36.0)]
+        .into_iter()
+        .map(|(x, y)| v(x * mm_per_unit, -(y * mm_per_unit)))
+        .collect()
+}
+
+/// usvg holds the document's mm-to-px scale (3.7795276 px/mm) and the
+/// viewBox's scale in f32, and every drawing came in 1 + 2.8e-8 times too
+/// large (4 and 36 mm as 4.000000111 and 36.000001001): the scale from
+/// user units to mm is now f64, so round numbers stay round.
+#[test]
+fn a_drawing_in_mm_is_not_2_8e_8_too_large() {
+    let mm = 1.0;
+    let cases = [
+        (r#"width="40mm" height="40mm" viewBox="0 0 40 40""#, mm),
+        (r#"width="4cm" height="4cm" viewBox="0 0 40 40""#, mm),
+        // The height follows the viewBox's aspect.
+        (r#"width="40mm" viewBox="0 0 40 40""#, mm),
+        (r#"height="40mm" viewBox="0 0 40 40""#, mm),
+        (r#"width="20mm" height="20mm" viewBox="0 0 40 40""#, 0.5),
+        (
+            r#"width="1.5in" height="1.5in" viewBox="0 0 1.5 1.5""#,
+            25.4,
+        ),
+        (
+            r#"width="40px" height="40px" viewBox="0 0 40 40""#,
+            25.4 / 96.0,
+        ),
+        (r#"width="40" height="40" viewBox="0 0 40 40""#, 25.4 / 96.0),
+        (r#"viewBox="0 0 40 40""#, 25.4 / 96.0),
+        (r#"width="40" height="40""#, 25.4 / 96.0),
+        (r#"width="40mm" height="40mm""#, 25.4 / 96.0),
+        (
+            r#"width="72pt" height="72pt" viewBox="0 0 72 72""#,
+            25.4 / 72.0,
+        ),
+        (r#"width="6pc" height="6pc" viewBox="0 0 6 6""#, 25.4 / 6.0),
+        (
+            r#"width="100%" height="100%" viewBox="0 0 40 40""#,
+            25.4 / 96.0,
+        ),
+    ];
+    for (size, mm_per_unit) in cases {
+        let subs = import(&doc(size, SQUARE));
+        assert_eq!(subs[0].points, square_points(mm_per_unit), "{size}");
+    }
+    // An inch is 25.4 mm to the last bit.
+    let subs = import(&doc(
+        r#"width="1.5in" height="1.5in" viewBox="0 0 1.5 1.5""#,
+        r#"<path d="M0.25 0.5 L1 0.5" stroke="black"/>"#,
+    ));
+    assert_eq!(subs[0].points, vec![v(6.35, -12.7), v(25.4, -12.7)]);
+}
+
+#[test]
+fn a_viewbox_offset_and_its_alignment_are_exact_in_mm() {
+    let cases = [
+        (
+            r#"width="40mm" height="40mm" viewBox="10 -5 40 40""#,
+            r#"<path d="M14 -1 L46 -1" stroke="black"/>"#,
+            [v(4.0, -4.0), v(36.0, -4.0)],
+        ),
+        // meet: the 40-unit box scaled by 1 in the middle of the 80 mm.
+        (
+            r#"width="80mm" height="40mm" viewBox="0 0 40 40""#,
+            SQUARE,
+            [v(24.0, -4.0), v(56.0, -4.0)],
+        ),
+        (
+            r#"width="80mm" height="40mm" viewBox="0 0 40 40" preserveAspectRatio="xMaxYMax""#,
+            SQUARE,
+            [v(44.0, -4.0), v(76.0, -4.0)],
+        ),
+        // slice: scaled by 2, the middle 20 mm of its height cut away.
+        (
+            r#"width="80mm" height="40mm" viewBox="0 0 40 40" preserveAspectRatio="xMidYMid slice""#,
+            SQUARE,
+            [v(8.0, 12.0), v(72.0, 12.0)],
+        ),
+        (
+            r#"width="80mm" height="40mm" viewBox="0 0 40 40" preserveAspectRatio="none""#,
+            SQUARE,
+            [v(8.0, -4.0), v(72.0, -4.0)],
+        ),
+    ];
+    for (size, body, want) in cases {
+        let subs = import(&doc(size, body));
+        assert_eq!(subs[0].points[..2], want, "{size}");
+    }
+}
+
+#[test]
+fn rects_and_nested_transforms_are_exact_in_mm() {
+    let subs = import(&doc(
+        r#"width="40mm" height="40mm" viewBox="0 0 40 40""#,
+        r#"<rect x="4" y="4" width="32" height="32" stroke="black" fill="none"/>
+           <g transform="translate(10 20)"><path transform="scale(2)" d="M1 1 L3 1" stroke="black"/></g>
+           <g transform="scale(0.1)"><g><path d="M40 40 L360 40" stroke="black"/></g></g>
+           <g transform="matrix(0.26458333,0,0,0.26458333,0,0)"><path d="M0 0 L100 0" stroke="black"/></g>"#,
+    ));
+    assert_eq!(subs.len(), 4);
+    assert_eq!(
+        subs[0].points,
+        vec![
+            v(4.0, -4.0),
+            v(36.0, -4.0),
+            v(36.0, -36.0),
+            v(4.0, -36.0),
+            v(4.0, -4.0)
+        ]
+    );
+    assert_eq!(subs[1].points, vec![v(12.0, -22.0), v(16.0, -22.0)]);
+    // (0.1 and 0.26458333 are not f32 numbers: usvg's 0.1f32 had put the
+    // line at 4.0000000596 mm.)
+    assert_eq!(subs[2].points, vec![v(4.0, -4.0), v(36.0, -4.0)]);
+    assert_eq!(
+        subs[3].points,
+        vec![v(0.0, 0.0), v(100.0 * 0.26458333, 0.0)]
+    );
+}
+
+/// Shapes placed by usvg's own transforms (a `use` instance, a nested
+/// `svg`, a transform set in CSS) get the f64 root scale too: only f64's
+/// rounding is left, not f32's 2.8e-8.
+#[test]
+fn uses_nested_svgs_and_css_transforms_get_the_exact_root_scale() {
+    let cases = [
+        (
+            r##"<defs><path id="seg" d="M4 4 L36 4" stroke="black"/></defs><use href="#seg" x="1" y="2"/>"##,
+            [v(5.0, -6.0), v(37.0, -6.0)],
+        ),
+        (
+            r#"<svg x="2" y="3" overflow="visible"><path d="M4 4 L36 4" stroke="black"/></svg>"#,
+            [v(6.0, -7.0), v(38.0, -7.0)],
+        ),
+        (
+            r#"<style>.moved { transform: translate(1 2) }</style>
+               <path class="moved" d="M4 4 L36 4" stroke="black"/>"#,
+            [v(5.0, -6.0), v(37.0, -6.0)],
+        ),
+        (
+            r#"<g style="transform: translate(1 2)"><path d="M4 4 L36 4" stroke="black"/></g>"#,
+            [v(5.0, -6.0), v(37.0, -6.0)],
+        ),
+    ];
+    for (body, want) in cases {
+        let subs = import(&doc(
+            r#"width="40mm" height="40mm" viewBox="0 0 40 40""#,
+            body,
+        ));
+        assert_eq!(subs.len(), 1, "{body}");
+        for (got, want) in subs[0].points.iter().zip(want) {
+            assert_near(*got, want, 1e-12);
+        }
+    }
+}
+
+/// The root's own `transform` (SVG 2) acts in the viewport, in px, about
+/// its centre, as usvg applies it.
+#[test]
+fn a_transform_on_the_root_is_applied_in_f64() {
+    let cases = [
+        (
+            r#"transform="translate(10 0)""#,
+            v(4.0 + 10.0 * 25.4 / 96.0, -4.0),
+        ),
+        // A quarter turn about the page's centre (20, 20) mm.
+        (r#"transform="rotate(90)""#, v(36.0, -4.0)),
+    ];
+    for (transform, want) in cases {
+        let size = format!(r#"width="40mm" height="40mm" viewBox="0 0 40 40" {transform}"#);
+        let subs = import(&doc(&size, SQUARE));
+        assert_near(subs[0].points[0], want, 1e-12);
+    }
+}
+
+/// `--place centre` of the 40 mm drawing on the demo part (80 x 80 mm)
+/// printed "offset (19.99999944368998, 60.00000055631002) mm".
+#[test]
+fn centring_a_round_drawing_gives_a_round_offset() {
+    let text = doc(r#"width="40mm" height="40mm" viewBox="0 0 40 40""#, SQUARE);
+    let drawn = pcpp::pipeline::load_path(text.as_bytes(), "sq.svg").unwrap();
+    let Some((lo, hi)) = pcpp::demo::test_part::test_part().bbox() else {
+        panic!("the demo part has no triangles");
+    };
+    let footprint = (lo.truncate(), hi.truncate());
+    assert_eq!(footprint, (v(0.0, 0.0), v(80.0, 80.0)));
+    let (placement, note) =
+        pcpp::placement::centre_drawing(&drawn.subpaths, footprint, &Placement::IDENTITY, true)
+            .unwrap();
+    assert_eq!(note, None);
+    assert_eq!(placement.offset_mm, v(20.0, 60.0));
+    // The line drawn 32 mm long is printed 32 mm long.
+    let placed = placement.apply_subpath(&drawn.subpaths[0]);
+    assert_eq!(placed.points[0], v(24.0, 56.0));
+    assert_eq!(placed.points[1].distance(placed.points[0]), 32.0);
 }

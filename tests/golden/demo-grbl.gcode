@@ -8,7 +8,7 @@
 ( registration: unregistered  taken as it is [the scan's frame is the printer's]; G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000] )
 ( residuals: [] mm  rms 0.0000 mm )
 ( path: 6 piece[s]  1362 points  457.438 mm  height change 4.504 mm  max inclination 86.9 deg  min radius 0.145 mm  print time 91.5 s )
-( predicted quality: mean |e| 0.0107 mm  mean e- -0.0058 mm  mean e+ 0.0190 mm  contact 0.00%  flattening 0.59%  floating 1.62% )
+( predicted quality: mean |e| 0.0107 mm  mean e- -0.0056 mm  mean e+ 0.0199 mm  contact 0.00%  flattening 0.59%  floating 1.62% )
 ( safe motion: min clearance 0.101 mm [tol 0.1 mm] along all 1444 moves; 70 waypoint[s] added [+3.615 mm] )
 ( warnings: 1 )
 ( profile: grbl )
@@ -266,7 +266,7 @@ G1 X73.098 Y16.000 Z5.603
 G1 X73.399 Y16.000 Z5.603
 G1 X73.700 Y16.000 Z5.603
 G1 X74.001 Y16.000 Z5.603
-G1 X74.302 Y16.000 Z5.603
+G1 X74.301 Y16.000 Z5.603
 M9
 G0 Z13.603
 ( subpath 1: 245 points )
@@ -516,7 +516,7 @@ G1 X73.098 Y22.000 Z5.603
 G1 X73.399 Y22.000 Z5.603
 G1 X73.700 Y22.000 Z5.603
 G1 X74.001 Y22.000 Z5.603
-G1 X74.302 Y22.000 Z5.603
+G1 X74.301 Y22.000 Z5.603
 M9
 G0 Z13.603
 ( subpath 2: 238 points )
@@ -1152,10 +1152,10 @@ G1 X47.954 Y60.000 Z5.603
 G1 X48.029 Y60.000 Z5.598
 G1 X48.104 Y60.000 Z5.602
 G1 X48.499 Y60.000 Z6.266
-G1 X48.754 Y59.927 Z6.736
-G1 X48.818 Y59.909 Z6.804
-G1 X48.844 Y59.917 Z6.894
-G1 X48.954 Y59.953 Z7.083
+G1 X48.761 Y60.075 Z6.750
+G1 X48.818 Y60.091 Z6.804
+G1 X48.854 Y60.080 Z6.910
+G1 X48.954 Y60.047 Z7.083
 G1 X49.101 Y60.000 Z7.102
 G1 X49.780 Y60.000 Z7.584
 G1 X50.361 Y60.000 Z7.602
