@@ -169,7 +169,7 @@ const yes = (ok) => (ok ? 'yes' : 'no');
 const rows = [
   // step, target native, measured native, ok, target wasm, measured wasm, ok
   ['W1 binary PLY import + acceleration structure', '<= 0.8 s', f(plyS, 2) + ' s', plyS <= 0.8,
-    '<= 1.2 s', f(wasm.ply_session_s, 2) + ' s', wasm.ply_session_s <= 1.2],
+    '<= 1.2 s', f(wasm.ply_page_s, 2) + ' s (a)', wasm.ply_page_s <= 1.2],
   ['W1 OBJ import', '>= 200 MB/s', f(objMbS, 0) + ' MB/s', objMbS >= 200,
     '>= 120 MB/s', f(wasm.obj_import_mb_s, 0) + ' MB/s (a)', wasm.obj_import_mb_s >= 120],
   ['plan W2 on W1 (project, spline, the default planner with its safe-motion stage, quality)', '<= 5 ms', ms(w2S), w2S <= 0.005,
@@ -212,12 +212,17 @@ for (const [step, tn, mn, okn, tw, mw, okw] of rows) {
   out.push(`| ${step} | ${tn} | ${mn} | ${tw} | ${mw} | ${yes(okn)} / ${yes(okw)} |`);
 }
 out.push('');
-const steps = (t) => `write + SHA-256 ${ms(t.read_ms / 1e3)}, import ${ms(t.import_ms / 1e3)}, ` +
-  `register (topology, holes) ${ms(t.register_ms / 1e3)}, index ${ms(t.index_ms / 1e3)}`;
-out.push(`(a) The importer alone, in wasm the page's importScan (web/worker.js's steps, each ` +
-  `timed: W1.obj ${steps(wasm.obj_staged)}; W1.ply ${steps(wasm.ply_staged)}). A whole Session ` +
-  `from the OBJ's bytes (hash, import, holes, index): ${f(wasm.obj_session_mb_s, 0)} MB/s in ` +
-  `wasm, ${f(obj.bytes / 1e6 / objSessionS, 0)} MB/s natively.`);
+const steps = (t) => `write ${ms(t.read_ms / 1e3)}, import ${ms(t.import_ms / 1e3)}, ` +
+  `register (topology, holes) ${ms(t.register_ms / 1e3)}, index ${ms(t.index_ms / 1e3)}, and ` +
+  `beside them the SHA-256 ${ms(t.hash_ms / 1e3)}`;
+out.push(`(a) In wasm, the page's steps (web/worker.js, each timed; the page finds the file's ` +
+  `SHA-256 in a second worker beside the others, as the CLI on a second thread, so the PLY row ` +
+  `is the sum of the others): W1.obj ${steps(wasm.obj_staged)}; W1.ply ` +
+  `${steps(wasm.ply_staged)}. The OBJ row is the importer alone (importScan). A whole Session ` +
+  `from the PLY's bytes, hash included, in one call: ${f(wasm.ply_session_s, 2)} s. From the ` +
+  `OBJ's bytes (hash, import, holes, index): ${f(wasm.obj_session_mb_s, 0)} MB/s in ` +
+  `wasm, ${f(obj.bytes / 1e6 / objSessionS, 0)} MB/s natively. Natively the stages here run on ` +
+  `one thread (PCPP_THREADS=1), the PLY row's SHA-256 (SHA-NI) included.`);
 out.push('');
 out.push(`(b) Session.plan: the plan, its report and G-code, the G-code converted to JS, the ` +
   `report kept and its JSON not written (the page writes it only for a download, as the CLI ` +

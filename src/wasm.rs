@@ -30,7 +30,7 @@ mod scan;
 mod session;
 mod view;
 
-pub use scan::{ScanBuffer, ScanImport};
+pub use scan::{ScanBuffer, ScanImport, Sha256Stream};
 use session::LoadedPath;
 pub use session::Session;
 pub use view::{PreviewTimeline, Viewer};

@@ -519,8 +519,17 @@ fn bytes_text(v: &JsValue) -> String {
 /// A session built the way the worker builds it: the file written into a
 /// ScanBuffer in chunks, then imported, registered and indexed.
 fn staged_session(bytes: &[u8], name: &str, settings: &JobSettings) -> pcpp::wasm::Session {
-    let mut buf =
-        pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64).unwrap_or_else(|e| panic!("{e:?}"));
+    staged_session_hashed(bytes, name, settings, None)
+}
+
+fn staged_session_hashed(
+    bytes: &[u8],
+    name: &str,
+    settings: &JobSettings,
+    hashed: Option<bool>,
+) -> pcpp::wasm::Session {
+    let mut buf = pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64, hashed)
+        .unwrap_or_else(|e| panic!("{e:?}"));
     for chunk in bytes.chunks(100_000) {
         buf.write(chunk).unwrap_or_else(|e| panic!("{e:?}"));
     }
@@ -542,6 +551,65 @@ fn demo_page_settings() -> JobSettings {
         ..Default::default()
     };
     s
+}
+
+/// The page hashes the scan in a second worker, beside the import: a
+/// session whose ScanBuffer did not hash neither plans nor checks until
+/// it is given the digest, then writes the bytes of one that did.
+#[wasm_bindgen_test]
+fn a_scan_hashed_beside_its_import_plans_once_its_digest_is_given() {
+    let scan = demo::demo_scan_bytes();
+    let svg = test_part::test_part_svg();
+    let settings = golden_settings();
+    let mut hashed = staged_session(&scan, demo::DEMO_SCAN_NAME, &settings);
+    let mut session = staged_session_hashed(&scan, demo::DEMO_SCAN_NAME, &settings, Some(false));
+    let plan = |s: &mut pcpp::wasm::Session| {
+        s.plan(
+            svg.as_bytes(),
+            demo::DEMO_PATH_NAME,
+            js(&settings.plan),
+            "marlin",
+            false,
+            None,
+            None,
+        )
+    };
+    let err = plan(&mut session).expect_err("no digest yet");
+    let (message, _) = message_and_kind(&err);
+    assert!(
+        message.starts_with(&format!("{}: its SHA-256", demo::DEMO_SCAN_NAME)),
+        "{message}"
+    );
+    let program = get(&plan(&mut hashed).unwrap(), "gcode")
+        .as_string()
+        .unwrap();
+    let checked = session.check_gcode(
+        program.as_bytes(),
+        "demo.gcode",
+        js(&settings.plan.nozzle),
+        settings.plan.process.tolerance_mm,
+    );
+    assert!(
+        checked.is_err(),
+        "a check compares the header with the digest"
+    );
+    assert!(session.set_scan_sha256(&[0u8; 31]).is_err());
+    // The digest as the second worker finds it, in chunks.
+    let mut stream = pcpp::wasm::Sha256Stream::new();
+    for chunk in scan.chunks(70_000) {
+        stream.update(chunk);
+    }
+    session
+        .set_scan_sha256(&stream.finish())
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let out = plan(&mut session).unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(get(&out, "gcode").as_string().unwrap(), program);
+    assert_eq!(
+        get(&out, "report_json").as_string().unwrap(),
+        get(&plan(&mut hashed).unwrap(), "report_json")
+            .as_string()
+            .unwrap()
+    );
 }
 
 #[wasm_bindgen_test]
@@ -744,7 +812,7 @@ fn the_page_refuses_scans_past_its_size_limit_before_reading() {
         message.contains("huge-scan.stl") && message.contains("512 MiB"),
         "{message}"
     );
-    let err = pcpp::wasm::ScanBuffer::new("huge-scan.stl", limit + 1.0)
+    let err = pcpp::wasm::ScanBuffer::new("huge-scan.stl", limit + 1.0, None)
         .err()
         .expect("no buffer past the limit");
     assert_eq!(message_and_kind(&err).1, "limit");
@@ -757,7 +825,7 @@ fn the_page_refuses_scans_past_its_size_limit_before_reading() {
     assert!(message.contains("huge.svg") && message.contains("64 MiB"));
 
     // A buffer that was not filled does not import.
-    let mut buf = pcpp::wasm::ScanBuffer::new("short.ply", 10.0).unwrap();
+    let mut buf = pcpp::wasm::ScanBuffer::new("short.ply", 10.0, None).unwrap();
     buf.write(b"ply\n").unwrap();
     assert!(buf.write(&[0; 7]).is_err(), "more than the declared size");
     let err = buf
@@ -1210,8 +1278,8 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
 
 /// A file written into a ScanBuffer in chunks, as the worker reads it.
 fn written(name: &str, bytes: &[u8]) -> pcpp::wasm::ScanBuffer {
-    let mut buf =
-        pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64).unwrap_or_else(|e| panic!("{e:?}"));
+    let mut buf = pcpp::wasm::ScanBuffer::new(name, bytes.len() as f64, None)
+        .unwrap_or_else(|e| panic!("{e:?}"));
     for chunk in bytes.chunks(100_000) {
         buf.write(chunk).unwrap_or_else(|e| panic!("{e:?}"));
     }

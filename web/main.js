@@ -112,11 +112,17 @@ function runPlan() {
     state.sentSvgKey = svg.key;
   }
   const { dialect, file: profileFile } = profile();
+  // A user's file is hashed by a second worker beside its import.
+  const hashBeside = !!scan.blob;
+  if (hashBeside) hashScan(scan);
   state.worker.postMessage({
     type: 'plan',
     id,
     // A File is a handle: posting it copies no bytes (the worker reads it).
-    scan: { key: scan.key, name: scan.name, blob: scan.blob, part: scan.part, external: scan.external },
+    scan: {
+      key: scan.key, name: scan.name, blob: scan.blob, part: scan.part, external: scan.external,
+      hashBeside, sha256: state.digests.get(scan.key) || null,
+    },
     scanSettings: job.scan,
     registration: job.registration,
     svg: msgSvg,
@@ -211,6 +217,36 @@ function onReport(m) {
   state.reportAsks.delete(m.id);
   if (m.error) ask.reject(new Error(m.error));
   else ask.resolve(m.bytes);
+}
+
+// The SHA-256 of a scan file, found by a second worker while the planning
+// worker imports it (as the CLI hashes on a second thread): the G-code's
+// header names the scan by it, and the planning worker waits for it only
+// before it plans. Asked once per file; the answer goes to the planning
+// worker (a restarted one gets it with its next plan).
+function hashScan(scan) {
+  if (state.digests.has(scan.key) || state.hashing.has(scan.key)) return;
+  if (!state.hashWorker) {
+    const w = startWorker(state.module);
+    w.onmessage = (e) => {
+      const m = e.data;
+      if (m.type !== 'hashed') return;
+      state.hashing.delete(m.key);
+      if (m.digest) state.digests.set(m.key, m.digest);
+      state.worker.postMessage({ type: 'sha256', key: m.key, digest: m.digest, error: m.error });
+    };
+    w.onerror = (e) => {
+      // Every file it was hashing: the planning worker is told why.
+      for (const key of state.hashing.keys()) {
+        state.worker.postMessage({ type: 'sha256', key, error: `the hashing worker failed (${e.message || 'no reason given'})` });
+      }
+      state.hashing.clear();
+      state.hashWorker = null;
+    };
+    state.hashWorker = w;
+  }
+  state.hashing.set(scan.key, true);
+  state.hashWorker.postMessage({ type: 'hash', key: scan.key, name: scan.name, blob: scan.blob });
 }
 
 // What the page keeps of a plan: the bytes to download (decoded to text

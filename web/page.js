@@ -109,6 +109,11 @@ export const state = {
   workerGen: 0,
   reportId: 0, // the report request in flight counts up
   reportAsks: new Map(), // request id -> {resolve, reject}
+  // Scan files' SHA-256s by file key (Uint8Array), and those being found
+  // by the hashing worker (main.js's hashScan).
+  digests: new Map(),
+  hashing: new Map(),
+  hashWorker: null,
   // The last comparison of every planner {rows, series, gen} (series: the
   // per-point errors of each planner, for the plot; null after a failed plan).
   lastComparison: null,

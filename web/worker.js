@@ -10,7 +10,7 @@
 // holds it whole. The files opened with it (`external`) are read the same
 // way, only those the scan names (a .gltf's .bin buffers). Results go back
 // as typed arrays whose buffers are transferred, not copied.
-import { initSync, initPanicHook, memoryBytes, ScanBuffer } from '../pkg/pcpp.js';
+import { initSync, initPanicHook, memoryBytes, ScanBuffer, Sha256Stream } from '../pkg/pcpp.js';
 
 // Slices of the file read per step: progress every 8 MiB.
 const CHUNK = 8 << 20;
@@ -51,10 +51,57 @@ function progress(id, step, label, fraction, first) {
   post({ type: 'progress', id, stage: step === 'plan' ? 'plan' : 'scan', step, label, fraction, first });
 }
 
-// A File read in slices into a new ScanBuffer named `name`, with progress.
-async function readFile(id, blob, name, first) {
+// The SHA-256s of scan files found by the page's second worker (this same
+// script, `hashFile`), by the page's file key: {promise, resolve, reject}.
+// The scan is imported without hashing it and the session is given its
+// digest before it plans or checks (`needDigest`), as the CLI hashes on a
+// second thread beside the import.
+const digests = new Map();
+function digestOf(key) {
+  let e = digests.get(key);
+  if (!e) {
+    e = {};
+    e.promise = new Promise((resolve, reject) => { e.resolve = resolve; e.reject = reject; });
+    e.promise.catch(() => {});
+    digests.set(key, e);
+  }
+  return e;
+}
+// The file key whose digest the session still needs (null: it has it).
+let needDigest = null;
+
+// Gives the session its scan's SHA-256 once the second worker found it.
+// Called before a plan's or a check's synchronous part, so a message
+// handled while it waits cannot set another drawing under it.
+async function withDigest() {
+  if (!needDigest || !session) return;
+  const [s, key] = [session, needDigest];
+  const digest = await digestOf(key).promise;
+  // Another scan was read meanwhile: its own digest is waited for.
+  if (session !== s || needDigest !== key) return;
+  s.setScanSha256(digest);
+  needDigest = null;
+}
+
+// The second worker's task: a file's SHA-256, read in slices.
+async function hashFile(m) {
+  try {
+    const h = new Sha256Stream();
+    for (let at = 0; at < m.blob.size; at += CHUNK) {
+      h.update(new Uint8Array(await m.blob.slice(at, at + CHUNK).arrayBuffer()));
+    }
+    const digest = h.finish();
+    post({ type: 'hashed', key: m.key, digest }, [digest.buffer]);
+  } catch (err) {
+    post({ type: 'hashed', key: m.key, error: `could not read ${m.name} to hash it: ${errorOf(err).message}` });
+  }
+}
+
+// A File read in slices into a new ScanBuffer named `name`, with progress;
+// its SHA-256 found here unless `hashed` is false.
+async function readFile(id, blob, name, first, hashed = true) {
   progress(id, 'read', `reading ${name} (${mib(blob.size)} MiB)`, 0, first);
-  const buf = new ScanBuffer(name, blob.size);
+  const buf = new ScanBuffer(name, blob.size, hashed);
   try {
     for (let at = 0; at < blob.size; at += CHUNK) {
       const part = new Uint8Array(await blob.slice(at, at + CHUNK).arrayBuffer());
@@ -102,8 +149,11 @@ async function loadScan(m) {
   }
   let buf;
   let missing = [];
+  // The page hashes a user's file in its second worker (`m.scan.hashBeside`).
+  const beside = !!blob && !!m.scan.hashBeside;
+  if (beside && m.scan.sha256) digestOf(m.scan.key).resolve(m.scan.sha256);
   if (blob) {
-    buf = await readFile(id, blob, name, true);
+    buf = await readFile(id, blob, name, true, !beside);
     try {
       missing = await readExternal(id, buf, external);
     } catch (err) {
@@ -141,6 +191,7 @@ async function loadScan(m) {
   if (session) session.free();
   session = s;
   pathKey = null;
+  needDigest = beside ? m.scan.key : null;
   const info = s.info();
   const positions = s.meshPositions();
   const indices = s.meshIndices();
@@ -177,6 +228,9 @@ async function plan(m) {
       await loadScan(m);
       sessionKey = key;
     }
+    // The scan's SHA-256 from the second worker, for the G-code's header:
+    // waited for before this plan's synchronous part below.
+    await withDigest();
     stage = 'plan';
     if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
     if (!svg || svg.key !== m.svg.key) throw new Error(`the drawing ${m.svg.name} did not reach the planner; plan again`);
@@ -226,6 +280,7 @@ async function onProgram(m, type, run) {
     const bytes = m.bytes || new Uint8Array(await m.file.arrayBuffer());
     await planning;
     if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
+    await withDigest();
     const [fields, transfer] = run(bytes);
     post({ type, id, name, ...fields }, transfer);
   } catch (err) {
@@ -268,6 +323,12 @@ self.onmessage = (e) => {
     }
   } else if (m.type === 'plan') {
     planning = plan(m);
+  } else if (m.type === 'hash') {
+    hashFile(m);
+  } else if (m.type === 'sha256') {
+    // A scan's SHA-256 found by the page's second worker (or why not).
+    if (m.error) digestOf(m.key).reject(new Error(m.error));
+    else digestOf(m.key).resolve(m.digest);
   } else if (m.type === 'check') {
     check(m);
   } else if (m.type === 'preview') {

@@ -35,10 +35,41 @@ pub struct ScanBuffer {
     /// The report's sha256, chunk by chunk as the bytes arrive: V8 runs a
     /// long single call in its baseline tier (no on-stack replacement for
     /// wasm), where hashing a large file at once took 16 times longer.
-    sha256: Sha256,
+    /// `None` when it is found elsewhere (the page's second worker,
+    /// [`Sha256Stream`]) and given to the session ([`Session::set_scan_sha256`]).
+    sha256: Option<Sha256>,
     /// The files given with the scan, by name, and their SHA-256s.
     external: ExternalFiles,
     external_sha256: Vec<[u8; 32]>,
+}
+
+/// A file's SHA-256 found chunk by chunk, for the page's second worker: it
+/// reads the scan's file beside the worker that imports it, so the hash is
+/// off the import's path (as the CLI hashes on a second thread).
+#[wasm_bindgen]
+pub struct Sha256Stream {
+    hasher: Sha256,
+}
+
+#[wasm_bindgen]
+impl Sha256Stream {
+    #[wasm_bindgen(constructor)]
+    #[allow(clippy::new_without_default)]
+    pub fn new() -> Sha256Stream {
+        Sha256Stream {
+            hasher: Sha256::new(),
+        }
+    }
+
+    /// Hashes the next chunk of the file.
+    pub fn update(&mut self, chunk: &[u8]) {
+        job::hash_in_pieces(&mut self.hasher, chunk);
+    }
+
+    /// The digest (32 bytes).
+    pub fn finish(self) -> Vec<u8> {
+        self.hasher.finalize().to_vec()
+    }
 }
 
 /// A file a `.gltf` needs besides itself, as the page is told of it.
@@ -56,9 +87,12 @@ struct ExternalView<'a> {
 impl ScanBuffer {
     /// Room for a file of `size` bytes; refuses sizes past the page's limit
     /// ([`check_scan_size`]) and, without aborting, sizes the tab's memory
-    /// cannot hold.
+    /// cannot hold. With `hashed` false the file's SHA-256 is not found
+    /// here: the page finds it beside the import, in another worker
+    /// ([`Sha256Stream`]), as the CLI does on a second thread, and gives it
+    /// to the session before it plans ([`Session::set_scan_sha256`]).
     #[wasm_bindgen(constructor)]
-    pub fn new(name: &str, size: f64) -> Result<ScanBuffer, JsValue> {
+    pub fn new(name: &str, size: f64, hashed: Option<bool>) -> Result<ScanBuffer, JsValue> {
         check_scan_size(name, size)?;
         let size = size as usize;
         let mut bytes = Vec::new();
@@ -77,7 +111,7 @@ impl ScanBuffer {
             name: name.to_string(),
             size,
             bytes,
-            sha256: Sha256::new(),
+            sha256: hashed.unwrap_or(true).then(Sha256::new),
             external: ExternalFiles::new(),
             external_sha256: Vec::new(),
         })
@@ -103,7 +137,9 @@ impl ScanBuffer {
             )));
         }
         self.bytes.extend_from_slice(chunk);
-        job::hash_in_pieces(&mut self.sha256, chunk);
+        if let Some(h) = &mut self.sha256 {
+            job::hash_in_pieces(h, chunk);
+        }
         Ok(())
     }
 
@@ -146,7 +182,11 @@ impl ScanBuffer {
             &format!("{} with {}", self.name, file.name),
             (total + file.size) as f64,
         )?;
-        self.external_sha256.push(file.sha256.finalize().into());
+        let digest = match file.sha256 {
+            Some(h) => h.finalize().into(),
+            None => job::sha256(&file.bytes),
+        };
+        self.external_sha256.push(digest);
         self.external.add(file.name, file.bytes);
         Ok(())
     }
@@ -161,7 +201,12 @@ impl ScanBuffer {
         let imported = pipeline::load_scan_with(&self.bytes, &self.name, &options, &self.external)
             .map_err(core_err)?;
         let external = InputFile::external_of(&imported, &self.external, &self.external_sha256);
-        let file = InputFile::from_digest(&self.name, self.bytes.len(), &self.sha256.finalize())
+        // (An empty hash until the page gives it: `Session::set_scan_sha256`.)
+        let digest = self
+            .sha256
+            .map(|h| h.finalize().to_vec())
+            .unwrap_or_default();
+        let file = InputFile::from_digest(&self.name, self.bytes.len(), &digest)
             .with_external_files(external);
         Ok(ScanImport {
             file,
@@ -196,7 +241,7 @@ impl ScanBuffer {
             name: part.scan_name(),
             size: bytes.len(),
             bytes,
-            sha256,
+            sha256: Some(sha256),
             external: ExternalFiles::new(),
             external_sha256: Vec::new(),
         }

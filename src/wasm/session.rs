@@ -92,6 +92,19 @@ struct PlanSummary<'a> {
 }
 
 impl Session {
+    /// Ok once the scan's SHA-256 is known (see [`Session::set_scan_sha256`]).
+    fn digest_known(&self) -> Result<(), JsValue> {
+        if self.scan.file.sha256.is_empty() {
+            return Err(JsError::new(&format!(
+                "{}: its SHA-256 (which the G-code and the report name it by) is not found yet; \
+                 plan again",
+                self.scan.file.name
+            ))
+            .into());
+        }
+        Ok(())
+    }
+
     /// Keeps `report` for [`Session::report_json`] in place of the last one
     /// kept, and returns its number.
     fn keep_report(&mut self, report: job::Report) -> u32 {
@@ -313,6 +326,7 @@ impl Session {
         profile_file: Option<String>,
         with_report: Option<bool>,
     ) -> Result<JsValue, JsValue> {
+        self.digest_known()?;
         let settings: PlanSettings = from_js("plan settings", settings)?;
         let profile = profile(dialect, profile_file.as_deref())?;
         let out = job::run_on(&self.scan, svg, svg_name, &settings, &profile, accept_risk)
@@ -343,6 +357,25 @@ impl Session {
             )
             .into()),
         }
+    }
+
+    /// Gives the scan's SHA-256 (32 bytes) found beside its import (a
+    /// `ScanBuffer` made with `hashed` false, [`super::Sha256Stream`]): the
+    /// G-code header and the report name the scan by it, and a check
+    /// compares a program's header with it, so until it is given the
+    /// session neither plans nor checks.
+    #[wasm_bindgen(js_name = setScanSha256)]
+    pub fn set_scan_sha256(&mut self, digest: &[u8]) -> Result<(), JsError> {
+        if digest.len() != 32 {
+            return Err(JsError::new(&format!(
+                "a SHA-256 has 32 bytes, this one {}",
+                digest.len()
+            )));
+        }
+        let file = &self.scan.file;
+        self.scan.file = InputFile::from_digest(&file.name, file.bytes, digest)
+            .with_external_files(file.external_files.clone());
+        Ok(())
     }
 
     /// Reads the drawing the next plans use (an error, kind `svg`, names
@@ -419,6 +452,7 @@ impl Session {
         compare: bool,
         with_report: Option<bool>,
     ) -> Result<JsValue, JsValue> {
+        self.digest_known()?;
         let settings: PlanSettings = from_js("plan settings", settings)?;
         // As job::run_on: bad settings and profiles fail before any work.
         settings.validate().map_err(core_err)?;
@@ -529,6 +563,7 @@ impl Session {
     ) -> Result<JsValue, JsValue> {
         let nozzle: Nozzle = from_js("nozzle", nozzle)?;
         let text = gcode_text(bytes, name)?;
+        self.digest_known()?;
         let check = job::check_gcode(&self.scan, text, name, &nozzle, tol_mm).map_err(core_err)?;
         let out = to_js(&check)?;
         let o: &js_sys::Object = out.unchecked_ref();

@@ -3,6 +3,7 @@
 // writes for the same files and settings.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
+import { createHash } from 'node:crypto';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -95,6 +96,16 @@ test('an uploaded OBJ and SVG plan, and the downloads equal the CLI output', asy
   const json = JSON.parse(report.bytes.toString('utf8'));
   assert.equal(json.inputs[0].name, 'bumpy-sheet.obj');
   assert.deepEqual(json.settings.placement, { offset_mm: [10, 32], rotation_deg: 15, scale: 1.1 });
+  // The scan's SHA-256 was found by the page's second worker, beside the
+  // import, and is the one the G-code and the report name.
+  const sha = createHash('sha256').update(readFileSync(scanPath)).digest('hex');
+  const beside = await page.evaluate(() => {
+    const s = window.pcpp.state;
+    return Array.from(s.digests.get(s.scan.key) || [], (b) => b.toString(16).padStart(2, '0')).join('');
+  });
+  assert.equal(beside, sha);
+  assert.equal(json.inputs[0].sha256, sha);
+  assert.match(gcode.bytes.toString('utf8'), new RegExp(`sha256 ${sha}`));
   await context.close();
   assert.deepEqual(problems, []);
 
