@@ -228,21 +228,29 @@ function hashScan(scan) {
   if (state.digests.has(scan.key) || state.hashing.has(scan.key)) return;
   if (!state.hashWorker) {
     const w = startWorker(state.module);
+    // It failed (or its wasm did not start): every file it was hashing is
+    // answered with why, so no plan waits for it, and the next file gets a
+    // new one.
+    const failed = (why) => {
+      for (const key of state.hashing.keys()) {
+        state.worker.postMessage({ type: 'sha256', key, error: `the hashing worker failed (${why || 'no reason given'})` });
+      }
+      state.hashing.clear();
+      if (state.hashWorker === w) state.hashWorker = null;
+      w.terminate();
+    };
     w.onmessage = (e) => {
       const m = e.data;
+      if (m.type === 'error') {
+        failed(m.message);
+        return;
+      }
       if (m.type !== 'hashed') return;
       state.hashing.delete(m.key);
       if (m.digest) state.digests.set(m.key, m.digest);
       state.worker.postMessage({ type: 'sha256', key: m.key, digest: m.digest, error: m.error });
     };
-    w.onerror = (e) => {
-      // Every file it was hashing: the planning worker is told why.
-      for (const key of state.hashing.keys()) {
-        state.worker.postMessage({ type: 'sha256', key, error: `the hashing worker failed (${e.message || 'no reason given'})` });
-      }
-      state.hashing.clear();
-      state.hashWorker = null;
-    };
+    w.onerror = (e) => failed(e.message);
     state.hashWorker = w;
   }
   state.hashing.set(scan.key, true);

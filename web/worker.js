@@ -192,6 +192,10 @@ async function loadScan(m) {
   session = s;
   pathKey = null;
   needDigest = beside ? m.scan.key : null;
+  // Its SHA-256 from the second worker (found by now, as a rule: it reads
+  // the file while this one imports and indexes it); a file it could not
+  // read fails here, as a scan that cannot be read.
+  await withDigest();
   const info = s.info();
   const positions = s.meshPositions();
   const indices = s.meshIndices();

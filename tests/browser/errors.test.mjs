@@ -58,6 +58,42 @@ test('a corrupt scan shows the error and keeps the previous plan, its download a
   await context.close();
 });
 
+// The scan's SHA-256 comes from a second worker: when it cannot find it,
+// the scan is not taken (no plan waits for it), and the previous one stays.
+test('a scan whose SHA-256 cannot be found is not read, and the previous scan stays', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  const demo = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  // A scan of the user's: the hashing worker starts and finds its digest.
+  const obj = 'v 0 0 0\nv 80 0 0\nv 80 80 0\nv 0 80 0\nf 1 2 3\nf 1 3 4\n';
+  await page.setInputFiles('#scan-input', file('plate.obj', obj));
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'plate.obj');
+  await waitIdle(page);
+  await waitForPlan(page);
+  // The next file's hash fails as a read of it would.
+  await page.evaluate(() => {
+    const real = window.pcpp.state.hashWorker;
+    const answer = real.onmessage;
+    real.postMessage = (m) => setTimeout(() => answer({
+      data: { type: 'hashed', key: m.key, error: `could not read ${m.name} to hash it: NotReadableError` },
+    }), 50);
+  });
+  await page.setInputFiles('#scan-input', file('second.obj', obj.replace('80 80 0', '80 80 1')));
+  await page.waitForSelector('#error-panel:not([hidden])');
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'Could not read the scan second.obj');
+  assert.match(await page.textContent('#error-message'), /^could not read second\.obj to hash it: NotReadableError\nStill using the previous scan, plate\.obj\.$/);
+  assert.equal(await page.textContent('#scan-name'), 'plate.obj');
+  // Planning again plans on the previous scan, named by its own digest.
+  await page.click('#plan-btn');
+  await waitForPlan(page);
+  const gcode = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
+  assert.notEqual(gcode, demo);
+  assert.match(gcode, /; scan file: plate\.obj \(\d+ bytes, sha256 [0-9a-f]{64}\)/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('a corrupt SVG names the file and falls back; bad settings name the parameter', async () => {
   const { page, context } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
