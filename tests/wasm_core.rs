@@ -232,16 +232,17 @@ fn js<T: serde::Serialize>(v: &T) -> JsValue {
     serde_wasm_bindgen::to_value(v).unwrap()
 }
 
+/// A session on the scan `bytes` (named `name`) prepared with the scan
+/// and registration settings of `settings`, in one call.
+fn session_on(bytes: &[u8], name: &str, settings: &JobSettings) -> pcpp::wasm::Session {
+    pcpp::wasm::Session::new(bytes, name, js(&settings.scan), js(&settings.registration))
+        .unwrap_or_else(|e| panic!("{e:?}"))
+}
+
 #[wasm_bindgen_test]
 fn session_plans_the_golden_gcode_and_the_cli_report() {
     let settings = golden_settings();
-    let mut session = pcpp::wasm::Session::new(
-        &demo::demo_scan_bytes(),
-        demo::DEMO_SCAN_NAME,
-        js(&settings.scan),
-        js(&settings.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
     let svg = test_part::test_part_svg();
     let out = session
         .plan(
@@ -287,13 +288,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
 #[wasm_bindgen_test]
 fn a_report_left_for_later_is_the_same_bytes_and_kept_until_the_next_plan() {
     let settings = golden_settings();
-    let mut session = pcpp::wasm::Session::new(
-        &demo::demo_scan_bytes(),
-        demo::DEMO_SCAN_NAME,
-        js(&settings.scan),
-        js(&settings.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
     let svg = test_part::test_part_svg();
     let plan = |session: &mut pcpp::wasm::Session,
                 with_report: Option<bool>,
@@ -378,13 +373,7 @@ fn session_errors_name_the_cause_and_the_stage() {
     assert_eq!(kind.as_string().as_deref(), Some("registration"));
 
     // Unknown dialect and bad settings objects are errors, not panics.
-    let mut ok = pcpp::wasm::Session::new(
-        small_obj().as_bytes(),
-        "sheet.obj",
-        js(&none.scan),
-        js(&none.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut ok = session_on(small_obj().as_bytes(), "sheet.obj", &none);
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M1 5 L9 5"/></svg>"#;
     assert!(ok
         .plan(
@@ -413,13 +402,7 @@ fn session_errors_name_the_cause_and_the_stage() {
 #[wasm_bindgen_test]
 fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
     let settings = golden_settings();
-    let mut session = pcpp::wasm::Session::new(
-        &demo::demo_scan_bytes(),
-        demo::DEMO_SCAN_NAME,
-        js(&settings.scan),
-        js(&settings.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
     let svg = test_part::test_part_svg();
     let svg = svg.as_bytes();
     let mut profile: serde_json::Value =
@@ -474,13 +457,7 @@ fn session_plans_with_a_custom_profile_and_names_its_bad_field() {
 #[wasm_bindgen_test]
 fn session_pick_finds_the_surface_under_a_vertical_ray() {
     let none = JobSettings::default();
-    let session = pcpp::wasm::Session::new(
-        &demo::demo_scan_bytes(),
-        demo::DEMO_SCAN_NAME,
-        js(&none.scan),
-        js(&none.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &none);
     // The demo part's flat margin is at 5 mm.
     let hit = session
         .pick(&[2.0, 40.0, 100.0], &[0.0, 0.0, -1.0])
@@ -1238,13 +1215,7 @@ fn a_whole_objects_cloud_is_refused_with_its_own_kind() {
     settings.registration.scan_placement = pcpp::placement::ScanPlacement::on_bed(&marlin);
     let centre = pcpp::placement::Bed::of_profile(&marlin).centre_mm;
     settings.plan.placement.offset_mm = centre - pcpp::DVec2::new(6.0, 1.0);
-    let mut session = pcpp::wasm::Session::new(
-        text.as_bytes(),
-        "pebble.xyz",
-        js(&settings.scan),
-        js(&settings.registration),
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
+    let mut session = session_on(text.as_bytes(), "pebble.xyz", &settings);
     let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="12mm" height="2mm" viewBox="0 0 12 2"><path d="M0 1 H12" fill="none" stroke="black"/></svg>"#;
     let err = session
         .plan(
