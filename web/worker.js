@@ -194,8 +194,19 @@ async function loadScan(m) {
   needDigest = beside ? m.scan.key : null;
   // Its SHA-256 from the second worker (found by now, as a rule: it reads
   // the file while this one imports and indexes it); a file it could not
-  // read fails here, as a scan that cannot be read.
-  await withDigest();
+  // read fails here, as a scan that cannot be read, and the session goes
+  // with it (the page's next plan reads the scan it keeps again).
+  try {
+    await withDigest();
+  } catch (err) {
+    if (session === s) {
+      session.free();
+      session = null;
+      sessionKey = null;
+      needDigest = null;
+    }
+    throw err;
+  }
   const info = s.info();
   const positions = s.meshPositions();
   const indices = s.meshIndices();

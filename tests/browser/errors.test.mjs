@@ -84,12 +84,20 @@ test('a scan whose SHA-256 cannot be found is not read, and the previous scan st
   assert.equal(await page.textContent('#error-title'), 'Could not read the scan second.obj');
   assert.match(await page.textContent('#error-message'), /^could not read second\.obj to hash it: NotReadableError\nStill using the previous scan, plate\.obj\.$/);
   assert.equal(await page.textContent('#scan-name'), 'plate.obj');
-  // Planning again plans on the previous scan, named by its own digest.
+  // Planning again plans on the previous scan (read again: the worker
+  // dropped the one it could not hash), named by its own digest.
+  const shown = await page.evaluate(() => window.pcpp.state.lastPlan.gen);
+  await page.evaluate(() => { window.pcpp.state.lastPlan.seen = true; });
   await page.click('#plan-btn');
-  await waitForPlan(page);
-  const gcode = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
-  assert.notEqual(gcode, demo);
-  assert.match(gcode, /; scan file: plate\.obj \(\d+ bytes, sha256 [0-9a-f]{64}\)/);
+  await page.waitForFunction(() => {
+    const s = window.pcpp.state;
+    return !s.busy && s.lastPlan && !s.lastPlan.seen && !document.getElementById('dl-gcode').hidden;
+  }, null, { timeout: 120_000 });
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  const plan = await page.evaluate(() => ({ gcode: window.pcpp.state.lastPlan.gcode, gen: window.pcpp.state.lastPlan.gen }));
+  assert.ok(plan.gen >= shown);
+  assert.notEqual(plan.gcode, demo);
+  assert.match(plan.gcode, /; scan file: plate\.obj \(\d+ bytes, sha256 [0-9a-f]{64}\)/);
   assert.deepEqual(problems, []);
   await context.close();
 });
