@@ -221,9 +221,9 @@ function onReport(m) {
 
 // The SHA-256 of a scan file, found by a second worker while the planning
 // worker imports it (as the CLI hashes on a second thread): the G-code's
-// header names the scan by it, and the planning worker waits for it only
-// before it plans. Asked once per file; the answer goes to the planning
-// worker (a restarted one gets it with its next plan).
+// header names the scan by it, and the planning worker waits for it once
+// the scan is indexed, before it shows it. Asked once per file; the answer
+// goes to the planning worker (a restarted one gets it with its next plan).
 function hashScan(scan) {
   if (state.digests.has(scan.key) || state.hashing.has(scan.key)) return;
   if (!state.hashWorker) {
