@@ -839,8 +839,18 @@ struct PathDataRead {
     error: Option<(usize, String)>,
 }
 
-/// Characters of path data quoted in a note.
+/// Characters of path data or points quoted in a note.
 const EXCERPT_CHARS: usize = 16;
+
+/// The first [`EXCERPT_CHARS`] characters of `text` for a note, with "..."
+/// when there are more.
+fn excerpt(text: impl Iterator<Item = char>) -> String {
+    let mut out: String = text.take(EXCERPT_CHARS + 1).collect();
+    if out.chars().count() > EXCERPT_CHARS {
+        out = out.chars().take(EXCERPT_CHARS).collect::<String>() + "...";
+    }
+    out
+}
 
 fn read_path_data(d: &str) -> PathDataRead {
     let mut read = PathDataRead {
@@ -867,22 +877,14 @@ fn read_path_data(d: &str) -> PathDataRead {
                     _ => d.chars().count() + 1,
                 };
                 // (Path data may span lines: quoted on one.)
-                let mut excerpt: String = d
-                    .chars()
-                    .skip(at.saturating_sub(1))
-                    .take(EXCERPT_CHARS + 1)
-                    .map(|c| {
-                        if c.is_whitespace() || c.is_control() {
-                            ' '
-                        } else {
-                            c
-                        }
-                    })
-                    .collect();
-                if excerpt.chars().count() > EXCERPT_CHARS {
-                    excerpt = excerpt.chars().take(EXCERPT_CHARS).collect::<String>() + "...";
-                }
-                read.error = Some((at, excerpt));
+                let text = d.chars().skip(at.saturating_sub(1)).map(|c| {
+                    if c.is_whitespace() || c.is_control() {
+                        ' '
+                    } else {
+                        c
+                    }
+                });
+                read.error = Some((at, excerpt(text)));
                 break;
             }
         }
@@ -955,15 +957,10 @@ fn read_points(points: &str) -> PointsRead {
                 if rest.chars().all(|c| c.is_whitespace() || c == ',') {
                     break;
                 }
-                let mut word: String = rest
+                let word = rest
                     .chars()
-                    .take_while(|&c| !(c.is_whitespace() || c == ','))
-                    .take(EXCERPT_CHARS + 1)
-                    .collect();
-                if word.chars().count() > EXCERPT_CHARS {
-                    word = word.chars().take(EXCERPT_CHARS).collect::<String>() + "...";
-                }
-                read.error = Some((at, word));
+                    .take_while(|&c| !(c.is_whitespace() || c == ','));
+                read.error = Some((at, excerpt(word)));
                 break;
             }
         }
