@@ -239,22 +239,30 @@ fn session_on(bytes: &[u8], name: &str, settings: &JobSettings) -> pcpp::wasm::S
         .unwrap_or_else(|e| panic!("{e:?}"))
 }
 
+/// The demo's drawing planned on `session` with `plan` for Marlin, the risk
+/// not accepted; `with_report` as [`pcpp::wasm::Session::plan`] takes it.
+fn plan_demo_drawing(
+    session: &mut pcpp::wasm::Session,
+    plan: &pcpp::pipeline::PlanSettings,
+    with_report: Option<bool>,
+) -> Result<JsValue, JsValue> {
+    session.plan(
+        test_part::test_part_svg().as_bytes(),
+        demo::DEMO_PATH_NAME,
+        js(plan),
+        "marlin",
+        false,
+        None,
+        with_report,
+    )
+}
+
 #[wasm_bindgen_test]
 fn session_plans_the_golden_gcode_and_the_cli_report() {
     let settings = golden_settings();
     let mut session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
-    let svg = test_part::test_part_svg();
-    let out = session
-        .plan(
-            svg.as_bytes(),
-            demo::DEMO_PATH_NAME,
-            js(&settings.plan),
-            "marlin",
-            false,
-            None,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e:?}"));
+    let out =
+        plan_demo_drawing(&mut session, &settings.plan, None).unwrap_or_else(|e| panic!("{e:?}"));
     let gcode = js_sys::Reflect::get(&out, &"gcode".into()).unwrap();
     assert_eq!(gcode.as_string().unwrap(), GOLDEN_MARLIN);
     let report = js_sys::Reflect::get(&out, &"report_json".into())
@@ -268,17 +276,7 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
     // A placement change re-plans on the same session (no re-import).
     let mut moved = settings.plan;
     moved.placement.offset_mm.x += 1.0;
-    let again = session
-        .plan(
-            svg.as_bytes(),
-            demo::DEMO_PATH_NAME,
-            js(&moved),
-            "marlin",
-            false,
-            None,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e:?}"));
+    let again = plan_demo_drawing(&mut session, &moved, None).unwrap_or_else(|e| panic!("{e:?}"));
     let g2 = js_sys::Reflect::get(&again, &"gcode".into()).unwrap();
     assert_ne!(g2.as_string().unwrap(), GOLDEN_MARLIN);
 }
@@ -289,23 +287,11 @@ fn session_plans_the_golden_gcode_and_the_cli_report() {
 fn a_report_left_for_later_is_the_same_bytes_and_kept_until_the_next_plan() {
     let settings = golden_settings();
     let mut session = session_on(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
-    let svg = test_part::test_part_svg();
     let plan = |session: &mut pcpp::wasm::Session,
                 with_report: Option<bool>,
                 settings: &pcpp::pipeline::PlanSettings| {
-        session
-            .plan(
-                svg.as_bytes(),
-                demo::DEMO_PATH_NAME,
-                js(settings),
-                "marlin",
-                false,
-                None,
-                with_report,
-            )
-            .unwrap_or_else(|e| panic!("{e:?}"))
+        plan_demo_drawing(session, settings, with_report).unwrap_or_else(|e| panic!("{e:?}"))
     };
-    let get = |v: &JsValue, k: &str| js_sys::Reflect::get(v, &k.into()).unwrap();
     let whole = plan(&mut session, Some(true), &settings.plan);
     let expected = get(&whole, "report_json").as_string().unwrap();
     let absent = |v: JsValue| v.is_null() || v.is_undefined();
@@ -323,8 +309,7 @@ fn a_report_left_for_later_is_the_same_bytes_and_kept_until_the_next_plan() {
     let err = session
         .report_json(id)
         .expect_err("replaced by the next plan");
-    let message = js_sys::Reflect::get(&err, &"message".into()).unwrap();
-    assert!(message.as_string().unwrap().contains("no longer kept"));
+    assert!(message_and_kind(&err).0.contains("no longer kept"));
     let moved_report = String::from_utf8(session.report_json(next_id).unwrap()).unwrap();
     assert_ne!(moved_report, expected);
     // Asked again for the first settings: the bytes of the report written
@@ -536,21 +521,10 @@ fn demo_page_settings() -> JobSettings {
 #[wasm_bindgen_test]
 fn a_scan_hashed_beside_its_import_plans_once_its_digest_is_given() {
     let scan = demo::demo_scan_bytes();
-    let svg = test_part::test_part_svg();
     let settings = golden_settings();
     let mut hashed = staged_session(&scan, demo::DEMO_SCAN_NAME, &settings);
     let mut session = staged_session_hashed(&scan, demo::DEMO_SCAN_NAME, &settings, Some(false));
-    let plan = |s: &mut pcpp::wasm::Session| {
-        s.plan(
-            svg.as_bytes(),
-            demo::DEMO_PATH_NAME,
-            js(&settings.plan),
-            "marlin",
-            false,
-            None,
-            None,
-        )
-    };
+    let plan = |s: &mut pcpp::wasm::Session| plan_demo_drawing(s, &settings.plan, None);
     let err = plan(&mut session).expect_err("no digest yet");
     let (message, _) = message_and_kind(&err);
     assert!(
