@@ -258,6 +258,11 @@ pub fn hash_in_pieces(hasher: &mut Sha256, bytes: &[u8]) {
     }
 }
 
+/// A digest as the report writes it: lower-case hex.
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// A file as the report names it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct InputFile {
@@ -283,9 +288,15 @@ impl InputFile {
         InputFile {
             name: name.to_string(),
             bytes,
-            sha256: sha256.iter().map(|b| format!("{b:02x}")).collect(),
+            sha256: hex(sha256),
             external_files: Vec::new(),
         }
+    }
+
+    /// Its SHA-256 given once it is known (the page finds a scan's beside
+    /// its import).
+    pub fn set_digest(&mut self, sha256: &[u8]) {
+        self.sha256 = hex(sha256);
     }
 
     /// This scan with the external files it was read from.

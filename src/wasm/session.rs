@@ -372,9 +372,7 @@ impl Session {
                 digest.len()
             )));
         }
-        let file = &self.scan.file;
-        self.scan.file = InputFile::from_digest(&file.name, file.bytes, digest)
-            .with_external_files(file.external_files.clone());
+        self.scan.file.set_digest(digest);
         Ok(())
     }
 
