@@ -54,8 +54,8 @@ function progress(id, step, label, fraction, first) {
 // The SHA-256s of scan files found by the page's second worker (this same
 // script, `hashFile`), by the page's file key: {promise, resolve, reject}.
 // The scan is imported without hashing it and the session is given its
-// digest before it plans or checks (`needDigest`), as the CLI hashes on a
-// second thread beside the import.
+// digest once it is indexed (`loadScan`), as the CLI hashes on a second
+// thread beside the import.
 const digests = new Map();
 function digestOf(key) {
   let e = digests.get(key);
@@ -66,21 +66,6 @@ function digestOf(key) {
     digests.set(key, e);
   }
   return e;
-}
-// The file key whose digest the session still needs (null: it has it).
-let needDigest = null;
-
-// Gives the session its scan's SHA-256 once the second worker found it.
-// Called before a plan's or a check's synchronous part, so a message
-// handled while it waits cannot set another drawing under it.
-async function withDigest() {
-  if (!needDigest || !session) return;
-  const [s, key] = [session, needDigest];
-  const digest = await digestOf(key).promise;
-  // Another scan was read meanwhile: its own digest is waited for.
-  if (session !== s || needDigest !== key) return;
-  s.setScanSha256(digest);
-  needDigest = null;
 }
 
 // The second worker's task: a file's SHA-256, read in slices.
@@ -191,21 +176,26 @@ async function loadScan(m) {
   if (session) session.free();
   session = s;
   pathKey = null;
-  needDigest = beside ? m.scan.key : null;
   // Its SHA-256 from the second worker (found by now, as a rule: it reads
   // the file while this one imports and indexes it); a file it could not
   // read fails here, as a scan that cannot be read, and the session goes
-  // with it (the page's next plan reads the scan it keeps again).
-  try {
-    await withDigest();
-  } catch (err) {
-    if (session === s) {
-      session.free();
-      session = null;
-      sessionKey = null;
-      needDigest = null;
+  // with it (the page's next plan reads the scan it keeps again). The
+  // session refuses to plan or check without it.
+  if (beside) {
+    let digest;
+    try {
+      digest = await digestOf(m.scan.key).promise;
+    } catch (err) {
+      if (session === s) {
+        session.free();
+        session = null;
+        sessionKey = null;
+      }
+      throw err;
     }
-    throw err;
+    // Another scan was read while this one waited (and freed it).
+    if (session !== s) throw new Error(`${name} was replaced by another scan while it was read`);
+    s.setScanSha256(digest);
   }
   const info = s.info();
   const positions = s.meshPositions();
@@ -243,9 +233,6 @@ async function plan(m) {
       await loadScan(m);
       sessionKey = key;
     }
-    // The scan's SHA-256 from the second worker, for the G-code's header:
-    // waited for before this plan's synchronous part below.
-    await withDigest();
     stage = 'plan';
     if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
     if (!svg || svg.key !== m.svg.key) throw new Error(`the drawing ${m.svg.name} did not reach the planner; plan again`);
@@ -295,7 +282,6 @@ async function onProgram(m, type, run) {
     const bytes = m.bytes || new Uint8Array(await m.file.arrayBuffer());
     await planning;
     if (!session) throw new Error('No scan read yet: load a scan (or the demo) first.');
-    await withDigest();
     const [fields, transfer] = run(bytes);
     post({ type, id, name, ...fields }, transfer);
   } catch (err) {
