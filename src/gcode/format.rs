@@ -6,28 +6,58 @@
 //! byte for byte; the only fix needed is `-0.000`, which some controllers
 //! reject and which would make golden files depend on rounding noise.
 
-use std::fmt::Write as _;
-
 use super::profile::CommentStyle;
 
 /// `value` with exactly `decimals` digits after the point, never `-0.000`.
 /// The caller has checked that `value` is finite.
 pub(crate) fn fixed(value: f64, decimals: u32) -> String {
-    let Some((negative, q)) = scaled(value, decimals) else {
-        return fixed_by_format(value, decimals);
-    };
-    let p = POW10[decimals as usize] as u64;
     let mut text = String::with_capacity(24);
-    if negative && q != 0 {
-        text.push('-');
-    }
-    let (whole, part) = (q / p, q % p);
-    // (Writing to a String cannot fail.)
-    let _ = write!(text, "{whole}");
-    if decimals > 0 {
-        let _ = write!(text, ".{part:0width$}", width = decimals as usize);
-    }
+    push_fixed(&mut text, value, decimals);
     text
+}
+
+/// [`fixed`] appended to `out`, returning the value a controller reads
+/// from it ([`read_back`]): the writer does both for every coordinate of
+/// every move, and they share the scaling (issue 15).
+pub(crate) fn push_fixed(out: &mut String, value: f64, decimals: u32) -> f64 {
+    let Some((negative, q)) = scaled(value, decimals) else {
+        let text = fixed_by_format(value, decimals);
+        out.push_str(&text);
+        return text.parse().unwrap_or(value);
+    };
+    let negative = negative && q != 0;
+    if negative {
+        out.push('-');
+    }
+    // The digits of q from the last, with the point before the last
+    // `decimals` of them and at least one digit before it (q < 2^53: 16
+    // digits at most, and the point).
+    let mut digits = [0u8; 24];
+    let mut i = digits.len();
+    let (mut rest, mut k) = (q, 0);
+    loop {
+        if decimals > 0 && k == decimals {
+            i -= 1;
+            digits[i] = b'.';
+        }
+        i -= 1;
+        digits[i] = b'0' + (rest % 10) as u8;
+        rest /= 10;
+        k += 1;
+        if rest == 0 && k > decimals {
+            break;
+        }
+    }
+    for &b in &digits[i..] {
+        out.push(char::from(b));
+    }
+    // As `read_back`: q < 2^53 and the power of ten are exact.
+    let v = q as f64 / POW10[decimals as usize];
+    if negative {
+        -v
+    } else {
+        v
+    }
 }
 
 /// [`fixed`] through `{:.N}`, for what [`scaled`] does not take.
@@ -168,7 +198,7 @@ mod tests {
     }
 
     #[test]
-    fn fixed_writes_and_reads_back_what_format_and_parse_give() {
+    fn fixed_and_push_fixed_write_and_read_back_what_format_and_parse_give() {
         let mut bits = crate::demo::workloads::Rng(0x9e37_79b9_7f4a_7c15);
         let mut values = vec![
             0.0, -0.0, 0.5, 1.5, 2.5, -2.5, 1e-320, -5e-324, 9.0e15, 1.0e16,
@@ -192,6 +222,11 @@ mod tests {
                 assert_eq!(fixed(v, d), want, "{v:e} at {d} decimals");
                 let back: f64 = want.parse().unwrap();
                 assert_eq!(read_back(v, d).to_bits(), back.to_bits(), "{v:e} at {d}");
+                // Appended after what the line holds, with the value read back.
+                let mut line = String::from("G1 X");
+                let pushed = push_fixed(&mut line, v, d);
+                assert_eq!(line, format!("G1 X{want}"), "{v:e} at {d}");
+                assert_eq!(pushed.to_bits(), back.to_bits(), "{v:e} at {d}");
             }
         }
     }

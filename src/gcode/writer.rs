@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::format::{comment_line, fixed, trimmed};
+use super::format::{comment_line, fixed, push_fixed, trimmed};
 use super::profile::{template_error, MachineProfile, BLOCK_TOKENS, DWELL_TOKENS, FEED_RANGE_MM_S};
 use super::template;
 use super::GcodeError;
@@ -245,6 +245,11 @@ impl<'p> Program<'p> {
             self.read_back(to.y),
             self.read_back(to.z),
         );
+        self.moved_to(to, kind);
+    }
+
+    /// [`Self::moved`] to `to` as the controller reads it already.
+    fn moved_to(&mut self, to: DVec3, kind: MoveKind) {
         self.moves.push(WrittenMove {
             line: self.lines,
             from: self.at,
@@ -412,14 +417,25 @@ impl<'p> Program<'p> {
         if let Some(dwell) = dwell {
             self.line(dwell);
         }
+        // Most of a program's lines: written in place, each coordinate
+        // read back as it is written (the same text and values as `xyz`
+        // and `moved`).
+        let d = self.decimals;
         for (i, p) in rest.iter().enumerate() {
-            let line = if i == 0 {
-                format!("G1 {} F{}", self.xyz(*p), self.print_f)
-            } else {
-                format!("G1 {}", self.xyz(*p))
-            };
-            self.line(&line);
-            self.moved(*p, MoveKind::Print);
+            let out = &mut self.out;
+            out.push_str("G1 X");
+            let x = push_fixed(out, p.x, d);
+            out.push_str(" Y");
+            let y = push_fixed(out, p.y, d);
+            out.push_str(" Z");
+            let z = push_fixed(out, p.z, d);
+            if i == 0 {
+                out.push_str(" F");
+                out.push_str(&self.print_f);
+            }
+            out.push('\n');
+            self.lines += 1;
+            self.moved_to(DVec3::new(x, y, z), MoveKind::Print);
         }
         if let Some(dwell) = dwell {
             self.line(dwell);
