@@ -340,7 +340,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     }
     let mut out = Vec::new();
     let mut budget = MAX_POINTS;
-    let mut unpainted = 0usize;
+    let (mut unpainted, mut first_unpainted) = (0usize, None::<String>);
     let mut images = 0usize;
     let mut non_finite = 0usize;
     let cos_corner = libm::cos(CORNER_ANGLE_DEG.to_radians());
@@ -406,12 +406,6 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         if id.starts_with(prepared.copy_prefix.as_str()) {
             continue;
         }
-        // usvg marks paths with neither fill nor stroke, and
-        // `visibility: hidden` ones, as invisible: they draw nothing.
-        if !path.is_visible() {
-            unpainted += 1;
-            continue;
-        }
         let shape_index = if id.is_empty() {
             fingerprints
                 .iter()
@@ -426,6 +420,13 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             None if id.is_empty() => "use instance".to_string(),
             None => id.to_string(),
         };
+        // usvg marks paths with neither fill nor stroke, and
+        // `visibility: hidden` ones, as invisible: they draw nothing.
+        if !path.is_visible() {
+            unpainted += 1;
+            first_unpainted.get_or_insert(label);
+            continue;
+        }
         // A filled shape with no stroke (an icon, a PCB pad) is printed
         // along its outline: the nozzle draws lines, it does not fill.
         if path.stroke().is_none() {
@@ -644,9 +645,10 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         notes.push(note(&format!(" in {file}")));
     }
 
-    if unpainted > 0 {
+    if let Some(first) = &first_unpainted {
         notes.push(format!(
-            "{unpainted} shape(s) with no stroke and no fill, or hidden, were not printed"
+            "{unpainted} shape(s) with no stroke and no fill, or hidden, were not printed (the \
+             first: '{first}')"
         ));
     }
     if images > 0 {

@@ -395,6 +395,28 @@ fn unpainted_and_hidden_elements_are_not_printed() {
 }
 
 #[test]
+fn the_note_on_shapes_not_printed_counts_them_and_names_the_first() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<path d="M 0 0 L 10 0" stroke="black" display="none"/>
+           <path id="ghost" d="M 0 0 L 10 0" stroke="black" visibility="hidden"/>
+           <path d="M 0 0 L 10 0" stroke="none" fill="none"/>
+           <path id="kept" d="M 0 5 L 10 5" stroke="black"/>"#,
+    ));
+    assert_eq!(subs.len(), 1, "{subs:?}");
+    let note = notes
+        .iter()
+        .find(|n| n.contains("were not printed"))
+        .unwrap_or_else(|| panic!("no note on the hidden shapes: {notes:?}"));
+    // `display: none` draws nothing and is left out without a word, as
+    // SVG viewers leave it out; the hidden and the unpainted are counted.
+    assert!(
+        note.starts_with("2 shape(s)") && note.contains("(the first: 'ghost')"),
+        "{note}"
+    );
+}
+
+#[test]
 fn nothing_printable_is_an_error_that_names_the_file() {
     let text = doc(
         MM,
