@@ -995,9 +995,11 @@ fn exhaustive_byte_corruption_never_panics() {
     }
 }
 
-/// What real glTF files require beyond the core: compressed geometry is
-/// named (Draco's accessors have no data, which the validation reported
-/// accessor by accessor in 4 KB), glTF 1.0 written with a numeric version
+/// What real glTF files require beyond the core: meshopt-compressed
+/// geometry is named (its accessors have no data, which the validation
+/// reported accessor by accessor in 4 KB), a file that requires Draco
+/// but holds a plain primitive is read as it is (Draco itself is decoded:
+/// `realworld::gltf_draco_*`), glTF 1.0 written with a numeric version
 /// is named, appearance-only required extensions do not stop the import,
 /// and a POSITION accessor without min/max is read (its bounds come from
 /// the data).
@@ -1012,16 +1014,23 @@ fn gltf_extensions_versions_and_missing_bounds() {
         ))
     };
     let e = import_mesh(
-        &with(r#""KHR_draco_mesh_compression""#),
+        &with(r#""EXT_meshopt_compression""#),
         "engine.gltf",
         &ImportOptions::DEFAULT,
     )
     .unwrap_err()
     .to_string();
     assert!(
-        e.contains("compressed (KHR_draco_mesh_compression)") && e.len() < 300,
+        e.contains("compressed (EXT_meshopt_compression)") && e.len() < 300,
         "{e}"
     );
+    let m = import_mesh(
+        &with(r#""KHR_draco_mesh_compression""#),
+        "plain.gltf",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
     let e = import_mesh(
         &with(r#""EXT_mesh_gpu_instancing""#),
         "i.gltf",

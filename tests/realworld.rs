@@ -277,6 +277,223 @@ fn gltf_five_nodes_with_data_uri_buffers() {
     );
 }
 
+// ------------------------------------------------------------ glTF Draco
+//
+// Draco bitstreams written by Google's own encoder (draco3dgltf, through
+// glTF-Transform's `draco` command, SOURCES.md): EdgeBreaker standard,
+// EdgeBreaker valence and sequential connectivity, positions quantized to
+// 14 bits as that command does by default.
+
+/// Each vertex of `decoded` snapped to the nearest vertex of `original`
+/// (brute force), no farther than `tol`: the triangles must be the
+/// original's, as sets of its vertices.
+fn assert_same_surface(decoded: &TriMesh, original: &TriMesh, tol: f64, what: &str) {
+    let nearest: Vec<u32> = decoded
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let (k, d) = original
+                .vertices
+                .iter()
+                .enumerate()
+                .map(|(k, o)| (k, o.distance(*v)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("vertices");
+            assert!(
+                d <= tol,
+                "{what}: vertex {i} at {v} is {d} mm from the nearest"
+            );
+            k as u32
+        })
+        .collect();
+    let key = |t: [u32; 3]| {
+        let mut t = t;
+        t.sort_unstable();
+        t
+    };
+    let want: BTreeSet<[u32; 3]> = original.triangles.iter().map(|&t| key(t)).collect();
+    let got: BTreeSet<[u32; 3]> = decoded
+        .triangles
+        .iter()
+        .map(|t| key(t.map(|v| nearest[v as usize])))
+        .collect();
+    assert_eq!(
+        decoded.triangle_count(),
+        original.triangle_count(),
+        "{what}"
+    );
+    assert_eq!(got, want, "{what}: the triangles differ");
+}
+
+/// The Stanford bunny (3,674 triangles) as glTF, then Draco-compressed
+/// with EdgeBreaker's standard and valence traversals: the same surface,
+/// each vertex within a quantization step of its own (the file's largest
+/// extent over 2^14 - 1: the bunny is about 15 units across, read as
+/// metres).
+#[test]
+fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
+    let original = import(data!("mesh/bunny.glb"), "bunny.glb");
+    assert_eq!(original.mesh.triangle_count(), 3674);
+    let (lo, hi) = original.mesh.bbox().unwrap();
+    let step = (hi - lo).max_element() / 16383.0;
+    for (bytes, name) in [
+        (data!("mesh/bunny-draco.glb"), "bunny-draco.glb"),
+        (
+            data!("mesh/bunny-draco-valence.glb"),
+            "bunny-draco-valence.glb",
+        ),
+    ] {
+        let m = import(bytes, name);
+        assert_eq!(m.format, MeshFormat::Glb);
+        assert_eq!(m.units, ScanUnits::M);
+        assert_eq!(
+            m.mesh.vertices.len(),
+            original.mesh.vertices.len(),
+            "{name}"
+        );
+        assert_same_surface(&m.mesh, &original.mesh, step, name);
+    }
+}
+
+/// The glTF sample box (a rotated root node over the mesh's node) with
+/// sequential connectivity and POSITION as Draco attribute 1, beside the
+/// normals and texture coordinates: the uncompressed box, its 24 points
+/// welded to 8 again.
+#[test]
+fn gltf_draco_sequential_box_with_a_node_hierarchy_is_the_box() {
+    let m = import(
+        data!("mesh/BoxTextured-draco-sequential.glb"),
+        "BoxTextured-draco-sequential.glb",
+    );
+    let original = import(data!("mesh/BoxTextured.glb"), "BoxTextured.glb");
+    assert_eq!(m.mesh.vertices.len(), 8, "seams welded");
+    assert_bbox(&m.mesh, [-500.0; 3], [500.0; 3], 0.04);
+    assert_same_surface(&m.mesh, &original.mesh, 0.04, "box");
+}
+
+/// The demo test part (247,490 triangles, a root node scaling mm to
+/// metres and turning +Z up to +Y) Draco-compressed: it plans as the
+/// uncompressed part does. Quantization (80 mm / 2^14) collapses 292 of
+/// the thinnest triangles, and moves the surface by less than a hundredth
+/// of a mm (at 3,600 points off its walls).
+#[test]
+fn gltf_draco_test_part_plans_as_the_uncompressed_part() {
+    use pcpp::surface::Surface;
+    let m = import(data!("mesh/test-part-draco.glb"), "test-part-draco.glb");
+    let part = pcpp::demo::test_part::test_part();
+    // Quantization collapses the thinnest triangles: Draco's encoder drops
+    // those whose points merge, the import skips those left with zero area
+    // and says so.
+    let lost = part.triangle_count() - m.mesh.triangle_count();
+    assert!(lost * 500 < part.triangle_count(), "{lost} triangles lost");
+    assert!(degenerate_warning(&m).is_some(), "{:?}", m.warnings);
+    let (decoded, original) = (
+        Surface::new(m.mesh.clone()).unwrap(),
+        Surface::new(part.clone()).unwrap(),
+    );
+    let (lo, hi) = part.bbox().unwrap();
+    let (mut close, mut asked) = (0, 0);
+    for i in 0..60 {
+        for j in 0..60 {
+            // (Off the part's whole and half mm, where its walls stand: a
+            // wall moved by quantization moves the height found there.)
+            let xy = DVec2::new(
+                lo.x + (hi.x - lo.x) * (i as f64 + 0.1) / 60.0,
+                lo.y + (hi.y - lo.y) * (j as f64 + 0.1) / 60.0,
+            );
+            if let (Some(a), Some(b)) = (decoded.highest_hit(xy), original.highest_hit(xy)) {
+                asked += 1;
+                close += usize::from((a - b).abs() <= 0.01);
+            }
+        }
+    }
+    assert!(asked > 3000 && close == asked, "{close} of {asked}");
+    // The whole job, as a user runs it: the demo drawing planned with
+    // `even` on the Draco file's bytes, every written move checked against
+    // the decoded scan (no risk accepted), as on the uncompressed part.
+    let drawing = pcpp::demo::test_part::test_part_svg();
+    let settings = PlanSettings {
+        placement: pcpp::demo::test_part::placement(),
+        ..PlanSettings::default()
+    };
+    let profile = MachineProfile::builtin("marlin").expect("marlin profile");
+    let ply = pcpp::demo::to_binary_ply(&part);
+    let plans: Vec<_> = [
+        (data!("mesh/test-part-draco.glb"), "test-part-draco.glb"),
+        (ply.as_slice(), "test-part.ply"),
+    ]
+    .into_iter()
+    .map(|(bytes, name)| {
+        let scan = prepare_scan(
+            bytes,
+            name,
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        run_on(
+            &scan,
+            drawing.as_bytes(),
+            "lines.svg",
+            &settings,
+            &profile,
+            false,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    })
+    .collect();
+    let points = |o: &pcpp::job::JobOutput| {
+        o.plan
+            .pieces
+            .iter()
+            .map(|p| p.toolpath.len())
+            .sum::<usize>()
+    };
+    assert_eq!(points(&plans[0]), points(&plans[1]));
+    assert!(plans[0].gcode.contains("test-part-draco.glb"));
+}
+
+/// Draco data damaged anywhere is read or refused with the file named,
+/// never a panic; a stream that is not Draco at all is named as such, with
+/// its primitive and bufferView.
+#[test]
+fn gltf_draco_damaged_data_is_an_error_not_a_panic() {
+    let bytes = data!("mesh/bunny-draco.glb");
+    let json = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    // The BIN chunk's data, which is the Draco stream (bufferView 0).
+    let bin = 20 + json + 8;
+    assert_eq!(&bytes[bin..bin + 5], b"DRACO");
+    let mut refused = 0;
+    for at in (bin..bytes.len()).step_by(3) {
+        for value in [0x00, 0xff, bytes[at] ^ 0x55] {
+            let mut b = bytes.to_vec();
+            b[at] = value;
+            if let Err(e) = import_mesh_with(
+                &b,
+                "bunny-draco.glb",
+                &ImportOptions::DEFAULT,
+                &ExternalFiles::new(),
+            ) {
+                refused += 1;
+                assert!(e.to_string().contains("bunny-draco.glb"), "{e}");
+            }
+        }
+    }
+    assert!(refused > 0);
+    let mut b = bytes.to_vec();
+    b[bin..bin + 5].copy_from_slice(b"DRACX");
+    assert_import_error(
+        &b,
+        "bunny-draco.glb",
+        &[
+            "bunny-draco.glb",
+            "mesh 0 primitive 0",
+            "Draco data (bufferView 0) could not be decoded",
+        ],
+    );
+}
+
 #[test]
 fn gltf_1_glb_is_refused_by_version() {
     assert_import_error(

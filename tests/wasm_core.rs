@@ -1329,3 +1329,60 @@ fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
         "{message}"
     );
 }
+
+/// A Draco-compressed glTF (Google's encoder, EdgeBreaker; see
+/// tests/data/realworld/SOURCES.md) decodes in wasm32 to the uncompressed
+/// bunny: the same triangles, each vertex within a quantization step of its
+/// own; and the page's staged import takes it.
+#[wasm_bindgen_test]
+fn a_draco_compressed_gltf_decodes_to_the_uncompressed_scan() {
+    let plain = include_bytes!("data/realworld/mesh/bunny.glb");
+    let draco = include_bytes!("data/realworld/mesh/bunny-draco.glb");
+    let original = import_mesh(plain, "bunny.glb", &ImportOptions::DEFAULT).unwrap();
+    let decoded = import_mesh(draco, "bunny-draco.glb", &ImportOptions::DEFAULT).unwrap();
+    let (lo, hi) = original.mesh.bbox().unwrap();
+    let step = (hi - lo).max_element() / 16383.0;
+    assert_eq!(
+        decoded.mesh.triangle_count(),
+        original.mesh.triangle_count()
+    );
+    let nearest: Vec<u32> = decoded
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| {
+            let (k, d) = original
+                .mesh
+                .vertices
+                .iter()
+                .enumerate()
+                .map(|(k, o)| (k, o.distance(*v)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            assert!(d <= step, "{v} is {d} mm from the nearest vertex");
+            k as u32
+        })
+        .collect();
+    let sorted = |mut t: [u32; 3]| {
+        t.sort_unstable();
+        t
+    };
+    let want: std::collections::BTreeSet<[u32; 3]> =
+        original.mesh.triangles.iter().map(|&t| sorted(t)).collect();
+    let got: std::collections::BTreeSet<[u32; 3]> = decoded
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| sorted(t.map(|v| nearest[v as usize])))
+        .collect();
+    assert_eq!(got, want);
+    // The page's staged steps (web/worker.js).
+    let settings = JobSettings::default();
+    let mut import = written("bunny-draco.glb", draco)
+        .import_scan(js(&settings.scan))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    import
+        .register(js(&RegistrationSettings::default()))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    import.index().unwrap_or_else(|e| panic!("{e:?}"));
+}

@@ -21,7 +21,7 @@ use gltf::{Accessor, Document, Mesh, Node};
 
 use super::external::{relative_path, ExternalFiles, ExternalRef};
 use super::import::{Parsed, Welder};
-use super::MeshError;
+use super::{MeshError, MAX_SCAN_BYTES, MAX_TRIANGLES};
 
 /// Data URIs from some exporters omit the base64 padding.
 const BASE64: GeneralPurpose = GeneralPurpose::new(
@@ -57,26 +57,43 @@ pub(super) fn parse(
     })?;
     // Compressed geometry cannot be read without its decoder; its accessors
     // hold no data, which the validation would report accessor by accessor.
-    if let Some(ext) = compression(&root) {
-        let what = if ext.contains("draco") {
-            "Draco"
-        } else {
-            "meshopt"
-        };
+    // Draco is decoded (`SceneReader::draco`); meshopt is not.
+    if let Some(ext) = compression(&root).filter(|&e| e == MESHOPT) {
         return Err(MeshError::invalid(
             file,
             format!(
                 "its meshes are compressed ({ext}), which is not supported: this program does \
-                 not decode {what}; export the scan without {what} compression (Blender imports \
-                 it and exports it uncompressed)"
+                 not decode meshopt; export the scan without meshopt compression (Blender \
+                 imports it and exports it uncompressed)"
             ),
         ));
     }
+    let draco = draco_primitives(json, &root, file)?;
+    if let Some(d) = draco.values().next() {
+        // glTF lets an accessor have neither bufferView nor sparse values
+        // (it then holds zeros), and Draco primitives' accessors are
+        // written so; `gltf-json` refuses them. They are never read (the
+        // Draco data is), so each gets a stand-in view of one byte.
+        let mut stand_in = root.buffer_views[d.view].clone();
+        stand_in.byte_length = gltf::json::validation::USize64(1);
+        stand_in.byte_offset = None;
+        stand_in.byte_stride = None;
+        stand_in.target = None;
+        let index = gltf::json::Index::new(root.buffer_views.len() as u32);
+        root.buffer_views.push(stand_in);
+        for a in &mut root.accessors {
+            if a.buffer_view.is_none() && a.sparse.is_none() {
+                a.buffer_view = Some(index);
+            }
+        }
+    }
     // What the file requires of materials, textures and lights does not
-    // change its surface, and quantized positions are read here: only
-    // what would change the geometry stops the import.
+    // change its surface, and quantized and Draco-compressed positions are
+    // read here: only what would change the geometry stops the import.
     root.extensions_required.retain(|e| {
-        e != "KHR_mesh_quantization" && !IGNORED_PREFIXES.iter().any(|p| e.starts_with(p))
+        e != "KHR_mesh_quantization"
+            && e != DRACO
+            && !IGNORED_PREFIXES.iter().any(|p| e.starts_with(p))
     });
     if let Some(ext) = root.extensions_required.first() {
         return Err(MeshError::invalid(
@@ -94,6 +111,7 @@ pub(super) fn parse(
     let mut scene = SceneReader {
         file,
         buffers,
+        draco,
         welder: Welder::default(),
         triangles: Vec::new(),
         warnings: Vec::new(),
@@ -216,7 +234,93 @@ fn compression(root: &gltf::json::Root) -> Option<&'static str> {
 
 /// Extensions that compress a glTF's geometry (its accessors then hold
 /// no data until decoded).
-const COMPRESSION_EXTENSIONS: [&str; 2] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
+const COMPRESSION_EXTENSIONS: [&str; 2] = [DRACO, MESHOPT];
+const DRACO: &str = "KHR_draco_mesh_compression";
+const MESHOPT: &str = "EXT_meshopt_compression";
+
+/// Where a Draco-compressed primitive's data lies, and which of its
+/// attributes is POSITION (KHR_draco_mesh_compression).
+#[derive(Debug, Clone, Copy)]
+struct DracoRef {
+    view: usize,
+    buffer: usize,
+    offset: usize,
+    length: usize,
+    /// The Draco attribute id of POSITION.
+    position: u32,
+}
+
+/// The Draco-compressed primitives of the file, by (mesh, primitive). The
+/// extension object is read from the JSON text (the `gltf` crate keeps no
+/// unknown extensions); its bufferView is checked against the list.
+fn draco_primitives(
+    json: &[u8],
+    root: &gltf::json::Root,
+    file: &str,
+) -> Result<std::collections::HashMap<(usize, usize), DracoRef>, MeshError> {
+    #[derive(serde::Deserialize)]
+    struct Doc {
+        #[serde(default)]
+        meshes: Vec<MeshJson>,
+    }
+    #[derive(serde::Deserialize)]
+    struct MeshJson {
+        #[serde(default)]
+        primitives: Vec<PrimitiveJson>,
+    }
+    #[derive(serde::Deserialize)]
+    struct PrimitiveJson {
+        #[serde(default)]
+        extensions: Option<serde_json::Map<String, serde_json::Value>>,
+    }
+    let mut out = std::collections::HashMap::new();
+    let uses = |list: &[String]| list.iter().any(|e| e == DRACO);
+    if !uses(&root.extensions_used) && !uses(&root.extensions_required) {
+        return Ok(out);
+    }
+    let doc: Doc = serde_json::from_slice(json)
+        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
+    for (m, mesh) in doc.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let Some(ext) = primitive.extensions.as_ref().and_then(|e| e.get(DRACO)) else {
+                continue;
+            };
+            let bad = |what: &str| {
+                MeshError::invalid(
+                    file,
+                    format!("mesh {m} primitive {p}: its {DRACO} extension {what}"),
+                )
+            };
+            let view = ext
+                .get("bufferView")
+                .and_then(serde_json::Value::as_u64)
+                .ok_or_else(|| bad("has no bufferView"))? as usize;
+            let position = ext
+                .get("attributes")
+                .and_then(|a| a.get("POSITION"))
+                .and_then(serde_json::Value::as_u64)
+                .and_then(|id| u32::try_from(id).ok())
+                .ok_or_else(|| bad("names no POSITION attribute"))?;
+            let v = root.buffer_views.get(view).ok_or_else(|| {
+                bad(&format!(
+                    "refers to bufferView {view}, but there are {}",
+                    root.buffer_views.len()
+                ))
+            })?;
+            out.insert(
+                (m, p),
+                DracoRef {
+                    view,
+                    buffer: v.buffer.value(),
+                    offset: v.byte_offset.map_or(0, |o| o.0 as usize),
+                    length: v.byte_length.0 as usize,
+                    position,
+                },
+            );
+        }
+    }
+    Ok(out)
+}
 
 /// Extensions of appearance only (materials, textures, lights): a file
 /// that requires them still describes its surface in full.
@@ -471,6 +575,8 @@ impl Elements<'_> {
 struct SceneReader<'f, 'b> {
     file: &'f str,
     buffers: Vec<Cow<'b, [u8]>>,
+    /// The primitives whose geometry is Draco-compressed.
+    draco: std::collections::HashMap<(usize, usize), DracoRef>,
     welder: Welder,
     triangles: Vec<[u32; 3]>,
     warnings: Vec<String>,
@@ -562,17 +668,29 @@ impl SceneReader<'_, '_> {
                 self.skipped_primitives += 1;
                 continue;
             }
-            let Some(accessor) = primitive.get(&Semantic::Positions) else {
-                self.warnings.push(format!(
-                    "{}: {at} has no POSITION attribute and was skipped",
-                    self.file
-                ));
-                continue;
-            };
-            let corners = self.positions(&accessor, world, &at)?;
-            let indices = match primitive.indices() {
-                Some(accessor) => self.indices(&accessor, corners.len(), &at)?,
-                None => (0..corners.len()).collect(),
+            let draco = self.draco.get(&(mesh.index(), primitive.index())).copied();
+            let (corners, indices) = if let Some(d) = draco {
+                if mode != Mode::Triangles {
+                    return Err(self.err(format!(
+                        "{at}: Draco-compressed triangle strips and fans are not read (Draco \
+                         holds triangle lists)"
+                    )));
+                }
+                self.draco(&d, world, &at)?
+            } else {
+                let Some(accessor) = primitive.get(&Semantic::Positions) else {
+                    self.warnings.push(format!(
+                        "{}: {at} has no POSITION attribute and was skipped",
+                        self.file
+                    ));
+                    continue;
+                };
+                let corners = self.positions(&accessor, world, &at)?;
+                let indices = match primitive.indices() {
+                    Some(accessor) => self.indices(&accessor, corners.len(), &at)?,
+                    None => (0..corners.len()).collect(),
+                };
+                (corners, indices)
             };
             let n = indices.len();
             let mut local: Vec<[usize; 3]> = match mode {
@@ -638,6 +756,98 @@ impl SceneReader<'_, '_> {
                 )
             })
             .collect();
+        self.place(points, world, at)
+    }
+
+    /// A Draco-compressed primitive (KHR_draco_mesh_compression): its
+    /// points placed in the scene and welded as [`Self::positions`] does,
+    /// and its triangles as indices of them. Decoded with `draco-core`
+    /// under the import's own ceilings ([`MAX_TRIANGLES`] faces, three
+    /// points each, [`MAX_SCAN_BYTES`] of decoded values): a header that
+    /// claims more is refused before anything is allocated.
+    fn draco(
+        &mut self,
+        d: &DracoRef,
+        world: &DMat4,
+        at: &str,
+    ) -> Result<(Vec<u32>, Vec<usize>), MeshError> {
+        let bytes = self
+            .buffers
+            .get(d.buffer)
+            .and_then(|b| {
+                d.offset
+                    .checked_add(d.length)
+                    .and_then(|end| b.get(d.offset..end))
+            })
+            .ok_or_else(|| {
+                self.err(format!(
+                    "{at}: its Draco data, bufferView {} (offset {}, length {}), lies outside \
+                     buffer {}",
+                    d.view, d.offset, d.length, d.buffer
+                ))
+            })?;
+        let mut mesh = draco_core::Mesh::new();
+        let limits = draco_core::DecodeLimits::default()
+            .with_max_faces(MAX_TRIANGLES as u64)
+            .with_max_points(3 * MAX_TRIANGLES as u64)
+            .with_max_decoded_bytes(MAX_SCAN_BYTES as u64);
+        draco_core::MeshDecoder::new()
+            .decode(
+                &mut draco_core::DecoderBuffer::new(bytes).with_limits(limits),
+                &mut mesh,
+            )
+            .map_err(|e| {
+                self.err(format!(
+                    "{at}: its Draco data (bufferView {}) could not be decoded: {e}",
+                    d.view
+                ))
+            })?;
+        let n = mesh.num_points();
+        let attribute = (0..mesh.num_attributes())
+            .map(|i| mesh.attribute(i))
+            .find(|a| a.unique_id() == d.position)
+            .ok_or_else(|| {
+                self.err(format!(
+                    "{at}: its Draco data has no attribute {}, which the extension names as \
+                     POSITION",
+                    d.position
+                ))
+            })?;
+        if attribute.num_components() != 3 {
+            return Err(self.err(format!(
+                "{at}: its Draco POSITION attribute has {} components, not 3",
+                attribute.num_components()
+            )));
+        }
+        let points: Vec<DVec3> = attribute
+            .read_f32s(n, 3)
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
+            .collect();
+        let corners = self.place(points, world, at)?;
+        let mut indices = Vec::with_capacity(3 * mesh.num_faces());
+        for (f, face) in mesh.faces().iter().enumerate() {
+            for p in face {
+                let i = p.0 as usize;
+                if i >= n {
+                    return Err(self.err(format!(
+                        "{at}: Draco face {f} refers to point {i}, but there are {n}"
+                    )));
+                }
+                indices.push(i);
+            }
+        }
+        Ok((corners, indices))
+    }
+
+    /// `points` placed in the scene by `world` and welded; point `i`
+    /// becomes vertex `result[i]`.
+    fn place(
+        &mut self,
+        points: Vec<DVec3>,
+        world: &DMat4,
+        at: &str,
+    ) -> Result<Vec<u32>, MeshError> {
         let mut out = Vec::with_capacity(points.len());
         for (i, p) in points.into_iter().enumerate() {
             let placed = world.transform_point3(p);
