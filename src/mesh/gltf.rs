@@ -238,6 +238,20 @@ const COMPRESSION_EXTENSIONS: [&str; 2] = [DRACO, MESHOPT];
 const DRACO: &str = "KHR_draco_mesh_compression";
 const MESHOPT: &str = "EXT_meshopt_compression";
 
+/// The most faces a Draco stream may decode to per byte of it. Google's
+/// encoder (glTF-Transform's defaults) writes 0.4 faces a byte for the
+/// Stanford bunny, 1.7 for a 2 M triangle scan of a wrinkled film and 3.5
+/// for a perfectly flat regular grid, the most compressible mesh there is;
+/// a stream that claims 70 times that is a decompression bomb.
+const DRACO_FACES_PER_BYTE: u64 = 256;
+
+/// Faces any Draco stream may decode to, however short.
+const DRACO_FACES_ANYWAY: u64 = 65_536;
+
+/// Decoded attribute bytes a Draco point may take: its position (12), and
+/// normals, colours and texture coordinates besides.
+const DRACO_BYTES_PER_POINT: u64 = 64;
+
 /// Where a Draco-compressed primitive's data lies, and which of its
 /// attributes is POSITION (KHR_draco_mesh_compression).
 #[derive(Debug, Clone, Copy)]
@@ -762,9 +776,12 @@ impl SceneReader<'_, '_> {
     /// A Draco-compressed primitive (KHR_draco_mesh_compression): its
     /// points placed in the scene and welded as [`Self::positions`] does,
     /// and its triangles as indices of them. Decoded with `draco-core`
-    /// under the import's own ceilings ([`MAX_TRIANGLES`] faces, three
-    /// points each, [`MAX_SCAN_BYTES`] of decoded values): a header that
-    /// claims more is refused before anything is allocated.
+    /// under the import's own ceilings: [`MAX_TRIANGLES`] faces, and no
+    /// more than [`DRACO_FACES_PER_BYTE`] of the stream's bytes allow
+    /// (as the other formats' counts are checked against the bytes
+    /// present), three points a face, [`DRACO_BYTES_PER_POINT`] of decoded
+    /// values a point and [`MAX_SCAN_BYTES`] in all: a stream that claims
+    /// more is refused before its geometry is allocated.
     fn draco(
         &mut self,
         d: &DracoRef,
@@ -787,10 +804,12 @@ impl SceneReader<'_, '_> {
                 ))
             })?;
         let mut mesh = draco_core::Mesh::new();
+        let faces = (MAX_TRIANGLES as u64)
+            .min(DRACO_FACES_PER_BYTE * bytes.len() as u64 + DRACO_FACES_ANYWAY);
         let limits = draco_core::DecodeLimits::default()
-            .with_max_faces(MAX_TRIANGLES as u64)
-            .with_max_points(3 * MAX_TRIANGLES as u64)
-            .with_max_decoded_bytes(MAX_SCAN_BYTES as u64);
+            .with_max_faces(faces)
+            .with_max_points(3 * faces)
+            .with_max_decoded_bytes((MAX_SCAN_BYTES as u64).min(3 * faces * DRACO_BYTES_PER_POINT));
         draco_core::MeshDecoder::new()
             .decode(
                 &mut draco_core::DecoderBuffer::new(bytes).with_limits(limits),
