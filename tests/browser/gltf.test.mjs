@@ -185,3 +185,49 @@ test('a .gltf dropped with its .bin loads; alone it is refused naming the .bin, 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A Draco-compressed .glb (Google's encoder, tests/data/realworld/SOURCES.md;
+// the demo part): the page decodes it and plans the G-code the CLI writes
+// for the same file.
+test('a Draco-compressed .glb loads and plans as the CLI plans it', async (t) => {
+  const glbPath = join(ROOT, 'tests/data/realworld/mesh/test-part-draco.glb');
+  const svgPath = join(dir, 'draco-line.svg');
+  writeFileSync(svgPath, LINE_SVG);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', glbPath);
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'test-part-draco.glb',
+    null, { timeout: 120_000 });
+  await page.setInputFiles('#svg-input', svgPath);
+  await page.waitForFunction(() => window.pcpp.state.pendingSvg || window.pcpp.state.svgFile);
+  await page.fill('#pl-x', '20');
+  await page.fill('#pl-y', '60');
+  await page.fill('#pl-rot', '0');
+  await page.fill('#pl-scale', '1');
+  await page.dispatchEvent('#pl-scale', 'change');
+  await waitIdle(page);
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  const info = await page.evaluate(() => window.pcpp.state.info);
+  // The part's 247,490 triangles less those its quantization collapsed.
+  assert.ok(info.triangles > 247_000 && info.triangles < 247_490, String(info.triangles));
+  const text = (await download(page, 'dl-gcode')).bytes.toString('utf8');
+  assert.match(text, /^; scan file: test-part-draco\.glb \(\d+ bytes, sha256 [0-9a-f]{64}\)$/m);
+  const settings = await page.evaluate(() => window.pcpp.state.lastPlan.summary.settings);
+  assert.deepEqual(settings.placement, { offset_mm: [20, 60], rotation_deg: 0, scale: 1 });
+  assert.deepEqual(problems, []);
+  await context.close();
+
+  if (!existsSync(CLI)) {
+    t.skip(`${CLI} not built (cargo build --bin pcpp)`);
+    return;
+  }
+  const out = join(dir, 'draco-cli.gcode');
+  const n = settings.nozzle;
+  const p = settings.process;
+  execFileSync(CLI, ['plan', '--scan', glbPath, '--path', svgPath, '-o', out, '--planner', settings.planner,
+    '--place', '20,60,0,1', '--nozzle-id', String(n.inner_diameter_mm), '--nozzle-od', String(n.outer_diameter_mm),
+    '--tol', String(p.tolerance_mm), '--speed', String(p.speed_mm_s), '--dwell', String(p.dwell_s)],
+  { stdio: ['ignore', 'ignore', 'pipe'] });
+  assert.equal(readFileSync(out, 'utf8'), text, 'the page G-code differs from the CLI G-code');
+});
