@@ -1125,19 +1125,35 @@ mod tests {
         assert_eq!(external_refs(b"glTF\x02", "t.glb").unwrap(), []);
     }
 
-    /// An exporter that lists Draco as used but not required: the
-    /// accessors without data are still named as compressed.
+    /// Exporters that list a compression as used but not required: a
+    /// primitive's Draco data is still decoded (here four bytes that are
+    /// not Draco, named as such), and meshopt's accessors without data are
+    /// still named as compressed.
     #[test]
-    fn draco_used_but_not_required_is_named() {
-        let json = r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],
-            "meshes":[{"primitives":[{"attributes":{"POSITION":0},
-              "extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],
-            "accessors":[{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
-            "bufferViews":[{"buffer":0,"byteLength":4}],"buffers":[{"byteLength":4,"uri":"d.bin"}]}"#;
-        let e = parse(json.as_bytes(), "d.gltf").unwrap_err().to_string();
+    fn compression_used_but_not_required() {
+        let json = |ext: &str| {
+            format!(
+                r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["{ext}"],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},
+              "extensions":{{"{ext}":{{"bufferView":0,"attributes":{{"POSITION":0}}}}}}}}]}}],
+            "accessors":[{{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":4}}],"buffers":[{{"byteLength":4,"uri":"d.bin"}}]}}"#
+            )
+        };
+        let bin = ExternalFiles::new().with("d.bin", vec![0; 4]);
+        let e = super::parse(json(DRACO).as_bytes(), "d.gltf", &bin)
+            .unwrap_err()
+            .to_string();
         assert!(
-            e.contains("compressed (KHR_draco_mesh_compression), which is not supported")
-                && e.contains("without Draco compression"),
+            e.contains("mesh 0 primitive 0: its Draco data (bufferView 0) could not be decoded"),
+            "{e}"
+        );
+        let e = parse(json(MESHOPT).as_bytes(), "m.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("compressed (EXT_meshopt_compression), which is not supported")
+                && e.contains("without meshopt compression"),
             "{e}"
         );
     }
