@@ -57,13 +57,14 @@ pub(super) fn parse(
     })?;
     // Compressed geometry cannot be read without its decoder; its accessors
     // hold no data, which the validation would report accessor by accessor.
-    // Draco is decoded (`SceneReader::draco`); meshopt is not.
-    if let Some(ext) = compression(&root).filter(|&e| e == MESHOPT) {
+    // Draco is decoded (`SceneReader::draco`); meshopt is not, even beside
+    // Draco.
+    if needs_decoding(&root, MESHOPT) {
         return Err(MeshError::invalid(
             file,
             format!(
-                "its meshes are compressed ({ext}), which is not supported: this program does \
-                 not decode meshopt; export the scan without meshopt compression (Blender \
+                "its meshes are compressed ({MESHOPT}), which is not supported: this program \
+                 does not decode meshopt; export the scan without meshopt compression (Blender \
                  imports it and exports it uncompressed)"
             ),
         ));
@@ -206,15 +207,11 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
         .collect()
 }
 
-/// The compression extension a file's meshes need decoded: one it
-/// requires, or one it uses where a POSITION accessor has no data of its
-/// own (an exporter that left `extensionsRequired` out).
-fn compression(root: &gltf::json::Root) -> Option<&'static str> {
-    let named = |list: &[String]| {
-        COMPRESSION_EXTENSIONS
-            .into_iter()
-            .find(|c| list.iter().any(|e| e == c))
-    };
+/// Whether the file's meshes need the compression extension `ext`
+/// decoded: it requires it, or uses it where a POSITION accessor has no
+/// data of its own (an exporter that left `extensionsRequired` out).
+fn needs_decoding(root: &gltf::json::Root, ext: &str) -> bool {
+    let named = |list: &[String]| list.iter().any(|e| e == ext);
     let no_data = || {
         root.meshes
             .iter()
@@ -229,12 +226,11 @@ fn compression(root: &gltf::json::Root) -> Option<&'static str> {
                     .is_some_and(|a| a.buffer_view.is_none())
             })
     };
-    named(&root.extensions_required).or_else(|| named(&root.extensions_used).filter(|_| no_data()))
+    named(&root.extensions_required) || (named(&root.extensions_used) && no_data())
 }
 
-/// Extensions that compress a glTF's geometry (its accessors then hold
-/// no data until decoded).
-const COMPRESSION_EXTENSIONS: [&str; 2] = [DRACO, MESHOPT];
+/// The extensions that compress a glTF's geometry (its accessors then hold
+/// no data until decoded): Draco's is decoded, meshopt's is not.
 const DRACO: &str = "KHR_draco_mesh_compression";
 const MESHOPT: &str = "EXT_meshopt_compression";
 
@@ -1156,6 +1152,16 @@ mod tests {
                 && e.contains("without meshopt compression"),
             "{e}"
         );
+        // Both required: meshopt is named, Draco or not.
+        let both = json(DRACO).replace(
+            r#""extensionsUsed":["KHR_draco_mesh_compression"]"#,
+            r#""extensionsUsed":["KHR_draco_mesh_compression","EXT_meshopt_compression"],
+            "extensionsRequired":["KHR_draco_mesh_compression","EXT_meshopt_compression"]"#,
+        );
+        let e = super::parse(both.as_bytes(), "d.gltf", &bin)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("compressed (EXT_meshopt_compression)"), "{e}");
     }
 
     #[test]
