@@ -51,9 +51,15 @@ pub(crate) fn push_fixed(out: &mut String, value: f64, decimals: u32) -> f64 {
     for &b in &digits[i..] {
         out.push(char::from(b));
     }
-    // As `read_back`: q < 2^53 and the power of ten are exact.
+    unscaled(negative, q, decimals)
+}
+
+/// The f64 nearest to the text [`scaled`]'s (sign, magnitude) stands for:
+/// q < 2^53 and the power of ten are exact, and IEEE division rounds the
+/// exact quotient to the nearest f64, as parsing does.
+fn unscaled(negative: bool, q: u64, decimals: u32) -> f64 {
     let v = q as f64 / POW10[decimals as usize];
-    if negative {
+    if negative && q != 0 {
         -v
     } else {
         v
@@ -75,16 +81,7 @@ fn fixed_by_format(value: f64, decimals: u32) -> String {
 /// the rest of writing the move).
 pub(crate) fn read_back(value: f64, decimals: u32) -> f64 {
     match scaled(value, decimals) {
-        // q < 2^53 and the power of ten are exact, and IEEE division
-        // rounds the exact quotient to the nearest f64, as parsing does.
-        Some((negative, q)) => {
-            let v = q as f64 / POW10[decimals as usize];
-            if negative && q != 0 {
-                -v
-            } else {
-                v
-            }
-        }
+        Some((negative, q)) => unscaled(negative, q, decimals),
         None => fixed_by_format(value, decimals).parse().unwrap_or(value),
     }
 }
