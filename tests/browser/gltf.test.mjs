@@ -75,6 +75,19 @@ function sheetGltf(uri) {
   return [gltf, bin];
 }
 
+// The drawing's origin put at printer (x, y) mm, unturned and full size,
+// then the plan awaited: it must plan without an error.
+async function placeByHand(page, x, y) {
+  await page.fill('#pl-x', String(x));
+  await page.fill('#pl-y', String(y));
+  await page.fill('#pl-rot', '0');
+  await page.fill('#pl-scale', '1');
+  await page.dispatchEvent('#pl-scale', 'change');
+  await waitIdle(page);
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+}
+
 const LINE_SVG = '<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">'
   + '<path d="M 4 20 L 36 20 L 36 30" fill="none" stroke="black"/></svg>\n';
 
@@ -96,14 +109,7 @@ test('a .gltf and its .bin selected together plan as the CLI plans them, and are
   // Placed by hand once the drawing is read (a new drawing is centred).
   await page.waitForFunction(() => window.pcpp.state.pendingSvg || window.pcpp.state.svgFile);
   await page.selectOption('#planner', 'pcpp-guarded');
-  await page.fill('#pl-x', '0');
-  await page.fill('#pl-y', '40');
-  await page.fill('#pl-rot', '0');
-  await page.fill('#pl-scale', '1');
-  await page.dispatchEvent('#pl-scale', 'change');
-  await waitIdle(page);
-  await waitSettled(page);
-  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  await placeByHand(page, 0, 40);
   assert.equal(await page.textContent('#scan-name'), 'sheet.gltf');
   const info = await page.evaluate(() => window.pcpp.state.info);
   assert.equal(info.triangles, 3200);
@@ -200,14 +206,7 @@ test('a Draco-compressed .glb loads and plans as the CLI plans it', async (t) =>
     null, { timeout: 120_000 });
   await page.setInputFiles('#svg-input', svgPath);
   await page.waitForFunction(() => window.pcpp.state.pendingSvg || window.pcpp.state.svgFile);
-  await page.fill('#pl-x', '20');
-  await page.fill('#pl-y', '60');
-  await page.fill('#pl-rot', '0');
-  await page.fill('#pl-scale', '1');
-  await page.dispatchEvent('#pl-scale', 'change');
-  await waitIdle(page);
-  await waitSettled(page);
-  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  await placeByHand(page, 20, 60);
   const info = await page.evaluate(() => window.pcpp.state.info);
   // The part's 247,490 triangles less those its quantization collapsed.
   assert.ok(info.triangles > 247_000 && info.triangles < 247_490, String(info.triangles));
