@@ -113,6 +113,7 @@ pub(super) fn parse(
         file,
         buffers,
         draco,
+        decoded: Default::default(),
         welder: Welder::default(),
         triangles: Vec::new(),
         warnings: Vec::new(),
@@ -247,6 +248,10 @@ const DRACO_FACES_ANYWAY: u64 = 65_536;
 /// Decoded attribute bytes a Draco point may take: its position (12), and
 /// normals, colours and texture coordinates besides.
 const DRACO_BYTES_PER_POINT: u64 = 64;
+
+/// A decoded Draco primitive: its points in the file's frame and its
+/// triangles' indices.
+type DecodedDraco = (Vec<DVec3>, Vec<usize>);
 
 /// Where a Draco-compressed primitive's data lies, and which of its
 /// attributes is POSITION (KHR_draco_mesh_compression).
@@ -587,6 +592,8 @@ struct SceneReader<'f, 'b> {
     buffers: Vec<Cow<'b, [u8]>>,
     /// The primitives whose geometry is Draco-compressed.
     draco: std::collections::HashMap<(usize, usize), DracoRef>,
+    /// Those decoded so far (a mesh drawn by several nodes is decoded once).
+    decoded: std::collections::HashMap<(usize, usize), DecodedDraco>,
     welder: Welder,
     triangles: Vec<[u32; 3]>,
     warnings: Vec<String>,
@@ -686,7 +693,16 @@ impl SceneReader<'_, '_> {
                          holds triangle lists)"
                     )));
                 }
-                self.draco(&d, world, &at)?
+                // Decoded once however many nodes draw the mesh.
+                let key = (mesh.index(), primitive.index());
+                let (points, indices) = match self.decoded.remove(&key) {
+                    Some(found) => found,
+                    None => self.decode_draco(&d, &at)?,
+                };
+                let corners = self.place(&points, world, &at)?;
+                let out = (corners, indices.clone());
+                self.decoded.insert(key, (points, indices));
+                out
             } else {
                 let Some(accessor) = primitive.get(&Semantic::Positions) else {
                     self.warnings.push(format!(
@@ -766,24 +782,18 @@ impl SceneReader<'_, '_> {
                 )
             })
             .collect();
-        self.place(points, world, at)
+        self.place(&points, world, at)
     }
 
     /// A Draco-compressed primitive (KHR_draco_mesh_compression): its
-    /// points placed in the scene and welded as [`Self::positions`] does,
-    /// and its triangles as indices of them. Decoded with `draco-core`
+    /// points, in the file's frame, and its triangles as indices of them. Decoded with `draco-core`
     /// under the import's own ceilings: [`MAX_TRIANGLES`] faces, and no
     /// more than [`DRACO_FACES_PER_BYTE`] of the stream's bytes allow
     /// (as the other formats' counts are checked against the bytes
     /// present), three points a face, [`DRACO_BYTES_PER_POINT`] of decoded
     /// values a point and [`MAX_SCAN_BYTES`] in all: a stream that claims
     /// more is refused before its geometry is allocated.
-    fn draco(
-        &mut self,
-        d: &DracoRef,
-        world: &DMat4,
-        at: &str,
-    ) -> Result<(Vec<u32>, Vec<usize>), MeshError> {
+    fn decode_draco(&self, d: &DracoRef, at: &str) -> Result<DecodedDraco, MeshError> {
         let bytes = self
             .buffers
             .get(d.buffer)
@@ -839,7 +849,6 @@ impl SceneReader<'_, '_> {
             .chunks_exact(3)
             .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
             .collect();
-        let corners = self.place(points, world, at)?;
         let mut indices = Vec::with_capacity(3 * mesh.num_faces());
         for (f, face) in mesh.faces().iter().enumerate() {
             for p in face {
@@ -852,19 +861,14 @@ impl SceneReader<'_, '_> {
                 indices.push(i);
             }
         }
-        Ok((corners, indices))
+        Ok((points, indices))
     }
 
     /// `points` placed in the scene by `world` and welded; point `i`
     /// becomes vertex `result[i]`.
-    fn place(
-        &mut self,
-        points: Vec<DVec3>,
-        world: &DMat4,
-        at: &str,
-    ) -> Result<Vec<u32>, MeshError> {
+    fn place(&mut self, points: &[DVec3], world: &DMat4, at: &str) -> Result<Vec<u32>, MeshError> {
         let mut out = Vec::with_capacity(points.len());
-        for (i, p) in points.into_iter().enumerate() {
+        for (i, &p) in points.iter().enumerate() {
             let placed = world.transform_point3(p);
             if !p.is_finite() || !placed.is_finite() {
                 return Err(self.err(format!(
