@@ -648,7 +648,10 @@ fn weld_in_place(vertices: &mut Vec<DVec3>) -> Option<Vec<u32>> {
         return None;
     }
     let mut table = WeldTable::with_capacity(n);
-    let mut remap = Vec::with_capacity(n);
+    // Made at the first repeat (until then every vertex is kept where it
+    // is): a scan whose vertices are all distinct, as most are, never
+    // fills it (4 MB of fresh memory for 1 M vertices).
+    let mut remap: Option<Vec<u32>> = None;
     let mut kept = 0usize;
     // In batches: the batch's slots are fetched before any is probed.
     const BATCH: usize = 16;
@@ -663,20 +666,25 @@ fn weld_in_place(vertices: &mut Vec<DVec3>) -> Option<Vec<u32>> {
         for (i, &(k, hash)) in (start..end).zip(&keys) {
             // The table has room for all n vertices: it never grows here.
             match table.find_or_add_hashed(k, hash, &vertices[..kept]) {
-                Some(j) => remap.push(j),
+                Some(j) => remap
+                    .get_or_insert_with(|| {
+                        let mut r = Vec::with_capacity(n);
+                        r.extend(0..i as u32);
+                        r
+                    })
+                    .push(j),
                 None => {
                     vertices[kept] = vertices[i];
-                    remap.push(kept as u32);
+                    if let Some(r) = &mut remap {
+                        r.push(kept as u32);
+                    }
                     kept += 1;
                 }
             }
         }
     }
-    if kept == n {
-        return None;
-    }
     vertices.truncate(kept);
-    Some(remap)
+    remap
 }
 
 #[cfg(test)]
