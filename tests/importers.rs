@@ -995,6 +995,52 @@ fn exhaustive_byte_corruption_never_panics() {
     }
 }
 
+/// 62 bytes of Draco that decode to 2,000,000 points: one face, and a
+/// POSITION whose values are all the same, which entropy-codes to a run with
+/// no payload (written by draco-core 2.3.3's own `MeshEncoder`: sequential,
+/// 11-bit positions). 24 MB of floats from 62 bytes.
+const DRACO_2M_POINTS_IN_62_BYTES: [u8; 62] = [
+    0x44, 0x52, 0x41, 0x43, 0x4f, 0x02, 0x02, 0x01, 0x00, 0x00, 0x00, 0x01, //
+    0x80, 0x89, 0x7a, 0x01, 0x00, 0x01, 0x02, 0x01, 0x01, 0x00, 0x09, 0x03, //
+    0x00, 0x00, 0x02, 0x00, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x40, 0x01, //
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, //
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, //
+    0x3f, 0x0b,
+];
+
+/// A Draco stream that decodes to far more than a stream its size can hold
+/// of a real scan (a decompression bomb) is refused before it is decoded,
+/// naming the file and the primitive: the decoder's ceilings follow the
+/// stream's length (256 faces a byte and 65,536 besides, 3 points a face,
+/// 64 bytes a point), not only the program's limits on a whole scan, which
+/// a 62-byte stream of 2 M points (24 MB) passes.
+#[test]
+fn gltf_draco_stream_decoding_to_far_more_than_its_size_is_refused() {
+    let mut g = GltfBuilder::default();
+    let view = g.view(&DRACO_2M_POINTS_IN_62_BYTES);
+    g.accessors.push(
+        r#"{"componentType":5126,"count":2000000,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}"#
+            .into(),
+    );
+    g.accessors
+        .push(r#"{"componentType":5125,"count":3,"type":"SCALAR"}"#.into());
+    let draco = r#""KHR_draco_mesh_compression""#;
+    let bytes = g.glb(&format!(
+        r#"{ONE_NODE},"extensionsUsed":[{draco}],"extensionsRequired":[{draco}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,
+        "extensions":{{{draco}:{{"bufferView":{view},"attributes":{{"POSITION":0}}}}}}}}]}}]"#
+    ));
+    let e = import_mesh(&bytes, "bomb.glb", &ImportOptions::DEFAULT)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(
+            "bomb.glb: mesh 0 primitive 0: its Draco data (bufferView 0) could not be decoded"
+        ) && e.contains("ceiling"),
+        "{e}"
+    );
+}
+
 /// What real glTF files require beyond the core: meshopt-compressed
 /// geometry is named (its accessors have no data, which the validation
 /// reported accessor by accessor in 4 KB), a file that requires Draco
