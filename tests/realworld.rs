@@ -372,6 +372,42 @@ fn gltf_draco_sequential_box_with_a_node_hierarchy_is_the_box() {
     assert_same_surface(&m.mesh, &original.mesh, 0.04, "box");
 }
 
+/// One Draco mesh drawn by two nodes (decoded once, placed twice): the
+/// second box is the first moved by the second node's translation (2 m
+/// along x, 2,000 mm in the printer frame, the root's quarter turn about x
+/// leaving x as it is).
+#[test]
+fn gltf_draco_mesh_drawn_by_two_nodes_is_two_boxes() {
+    let file = data!("mesh/BoxTextured-draco-sequential.glb");
+    let json_len = u32::from_le_bytes(file[12..16].try_into().unwrap()) as usize;
+    let json = std::str::from_utf8(&file[20..20 + json_len]).unwrap();
+    let bin = &file[20 + json_len + 8..];
+    let one = r#""children":[1]},{"mesh":0}]"#;
+    assert!(json.contains(one), "{json}");
+    let two = json.replace(
+        one,
+        r#""children":[1,2]},{"mesh":0},{"mesh":0,"translation":[2,0,0]}]"#,
+    );
+    let bytes = pcpp::demo::glb_container(two.trim_end().as_bytes(), bin);
+    let m = import(&bytes, "two-boxes.glb");
+    let single = import(file, "BoxTextured-draco-sequential.glb");
+    assert_eq!(m.mesh.vertices.len(), 16);
+    assert_eq!(m.mesh.triangle_count(), 2 * single.mesh.triangle_count());
+    // Whichever box comes first: each vertex is one of the single box's,
+    // as it is or moved, and each of those is there once.
+    let moved = DVec3::new(2000.0, 0.0, 0.0);
+    let key = |v: DVec3| (v * 1e6).round().to_array().map(|c| c as i64);
+    let got: BTreeSet<[i64; 3]> = m.mesh.vertices.iter().map(|&v| key(v)).collect();
+    let want: BTreeSet<[i64; 3]> = single
+        .mesh
+        .vertices
+        .iter()
+        .flat_map(|&v| [key(v), key(v + moved)])
+        .collect();
+    assert_eq!(got, want);
+    assert_bbox(&m.mesh, [-500.0; 3], [2500.0, 500.0, 500.0], 0.04);
+}
+
 /// The demo test part (247,490 triangles, a root node scaling mm to
 /// metres and turning +Z up to +Y) Draco-compressed: it plans as the
 /// uncompressed part does. Quantization (80 mm / 2^14) collapses 292 of
