@@ -356,6 +356,118 @@ fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
     }
 }
 
+/// The Stanford bunny as glTF, meshopt-compressed by gltfpack (SOURCES.md):
+/// 16-bit positions placed by the node's scale and offset
+/// (KHR_mesh_quantization) in 8-byte elements, and float positions through
+/// the exponential filter in 12-byte elements, indices as TRIANGLES. The
+/// same surface, each vertex within a quantization step of its own (14
+/// bits over the largest extent).
+#[test]
+fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
+    let original = import(data!("mesh/bunny.glb"), "bunny.glb");
+    let (lo, hi) = original.mesh.bbox().unwrap();
+    let step = (hi - lo).max_element() / 16383.0;
+    for (bytes, name) in [
+        (data!("mesh/bunny-meshopt.glb"), "bunny-meshopt.glb"),
+        (data!("mesh/bunny-meshopt-vpf.glb"), "bunny-meshopt-vpf.glb"),
+    ] {
+        let m = import(bytes, name);
+        assert_eq!(m.format, MeshFormat::Glb);
+        assert_eq!(m.units, ScanUnits::M);
+        assert_eq!(
+            m.mesh.vertices.len(),
+            original.mesh.vertices.len(),
+            "{name}"
+        );
+        assert_same_surface(&m.mesh, &original.mesh, step, name);
+    }
+}
+
+/// gltfpack's `.gltf` with a fallback: the compressed data in one `.bin`
+/// and the uncompressed data, for readers without meshopt, in a second,
+/// which is neither asked for nor read (it is not in this folder).
+#[test]
+fn gltf_meshopt_fallback_file_is_not_needed() {
+    let gltf = data!("mesh/bunny-meshopt-cf.gltf");
+    let needed: Vec<String> = external_files_needed(gltf, "bunny-meshopt-cf.gltf")
+        .unwrap()
+        .into_iter()
+        .map(|r| r.path)
+        .collect();
+    assert_eq!(needed, ["bunny-meshopt-cf.bin"]);
+    let files =
+        ExternalFiles::new().with("bunny-meshopt-cf.bin", data!("mesh/bunny-meshopt-cf.bin"));
+    let m = import_mesh_with(
+        gltf,
+        "bunny-meshopt-cf.gltf",
+        &ImportOptions::DEFAULT,
+        &files,
+    )
+    .unwrap();
+    assert_eq!(m.external_files, needed);
+    let glb = import(data!("mesh/bunny-meshopt.glb"), "bunny-meshopt.glb");
+    assert_eq!(m.mesh, glb.mesh);
+}
+
+/// meshopt data damaged anywhere is read or refused with the file named,
+/// never a panic; a stream whose header is not meshopt's is named with its
+/// bufferView; a view that claims far more elements than its stream can
+/// hold is refused before it is decoded.
+#[test]
+fn gltf_meshopt_damaged_data_is_an_error_not_a_panic() {
+    let bytes = data!("mesh/bunny-meshopt.glb");
+    let json = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    // The BIN chunk's data: the vertex stream (bufferView 0), then the
+    // index stream.
+    let bin = 20 + json + 8;
+    assert_eq!(bytes[bin], 0xa0, "meshopt's vertex header, version 0");
+    let mut refused = 0;
+    for at in (bin..bytes.len()).step_by(3) {
+        for value in [0x00, 0xff, bytes[at] ^ 0x55] {
+            let mut b = bytes.to_vec();
+            b[at] = value;
+            if let Err(e) = import_mesh_with(
+                &b,
+                "bunny-meshopt.glb",
+                &ImportOptions::DEFAULT,
+                &ExternalFiles::new(),
+            ) {
+                refused += 1;
+                assert!(e.to_string().contains("bunny-meshopt.glb"), "{e}");
+            }
+        }
+    }
+    assert!(refused > 0);
+    let mut b = bytes.to_vec();
+    b[bin] = 0x42;
+    assert_import_error(
+        &b,
+        "bunny-meshopt.glb",
+        &[
+            "bunny-meshopt.glb: bufferView 0",
+            "meshopt data (mode Attributes, 1839 elements of 8 bytes) could not be decoded",
+        ],
+    );
+    // The vertex view's count raised from 1,839 to 9,999,999 (80 MB from
+    // 8,482 bytes), the JSON chunk keeping its length (its padding spaces
+    // take the three digits more).
+    let text = std::str::from_utf8(&bytes[20..20 + json]).unwrap();
+    let claim = r#""mode":"ATTRIBUTES","count":1839}"#;
+    assert!(text.ends_with("   ") && text.contains(claim), "{text}");
+    let bomb = text.replacen(claim, r#""mode":"ATTRIBUTES","count":9999999}"#, 1);
+    let bomb = &bomb[..json];
+    let mut b = bytes.to_vec();
+    b[20..20 + json].copy_from_slice(bomb.as_bytes());
+    assert_import_error(
+        &b,
+        "bunny-meshopt.glb",
+        &[
+            "bufferView 0",
+            "claim 9999999 elements of 8 bytes, more than such a stream decodes to",
+        ],
+    );
+}
+
 /// The glTF sample box (a rotated root node over the mesh's node) with
 /// sequential connectivity and POSITION as Draco attribute 1, beside the
 /// normals and texture coordinates: the uncompressed box, its 24 points

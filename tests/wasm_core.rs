@@ -1336,10 +1336,34 @@ fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
 /// own; and the page's staged import takes it.
 #[wasm_bindgen_test]
 fn a_draco_compressed_gltf_decodes_to_the_uncompressed_scan() {
+    decodes_to_the_bunny(
+        "bunny-draco.glb",
+        include_bytes!("data/realworld/mesh/bunny-draco.glb"),
+    );
+}
+
+/// meshopt-compressed glTFs (gltfpack: 16-bit positions, and float
+/// positions through the exponential filter) decode in wasm32 to the
+/// uncompressed bunny, and the page's staged import takes them.
+#[wasm_bindgen_test]
+fn a_meshopt_compressed_gltf_decodes_to_the_uncompressed_scan() {
+    decodes_to_the_bunny(
+        "bunny-meshopt.glb",
+        include_bytes!("data/realworld/mesh/bunny-meshopt.glb"),
+    );
+    decodes_to_the_bunny(
+        "bunny-meshopt-vpf.glb",
+        include_bytes!("data/realworld/mesh/bunny-meshopt-vpf.glb"),
+    );
+}
+
+/// The compressed bunny `name` imports as the uncompressed one: the same
+/// triangles, each vertex within a quantization step (14 bits) of its own;
+/// and the page's staged import (web/worker.js) takes it.
+fn decodes_to_the_bunny(name: &str, compressed: &[u8]) {
     let plain = include_bytes!("data/realworld/mesh/bunny.glb");
-    let draco = include_bytes!("data/realworld/mesh/bunny-draco.glb");
     let original = import_mesh(plain, "bunny.glb", &ImportOptions::DEFAULT).unwrap();
-    let decoded = import_mesh(draco, "bunny-draco.glb", &ImportOptions::DEFAULT).unwrap();
+    let decoded = import_mesh(compressed, name, &ImportOptions::DEFAULT).unwrap();
     let (lo, hi) = original.mesh.bbox().unwrap();
     let step = (hi - lo).max_element() / 16383.0;
     assert_eq!(
@@ -1359,7 +1383,7 @@ fn a_draco_compressed_gltf_decodes_to_the_uncompressed_scan() {
                 .map(|(k, o)| (k, o.distance(*v)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .unwrap();
-            assert!(d <= step, "{v} is {d} mm from the nearest vertex");
+            assert!(d <= step, "{name}: {v} is {d} mm from the nearest vertex");
             k as u32
         })
         .collect();
@@ -1375,10 +1399,10 @@ fn a_draco_compressed_gltf_decodes_to_the_uncompressed_scan() {
         .iter()
         .map(|t| sorted(t.map(|v| nearest[v as usize])))
         .collect();
-    assert_eq!(got, want);
+    assert_eq!(got, want, "{name}");
     // The page's staged steps (web/worker.js).
     let settings = JobSettings::default();
-    let mut import = written("bunny-draco.glb", draco)
+    let mut import = written(name, compressed)
         .import_scan(js(&settings.scan))
         .unwrap_or_else(|e| panic!("{e:?}"));
     import

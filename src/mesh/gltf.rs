@@ -21,7 +21,7 @@ use gltf::{Accessor, Document, Mesh, Node};
 
 use super::external::{relative_path, ExternalFiles, ExternalRef};
 use super::import::{Parsed, Welder};
-use super::{MeshError, MAX_SCAN_BYTES, MAX_TRIANGLES};
+use super::{meshopt, MeshError, MAX_SCAN_BYTES, MAX_TRIANGLES};
 
 /// Data URIs from some exporters omit the base64 padding.
 const BASE64: GeneralPurpose = GeneralPurpose::new(
@@ -55,20 +55,15 @@ pub(super) fn parse(
             _ => not_gltf(&e),
         }
     })?;
-    // Compressed geometry cannot be read without its decoder; its accessors
-    // hold no data, which the validation would report accessor by accessor.
-    // Draco is decoded (`SceneReader::draco`); meshopt is not, even beside
-    // Draco.
-    if needs_decoding(&root, MESHOPT) {
-        return Err(MeshError::invalid(
-            file,
-            format!(
-                "its meshes are compressed ({MESHOPT}), which is not supported: this program \
-                 does not decode meshopt; export the scan without meshopt compression (Blender \
-                 imports it and exports it uncompressed)"
-            ),
-        ));
-    }
+    // Compressed geometry is decoded: Draco's primitives as they are drawn
+    // (`SceneReader::draw`), meshopt's buffer views before (`decode_views`).
+    let uses = |ext: &str| {
+        root.extensions_used
+            .iter()
+            .chain(&root.extensions_required)
+            .any(|e| e == ext)
+    };
+    let (compressed, fallbacks) = meshopt::views(json, uses(meshopt::EXT), file)?;
     let draco = draco_primitives(json, &root, file)?;
     if let Some(d) = draco.values().next() {
         // glTF lets an accessor have neither bufferView nor sparse values
@@ -94,6 +89,7 @@ pub(super) fn parse(
     root.extensions_required.retain(|e| {
         e != "KHR_mesh_quantization"
             && e != DRACO
+            && e != meshopt::EXT
             && !IGNORED_PREFIXES.iter().any(|p| e.starts_with(p))
     });
     if let Some(ext) = root.extensions_required.first() {
@@ -108,10 +104,12 @@ pub(super) fn parse(
     check_position_accessors(&root, file)?;
     fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
-    let (buffers, read) = load_buffers(&gltf, blob, file, external)?;
+    let (buffers, read) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
+    let views = decode_views(&gltf, &compressed, &buffers, file)?;
     let mut scene = SceneReader {
         file,
         buffers,
+        views,
         draco,
         decoded: Default::default(),
         welder: Welder::default(),
@@ -184,7 +182,19 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
     #[derive(serde::Deserialize)]
     struct Buffer {
         uri: Option<String>,
+        #[serde(default)]
+        extensions: Option<serde_json::Value>,
     }
+    // A meshopt fallback's file (uncompressed data for readers without the
+    // decoder) is never read.
+    let fallback = |b: &Buffer| {
+        b.extensions
+            .as_ref()
+            .and_then(|e| e.get(meshopt::EXT))
+            .and_then(|e| e.get("fallback"))
+            .and_then(serde_json::Value::as_bool)
+            .unwrap_or(false)
+    };
     let json = if bytes.starts_with(b"glTF") {
         match split_glb(bytes, file) {
             Ok((json, _)) => json,
@@ -199,6 +209,7 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
     root.buffers
         .into_iter()
         .enumerate()
+        .filter(|(_, b)| !fallback(b))
         .filter_map(|(buffer, b)| b.uri.map(|uri| (buffer, uri)))
         .filter(|(_, uri)| !uri.starts_with("data:"))
         .map(|(buffer, uri)| {
@@ -208,32 +219,9 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
         .collect()
 }
 
-/// Whether the file's meshes need the compression extension `ext`
-/// decoded: it requires it, or uses it where a POSITION accessor has no
-/// data of its own (an exporter that left `extensionsRequired` out).
-fn needs_decoding(root: &gltf::json::Root, ext: &str) -> bool {
-    let named = |list: &[String]| list.iter().any(|e| e == ext);
-    let no_data = || {
-        root.meshes
-            .iter()
-            .flat_map(|m| &m.primitives)
-            .filter_map(|p| {
-                p.attributes
-                    .get(&gltf::json::validation::Checked::Valid(Semantic::Positions))
-            })
-            .any(|a| {
-                root.accessors
-                    .get(a.value())
-                    .is_some_and(|a| a.buffer_view.is_none())
-            })
-    };
-    named(&root.extensions_required) || (named(&root.extensions_used) && no_data())
-}
-
-/// The extensions that compress a glTF's geometry (its accessors then hold
-/// no data until decoded): Draco's is decoded, meshopt's is not.
+/// Draco's extension, which compresses a primitive's geometry (its
+/// accessors then hold no data of their own).
 const DRACO: &str = "KHR_draco_mesh_compression";
-const MESHOPT: &str = "EXT_meshopt_compression";
 
 /// The most faces a Draco stream may decode to per byte of it. Google's
 /// encoder (glTF-Transform's defaults) writes 0.4 faces a byte for the
@@ -481,12 +469,18 @@ fn load_buffers<'a>(
     blob: Option<&'a [u8]>,
     file: &str,
     external: &'a ExternalFiles,
+    fallbacks: &std::collections::HashSet<usize>,
 ) -> Result<(Buffers<'a>, Vec<String>), MeshError> {
     let mut read: Vec<String> = Vec::new();
     let buffers = gltf
         .buffers()
         .map(|buffer| {
             let index = buffer.index();
+            // A meshopt fallback is read by no decoder, and usually has no
+            // data (a GLB's would otherwise be taken for its binary chunk).
+            if fallbacks.contains(&index) {
+                return Ok(Cow::Borrowed(&[][..]));
+            }
             let mut from = String::new();
             let data: Cow<[u8]> = match buffer.source() {
                 gltf::buffer::Source::Bin => Cow::Borrowed(blob.ok_or_else(|| {
@@ -541,6 +535,36 @@ fn load_buffers<'a>(
     Ok((buffers, read))
 }
 
+/// The meshopt-compressed views that hold what the import reads (the
+/// POSITION and indices of primitives not Draco-compressed), decoded once
+/// each, by view.
+fn decode_views(
+    gltf: &Document,
+    compressed: &std::collections::HashMap<usize, meshopt::View>,
+    buffers: &[Cow<'_, [u8]>],
+    file: &str,
+) -> Result<std::collections::HashMap<usize, Vec<u8>>, MeshError> {
+    let mut decoded = std::collections::HashMap::new();
+    if compressed.is_empty() {
+        return Ok(decoded);
+    }
+    let read = gltf.meshes().flat_map(|m| m.primitives()).flat_map(|p| {
+        [p.get(&Semantic::Positions), p.indices()]
+            .into_iter()
+            .flatten()
+            .filter_map(|a| a.view().map(|v| v.index()))
+            .collect::<Vec<_>>()
+    });
+    for view in read {
+        if let (Some(v), std::collections::hash_map::Entry::Vacant(slot)) =
+            (compressed.get(&view), decoded.entry(view))
+        {
+            slot.insert(meshopt::decode(view, v, buffers, file)?);
+        }
+    }
+    Ok(decoded)
+}
+
 fn local_transform(node: &Node) -> DMat4 {
     match node.transform() {
         Transform::Matrix { matrix } => {
@@ -590,6 +614,8 @@ impl Elements<'_> {
 struct SceneReader<'f, 'b> {
     file: &'f str,
     buffers: Vec<Cow<'b, [u8]>>,
+    /// The meshopt-compressed views read, decoded ([`decode_views`]).
+    views: std::collections::HashMap<usize, Vec<u8>>,
     /// The primitives whose geometry is Draco-compressed.
     draco: std::collections::HashMap<(usize, usize), DracoRef>,
     /// Those decoded so far (a mesh drawn by several nodes is decoded once).
@@ -605,6 +631,27 @@ impl SceneReader<'_, '_> {
         MeshError::invalid(self.file, message)
     }
 
+    /// The bytes of a view as its buffer holds them.
+    fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], MeshError> {
+        let buffer = self
+            .buffers
+            .get(view.buffer().index())
+            .ok_or_else(|| self.err(format!("bufferView {} has no buffer", view.index())))?;
+        view.offset()
+            .checked_add(view.length())
+            .and_then(|end| buffer.get(view.offset()..end))
+            .ok_or_else(|| {
+                self.err(format!(
+                    "bufferView {} (offset {}, length {}) lies outside buffer {} of {} bytes",
+                    view.index(),
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index(),
+                    buffer.len()
+                ))
+            })
+    }
+
     fn elements(&self, accessor: &Accessor, what: &str) -> Result<Elements<'_>, MeshError> {
         let index = accessor.index();
         if accessor.sparse().is_some() {
@@ -617,24 +664,11 @@ impl SceneReader<'_, '_> {
                 "{what} accessor {index} has no bufferView (no data)"
             ))
         })?;
-        let buffer = self
-            .buffers
-            .get(view.buffer().index())
-            .ok_or_else(|| self.err(format!("bufferView {} has no buffer", view.index())))?;
-        let view_bytes = view
-            .offset()
-            .checked_add(view.length())
-            .and_then(|end| buffer.get(view.offset()..end))
-            .ok_or_else(|| {
-                self.err(format!(
-                    "bufferView {} (offset {}, length {}) lies outside buffer {} of {} bytes",
-                    view.index(),
-                    view.offset(),
-                    view.length(),
-                    view.buffer().index(),
-                    buffer.len()
-                ))
-            })?;
+        let view_bytes = match self.views.get(&view.index()) {
+            // Decoded meshopt data, at most the view's declared length.
+            Some(decoded) => &decoded[..decoded.len().min(view.length())],
+            None => self.view_bytes(&view)?,
+        };
         let ty = accessor.data_type();
         let size = ty.size() * accessor.dimensions().multiplicity();
         let stride = view.stride().unwrap_or(size);
@@ -1127,8 +1161,8 @@ mod tests {
 
     /// Exporters that list a compression as used but not required: a
     /// primitive's Draco data is still decoded (here four bytes that are
-    /// not Draco, named as such), and meshopt's accessors without data are
-    /// still named as compressed.
+    /// not Draco, named as such), and so is a meshopt-compressed view (four
+    /// bytes that are not meshopt).
     #[test]
     fn compression_used_but_not_required() {
         let json = |ext: &str| {
@@ -1148,24 +1182,25 @@ mod tests {
             e.contains("mesh 0 primitive 0: its Draco data (bufferView 0) could not be decoded"),
             "{e}"
         );
-        let e = parse(json(MESHOPT).as_bytes(), "m.gltf")
+        // meshopt's views, the fallback buffer without data.
+        let meshopt = r#"{"asset":{"version":"2.0"},"extensionsUsed":["EXT_meshopt_compression"],
+            "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+            "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+              "min":[0,0,0],"max":[1,1,0]}],
+            "bufferViews":[{"buffer":1,"byteLength":36,"extensions":{"EXT_meshopt_compression":
+              {"buffer":0,"byteLength":4,"byteStride":12,"mode":"ATTRIBUTES","count":3}}}],
+            "buffers":[{"byteLength":4,"uri":"d.bin"},
+              {"byteLength":36,"extensions":{"EXT_meshopt_compression":{"fallback":true}}}]}"#;
+        let e = super::parse(meshopt.as_bytes(), "m.gltf", &bin)
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("compressed (EXT_meshopt_compression), which is not supported")
-                && e.contains("without meshopt compression"),
+            e.contains(
+                "m.gltf: bufferView 0: its meshopt data (mode Attributes, 3 elements of 12 \
+                 bytes) could not be decoded"
+            ),
             "{e}"
         );
-        // Both required: meshopt is named, Draco or not.
-        let both = json(DRACO).replace(
-            r#""extensionsUsed":["KHR_draco_mesh_compression"]"#,
-            r#""extensionsUsed":["KHR_draco_mesh_compression","EXT_meshopt_compression"],
-            "extensionsRequired":["KHR_draco_mesh_compression","EXT_meshopt_compression"]"#,
-        );
-        let e = super::parse(both.as_bytes(), "d.gltf", &bin)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("compressed (EXT_meshopt_compression)"), "{e}");
     }
 
     #[test]

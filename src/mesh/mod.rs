@@ -21,6 +21,7 @@ mod error;
 mod external;
 mod gltf;
 mod import;
+mod meshopt;
 mod obj;
 mod pcd;
 mod ply;

@@ -230,3 +230,24 @@ test('a Draco-compressed .glb loads and plans as the CLI plans it', async (t) =>
   { stdio: ['ignore', 'ignore', 'pipe'] });
   assert.equal(readFileSync(out, 'utf8'), text, 'the page G-code differs from the CLI G-code');
 });
+
+// gltfpack's meshopt-compressed .gltf with a fallback (tests/data/realworld/
+// SOURCES.md): selected with its compressed .bin only, it loads (the
+// fallback's file, for readers without meshopt, is never asked for), and its
+// G-code names the one external file read.
+test('a meshopt-compressed .gltf loads with its .bin, its fallback file not asked for', async () => {
+  const mesh = (f) => join(ROOT, 'tests/data/realworld/mesh', f);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', [mesh('bunny-meshopt-cf.gltf'), mesh('bunny-meshopt-cf.bin')]);
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'bunny-meshopt-cf.gltf',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const info = await page.evaluate(() => window.pcpp.state.info);
+  assert.equal(info.triangles, 3674);
+  const bin = readFileSync(mesh('bunny-meshopt-cf.bin'));
+  assert.deepEqual(info.external_files.map((f) => [f.name, f.bytes]), [['bunny-meshopt-cf.bin', bin.length]]);
+  assert.equal(await page.textContent('#scan-name'), 'bunny-meshopt-cf.gltf');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
