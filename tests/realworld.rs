@@ -421,23 +421,7 @@ fn gltf_meshopt_damaged_data_is_an_error_not_a_panic() {
     // index stream.
     let bin = 20 + json + 8;
     assert_eq!(bytes[bin], 0xa0, "meshopt's vertex header, version 0");
-    let mut refused = 0;
-    for at in (bin..bytes.len()).step_by(3) {
-        for value in [0x00, 0xff, bytes[at] ^ 0x55] {
-            let mut b = bytes.to_vec();
-            b[at] = value;
-            if let Err(e) = import_mesh_with(
-                &b,
-                "bunny-meshopt.glb",
-                &ImportOptions::DEFAULT,
-                &ExternalFiles::new(),
-            ) {
-                refused += 1;
-                assert!(e.to_string().contains("bunny-meshopt.glb"), "{e}");
-            }
-        }
-    }
-    assert!(refused > 0);
+    assert!(damaged_somewhere(bytes, bin, "bunny-meshopt.glb") > 0);
     let mut b = bytes.to_vec();
     b[bin] = 0x42;
     assert_import_error(
@@ -602,6 +586,26 @@ fn gltf_draco_test_part_plans_as_the_uncompressed_part() {
     assert!(plans[0].gcode.contains("test-part-draco.glb"));
 }
 
+/// Every third byte of the GLB `bytes` from `bin` on, set to 0, to 255
+/// and flipped, one at a time: each import reads or is refused naming
+/// `name`, never a panic. How many were refused.
+fn damaged_somewhere(bytes: &[u8], bin: usize, name: &str) -> usize {
+    let mut refused = 0;
+    for at in (bin..bytes.len()).step_by(3) {
+        for value in [0x00, 0xff, bytes[at] ^ 0x55] {
+            let mut b = bytes.to_vec();
+            b[at] = value;
+            if let Err(e) =
+                import_mesh_with(&b, name, &ImportOptions::DEFAULT, &ExternalFiles::new())
+            {
+                refused += 1;
+                assert!(e.to_string().contains(name), "{e}");
+            }
+        }
+    }
+    refused
+}
+
 /// Draco data damaged anywhere is read or refused with the file named,
 /// never a panic; a stream that is not Draco at all is named as such, with
 /// its primitive and bufferView.
@@ -612,23 +616,7 @@ fn gltf_draco_damaged_data_is_an_error_not_a_panic() {
     // The BIN chunk's data, which is the Draco stream (bufferView 0).
     let bin = 20 + json + 8;
     assert_eq!(&bytes[bin..bin + 5], b"DRACO");
-    let mut refused = 0;
-    for at in (bin..bytes.len()).step_by(3) {
-        for value in [0x00, 0xff, bytes[at] ^ 0x55] {
-            let mut b = bytes.to_vec();
-            b[at] = value;
-            if let Err(e) = import_mesh_with(
-                &b,
-                "bunny-draco.glb",
-                &ImportOptions::DEFAULT,
-                &ExternalFiles::new(),
-            ) {
-                refused += 1;
-                assert!(e.to_string().contains("bunny-draco.glb"), "{e}");
-            }
-        }
-    }
-    assert!(refused > 0);
+    assert!(damaged_somewhere(bytes, bin, "bunny-draco.glb") > 0);
     let mut b = bytes.to_vec();
     b[bin..bin + 5].copy_from_slice(b"DRACX");
     assert_import_error(
