@@ -359,9 +359,10 @@ fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
 /// The Stanford bunny as glTF, meshopt-compressed by gltfpack (SOURCES.md):
 /// 16-bit positions placed by the node's scale and offset
 /// (KHR_mesh_quantization) in 8-byte elements, and float positions through
-/// the exponential filter in 12-byte elements, indices as TRIANGLES. The
-/// same surface, each vertex within a quantization step of its own (14
-/// bits over the largest extent).
+/// the exponential filter in 12-byte elements, indices as TRIANGLES; and by
+/// glTF-Transform (its own quantization, the same codecs). The same
+/// surface, each vertex within a quantization step of its own (14 bits
+/// over the largest extent).
 #[test]
 fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
     let original = import(data!("mesh/bunny.glb"), "bunny.glb");
@@ -370,6 +371,10 @@ fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
     for (bytes, name) in [
         (data!("mesh/bunny-meshopt.glb"), "bunny-meshopt.glb"),
         (data!("mesh/bunny-meshopt-vpf.glb"), "bunny-meshopt-vpf.glb"),
+        (
+            data!("mesh/bunny-meshopt-gltf-transform.glb"),
+            "bunny-meshopt-gltf-transform.glb",
+        ),
     ] {
         let m = import(bytes, name);
         assert_eq!(m.format, MeshFormat::Glb);
@@ -381,6 +386,21 @@ fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
         );
         assert_same_surface(&m.mesh, &original.mesh, step, name);
     }
+}
+
+/// glTF-Transform's meshopt box (SOURCES.md): its normals are unit vectors
+/// through the OCTAHEDRAL filter, which is not decoded, as nothing reads
+/// them; the box is the uncompressed one.
+#[test]
+fn gltf_meshopt_box_with_octahedral_normals_is_the_box() {
+    let m = import(
+        data!("mesh/BoxTextured-meshopt.glb"),
+        "BoxTextured-meshopt.glb",
+    );
+    let original = import(data!("mesh/BoxTextured.glb"), "BoxTextured.glb");
+    assert_eq!(m.mesh.vertices.len(), 8, "seams welded");
+    assert_bbox(&m.mesh, [-500.0; 3], [500.0; 3], 0.04);
+    assert_same_surface(&m.mesh, &original.mesh, 0.04, "box");
 }
 
 /// gltfpack's `.gltf` with a fallback: the compressed data in one `.bin`
