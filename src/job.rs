@@ -1058,6 +1058,14 @@ pub fn check_gcode(
         .with_tolerance_mm(tol_mm)
         .validate()?;
     let program = crate::gcode::read_gcode(text, file)?;
+    // A file without a single move (empty, comments only, or not G-code
+    // at all) shows nothing about the nozzle: it is not "clear".
+    if program.moves.is_empty() && program.unknown_moves.is_empty() {
+        return Err(Error::Plan(format!(
+            "{file} has no moves (no G0, G1 or other linear move with a coordinate): there is \
+             nothing to check; is it the G-code file the printer runs?"
+        )));
+    }
     let frame_notes = header_mismatch(text, scan);
     let clearance = Clearance::new(nozzle, tol_mm);
     let summary = check_moves(

@@ -548,3 +548,34 @@ fn regression_check_did_not_compare_the_programs_header_with_its_scan() {
         "{n:?}"
     );
 }
+
+/// A file without a move (empty, comments only, a point cloud's numbers)
+/// was checked as "clear: none of the 0 moves comes closer than tol"; it
+/// shows nothing, and now says so.
+#[test]
+fn regression_a_program_without_moves_was_clear() {
+    use pcpp::job::{check_gcode, prepare_scan, RegistrationSettings};
+    use pcpp::mesh::ImportOptions;
+
+    let ply = pcpp::demo::demo_scan_bytes();
+    let scan = prepare_scan(
+        &ply,
+        pcpp::demo::DEMO_SCAN_NAME,
+        &ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )
+    .unwrap();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    for text in ["", "; only a comment\n(and another)\n", "G21\nG90\nM82\n"] {
+        let e = check_gcode(&scan, text, "empty.gcode", &nozzle, 0.1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("empty.gcode has no moves") && e.contains("nothing to check"),
+            "{text:?}: {e}"
+        );
+    }
+    // One move is checked as before.
+    let one = check_gcode(&scan, "G90\nG0 X10 Y10 Z60\n", "one.gcode", &nozzle, 0.1).unwrap();
+    assert!(one.is_clear());
+}

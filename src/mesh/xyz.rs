@@ -1,7 +1,9 @@
 //! Point clouds as text: XYZ, CSV, TXT, ASC and PTS files, one point a
 //! line (spec "Inputs", raw point clouds).
 //!
-//! Values are separated by spaces, tabs, commas or semicolons; `#` and
+//! Values are separated by spaces, tabs, commas or semicolons; in a row
+//! separated by semicolons or tabs whose numbers have commas and no point,
+//! the commas are decimal commas (a European spreadsheet's CSV); `#` and
 //! `//` start comments. x, y and z are the first three columns unless a
 //! header line names them (`x,y,z,nx,ny,nz`, CloudCompare's `//X Y Z R G
 //! B`); further columns (normals, colour, intensity) are skipped. A first
@@ -15,8 +17,34 @@ use super::obj::parse_f64;
 use super::MeshError;
 
 fn fields(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-    line.split(|&c| c == b' ' || c == b'\t' || c == b',' || c == b';')
+    fields_in(line, false)
+}
+
+/// The values of `line`: separated by spaces, tabs, semicolons and, unless
+/// the commas are decimal commas, commas.
+fn fields_in(line: &[u8], decimal_comma: bool) -> impl Iterator<Item = &[u8]> {
+    line.split(move |&c| c == b' ' || c == b'\t' || c == b';' || (c == b',' && !decimal_comma))
         .filter(|t| !t.is_empty())
+}
+
+/// Whether the commas of a data line are decimal commas (spreadsheets in
+/// most of Europe write CSV so: `0,0912;0,0896;1,0003`): values separated
+/// by semicolons or tabs, and commas but no decimal point.
+fn decimal_commas(line: &[u8]) -> bool {
+    line.iter().any(|&c| c == b';' || c == b'\t') && line.contains(&b',') && !line.contains(&b'.')
+}
+
+/// A value, its decimal comma (if any) read as a point.
+fn number(token: &[u8], decimal_comma: bool) -> Option<f64> {
+    if !decimal_comma || !token.contains(&b',') {
+        return parse_f64(token);
+    }
+    let mut buf = [0u8; 64];
+    let digits = buf.get_mut(..token.len())?;
+    for (d, &c) in digits.iter_mut().zip(token) {
+        *d = if c == b',' { b'.' } else { c };
+    }
+    parse_f64(digits)
 }
 
 /// The columns of x, y and z named by a header line, if it names them.
@@ -74,7 +102,10 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Vec<DVec3>, MeshError> {
             if it.next().is_none() && first.iter().all(u8::is_ascii_digit) {
                 continue;
             }
-            let numeric = fields(line).take(3).all(|t| parse_f64(t).is_some());
+            let comma = decimal_commas(line);
+            let numeric = fields_in(line, comma)
+                .take(3)
+                .all(|t| number(t, comma).is_some());
             if !numeric && !named {
                 columns = header_columns(line).ok_or_else(|| MeshError::Syntax {
                     file: file.into(),
@@ -90,11 +121,12 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Vec<DVec3>, MeshError> {
         let mut p = [0.0f64; 3];
         let mut found = 0;
         let need = columns.iter().max().map_or(3, |m| m + 1);
-        for (col, tok) in fields(line).enumerate().take(need) {
+        let comma = decimal_commas(line);
+        for (col, tok) in fields_in(line, comma).enumerate().take(need) {
             let Some(slot) = columns.iter().position(|&c| c == col) else {
                 continue;
             };
-            let v = parse_f64(tok).ok_or_else(|| MeshError::Syntax {
+            let v = number(tok, comma).ok_or_else(|| MeshError::Syntax {
                 file: file.into(),
                 line: line_no,
                 message: format!(
@@ -122,7 +154,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Vec<DVec3>, MeshError> {
                 line: line_no,
                 message: format!(
                     "{} value(s) where a point needs x, y and z (columns {}, {} and {})",
-                    fields(line).count(),
+                    fields_in(line, comma).count(),
                     columns[0] + 1,
                     columns[1] + 1,
                     columns[2] + 1
@@ -186,6 +218,37 @@ mod tests {
         // PTS: a count line first.
         let text = b"2\r\n1 2 3 10 1 2 3\r\n4 5 6 10 1 2 3\r\n";
         assert_eq!(parse(text, "s.pts").unwrap().len(), 2);
+    }
+
+    /// A European spreadsheet's CSV (semicolons between values, decimal
+    /// commas) was read with its commas as separators: 0,0912 became the
+    /// two values 0 and 912, silently. Tab-separated likewise; a row with
+    /// decimal points keeps its commas as separators.
+    #[test]
+    fn regression_decimal_commas_were_separators() {
+        let text = b"X;Y;Z\n0,0912;0,0896;1,0003\n-2,5;3;-1,25e1\n";
+        assert_eq!(
+            parse(text, "eu.csv").unwrap(),
+            vec![
+                DVec3::new(0.0912, 0.0896, 1.0003),
+                DVec3::new(-2.5, 3.0, -12.5)
+            ]
+        );
+        let text = b"1,5\t2,5\t3,5\t255\n";
+        assert_eq!(
+            parse(text, "eu.txt").unwrap(),
+            vec![DVec3::new(1.5, 2.5, 3.5)]
+        );
+        let text = b"1.5;2;3,4\n";
+        assert_eq!(
+            parse(text, "mixed.csv").unwrap(),
+            vec![DVec3::new(1.5, 2.0, 3.0)]
+        );
+        // A bad value is still named, as written.
+        let e = parse(b"1,5;2;3\n1,5;x,5;3\n", "eu.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("eu.csv:2: 'x,5' in column 2"), "{e}");
     }
 
     #[test]
