@@ -1139,3 +1139,32 @@ fn regression_a_point_cloud_saved_as_obj_had_no_triangles() {
     assert_eq!(info.points, 400);
     assert!(m.mesh.triangle_count() > 600, "{}", m.mesh.triangle_count());
 }
+
+/// A scan whose name gives another format than its content: the error
+/// says what the content is and the name to give it (a PLY named `.stl`
+/// was "binary STL header declares 1886351984 triangles"); a file whose
+/// content is no format at all keeps the error of its name's format.
+#[test]
+fn regression_a_misnamed_scan_was_diagnosed_as_its_names_format() {
+    let ply = include_bytes!("data/realworld/mesh/cube_binary.ply");
+    let glb = include_bytes!("data/realworld/mesh/bunny.glb");
+    let stl = include_bytes!("data/realworld/mesh/Spider_binary.stl");
+    for (bytes, name, says) in [
+        (&ply[..], "cube.stl", "its content is a PLY file, not what its name says: rename it to .ply (read as .stl: binary STL header declares"),
+        (&glb[..], "bunny.obj", "its content is a binary glTF file, not what its name says: rename it to .glb (read as .obj: not OBJ text"),
+        (&stl[..], "spider.ply", "its content is an STL file, not what its name says: rename it to .stl (read as .ply:1: PLY header"),
+    ] {
+        let e = import_mesh(bytes, name, &ImportOptions::DEFAULT)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&format!("{name}: {says}")), "{e}");
+    }
+    let e = import_mesh(
+        b"\x01\x02 not a scan \x03",
+        "junk.stl",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("junk.stl: ") && !e.contains("rename"), "{e}");
+}

@@ -155,17 +155,31 @@ pub fn import_mesh_with(
     }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
+    let mut external_files = Vec::new();
+    let parsed = parse_as(format, bytes, file, external, &mut external_files)
+        .map_err(|e| misnamed(e, format, bytes, file))?;
+    finish_import(parsed, format, file, options, external_files)
+}
+
+/// The file read as `format` (the external files a glTF read are added to
+/// `external_files`).
+fn parse_as(
+    format: MeshFormat,
+    bytes: &[u8],
+    file: &str,
+    external: &ExternalFiles,
+    external_files: &mut Vec<String>,
+) -> Result<Parsed, MeshError> {
     if let Some(e) = binary_in_text(bytes, file, format) {
         return Err(e);
     }
-    let mut external_files = Vec::new();
-    let parsed = match format {
+    Ok(match format {
         MeshFormat::Obj => obj::parse(bytes, file)?,
         MeshFormat::Ply => ply::parse(bytes, file)?,
         MeshFormat::Stl => stl::parse(bytes, file)?,
         MeshFormat::Gltf | MeshFormat::Glb => {
             let (parsed, read) = gltf::parse(bytes, file, external)?;
-            external_files = read;
+            *external_files = read;
             parsed
         }
         MeshFormat::Xyz => Parsed {
@@ -180,7 +194,47 @@ pub fn import_mesh_with(
                 ..Parsed::default()
             }
         }
+    })
+}
+
+/// `e`, the error of reading a file as the format its name gives, with
+/// what its content looks like when that is another format (a PLY named
+/// `.stl` was "binary STL header declares 1886351984 triangles").
+fn misnamed(e: MeshError, format: MeshFormat, bytes: &[u8], file: &str) -> MeshError {
+    let Some(content) = sniff(bytes).filter(|&c| c != format && from_extension(file).is_some())
+    else {
+        return e;
     };
+    let (name, ext) = match content {
+        MeshFormat::Obj => ("an OBJ", "obj"),
+        MeshFormat::Ply => ("a PLY", "ply"),
+        MeshFormat::Stl => ("an STL", "stl"),
+        MeshFormat::Gltf => ("a glTF", "gltf"),
+        MeshFormat::Glb => ("a binary glTF", "glb"),
+        MeshFormat::Xyz => ("a text point cloud", "xyz"),
+        MeshFormat::Pcd => ("a PCD point cloud", "pcd"),
+    };
+    let read = e.to_string();
+    let read = read.strip_prefix(file).unwrap_or(&read);
+    let named = file.rsplit_once('.').map_or("", |(_, x)| x);
+    MeshError::invalid(
+        file,
+        format!(
+            "its content is {name} file, not what its name says: rename it to .{ext} (read as \
+             .{named}{read})"
+        ),
+    )
+}
+
+/// The import's steps after parsing: a point cloud meshed, a mesh welded
+/// and checked, both into the printer's units and axes.
+fn finish_import(
+    parsed: Parsed,
+    format: MeshFormat,
+    file: &str,
+    options: &ImportOptions,
+    external_files: Vec<String>,
+) -> Result<ImportedMesh, MeshError> {
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
     // A PLY or OBJ with vertices and no faces is a point cloud too
