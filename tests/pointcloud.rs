@@ -427,3 +427,49 @@ fn a_whole_objects_cloud_is_meshed_from_above_and_its_gcode_needs_the_risk_accep
         "nothing was near: {oracle:?}"
     );
 }
+
+/// The demo part sampled at random places (a photogrammetric or lidar
+/// cloud's points are spread so, not on a grid), as densely as the 0.2 mm
+/// grid, none in the fiducial holes. The default edge limit, 3 x the
+/// median nearest-neighbour spacing, left out more than a third of the
+/// triangles between such points: the part was meshed full of holes and
+/// the drawing planned in many pieces. Now the limit keeps 99.9 % of the
+/// triangulation, and the part's own holes stay: its three dots are found
+/// where the mesh has them, and the drawing plans in the mesh's pieces.
+#[test]
+fn regression_a_randomly_spread_cloud_was_meshed_full_of_holes() {
+    let surface = Surface::new(test_part::test_part()).unwrap();
+    let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+    let n = ((test_part::SIZE_MM / STEP) as usize + 1).pow(2);
+    let mut text = String::new();
+    for _ in 0..n {
+        let xy = DVec2::new(rng.unit(), rng.unit()) * test_part::SIZE_MM;
+        if let Some(z) = surface.highest_hit(xy) {
+            let z = z + NOISE * (2.0 * rng.unit() - 1.0);
+            text += &format!("{:.4} {:.4} {:.4}\n", xy.x, xy.y, z);
+        }
+    }
+    let imported = import(text.as_bytes(), "random.xyz");
+    let info = imported.cloud.unwrap();
+    assert!(info.uneven && !info.max_edge_given, "{info:?}");
+    assert!(info.max_edge_mm > 3.0 * info.spacing_mm, "{info:?}");
+    assert!(info.to_string().contains("spread unevenly"), "{info}");
+    let mesh = test_part::test_part();
+    let mesh_fids = find_fiducials(&mesh);
+    let fids = find_fiducials(&imported.mesh);
+    for f in mesh_fids.iter().take(3) {
+        let nearest = fids
+            .iter()
+            .take(3)
+            .map(|g| g.centroid.truncate().distance(f.centroid.truncate()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest < 0.2,
+            "the dot at {} is {nearest:.3} mm away",
+            f.centroid
+        );
+    }
+    let mesh_plan = plan(mesh);
+    let cloud_plan = plan(imported.mesh);
+    assert_eq!(cloud_plan.pieces.len(), mesh_plan.pieces.len());
+}

@@ -34,6 +34,11 @@ use super::{MeshError, TriMesh};
 /// from a point to its nearest neighbour (in XY).
 pub const EDGE_LIMIT_PER_SPACING: f64 = 3.0;
 
+/// Points spread unevenly: the default edge limit is this many times the
+/// longest edge of 99 % of the triangles between them (see
+/// [`triangulate`]).
+pub const UNEVEN_LIMIT_PER_P99: f64 = 1.5;
+
 /// A point is hidden under higher points that rise from it more steeply
 /// than this, on every side ([`hidden_points`]).
 pub const HIDDEN_SLOPE_DEG: f64 = 80.0;
@@ -74,6 +79,11 @@ pub struct CloudInfo {
     /// Whether that limit was set by the user (else it is
     /// [`EDGE_LIMIT_PER_SPACING`] times the spacing).
     pub max_edge_given: bool,
+    /// Whether the default limit was raised for points spread unevenly
+    /// (to keep 99 % of the triangles between them) from
+    /// [`EDGE_LIMIT_PER_SPACING`] times the spacing.
+    #[serde(default)]
+    pub uneven: bool,
 }
 
 impl std::fmt::Display for CloudInfo {
@@ -101,6 +111,14 @@ impl std::fmt::Display for CloudInfo {
             write!(
                 f,
                 "(as set; median point spacing {:.3} mm)",
+                self.spacing_mm
+            )
+        } else if self.uneven {
+            write!(
+                f,
+                "({UNEVEN_LIMIT_PER_P99} x the longest edge of 99% of the triangles between \
+                 the points, which are spread unevenly: {EDGE_LIMIT_PER_SPACING} x their median \
+                 spacing {:.3} mm left out more than a tenth)",
                 self.spacing_mm
             )
         } else {
@@ -220,13 +238,43 @@ pub fn triangulate(
     // a whole object's scan has its points spread unevenly (close on its
     // steep sides, where the points under them were), and a limit from the
     // closest would open holes the nozzle would be let into.
-    let limit = max_edge_mm.unwrap_or(EDGE_LIMIT_PER_SPACING * spacing);
-    let limit2 = limit * limit;
-    let mut triangles = Vec::with_capacity(t.num_inner_faces());
-    for f in t.inner_faces() {
-        let [a, b, c] = f.vertices().map(|v| v.fix().index());
-        if len2(a, b) <= limit2 && len2(b, c) <= limit2 && len2(c, a) <= limit2 {
-            triangles.push([a as u32, b as u32, c as u32]);
+    let kept = |limit: f64| {
+        let limit2 = limit * limit;
+        let mut triangles = Vec::with_capacity(t.num_inner_faces());
+        for f in t.inner_faces() {
+            let [a, b, c] = f.vertices().map(|v| v.fix().index());
+            if len2(a, b) <= limit2 && len2(b, c) <= limit2 && len2(c, a) <= limit2 {
+                triangles.push([a as u32, b as u32, c as u32]);
+            }
+        }
+        triangles
+    };
+    let mut limit = max_edge_mm.unwrap_or(EDGE_LIMIT_PER_SPACING * spacing);
+    let mut triangles = kept(limit);
+    // Points spread unevenly (a random sampling, a photogrammetric or
+    // lidar cloud) are often farther apart than a few nearest-neighbour
+    // spacings: where the default left out more than a tenth of the
+    // triangulation, it is raised to 1.5 times the longest edge of 99 %
+    // of it (each triangle's longest edge, the 99th percentile), which
+    // keeps nearly all. The scan's holes stay: the triangles across them
+    // are the last percent, and longer still. A regular grid's limit is
+    // never raised (its triangles' longest edges are its diagonals, under
+    // 3 spacings).
+    let mut uneven = false;
+    if max_edge_mm.is_none() && (t.num_inner_faces() - triangles.len()) * 10 > t.num_inner_faces() {
+        let mut longest: Vec<f64> = t
+            .inner_faces()
+            .map(|f| {
+                let [a, b, c] = f.vertices().map(|v| v.fix().index());
+                len2(a, b).max(len2(b, c)).max(len2(c, a))
+            })
+            .collect();
+        let k = (longest.len() * 99 / 100).min(longest.len() - 1);
+        let p99 = longest.select_nth_unstable_by(k, f64::total_cmp).1.sqrt();
+        if UNEVEN_LIMIT_PER_P99 * p99 > limit {
+            limit = UNEVEN_LIMIT_PER_P99 * p99;
+            uneven = true;
+            triangles = kept(limit);
         }
     }
     if triangles.is_empty() {
@@ -248,6 +296,7 @@ pub fn triangulate(
         spacing_mm: spacing,
         max_edge_mm: limit,
         max_edge_given: max_edge_mm.is_some(),
+        uneven,
     };
     Ok((
         TriMesh {

@@ -361,7 +361,8 @@ pub struct ScanArgs {
     pub up_axis: Option<UpAxis>,
 
     /// Point clouds: the longest edge (in XY) of a triangle of the meshed
-    /// cloud; longer gaps stay holes [default: 3 x the median point spacing]
+    /// cloud; longer gaps stay holes [default: 3 x the median point spacing;
+    /// points spread unevenly: 1.5 x the longest edge of 99% of the triangles]
     #[arg(long, value_name = "MM", value_parser = max_edge, allow_hyphen_values = true)]
     pub max_edge: Option<f64>,
 }
