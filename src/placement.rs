@@ -274,14 +274,15 @@ pub fn centre_drawing(
     if scale < 1.0 && fit {
         placement.scale *= scale;
         note = Some(format!(
-            "the drawing ({:.1} x {:.1} mm) is larger than the scan's footprint ({:.1} x {:.1} \
-             mm): it was scaled by {:.3} to fit; a scale given with the placement (--place \
-             centre,ROT,SCALE; the page's scale) is kept as given",
+            "the drawing ({:.1} x {:.1} mm) is larger than {:.0}% of the scan's footprint \
+             ({:.1} x {:.1} mm): it was scaled by {} to fit; a scale given with the placement \
+             (--place centre,ROT,SCALE; the page's scale) is kept as given",
             size.x,
             size.y,
+            FIT_SHARE * 100.0,
             fhi.x - flo.x,
             fhi.y - flo.y,
-            scale
+            three_digits(scale)
         ));
         lo *= scale;
         hi *= scale;
@@ -299,6 +300,17 @@ pub fn centre_drawing(
     }
     placement.offset_mm = 0.5 * (flo + fhi) - 0.5 * (lo + hi);
     Some((placement, note))
+}
+
+/// A factor below 1 with three significant digits (0.953, 0.000272): a
+/// drawing scaled down ten thousand times was "scaled by 0.000".
+fn three_digits(x: f64) -> String {
+    let decimals = if x > 0.0 && x < 1.0 {
+        (2 - x.log10().floor() as i32).clamp(3, 12) as usize
+    } else {
+        3
+    };
+    format!("{x:.decimals$}")
 }
 
 /// The drawing's placement after its scan moves from `from` to `to` (both
@@ -510,5 +522,13 @@ mod tests {
         let edge = (DVec2::new(-500.0, 0.0), DVec2::new(500.0, 0.0));
         let (p, _) = centre_drawing(&[square], edge, &Placement::IDENTITY, true).unwrap();
         assert_eq!(p.scale, 1.0);
+    }
+
+    #[test]
+    fn scale_factors_keep_three_significant_digits() {
+        assert_eq!(super::three_digits(0.953), "0.953");
+        assert_eq!(super::three_digits(0.0542), "0.0542");
+        assert_eq!(super::three_digits(0.000272), "0.000272");
+        assert_eq!(super::three_digits(0.5), "0.500");
     }
 }

@@ -186,7 +186,7 @@ test('new units or up axis for the scan centre the drawing again from the user\'
 
 // The drawing's size in the note, mm.
 const noteSize = (note) => {
-  const m = /the drawing \((\d+\.\d) x (\d+\.\d) mm\) is larger than the scan's footprint/.exec(note);
+  const m = /the drawing \((\d+\.\d) x (\d+\.\d) mm\) is larger than 90% of the scan's footprint/.exec(note);
   return m ? [Number(m[1]), Number(m[2])] : null;
 };
 
