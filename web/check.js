@@ -6,7 +6,7 @@ import { checkGcodeSize } from '../pkg/pcpp.js';
 import {
   $, cell, el, fmt, fmtPoint, hooks, num, pageText, settings, state,
 } from './page.js';
-import { showError } from './status.js';
+import { clearError, showError } from './status.js';
 import { drawPlanPaths, setViewShows } from './view.js';
 
 // A user's G-code (ours or another tool's) checked by the core against the
@@ -43,7 +43,7 @@ function showCheckError(name, message) {
   $('check-verdict').textContent = `could not check ${name}`;
   $('check-verdict').className = 'verdict bad';
   $('check-details').replaceChildren();
-  showError(`Could not check ${name}`, message, name);
+  showError(`Could not check ${name}`, message, name, 'check');
 }
 
 export function onCheck(m) {
@@ -54,6 +54,9 @@ export function onCheck(m) {
     showCheckError(m.name, m.error);
     return;
   }
+  // A new file read and checked: the error of the check before it (or of
+  // a file the page could not read at all) no longer stands beside it.
+  clearError(['check', 'file']);
   // The file checked, for the preview.
   state.checked = req ? { file: req.file, name: m.name, nozzle: req.nozzle, tol: req.tol } : null;
   if (hooks.checkShown) hooks.checkShown();

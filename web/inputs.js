@@ -18,34 +18,99 @@ import { keepInput, keptInput } from './store.js';
 const RESTORING_KEY = 'pcpp.restoring.v1';
 
 // G-code programs a user may check against the scan (by their extension).
-const GCODE_FILE = /\.(gcode|gco|g|nc|ngc|tap|txt)$/i;
+const GCODE_FILE = /\.(gcode|gco|g|nc|ngc|tap)$/i;
+// A .txt is either: a G-code program or a point cloud (XYZ rows), told
+// apart by its first lines (textKind).
+const TEXT_FILE = /\.txt$/i;
 // Scans, by the extensions the core reads (a glTF first: only it names
 // other files, its buffers in .bin files).
 const GLTF_FILE = /\.(gltf|glb)$/i;
 const SCAN_FILE = /\.(gltf|glb|obj|ply|stl|xyz|csv|txt|asc|pts|pcd)$/i;
+const SVG_FILE = /\.svg$/i;
 
-async function openFile(file) {
-  if (/\.svg$/i.test(file.name)) {
-    await openSvg(file);
-    return;
+// Whether `name` is a scan's by its extension (a file of another kind
+// that could not be read is an error about its kind, not about a scan).
+export const isScanName = (name) => SCAN_FILE.test(name);
+
+// How much of a .txt is read to tell what it is: a few dozen lines. Only
+// this head passes through this thread; a scan's bytes are still read by
+// the worker.
+const SNIFF_BYTES = 8192;
+const SNIFF_LINES = 100;
+// A point cloud's row: 2 to 6 numbers (x y z, then normals or colour)
+// separated by spaces, tabs, commas or semicolons.
+const NUMBER = /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/;
+// A G-code line: a word first (G1, M104, T0, N10), a comment, or an
+// address letter with its number anywhere (X1.2 on a modal line).
+const GCODE_START = /^[GMTN;(]/i;
+const GCODE_WORD = /[A-Z]\s*[-+]?(\d|\.\d)/i;
+
+// What the text `head` (a .txt's first bytes) holds, line by line:
+// 'gcode' or 'scan' (a point cloud), by which kind of line is in the
+// majority; lines of neither kind (a cloud's header "x y z", "#"
+// comments) do not count. With neither it is taken for G-code, whose
+// check names what it cannot read.
+function textKind(head, cut = false) {
+  const lines = head.split(/\r?\n|\r/);
+  // A head cut from a longer file ends in a partial line.
+  if (cut) lines.pop();
+  let gcode = 0;
+  let cloud = 0;
+  let seen = 0;
+  for (const raw of lines) {
+    const line = raw.trim();
+    if (!line) continue;
+    if (++seen > SNIFF_LINES) break;
+    const fields = line.split(/[\s,;]+/).filter((f) => f);
+    if (fields.length >= 2 && fields.length <= 6 && fields.every((f) => NUMBER.test(f))) cloud++;
+    else if (GCODE_START.test(line) || GCODE_WORD.test(line)) gcode++;
   }
-  if (GCODE_FILE.test(file.name)) {
-    checkGcodeFile(file);
-    return;
+  return cloud > gcode ? 'scan' : 'gcode';
+}
+
+// What a dropped or opened file is: 'svg', 'gcode' or 'scan' (a scan, or
+// a file a scan names), a .txt by its first lines.
+async function fileKind(file) {
+  if (SVG_FILE.test(file.name)) return 'svg';
+  if (GCODE_FILE.test(file.name)) return 'gcode';
+  if (!TEXT_FILE.test(file.name)) return 'scan';
+  let head;
+  try {
+    head = await file.slice(0, SNIFF_BYTES).text();
+  } catch {
+    // Unreadable: the check says so, naming the file.
+    return 'gcode';
   }
-  openScan(file, []);
+  return textKind(head, file.size > SNIFF_BYTES);
 }
 
 // Files opened together (selected at once, or dropped): drawings and
 // G-code programs each on their own; of the others, one is the scan and
 // the rest go with it, for the files it names (a .gltf's .bin buffers:
-// the worker reads only those the scan needs).
-function openFiles(files) {
-  const rest = [];
-  for (const f of files) {
-    if (/\.svg$/i.test(f.name) || GCODE_FILE.test(f.name)) openFile(f);
-    else rest.push(f);
+// the worker reads only those the scan needs). `scans`: chosen through
+// "Open scan…", every file is the scan or goes with it (a .txt there is
+// a point cloud, never a program to check).
+function openFiles(files, scans = false) {
+  // Only a .txt is read before it is opened: the others open at once, in
+  // the order they came (a scan, then a drawing right after it).
+  if (!scans && files.some((f) => TEXT_FILE.test(f.name))) {
+    Promise.all(files.map(fileKind)).then((kinds) => openKinds(files, kinds));
+    return;
   }
+  openKinds(files, files.map((f) => {
+    if (scans) return 'scan';
+    if (SVG_FILE.test(f.name)) return 'svg';
+    return GCODE_FILE.test(f.name) ? 'gcode' : 'scan';
+  }));
+}
+
+function openKinds(files, kinds) {
+  const rest = [];
+  files.forEach((f, i) => {
+    if (kinds[i] === 'svg') openSvg(f);
+    else if (kinds[i] === 'gcode') checkGcodeFile(f);
+    else rest.push(f);
+  });
   if (rest.length === 0) return;
   const scan = rest.find((f) => GLTF_FILE.test(f.name)) || rest.find((f) => SCAN_FILE.test(f.name)) || rest[0];
   openScan(scan, rest.filter((f) => f !== scan));
@@ -171,13 +236,13 @@ export function bindFiles() {
   // The scan input takes several files at once: a .gltf with its .bin.
   const scanInput = $('scan-input');
   scanInput.addEventListener('change', () => {
-    if (scanInput.files) openFiles([...scanInput.files]);
+    if (scanInput.files) openFiles([...scanInput.files], true);
     scanInput.value = '';
   });
   const svgInput = $('svg-input');
   svgInput.addEventListener('change', () => {
     const f = svgInput.files && svgInput.files[0];
-    if (f) openFile(f);
+    if (f) openFiles([f]);
     svgInput.value = '';
   });
   const overlay = $('drop-overlay');
@@ -249,6 +314,9 @@ export function dropCentre() {
 // (by the paths the scan gives; the browser's files have names only):
 // those are kept with it, not every file opened with it.
 export function acceptScan(info) {
+  // A new file accepted: a file the page could not read before it is
+  // past.
+  clearError('file');
   const scan = state.pendingScan;
   state.scan = scan;
   state.pendingScan = null;

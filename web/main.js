@@ -16,7 +16,7 @@ import {
 import { initFiducials } from './fiducials.js';
 import { loadWasm, startWorker } from './engine.js';
 import {
-  acceptScan, bindFiles, demoScanEntry, dropCentre, endRestoring, keep, loadDemo, restoreInputs,
+  acceptScan, bindFiles, demoScanEntry, dropCentre, endRestoring, isScanName, keep, loadDemo, restoreInputs,
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
@@ -386,6 +386,7 @@ function onPlanError(m, busy) {
   let title = 'Planning failed';
   let message = m.message;
   let file; // the file the title names
+  let topic = null; // what the error is about (status.js)
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -415,6 +416,9 @@ function onPlanError(m, busy) {
     dropCentre();
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
+    // A file of no kind the page reads (a dropped picture): the next file
+    // accepted supersedes it.
+    if (m.kind === 'mesh' && !isScanName(file)) topic = 'file';
   } else if (m.stage === 'scan') {
     // (The registration's messages start 'registration needs ...'.)
     title = m.kind === 'mesh' ? 'Could not read the scan' : `Could not register ${busy.scan.name}`;
@@ -464,7 +468,7 @@ function onPlanError(m, busy) {
   // it would only bury it.
   const offered = m.stage === 'plan' && bannerOffers(message);
   if (offered) clearError();
-  else showError(title, message, file);
+  else showError(title, message, file, topic);
   if (busy.gen === state.gen && restorePlan()) return;
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.
@@ -473,8 +477,11 @@ function onPlanError(m, busy) {
     state.viewer.setPathOffset(0, 0, 0);
     requestDraw();
   }
-  if (offered) setStatus('no G-code: the scan lies outside the build volume (see above)', true);
-  else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+  // The previous plan on screen is said to be that, whichever the failure.
+  if (offered) {
+    setStatus(`no G-code: the scan lies outside the build volume (see above)${
+      state.lastPlan ? '; showing the previous plan' : ''}`, true);
+  } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 
 function cancelPlan() {
@@ -555,7 +562,7 @@ async function start() {
     requestCentre();
     schedulePlan(0);
   });
-  $('error-close').addEventListener('click', clearError);
+  $('error-close').addEventListener('click', () => clearError());
   $('pick-btn').addEventListener('click', () => setPicking(!state.picking));
   $('clear-scan-btn').addEventListener('click', () => {
     settings.fidScanText = '';

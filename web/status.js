@@ -2,17 +2,30 @@
 // other module reports through.
 import { $, pageText, state } from './page.js';
 
+// What the error on screen is about (its topic), so that a later success
+// clears only the error it supersedes: 'check' (a G-code file that could
+// not be checked), 'file' (a file of a kind the page does not read), or
+// null (the others: planning, the scan, the drawing).
+let shownTopic = null;
+
 // `file`: the file the title names; the core's message starting with its
-// name does not say it a second time.
-export function showError(title, message, file) {
+// name does not say it a second time. `topic`: what the error is about
+// (above).
+export function showError(title, message, file, topic = null) {
   const m = String(message);
   $('error-title').textContent = title;
   $('error-message').textContent = pageText(file && m.startsWith(`${file}: `) ? m.slice(file.length + 2) : m);
   $('error-panel').hidden = false;
+  shownTopic = topic;
 }
 
-export function clearError() {
+// Hides the error panel; with `topics` (one or a list), only if the error
+// on screen is about one of them: a G-code file checked clears the error
+// of the check before it, not a scan that failed to load.
+export function clearError(topics) {
+  if (topics !== undefined && ![topics].flat().includes(shownTopic)) return;
   $('error-panel').hidden = true;
+  shownTopic = null;
 }
 
 export function setStatus(text, stale) {

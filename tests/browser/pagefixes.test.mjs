@@ -1,0 +1,198 @@
+// Regression tests for problems found by exploratory QA in the page: a
+// .txt point cloud taken for a G-code program, an old error left beside a
+// new result, and the previous plan shown unlabelled after a plan refused
+// for the build volume.
+import assert from 'node:assert/strict';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { after, before, test } from 'node:test';
+import { openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
+
+const env = withPageServer();
+
+let dir;
+before(() => { dir = mkdtempSync(join(tmpdir(), 'pcpp-pagefixes-')); });
+after(() => { if (dir) rmSync(dir, { recursive: true, force: true }); });
+
+// A tab-separated point cloud over the demo part's 80 x 80 mm, 5 mm up
+// with a gentle wave, with a header line (as scanners write).
+function cloudTxt() {
+  const rows = ['x\ty\tz'];
+  for (let j = 0; j <= 40; j++) {
+    for (let i = 0; i <= 40; i++) {
+      const x = i * 2;
+      const y = j * 2;
+      rows.push(`${x.toFixed(3)}\t${y.toFixed(3)}\t${(5 + 0.3 * Math.sin(x / 5) * Math.cos(y / 7)).toFixed(4)}`);
+    }
+  }
+  return `${rows.join('\n')}\n`;
+}
+
+// A small program in a .txt, well above the demo part.
+const GCODE_TXT = 'G21 G90\nG0 X30 Y30 Z30\nG1 X40 Y30 Z30 F300\nG0 Z40\n';
+
+const file = (name, text) => ({ name, mimeType: 'text/plain', buffer: Buffer.from(text) });
+
+// Drops files on the page as a user would: [[name, text or base64 bytes, binary?]].
+const drop = (page, files) => page.evaluate((fs) => {
+  const dt = new DataTransfer();
+  for (const [name, data, binary] of fs) {
+    const body = binary ? Uint8Array.from(atob(data), (c) => c.charCodeAt(0)) : data;
+    dt.items.add(new File([body], name));
+  }
+  window.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, cancelable: true }));
+}, files);
+
+const scanRead = (page, name) => page.waitForFunction((n) => window.pcpp.state.info
+  && window.pcpp.state.info.name === n && !window.pcpp.state.busy && !window.pcpp.state.queued, name,
+{ timeout: 120_000 });
+
+// Waits until the file `name` was either read as the scan or checked as a
+// G-code program (its verdict shown), and says which.
+const readOrChecked = async (page, name) => (await page.waitForFunction((n) => {
+  const s = window.pcpp.state;
+  if (s.info && s.info.name === n && !s.busy && !s.queued) return 'scan';
+  const v = document.getElementById('check-verdict').textContent;
+  return v.includes(n) && !/^checking /.test(v) ? `checked: ${v}` : false;
+}, name, { timeout: 120_000 })).jsonValue();
+
+test('a .txt point cloud opened with "Open scan…" is read as a scan, not checked as G-code', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', file('cloud.txt', cloudTxt()));
+  assert.equal(await readOrChecked(page, 'cloud.txt'), 'scan');
+  assert.equal(await page.textContent('#scan-name'), 'cloud.txt');
+  assert.match(await page.textContent('#scan-info'), /^XYZ, .*point cloud: 1681 points meshed/);
+  // Nothing was checked as a program.
+  assert.equal(await page.isHidden('#check-panel'), true, await page.textContent('#check-verdict'));
+  assert.equal(await page.evaluate(() => window.pcpp.state.checkId), 0);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a dropped .txt is a point cloud or a G-code program by its content', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A program in a .txt is checked against the scan.
+  await drop(page, [['program.txt', GCODE_TXT]]);
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 60_000 });
+  assert.match(await page.textContent('#check-verdict'), /^clear: none of the \d+ moves .*program\.txt against demo-test-part\.ply/);
+  assert.equal(await page.evaluate(() => window.pcpp.state.scan.name), 'demo-test-part.ply');
+  // A tab-separated cloud in a .txt is the scan.
+  await drop(page, [['cloud.txt', cloudTxt()]]);
+  assert.equal(await readOrChecked(page, 'cloud.txt'), 'scan');
+  await waitForPlan(page);
+  assert.equal(await page.textContent('#scan-name'), 'cloud.txt');
+  assert.match(await page.textContent('#scan-info'), /^XYZ, .*point cloud: 1681 points meshed/);
+  assert.match(await page.textContent('#plan-status'), /^planned .* on cloud\.txt/);
+  // The program was checked once, the cloud never.
+  assert.equal(await page.evaluate(() => window.pcpp.state.checkId), 1);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a G-code check that succeeds clears the error of the check before it, not a scan error', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // Arcs: refused by the checker, the red panel names the file.
+  await page.setInputFiles('#gcode-input', file('arcs.gcode', 'G21 G90\nG0 X10 Y10 Z30\nG2 X20 Y10 I5 J0\n'));
+  await page.waitForFunction(() => /arcs\.gcode/.test(document.getElementById('error-title').textContent));
+  assert.equal(await page.isVisible('#error-panel'), true);
+  // A good program: its verdict, and no red "Could not check arcs.gcode".
+  await page.setInputFiles('#gcode-input', file('good.gcode', GCODE_TXT));
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 60_000 });
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-title'));
+
+  // A scan that could not be read is not superseded by a G-code check:
+  // its error stays.
+  await page.setInputFiles('#scan-input', file('broken.obj', 'v 0 0 0\nv 1 0 0\nf 1 2 9\n'));
+  await page.waitForFunction(() => /broken\.obj/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 60_000 });
+  await waitIdle(page);
+  await page.setInputFiles('#gcode-input', file('good2.gcode', GCODE_TXT));
+  await page.waitForFunction(() => /good2\.gcode/.test(document.getElementById('check-verdict').textContent)
+    && /^clear: /.test(document.getElementById('check-verdict').textContent), null, { timeout: 60_000 });
+  assert.equal(await page.isVisible('#error-panel'), true);
+  assert.match(await page.textContent('#error-title'), /^Could not read the scan broken\.obj/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('a dropped picture\'s error goes once a G-code file dropped after it is checked', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A PNG's signature and a few bytes: no file the page reads.
+  const png = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 0x49, 0x48, 0x44, 0x52]);
+  await drop(page, [['photo.png', png.toString('base64'), true]]);
+  await page.waitForFunction(() => /photo\.png/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 60_000 });
+  assert.match(await page.textContent('#error-message'), /not a scan this program reads/);
+  await waitIdle(page);
+  await drop(page, [['part.gcode', GCODE_TXT]]);
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 60_000 });
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-title'));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A 40 x 40 mm sheet at x, y 0..40 whose edge at x = 0 dips to z -3 mm
+// (below the bed) and is 0.5 mm up from x = 12 on: the scan lies outside
+// the build volume, but a small drawing in its middle prints (with a dip
+// to -0.8 mm the tool path over it still cleared the bed).
+function dippedSheetPly() {
+  const n = 40;
+  const verts = [];
+  for (let j = 0; j <= n; j++) {
+    for (let i = 0; i <= n; i++) {
+      const z = 0.5 - 3.5 * Math.max(0, (12 - i) / 12);
+      verts.push(`${i} ${j} ${z.toFixed(4)}`);
+    }
+  }
+  const faces = [];
+  for (let j = 0; j < n; j++) {
+    for (let i = 0; i < n; i++) {
+      const a = j * (n + 1) + i;
+      faces.push(`3 ${a} ${a + 1} ${a + n + 2}`, `3 ${a} ${a + n + 2} ${a + n + 1}`);
+    }
+  }
+  return `ply\nformat ascii 1.0\nelement vertex ${verts.length}\nproperty float x\nproperty float y\nproperty float z\n`
+    + `element face ${faces.length}\nproperty list uchar int vertex_indices\nend_header\n`
+    + `${verts.join('\n')}\n${faces.join('\n')}\n`;
+}
+
+const SMALL_SVG = '<svg xmlns="http://www.w3.org/2000/svg" width="8mm" height="8mm" viewBox="0 0 8 8">'
+  + '<path d="M 1 4 L 7 4" fill="none" stroke="black"/></svg>\n';
+
+test('a plan refused for the build volume says the plan on screen is the previous one', async () => {
+  const scanPath = join(dir, 'dipped-sheet.ply');
+  const svgPath = join(dir, 'small-line.svg');
+  writeFileSync(scanPath, dippedSheetPly());
+  writeFileSync(svgPath, SMALL_SVG);
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', scanPath);
+  await scanRead(page, 'dipped-sheet.ply');
+  assert.equal(await page.isVisible('#place-banner'), true);
+  // A short line in the middle, 0.5 mm up: planned, G-code offered.
+  await page.setInputFiles('#svg-input', svgPath);
+  await waitSettled(page);
+  assert.match(await page.textContent('#plan-status'), /^planned small-line\.svg on dipped-sheet\.ply/);
+  // The spiral fitted to the sheet reaches the dip below the bed: refused.
+  await page.selectOption('#path-source', 'spiral');
+  await page.waitForFunction(() => /build volume/.test(document.getElementById('plan-status').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  // The line's plan is still on screen: the status says it is the previous one.
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.svgName), 'small-line.svg');
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /^no G-code: the scan lies outside the build volume \(see above\); showing the previous plan$/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
