@@ -45,7 +45,9 @@
 //!   more than f32 rounding (1e-5 relative), usvg's is used: it is what is
 //!   drawn.
 //! - Text is not converted to paths (no fonts are loaded); images, markers
-//!   and clip/mask/pattern content are not printed. Each is reported as a note.
+//!   and clip/mask/pattern content are not printed, nor are shapes whose
+//!   paint or group is transparent (opacity 0); a shape that is clipped or
+//!   masked is printed whole. Each is reported as a note.
 //! - A stroke is printed along its centre line whatever its width (a note
 //!   names the widest past [`WIDE_STROKE_MM`]).
 //! - A root `viewBox` of zero width or height is refused (SVG draws nothing
@@ -388,11 +390,23 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut dashed = (0usize, 0usize, None::<String>);
     let mut solid: Vec<(String, String, String)> = Vec::new();
     let mut widest: Option<(f64, String)> = None;
-    let mut stack: Vec<&usvg::Node> = tree.root().children().iter().rev().collect();
-    while let Some(node) = stack.pop() {
+    // Shapes under a clip path or mask: printed whole (the first's label).
+    let (mut clipped, mut first_clipped) = (0usize, None::<String>);
+    // Each node with whether an ancestor group is fully transparent
+    // (`opacity="0"`: it draws nothing) and whether one clips or masks.
+    let mut stack: Vec<(&usvg::Node, bool, bool)> = tree
+        .root()
+        .children()
+        .iter()
+        .rev()
+        .map(|n| (n, false, false))
+        .collect();
+    while let Some((node, transparent, clip)) = stack.pop() {
         let path = match node {
             usvg::Node::Group(g) => {
-                stack.extend(g.children().iter().rev());
+                let transparent = transparent || g.opacity().get() <= 0.0;
+                let clip = clip || g.clip_path().is_some() || g.mask().is_some();
+                stack.extend(g.children().iter().rev().map(|n| (n, transparent, clip)));
                 continue;
             }
             usvg::Node::Path(p) => p,
@@ -421,15 +435,24 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             None => id.to_string(),
         };
         // usvg marks paths with neither fill nor stroke, and
-        // `visibility: hidden` ones, as invisible: they draw nothing.
-        if !path.is_visible() {
+        // `visibility: hidden` ones, as invisible: they draw nothing; so
+        // does a shape whose paint is all transparent, or which lies in a
+        // transparent group (`opacity`, `stroke-opacity`, `fill-opacity`
+        // 0): print what a viewer shows.
+        let stroked = path.stroke().is_some_and(|s| s.opacity().get() > 0.0);
+        let filled = path.fill().is_some_and(|f| f.opacity().get() > 0.0);
+        if !path.is_visible() || transparent || !(stroked || filled) {
             unpainted += 1;
             first_unpainted.get_or_insert(label);
             continue;
         }
+        if clip {
+            clipped += 1;
+            first_clipped.get_or_insert_with(|| label.clone());
+        }
         // A filled shape with no stroke (an icon, a PCB pad) is printed
         // along its outline: the nozzle draws lines, it does not fill.
-        if path.stroke().is_none() {
+        if !stroked {
             filled_only += 1;
             first_filled.get_or_insert_with(|| label.clone());
         }
@@ -647,8 +670,14 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
 
     if let Some(first) = &first_unpainted {
         notes.push(format!(
-            "{unpainted} shape(s) with no stroke and no fill, or hidden, were not printed (the \
-             first: '{first}')"
+            "{unpainted} shape(s) with no stroke and no fill, or hidden or transparent, were not \
+             printed (the first: '{first}')"
+        ));
+    }
+    if let Some(first) = &first_clipped {
+        notes.push(format!(
+            "{clipped} shape(s) are clipped or masked (clip-path, mask; the first: '{first}'): \
+             they are printed whole, not as the viewer shows them; draw only the part to print"
         ));
     }
     if images > 0 {

@@ -1587,3 +1587,41 @@ fn centring_a_round_drawing_gives_a_round_offset() {
     assert_eq!(placed.points[0], v(24.0, 56.0));
     assert_eq!(placed.points[1].distance(placed.points[0]), 32.0);
 }
+
+/// Transparent shapes (`opacity`, `stroke-opacity` with no fill, a
+/// transparent group) were printed, and clipped or masked shapes printed
+/// whole without a word (exploratory QA): a viewer shows nothing of the
+/// first, and only a part of the second. Now the transparent are left out
+/// with the shapes not drawn, and the clipped are named.
+#[test]
+fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_unsaid() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<path id="gone" d="M 0 0 L 10 0" stroke="black" opacity="0"/>
+           <path d="M 0 1 L 10 1" stroke="black" stroke-opacity="0" fill="none"/>
+           <g opacity="0"><path d="M 0 2 L 10 2" stroke="black"/></g>
+           <path id="faint" d="M 0 3 L 10 3" stroke="black" stroke-opacity="0.2"/>
+           <path id="kept" d="M 0 5 L 10 5" stroke="black" fill-opacity="0"/>"#,
+    ));
+    assert_eq!(subs.len(), 2, "{subs:?}");
+    let note = note_with(&notes, "were not printed");
+    assert!(
+        note.starts_with("3 shape(s)") && note.contains("transparent") && note.contains("'gone'"),
+        "{note}"
+    );
+    assert!(notes.iter().all(|n| !n.contains("clipped")), "{notes:?}");
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<defs><clipPath id="c"><rect x="0" y="0" width="30" height="15"/></clipPath>
+           <mask id="m"><rect x="0" y="0" width="30" height="15" fill="white"/></mask></defs>
+           <circle id="half" cx="15" cy="15" r="10" stroke="black" fill="none" clip-path="url(#c)"/>
+           <g mask="url(#m)"><path d="M 0 5 L 10 5" stroke="black"/></g>
+           <path d="M 0 25 L 10 25" stroke="black"/>"#,
+    ));
+    assert_eq!(subs.len(), 3, "{subs:?}");
+    let note = note_with(&notes, "clipped or masked");
+    assert!(
+        note.starts_with("2 shape(s)") && note.contains("(clip-path, mask; the first: 'half')"),
+        "{note}"
+    );
+}
