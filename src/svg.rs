@@ -263,6 +263,11 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             "compressed SVG (.svgz) is not supported; unzip it first".into(),
         ));
     }
+    if bytes.starts_with(&[0xFE, 0xFF]) || bytes.starts_with(&[0xFF, 0xFE]) {
+        return Err(parse_err(
+            "the file is UTF-16 text; save it as UTF-8 (every SVG editor can)".into(),
+        ));
+    }
     let text = std::str::from_utf8(bytes)
         .map_err(|e| parse_err(format!("not UTF-8 text ({e}); SVG is an XML text file")))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);

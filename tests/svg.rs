@@ -1625,3 +1625,27 @@ fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_uns
         "{note}"
     );
 }
+
+/// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
+/// utf-8 sequence of 1 bytes from index 0)"; now it says what to do, as
+/// the UTF-16 OBJ message does.
+#[test]
+fn regression_a_utf16_svg_was_not_told_to_be_saved_as_utf8() {
+    let text = doc(MM, r#"<path d="M 0 0 L 10 0" stroke="black"/>"#);
+    for bom in [[0xFF, 0xFE], [0xFE, 0xFF]] {
+        let mut bytes = bom.to_vec();
+        for u in text.encode_utf16() {
+            let pair = if bom[0] == 0xFF {
+                u.to_le_bytes()
+            } else {
+                u.to_be_bytes()
+            };
+            bytes.extend_from_slice(&pair);
+        }
+        let e = import_svg(&bytes, "u16.svg").unwrap_err().to_string();
+        assert!(
+            e.contains("u16.svg") && e.contains("UTF-16 text; save it as UTF-8"),
+            "{e}"
+        );
+    }
+}
