@@ -75,7 +75,7 @@ impl RegistrationSettings {
         if !(d.is_finite() && d > 0.0 && d <= 100.0) {
             return Err(Error::Parameter {
                 name: "fiducial dot diameter (mm)",
-                value: format!("{d}"),
+                value: crate::params::shown(d),
                 reason: "must be a number greater than 0 and at most 100".into(),
             });
         }

@@ -39,7 +39,7 @@ impl Nozzle {
         if self.outer_diameter_mm <= self.inner_diameter_mm {
             return Err(Error::Parameter {
                 name: "nozzle outer diameter (mm)",
-                value: format!("{}", self.outer_diameter_mm),
+                value: shown(self.outer_diameter_mm),
                 reason: format!(
                     "must be larger than the inner diameter {}",
                     self.inner_diameter_mm
@@ -90,7 +90,7 @@ impl Process {
         if !(self.dwell_s.is_finite() && (0.0..=600.0).contains(&self.dwell_s)) {
             return Err(Error::Parameter {
                 name: "dwell (s)",
-                value: format!("{}", self.dwell_s),
+                value: shown(self.dwell_s),
                 reason: "must be between 0 and 600 s".into(),
             });
         }
@@ -104,13 +104,24 @@ impl Default for Process {
     }
 }
 
+/// A number as an error message shows what was typed: as written, but
+/// past a million or under a ten-thousandth with an exponent (a speed of
+/// 1e308 was a 309-digit number).
+pub fn shown(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 fn positive(name: &'static str, v: f64, max: f64) -> Result<()> {
     if v.is_finite() && v > 0.0 && v <= max {
         Ok(())
     } else {
         Err(Error::Parameter {
             name,
-            value: format!("{v}"),
+            value: shown(v),
             reason: format!("must be a number greater than 0 and at most {max}"),
         })
     }
@@ -147,5 +158,24 @@ mod tests {
             .validate()
             .unwrap_err();
         assert!(e.to_string().contains("speed"), "{e}");
+    }
+
+    /// A speed of 1e308 was shown in its error as a 309-digit number.
+    #[test]
+    fn huge_and_tiny_values_are_shown_with_an_exponent() {
+        let e = Process::DEFAULT
+            .with_speed_mm_s(1e308)
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "invalid parameter speed (mm/s) = 1e308: must be a number greater than 0 and at most 1000"
+        );
+        assert_eq!(shown(0.0001), "0.0001");
+        assert_eq!(shown(0.00001234), "1.234e-5");
+        assert_eq!(shown(-2.5), "-2.5");
+        assert_eq!(shown(999999.0), "999999");
+        assert_eq!(shown(f64::NAN), "NaN");
     }
 }

@@ -163,7 +163,7 @@ impl Placement {
     pub fn validate(&self) -> Result<(), SvgError> {
         let bad = |field: &'static str, value: f64, reason: &str| SvgError::Placement {
             field,
-            value: value.to_string(),
+            value: crate::params::shown(value),
             reason: reason.into(),
         };
         if !self.offset_mm.x.is_finite() {

@@ -44,7 +44,7 @@ fn check_size(name: &'static str, value: f64, allow_zero: bool) -> Result<(), An
     } else {
         Err(AntennaError::Parameter {
             name,
-            value: value.to_string(),
+            value: crate::params::shown(value),
             reason: format!(
                 "must be a finite length above {} and at most {MAX_SIZE_MM} mm",
                 if allow_zero { "or equal to 0" } else { "0" }
@@ -103,7 +103,7 @@ pub fn archimedean_spiral_svg(
     if !(turns.is_finite() && turns > 0.0 && turns <= MAX_TURNS) {
         return Err(AntennaError::Parameter {
             name: "turns",
-            value: turns.to_string(),
+            value: crate::params::shown(turns),
             reason: format!("must be a finite number above 0 and at most {MAX_TURNS}"),
         });
     }

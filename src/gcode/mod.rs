@@ -81,7 +81,7 @@ pub enum GcodeError {
         known: String,
     },
     /// A job parameter is out of range (names the parameter and value).
-    #[error("invalid {name} = {value}: {reason}")]
+    #[error("invalid {name} = {}: {reason}", crate::params::shown(*.value))]
     Parameter {
         name: &'static str,
         value: f64,
