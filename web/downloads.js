@@ -70,11 +70,15 @@ export function offerDownloads(plan) {
     linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
   }
   // No link until the report is written: focusable and pressed as one.
-  const r = $('dl-report');
-  reportOffer = { plan, name: `${stem}-${plan.planner}.json`, writing: false };
-  r.download = reportOffer.name;
-  r.tabIndex = 0;
-  r.hidden = false;
+  // A plan whose worker has ended since (a cancel offers the plan on
+  // screen again) has no report to write: none is offered.
+  if (plan.worker === undefined || plan.worker === state.workerGen) {
+    const r = $('dl-report');
+    reportOffer = { plan, name: `${stem}-${plan.planner}.json`, writing: false };
+    r.download = reportOffer.name;
+    r.tabIndex = 0;
+    r.hidden = false;
+  }
   const p = press;
   if (p && p.replanned) {
     press = null;

@@ -5,10 +5,11 @@ import { checkProfile, checkScanSize, checkSvgSize } from '../pkg/pcpp.js';
 import { checkGcodeFile, drawCheckedMoves } from './check.js';
 import { $, hooks, settings, state } from './page.js';
 import {
-  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, setNote, showScanPlacement, userPlacements,
+  SCAN_PLACE_DEFAULT, cancelCentre, moveScan, requestCentre, setNote, showFitNote, showScanPlacement,
+  userPlacements,
 } from './placement.js';
 import {
-  demoInfo, demoUiSettings, saveSettings, syncProfileOption, writeForm,
+  demoInfo, demoUiSettings, pathSourceBefore, saveSettings, syncProfileOption, writeForm,
 } from './settings.js';
 import { clearError, showError } from './status.js';
 import { keepInput, keptInput } from './store.js';
@@ -177,9 +178,16 @@ async function openSvg(file) {
     showError(`Could not read ${file.name}`, e.message);
     return;
   }
-  // The path source it replaces, taken back if it cannot be read.
-  const was = state.pendingSvg ? state.pendingSvg.pathSource : settings.pathSource;
-  state.pendingSvg = { key: `file-${state.nextKey++}`, name: file.name, bytes, pathSource: was };
+  // The path source it replaces, taken back if it cannot be read, and
+  // that drawing's placement: kept in the browser until this one is
+  // planned (a drawing that failed is not reopened, so neither is where
+  // it was centred), and taken back if this one is cancelled.
+  const prev = state.pendingSvg;
+  const was = prev ? prev.pathSource : settings.pathSource;
+  const before = prev ? prev.before : { placement: { ...settings.placement }, fit: settings.fit };
+  state.pendingSvg = {
+    key: `file-${state.nextKey++}`, name: file.name, bytes, pathSource: was, before,
+  };
   settings.pathSource = 'file';
   // A new drawing lands on the scan, unless the user placed it meanwhile.
   if (userPlacements() === placed) requestCentre(true);
@@ -306,6 +314,39 @@ export function loadDemo(part = settings.demoPart) {
 // new drawing opened with it is still centred).
 export function dropCentre() {
   if (state.centre && !state.centre.fresh) cancelCentre();
+}
+
+// The pending scan is not read after all (its request was cancelled):
+// the scan before it stays, and a kept scan being reopened is no longer
+// kept (as when it cannot be read).
+export function dropPendingScan() {
+  const scan = state.pendingScan;
+  if (!scan) return;
+  if (scan.restored) {
+    endRestoring();
+    keep('scan', null);
+  }
+  state.pendingScan = null;
+  dropCentre();
+  $('scan-name').textContent = state.scan.name;
+  showScanPlacement();
+}
+
+// The pending drawing is not planned after all (its request was
+// cancelled): back to the path before it, where it was placed.
+export function dropPendingSvg() {
+  const svg = state.pendingSvg;
+  if (!svg) return;
+  state.pendingSvg = null;
+  cancelCentre();
+  settings.pathSource = pathSourceBefore(svg);
+  if (svg.before) {
+    settings.placement = { ...svg.before.placement };
+    settings.fit = svg.before.fit;
+    showFitNote();
+  }
+  saveSettings();
+  writeForm();
 }
 
 // The pending scan was read: it becomes the scan, and the demo's fiducial

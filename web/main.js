@@ -16,7 +16,8 @@ import {
 import { initFiducials } from './fiducials.js';
 import { loadWasm, startWorker } from './engine.js';
 import {
-  acceptScan, bindFiles, demoScanEntry, dropCentre, endRestoring, isScanName, keep, loadDemo, restoreInputs,
+  acceptScan, bindFiles, demoScanEntry, dropCentre, dropPendingScan, dropPendingSvg, endRestoring, isScanName, keep,
+  loadDemo, restoreInputs,
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
@@ -282,6 +283,8 @@ function keptPlan(m, busy) {
     // What the worker planned (it may have centred the drawing).
     placement: m.summary.settings.placement,
     gen: busy.gen,
+    // The worker that made it (and holds its report).
+    worker,
     compared: !!m.comparison,
     scanName: busy.scan.name,
     mesh: meshOf(busy),
@@ -343,6 +346,9 @@ function onWorkerMessage(e) {
         state.svgFile = state.pendingSvg;
         state.pendingSvg = null;
         keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
+        // Its placement is now the one kept with it (saveSettings kept
+        // the previous drawing's while this one was not yet planned).
+        saveSettings();
       }
       state.lastPlan = keptPlan(m, busy);
       const latency = performance.now() - busy.t0;
@@ -485,15 +491,48 @@ function onPlanError(m, busy) {
 }
 
 function cancelPlan() {
-  if (!state.busy) return;
+  const busy = state.busy;
+  if (!busy) return;
   // The only way to stop wasm mid-computation: end the worker.
   restartWorker();
   state.busy = null;
   state.queued = false;
+  clearTimeout(state.debounce);
   endProgress();
-  hideDownloads();
   dropPress();
+  // What the cancelled request was bringing in goes with it: a scan being
+  // read (the next request would read it again and replace the scan kept)
+  // and a drawing not yet planned (back to the one before, where it was).
+  const dropped = [];
+  if (state.pendingScan && busy.scan === state.pendingScan) {
+    dropped.push(`reading ${state.pendingScan.name}`);
+    stopHashing(state.pendingScan.key);
+    dropPendingScan();
+  }
+  if (state.pendingSvg && busy.svg === state.pendingSvg) {
+    dropped.push(state.pendingSvg.name);
+    dropPendingSvg();
+  }
+  // The plan on screen is that of the inputs as they are again: offered
+  // (its G-code; its report went with the worker).
+  if (dropped.length && restorePlan()) {
+    const [text, stale] = plannedStatus(state.lastPlan);
+    setStatus(`cancelled ${dropped.join(' and ')}: ${text}`, stale);
+    return;
+  }
+  hideDownloads();
   setStatus('cancelled', true);
+}
+
+// The hashing worker is finding the SHA-256 of the scan `key`, no longer
+// wanted: it ends (a 50 MB file is read to its end otherwise); a new one
+// starts for the next file.
+function stopHashing(key) {
+  if (!state.hashing.has(key) || !state.hashWorker) return;
+  state.hashWorker.terminate();
+  state.hashWorker = null;
+  // The planning worker that waited for these was just restarted.
+  state.hashing.clear();
 }
 
 function restartWorker() {

@@ -98,9 +98,32 @@ export function loadSettings() {
   return base;
 }
 
+// The path source a pending drawing (state.pendingSvg) goes back to: the
+// one it replaced (the demo's drawing when that was a file no longer
+// there).
+export function pathSourceBefore(svg) {
+  const was = svg.pathSource;
+  return was === 'file' && !state.svgFile ? 'demo' : was || 'demo';
+}
+
+// What the next visit starts from. A drawing not yet planned is not kept
+// (inputs.js keeps a drawing once planned): nor are its path source and
+// placement, but those of the drawing kept, as it was placed (a drawing
+// too long for the page left its centring and fit on the good one).
+function keptSettings() {
+  const svg = state.pendingSvg;
+  if (settings.pathSource !== 'file' || !svg || !svg.before) return settings;
+  return {
+    ...settings,
+    pathSource: pathSourceBefore(svg),
+    placement: svg.before.placement,
+    fit: svg.before.fit,
+  };
+}
+
 export function saveSettings() {
   try {
-    localStorage.setItem(STORE_KEY, JSON.stringify(settings));
+    localStorage.setItem(STORE_KEY, JSON.stringify(keptSettings()));
   } catch {
     // Private mode or a full quota: settings just do not persist.
   }
@@ -317,6 +340,8 @@ export function bindForm() {
       // 20 mm one).
       const refit = antennaField && !!settings.fit;
       const before = antennaField && !refit ? pathCentre() : null;
+      // Turned or sized here, the drawing keeps its middle where it is.
+      const pivot = PIVOTED.has(id) ? pivotNow() : null;
       const value = el.type === 'checkbox' ? el.checked : el.value;
       // A new profile has its own bed: a scan placed on it moves, and the
       // drawing with it.
@@ -325,6 +350,7 @@ export function bindForm() {
       // The user places the drawing: no centring over it.
       if (/^pl-/.test(id)) userPlaced();
       if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
+      if (pivot) keepCentre(pivot);
       const after = before ? pathCentre() : null;
       if (before && after) {
         const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);
@@ -407,15 +433,92 @@ export function syncProfileOption() {
   opt.textContent = `custom: ${cp.name} (${cp.file})`;
 }
 
-// The centre of the path's box as imported (before placement), or null.
+// The centre of the path's box as imported (before placement), or null;
+// found once per drawing (a slider asks at every step).
+let boxCentre = { key: null, centre: null };
 function pathCentre() {
   try {
     const svg = currentSvg();
-    const b = pathBounds(svg.bytes, svg.name);
-    return [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2];
+    if (boxCentre.key !== svg.key) {
+      const b = pathBounds(svg.bytes, svg.name);
+      boxCentre = { key: svg.key, centre: [(b[0] + b[2]) / 2, (b[1] + b[3]) / 2] };
+    }
+    return boxCentre.centre;
   } catch {
     return null;
   }
+}
+
+// The fields that turn and size the drawing. The core turns and scales a
+// drawing about its SVG origin (the CLI's --place), most often a corner:
+// turned there, a drawing centred on the scan swung off it (at 180 deg
+// only a corner of it was printed). The page keeps the middle of the
+// drawing's box where it is instead, by moving the offset with the turn
+// or size: the placement handed to the core means what it always did.
+// The typed Rotation and Scale fields stay the numbers of --place, as
+// typed beside a typed offset (the CLI's placement, tests/browser/upload).
+const PIVOTED = new Set(['pl-rot-range', 'pl-scale-range']);
+
+// The middle kept over a run of turns and sizes: {svg, centre (the box's,
+// drawing frame), world (where it is on the printer), origin (the
+// placement the run started from), x, y, rot, scale (the placement the
+// last step left)}. Each step is placed from the same point, so a slider
+// dragged back and forth does not creep, and back at the run's turn and
+// size the drawing is exactly where it started.
+let pivotRun = null;
+
+// To 0.01 mm, as a drag or an arrow key places the drawing (view.js).
+const round2 = (v) => Math.round(v * 100) / 100;
+
+// Whether the placement value `v` (a setting, maybe text being typed) is
+// `was`, or not a number yet (a '-' typed before the digits).
+const sameOrUntyped = (was, v) => num(v) === was || !Number.isFinite(num(v));
+
+// The middle to keep for a turn or size about to be set, or null.
+function pivotNow() {
+  let svg;
+  try {
+    svg = currentSvg();
+  } catch {
+    return null;
+  }
+  const centre = pathCentre();
+  const p = settings.placement;
+  const [x, y, rot, scale] = [p.x, p.y, p.rot, p.scale].map(num);
+  if (!centre || !Number.isFinite(x) || !Number.isFinite(y)) return null;
+  const r = pivotRun;
+  if (r && r.svg === svg.key && r.x === x && r.y === y && sameOrUntyped(r.rot, p.rot)
+    && sameOrUntyped(r.scale, p.scale)) return r;
+  const v = placed(centre);
+  if (!v.every(Number.isFinite)) return null;
+  const at = { x, y, rot, scale };
+  return {
+    svg: svg.key, centre, world: [x + v[0], y + v[1]], origin: at, ...at,
+  };
+}
+
+// The turn or size was set: the offset that puts the middle back.
+function keepCentre(pivot) {
+  const p = settings.placement;
+  const rot = num(p.rot);
+  const scale = num(p.scale);
+  const v = placed(pivot.centre);
+  if (!v.every(Number.isFinite)) {
+    // Not a number yet: the drawing waits where it is.
+    pivotRun = pivot;
+    return;
+  }
+  const o = pivot.origin;
+  const back = rot === o.rot && scale === o.scale;
+  const x = back ? o.x : round2(pivot.world[0] - v[0]);
+  const y = back ? o.y : round2(pivot.world[1] - v[1]);
+  p.x = x;
+  p.y = y;
+  pivotRun = {
+    ...pivot, x, y, rot, scale,
+  };
+  writeField('pl-x');
+  writeField('pl-y');
 }
 
 // A drawing-frame vector after the placement's rotation and scale.
