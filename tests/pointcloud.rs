@@ -138,6 +138,29 @@ fn to_polyline(p: DVec3, line: &[DVec3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The mesh's three best fiducial candidates (`mesh_fids`) are among the
+/// three best of `meshed`, each within `tol` mm.
+fn assert_dots_found(
+    mesh_fids: &[pcpp::fiducials::Fiducial],
+    meshed: &pcpp::mesh::TriMesh,
+    tol: f64,
+    name: &str,
+) {
+    let fids = find_fiducials(meshed);
+    for (k, f) in mesh_fids.iter().take(3).enumerate() {
+        let nearest = fids
+            .iter()
+            .take(3)
+            .map(|g| g.centroid.truncate().distance(f.centroid.truncate()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest < tol,
+            "{name}: fiducial {k} at {} is {nearest:.3} mm from the cloud's best three",
+            f.centroid
+        );
+    }
+}
+
 #[test]
 fn the_demo_part_as_a_point_cloud_in_every_format_gives_the_meshs_fiducials_and_path() {
     let pts = sampled_cloud();
@@ -161,19 +184,7 @@ fn the_demo_part_as_a_point_cloud_in_every_format_gives_the_meshs_fiducials_and_
         assert!((info.spacing_mm - STEP).abs() < 1e-3, "{name}: {info:?}");
         assert!((info.max_edge_mm - 3.0 * info.spacing_mm).abs() < 1e-12);
         // The three dots are the three best candidates, each within 0.1 mm.
-        let fids = find_fiducials(&imported.mesh);
-        for (k, f) in mesh_fids.iter().take(3).enumerate() {
-            let nearest = fids
-                .iter()
-                .take(3)
-                .map(|g| g.centroid.truncate().distance(f.centroid.truncate()))
-                .fold(f64::INFINITY, f64::min);
-            assert!(
-                nearest < 0.1,
-                "{name}: fiducial {k} at {} is {nearest:.3} mm from the cloud's best three",
-                f.centroid
-            );
-        }
+        assert_dots_found(&mesh_fids, &imported.mesh, 0.1, &name);
         // The tool path: the plan on the meshed cloud against the mesh's.
         // Text and binary forms of one format mesh the same points, so the
         // path is planned for one file of each format.
@@ -456,19 +467,7 @@ fn regression_a_randomly_spread_cloud_was_meshed_full_of_holes() {
     assert!(info.to_string().contains("spread unevenly"), "{info}");
     let mesh = test_part::test_part();
     let mesh_fids = find_fiducials(&mesh);
-    let fids = find_fiducials(&imported.mesh);
-    for f in mesh_fids.iter().take(3) {
-        let nearest = fids
-            .iter()
-            .take(3)
-            .map(|g| g.centroid.truncate().distance(f.centroid.truncate()))
-            .fold(f64::INFINITY, f64::min);
-        assert!(
-            nearest < 0.2,
-            "the dot at {} is {nearest:.3} mm away",
-            f.centroid
-        );
-    }
+    assert_dots_found(&mesh_fids, &imported.mesh, 0.2, "random.xyz");
     let mesh_plan = plan(mesh);
     let cloud_plan = plan(imported.mesh);
     assert_eq!(cloud_plan.pieces.len(), mesh_plan.pieces.len());

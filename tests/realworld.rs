@@ -326,6 +326,26 @@ fn assert_same_surface(decoded: &TriMesh, original: &TriMesh, tol: f64, what: &s
     assert_eq!(got, want, "{what}: the triangles differ");
 }
 
+/// The compressed GLB `bytes` (`name`) imports as the Stanford bunny
+/// (3,674 triangles, `bunny.glb`): its vertices, each within a quantization
+/// step of its own (the largest extent over 2^14 - 1: the bunny is about 15
+/// units across, read as metres), and its triangles.
+fn assert_is_the_bunny(bytes: &[u8], name: &str) {
+    let original = import(data!("mesh/bunny.glb"), "bunny.glb");
+    assert_eq!(original.mesh.triangle_count(), 3674);
+    let (lo, hi) = original.mesh.bbox().unwrap();
+    let step = (hi - lo).max_element() / 16383.0;
+    let m = import(bytes, name);
+    assert_eq!(m.format, MeshFormat::Glb);
+    assert_eq!(m.units, ScanUnits::M);
+    assert_eq!(
+        m.mesh.vertices.len(),
+        original.mesh.vertices.len(),
+        "{name}"
+    );
+    assert_same_surface(&m.mesh, &original.mesh, step, name);
+}
+
 /// The Stanford bunny (3,674 triangles) as glTF, then Draco-compressed
 /// with EdgeBreaker's standard and valence traversals: the same surface,
 /// each vertex within a quantization step of its own (the file's largest
@@ -333,10 +353,6 @@ fn assert_same_surface(decoded: &TriMesh, original: &TriMesh, tol: f64, what: &s
 /// metres).
 #[test]
 fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
-    let original = import(data!("mesh/bunny.glb"), "bunny.glb");
-    assert_eq!(original.mesh.triangle_count(), 3674);
-    let (lo, hi) = original.mesh.bbox().unwrap();
-    let step = (hi - lo).max_element() / 16383.0;
     for (bytes, name) in [
         (data!("mesh/bunny-draco.glb"), "bunny-draco.glb"),
         (
@@ -344,15 +360,7 @@ fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
             "bunny-draco-valence.glb",
         ),
     ] {
-        let m = import(bytes, name);
-        assert_eq!(m.format, MeshFormat::Glb);
-        assert_eq!(m.units, ScanUnits::M);
-        assert_eq!(
-            m.mesh.vertices.len(),
-            original.mesh.vertices.len(),
-            "{name}"
-        );
-        assert_same_surface(&m.mesh, &original.mesh, step, name);
+        assert_is_the_bunny(bytes, name);
     }
 }
 
@@ -365,9 +373,6 @@ fn gltf_draco_bunny_edgebreaker_standard_and_valence_are_the_bunny() {
 /// over the largest extent).
 #[test]
 fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
-    let original = import(data!("mesh/bunny.glb"), "bunny.glb");
-    let (lo, hi) = original.mesh.bbox().unwrap();
-    let step = (hi - lo).max_element() / 16383.0;
     for (bytes, name) in [
         (data!("mesh/bunny-meshopt.glb"), "bunny-meshopt.glb"),
         (data!("mesh/bunny-meshopt-vpf.glb"), "bunny-meshopt-vpf.glb"),
@@ -376,15 +381,7 @@ fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
             "bunny-meshopt-gltf-transform.glb",
         ),
     ] {
-        let m = import(bytes, name);
-        assert_eq!(m.format, MeshFormat::Glb);
-        assert_eq!(m.units, ScanUnits::M);
-        assert_eq!(
-            m.mesh.vertices.len(),
-            original.mesh.vertices.len(),
-            "{name}"
-        );
-        assert_same_surface(&m.mesh, &original.mesh, step, name);
+        assert_is_the_bunny(bytes, name);
     }
 }
 
