@@ -238,12 +238,17 @@ pub fn triangulate(
     // a whole object's scan has its points spread unevenly (close on its
     // steep sides, where the points under them were), and a limit from the
     // closest would open holes the nozzle would be let into.
+    // A face's corners, and its longest XY edge squared.
+    let face = |f: spade::handles::FixedFaceHandle<spade::handles::InnerTag>| {
+        let [a, b, c] = t.face(f).vertices().map(|v| v.fix().index());
+        ([a, b, c], len2(a, b).max(len2(b, c)).max(len2(c, a)))
+    };
     let kept = |limit: f64| {
         let limit2 = limit * limit;
         let mut triangles = Vec::with_capacity(t.num_inner_faces());
-        for f in t.inner_faces() {
-            let [a, b, c] = f.vertices().map(|v| v.fix().index());
-            if len2(a, b) <= limit2 && len2(b, c) <= limit2 && len2(c, a) <= limit2 {
+        for f in t.fixed_inner_faces() {
+            let ([a, b, c], longest2) = face(f);
+            if longest2 <= limit2 {
                 triangles.push([a as u32, b as u32, c as u32]);
             }
         }
@@ -262,13 +267,7 @@ pub fn triangulate(
     // 3 spacings).
     let mut uneven = false;
     if max_edge_mm.is_none() && (t.num_inner_faces() - triangles.len()) * 10 > t.num_inner_faces() {
-        let mut longest: Vec<f64> = t
-            .inner_faces()
-            .map(|f| {
-                let [a, b, c] = f.vertices().map(|v| v.fix().index());
-                len2(a, b).max(len2(b, c)).max(len2(c, a))
-            })
-            .collect();
+        let mut longest: Vec<f64> = t.fixed_inner_faces().map(|f| face(f).1).collect();
         let k = (longest.len() * 99 / 100).min(longest.len() - 1);
         let p99 = longest.select_nth_unstable_by(k, f64::total_cmp).1.sqrt();
         if UNEVEN_LIMIT_PER_P99 * p99 > limit {

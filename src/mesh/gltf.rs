@@ -64,7 +64,7 @@ pub(super) fn parse(
             .any(|e| e == ext)
     };
     let (compressed, fallbacks) = meshopt::views(json, uses(meshopt::EXT), file)?;
-    let draco = draco_primitives(json, &root, file)?;
+    let draco = draco_primitives(json, &root, uses(DRACO), file)?;
     if let Some(d) = draco.values().next() {
         // glTF lets an accessor have neither bufferView nor sparse values
         // (it then holds zeros), and Draco primitives' accessors are
@@ -253,12 +253,14 @@ struct DracoRef {
     position: u32,
 }
 
-/// The Draco-compressed primitives of the file, by (mesh, primitive). The
-/// extension object is read from the JSON text (the `gltf` crate keeps no
-/// unknown extensions); its bufferView is checked against the list.
+/// The Draco-compressed primitives of the file, by (mesh, primitive); none
+/// when it does not use the extension (`used`). The extension object is
+/// read from the JSON text (the `gltf` crate keeps no unknown extensions);
+/// its bufferView is checked against the list.
 fn draco_primitives(
     json: &[u8],
     root: &gltf::json::Root,
+    used: bool,
     file: &str,
 ) -> Result<std::collections::HashMap<(usize, usize), DracoRef>, MeshError> {
     #[derive(serde::Deserialize)]
@@ -277,8 +279,7 @@ fn draco_primitives(
         extensions: Option<serde_json::Map<String, serde_json::Value>>,
     }
     let mut out = std::collections::HashMap::new();
-    let uses = |list: &[String]| list.iter().any(|e| e == DRACO);
-    if !uses(&root.extensions_used) && !uses(&root.extensions_required) {
+    if !used {
         return Ok(out);
     }
     let doc: Doc = serde_json::from_slice(json)

@@ -155,33 +155,26 @@ pub fn import_mesh_with(
     }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
-    let mut external_files = Vec::new();
-    let parsed = parse_as(format, bytes, file, external, &mut external_files)
-        .map_err(|e| misnamed(e, format, bytes, file))?;
+    let (parsed, external_files) =
+        parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
     finish_import(parsed, format, file, options, external_files)
 }
 
-/// The file read as `format` (the external files a glTF read are added to
-/// `external_files`).
+/// The file read as `format`, and the external files it read (a glTF's).
 fn parse_as(
     format: MeshFormat,
     bytes: &[u8],
     file: &str,
     external: &ExternalFiles,
-    external_files: &mut Vec<String>,
-) -> Result<Parsed, MeshError> {
+) -> Result<(Parsed, Vec<String>), MeshError> {
     if let Some(e) = binary_in_text(bytes, file, format) {
         return Err(e);
     }
-    Ok(match format {
+    let parsed = match format {
+        MeshFormat::Gltf | MeshFormat::Glb => return gltf::parse(bytes, file, external),
         MeshFormat::Obj => obj::parse(bytes, file)?,
         MeshFormat::Ply => ply::parse(bytes, file)?,
         MeshFormat::Stl => stl::parse(bytes, file)?,
-        MeshFormat::Gltf | MeshFormat::Glb => {
-            let (parsed, read) = gltf::parse(bytes, file, external)?;
-            *external_files = read;
-            parsed
-        }
         MeshFormat::Xyz => Parsed {
             vertices: xyz::parse(bytes, file)?,
             ..Parsed::default()
@@ -194,7 +187,8 @@ fn parse_as(
                 ..Parsed::default()
             }
         }
-    })
+    };
+    Ok((parsed, Vec::new()))
 }
 
 /// `e`, the error of reading a file as the format its name gives, with
