@@ -68,6 +68,13 @@ pub enum Error {
         hidden: usize,
         points: usize,
     },
+    /// G-code refused for a scan so small that its units are likely wrong
+    /// ([`crate::mesh::UnitsDoubt`]), none given.
+    #[error(
+        "{message}. No G-code written: give the scan's units (--scan-units mm if it really \
+         is this small)"
+    )]
+    UnitsDoubt { message: String },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

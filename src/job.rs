@@ -15,7 +15,8 @@ use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{
-    CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology, TriMesh,
+    CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology,
+    TriMesh, UnitsDoubt,
 };
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
@@ -463,6 +464,8 @@ pub struct PreparedScan {
     pub warnings: Vec<String>,
     /// For a point cloud, how it was meshed.
     pub cloud: Option<CloudInfo>,
+    /// Set when the scan is so small that its units are likely wrong.
+    pub units_doubt: Option<UnitsDoubt>,
     /// Fiducial candidates, scanner frame, smallest/roundest first.
     pub fiducials: Vec<Fiducial>,
     pub registration: Registration,
@@ -605,6 +608,7 @@ impl PreparedScan {
             units,
             warnings,
             cloud,
+            units_doubt,
             ..
         } = imported;
         Ok(PreparedScan {
@@ -613,6 +617,7 @@ impl PreparedScan {
             units,
             warnings,
             cloud,
+            units_doubt,
             fiducials,
             registration,
             method,
@@ -883,6 +888,19 @@ pub fn refuse_whole_object_cloud(scan: &PreparedScan, accept_risk: bool) -> Resu
     }
 }
 
+/// G-code refused for a scan so small in the units it was read in, none
+/// given, that they are likely wrong (a scan in metres read as mm): the
+/// drawing would be printed a thousand times too small, or not at all.
+/// Giving the units, mm included, is the user's word on its size.
+pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
+    match scan.units_doubt {
+        Some(d) if !d.given && !accept_risk => Err(Error::UnitsDoubt {
+            message: d.message(&scan.file.name),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// The refusal of a plan whose guarded planner could not clear some point
 /// (no G-code then), unless the user accepts the risk: the error lists the
 /// first ten points.
@@ -928,6 +946,7 @@ pub fn write_outputs(
 ) -> Result<(Report, String)> {
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     refuse_whole_object_cloud(scan, accept_risk)?;
+    refuse_unit_doubt(scan, accept_risk)?;
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     // What the G-code would have been refused for but for the accepted
@@ -949,6 +968,13 @@ pub fn write_outputs(
             "the scan is a whole object's point cloud ({} of its {} points lie under its top and \
              were left out): between its points the real surface may be higher",
             c.hidden, c.points
+        ));
+    }
+    if let Some(d) = scan.units_doubt.filter(|d| !d.given) {
+        risks.push(format!(
+            "the scan is only {:.3} mm across, read in {} without its units given",
+            d.size_mm.max_element(),
+            d.units
         ));
     }
     if !plan.uncleared.is_empty() {

@@ -88,6 +88,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "touching"
     } else if matches!(e, Error::WholeObjectCloud { .. }) {
         "whole-object"
+    } else if matches!(e, Error::UnitsDoubt { .. }) {
+        "units"
     } else {
         "other"
     };
@@ -608,8 +610,47 @@ struct ScanView<'a> {
     /// For a point cloud: how it was meshed, and that as one line.
     cloud: Option<crate::mesh::CloudInfo>,
     cloud_text: Option<String>,
+    /// Set when the scan is so small that its units are likely wrong
+    /// (`given` false: no G-code until the user gives them).
+    units_doubt: Option<UnitsDoubtView>,
     registration: RegistrationView<'a>,
     holes: Vec<HoleView>,
+}
+
+#[derive(Serialize)]
+struct UnitsDoubtView {
+    size_mm: [f64; 3],
+    units: crate::mesh::ScanUnits,
+    given: bool,
+    /// The core's warning, naming the file.
+    message: String,
+    /// The units it may be in, each with the size it would have.
+    offers: Vec<UnitsOffer>,
+}
+
+#[derive(Serialize)]
+struct UnitsOffer {
+    units: crate::mesh::ScanUnits,
+    size_mm: [f64; 3],
+}
+
+impl UnitsDoubtView {
+    fn new(d: &crate::mesh::UnitsDoubt, file: &str) -> UnitsDoubtView {
+        UnitsDoubtView {
+            size_mm: d.size_mm.to_array(),
+            units: d.units,
+            given: d.given,
+            message: d.message(file),
+            offers: d
+                .offers()
+                .into_iter()
+                .map(|(units, size)| UnitsOffer {
+                    units,
+                    size_mm: size.to_array(),
+                })
+                .collect(),
+        }
+    }
 }
 
 #[derive(Serialize)]

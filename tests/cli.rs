@@ -1811,6 +1811,99 @@ fn an_upside_down_registration_is_refused_naming_the_scan() {
 /// hint ("the scan is only 0.008 x ... mm, read in mm: check its units")
 /// was printed only after a plan that succeeded, so the error blamed the
 /// drawing's units alone (assimp's regr_3429812.obj, a 0.0075 mm quad).
+/// An 80 mm film saved in metres, read as mm (the file's default), is
+/// 0.08 mm across: the drawing would be fitted to it and printed a
+/// thousand times too small. No G-code until the units are given; given
+/// as m it plans on the 80 mm film, given as mm (the user's word that it
+/// is that small) it plans as read, and with the risk accepted the header
+/// says what was accepted.
+#[test]
+fn a_scan_in_metres_read_as_mm_writes_no_gcode_until_its_units_are_given() {
+    let dir = temp_dir("scan-in-metres");
+    // The 80 mm film `offset` (file units) in from the bed's corner,
+    // written in units of `per_mm` mm.
+    let film = |offset: f64, per_mm: f64| {
+        let mut obj = String::new();
+        for j in 0..=40 {
+            for i in 0..=40 {
+                let (x, y) = (i as f64 * 2.0, j as f64 * 2.0);
+                let z = 5.0 + 0.4 * (x / 6.0).sin() * (y / 9.0).cos();
+                obj += &format!(
+                    "v {} {} {}\n",
+                    offset + x / per_mm,
+                    offset + y / per_mm,
+                    z / per_mm
+                );
+            }
+        }
+        for j in 0..40 {
+            for i in 0..40 {
+                let a = j * 41 + i + 1;
+                obj += &format!("f {a} {} {}\nf {a} {} {}\n", a + 1, a + 42, a + 42, a + 41);
+            }
+        }
+        obj
+    };
+    let scan = dir.join("film-m.obj");
+    let obj = film(0.05, 1000.0);
+    std::fs::write(&scan, obj).unwrap();
+    let svg = demo_file("antenna-spiral.svg");
+    let out = dir.join("out.gcode");
+    let o = plan_on(&scan, &svg, &["--place", "centre", "-o", s(&out)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(
+            "error: film-m.obj: the scan is only 0.080 x 0.080 x 0.001 mm, read in mm: check its \
+             units; in m it would be 80.0 x 80.0 x 0.8 mm (--scan-units m). No G-code written"
+        ) && err.contains("--scan-units mm if it really is this small"),
+        "{err}"
+    );
+    assert!(!out.exists());
+
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "centre", "--scan-units", "m", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!stderr(&o).contains("check its units"), "{}", stderr(&o));
+    let gcode = std::fs::read_to_string(&out).unwrap();
+    assert!(!gcode.contains("WARNING"), "{}", &gcode[..2000]);
+    std::fs::remove_file(&out).unwrap();
+
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "centre", "--scan-units", "mm", "-o", s(&out)],
+    );
+    // Planned as read (its nozzle is wider than the whole film, so the
+    // tool path leaves the bed: another error).
+    assert!(stderr(&o).contains("check its units"), "{}", stderr(&o));
+    assert!(
+        !stderr(&o).contains("give the scan's units"),
+        "{}",
+        stderr(&o)
+    );
+
+    // 50 mm in, 0.08 mm across: with the risk accepted it is planned, and
+    // the header says what was accepted.
+    std::fs::write(&scan, film(50.0, 1000.0)).unwrap();
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "centre", "--accept-risk", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let gcode = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        gcode.contains("the scan is only 0.080 mm across, read in mm without its units given"),
+        "{}",
+        &gcode[..2000]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn regression_the_scans_units_hint_was_lost_when_planning_failed() {
     let dir = temp_dir("tiny-scan");

@@ -21,7 +21,7 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote,
+  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote, unitsBannerShown,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -456,6 +456,9 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'whole-object') {
     title = 'The scan is a point cloud of a whole object: no G-code';
     message += '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
+  } else if (m.kind === 'units') {
+    title = 'The scan is too small for its units: no G-code';
+    message += '\nChoose its units in the Scan panel (Units).';
   } else if (m.kind === 'registration') {
     // Refused at planning: fiducials far off their printer points, or the
     // scan turned upside down (printer points in the other order).
@@ -472,7 +475,8 @@ function onPlanError(m, busy) {
   // A scan outside the build volume, with the banner on screen offering to
   // place it: the banner says it, with its button; a red panel repeating
   // it would only bury it.
-  const offered = m.stage === 'plan' && bannerOffers(message);
+  const unitsOffered = m.kind === 'units' && unitsBannerShown();
+  const offered = m.stage === 'plan' && (bannerOffers(message) || unitsOffered);
   if (offered) clearError();
   else showError(title, message, file, topic);
   if (busy.gen === state.gen && restorePlan()) return;
@@ -484,7 +488,9 @@ function onPlanError(m, busy) {
     requestDraw();
   }
   // The previous plan on screen is said to be that, whichever the failure.
-  if (offered) {
+  if (unitsOffered) {
+    setStatus(`no G-code: choose the scan's units (see above)${state.lastPlan ? '; showing the previous plan' : ''}`, true);
+  } else if (offered) {
     setStatus(`no G-code: the scan lies outside the build volume (see above)${
       state.lastPlan ? '; showing the previous plan' : ''}`, true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);

@@ -251,6 +251,51 @@ export function showScanPlacement() {
     note.classList.toggle('bad-note', shown && outside);
   }
   writeFields(null);
+  showUnitsBanner(info);
+}
+
+// The units the Units list names.
+const UNIT_NAMES = { mm: 'mm', cm: 'cm', m: 'metres', in: 'inches', ft: 'feet' };
+const sizeText = (s, d) => s.map((v) => v.toFixed(d)).join(' × ');
+
+// A scan so small in the units it was read in that they are likely wrong
+// (a file in metres read as mm, which would print the drawing a thousand
+// times too small): the core writes no G-code until the user gives its
+// units (job::refuse_unit_doubt), and this banner offers them. Choosing
+// one is choosing it in the Units list.
+function showUnitsBanner(info) {
+  const d = info && info.units_doubt;
+  const shown = !!d && !d.given && !state.pendingScan;
+  $('units-banner').hidden = !shown;
+  const btns = $('units-banner-btns');
+  btns.replaceChildren();
+  if (!shown) {
+    $('units-banner-text').textContent = '';
+    return;
+  }
+  $('units-banner-text').textContent = `${info.name} is only ${sizeText(d.size_mm, 3)} mm read in `
+    + `${UNIT_NAMES[d.units]}: it was most likely saved in other units. No G-code until you choose them.`;
+  const offer = (units, text, primary) => {
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.textContent = text;
+    b.dataset.units = units;
+    if (primary) b.className = 'primary';
+    b.addEventListener('click', () => {
+      const sel = $('scan-units');
+      sel.value = units;
+      sel.dispatchEvent(new Event('change'));
+    });
+    btns.append(b);
+  };
+  d.offers.forEach((o, i) => offer(o.units, `Read in ${UNIT_NAMES[o.units]} (${sizeText(o.size_mm, 1)} mm)`, i === 0));
+  offer(d.units, `It is in ${UNIT_NAMES[d.units]}`, false);
+}
+
+// Whether the units banner is on screen (a plan refused for the scan's
+// units says no more than it does).
+export function unitsBannerShown() {
+  return !$('units-banner').hidden;
 }
 
 const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);

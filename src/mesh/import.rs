@@ -241,7 +241,7 @@ fn finish_import(
         _ => false,
     };
     if cloud {
-        return import_cloud(parsed, file, format, options.max_edge_mm, units, up_axis);
+        return import_cloud(parsed, file, format, options, units, up_axis);
     }
     // STL and glTF parsers weld as they read; OBJ and PLY files from
     // exporters often split vertices at UV seams too (a Blender PLY cube has
@@ -249,7 +249,8 @@ fn finish_import(
     // fiducial detector, so they are welded here.
     let weld = matches!(format, MeshFormat::Obj | MeshFormat::Ply);
     let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis, weld)?;
-    warnings.extend(units_hint(&mesh, file, units));
+    let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
+    warnings.extend(units_doubt.map(|d| d.message(file)));
     Ok(ImportedMesh {
         mesh,
         format,
@@ -257,6 +258,7 @@ fn finish_import(
         up_axis,
         warnings,
         cloud: None,
+        units_doubt,
         external_files,
     })
 }
@@ -300,7 +302,7 @@ fn import_cloud(
     parsed: Parsed,
     file: &str,
     format: MeshFormat,
-    max_edge_mm: Option<f64>,
+    options: &ImportOptions,
     units: ScanUnits,
     up_axis: UpAxis,
 ) -> Result<ImportedMesh, MeshError> {
@@ -311,9 +313,10 @@ fn import_cloud(
     } = parsed;
     check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
-    let (mesh, info) = cloud::triangulate(vertices, max_edge_mm, file)?;
+    let (mesh, info) = cloud::triangulate(vertices, options.max_edge_mm, file)?;
     check_triangle_count(mesh.triangle_count(), file)?;
-    warnings.extend(units_hint(&mesh, file, units));
+    let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
+    warnings.extend(units_doubt.map(|d| d.message(file)));
     if info.merged > 0 {
         warnings.push(format!(
             "{file}: {} point(s) shared their XY with another; the highest of each was kept",
@@ -336,6 +339,7 @@ fn import_cloud(
         up_axis,
         warnings,
         cloud: Some(info),
+        units_doubt,
         external_files: Vec::new(),
     })
 }
@@ -345,47 +349,80 @@ fn import_cloud(
 /// likely a file in metres or inches read as millimetres.
 pub const SMALL_SCAN_MM: f64 = 5.0;
 
-/// A warning for a scan so small that its units are likely wrong, with the
-/// size it would have in the units it may be in.
-fn units_hint(mesh: &TriMesh, file: &str, units: ScanUnits) -> Option<String> {
-    // Over the vertices in order (a pass through memory), not through the
-    // triangles: a stray vertex no triangle uses can only hide the hint.
-    let (lo, hi) = mesh
-        .vertices
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(*v), hi.max(*v))
-        });
-    if mesh.triangles.is_empty() || !(lo.is_finite() && hi.is_finite()) {
-        return None;
-    }
-    let size = hi - lo;
-    if size.max_element() >= SMALL_SCAN_MM {
-        return None;
-    }
-    let as_read = units.to_mm();
-    let others: Vec<String> = [(ScanUnits::M, "m"), (ScanUnits::In, "in")]
-        .into_iter()
-        .filter(|&(u, _)| u != units && u.to_mm() > as_read)
-        .map(|(u, name)| {
-            let k = u.to_mm() / as_read;
-            format!(
-                "in {name} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {name})",
-                size.x * k,
-                size.y * k,
-                size.z * k
-            )
+/// A scan so small in the units it was read in (less than
+/// [`SMALL_SCAN_MM`] across) that they are likely wrong: a file in metres
+/// or inches read as millimetres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnitsDoubt {
+    /// Its extent in mm, as read.
+    pub size_mm: DVec3,
+    /// The units it was read in.
+    pub units: ScanUnits,
+    /// Whether the user gave those units (`ImportOptions::units`): then
+    /// the size is theirs, and the doubt only a warning; otherwise
+    /// [`crate::job::refuse_unit_doubt`] writes no G-code.
+    pub given: bool,
+}
+
+impl UnitsDoubt {
+    /// The doubt about a mesh read in `units`, `None` when it is large
+    /// enough.
+    fn of(mesh: &TriMesh, units: ScanUnits, given: bool) -> Option<UnitsDoubt> {
+        // Over the vertices in order (a pass through memory), not through
+        // the triangles: a stray vertex no triangle uses can only hide it.
+        let (lo, hi) = mesh
+            .vertices
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        if mesh.triangles.is_empty() || !(lo.is_finite() && hi.is_finite()) {
+            return None;
+        }
+        let size_mm = hi - lo;
+        (size_mm.max_element() < SMALL_SCAN_MM).then_some(UnitsDoubt {
+            size_mm,
+            units,
+            given,
         })
-        .collect();
-    Some(format!(
-        "{file}: the scan is only {:.3} x {:.3} x {:.3} mm, read in {}: check its units{}{}",
-        size.x,
-        size.y,
-        size.z,
-        units,
-        if others.is_empty() { "" } else { "; " },
-        others.join(", ")
-    ))
+    }
+
+    /// The larger units the scan may be in (metres, inches), each with the
+    /// size it would have in them (mm): those in which it would no longer
+    /// be too small.
+    pub fn offers(&self) -> Vec<(ScanUnits, DVec3)> {
+        let as_read = self.units.to_mm();
+        [ScanUnits::M, ScanUnits::In]
+            .into_iter()
+            .filter(|&u| u != self.units && u.to_mm() > as_read)
+            .map(|u| (u, self.size_mm * (u.to_mm() / as_read)))
+            .filter(|(_, size)| size.max_element() >= SMALL_SCAN_MM)
+            .collect()
+    }
+
+    /// The warning: the size as read, and in the units it may be in.
+    pub fn message(&self, file: &str) -> String {
+        let s = self.size_mm;
+        let others: Vec<String> = self
+            .offers()
+            .into_iter()
+            .map(|(u, m)| {
+                format!(
+                    "in {u} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
+                    m.x, m.y, m.z
+                )
+            })
+            .collect();
+        format!(
+            "{file}: the scan is only {:.3} x {:.3} x {:.3} mm, read in {}: check its units{}{}",
+            s.x,
+            s.y,
+            s.z,
+            self.units,
+            if others.is_empty() { "" } else { "; " },
+            others.join(", ")
+        )
+    }
 }
 
 /// The file's units to mm and its up axis to the printer's +Z.
@@ -852,6 +889,31 @@ mod tests {
             (lo, hi),
             (DVec3::new(0.0, 0.0, 304.8), DVec3::new(304.8, 304.8, 304.8))
         );
+    }
+
+    #[test]
+    fn units_are_offered_only_where_the_scan_would_not_be_too_small() {
+        let obj = b"v 0 0 0\nv 0.08 0 0\nv 0 0.08 0.004\nf 1 2 3\n";
+        let m = import_mesh(obj, "film.obj", &ImportOptions::DEFAULT).unwrap();
+        let d = m.units_doubt.unwrap();
+        assert!(!d.given);
+        // In inches it would still be 2 mm across: not offered.
+        let offers = d.offers();
+        assert_eq!(offers.len(), 1, "{offers:?}");
+        assert_eq!(offers[0].0, ScanUnits::M);
+        assert!((offers[0].1.x - 80.0).abs() < 1e-9);
+        assert!(!d.message("film.obj").contains("--scan-units in"));
+        // Given as mm, the doubt stays (a warning) but is the user's word.
+        let opts = ImportOptions {
+            units: Some(ScanUnits::Mm),
+            ..ImportOptions::DEFAULT
+        };
+        let m = import_mesh(obj, "film.obj", &opts).unwrap();
+        assert!(m.units_doubt.unwrap().given);
+        // Large enough: no doubt.
+        let big = b"v 0 0 0\nv 8 0 0\nv 0 8 0.4\nf 1 2 3\n";
+        let m = import_mesh(big, "film.obj", &ImportOptions::DEFAULT).unwrap();
+        assert_eq!(m.units_doubt, None);
     }
 
     #[test]

@@ -32,7 +32,9 @@ mod xyz;
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use external::{ExternalFiles, ExternalRef};
-pub use import::{detect_format, external_files_needed, import_mesh, import_mesh_with};
+pub use import::{
+    detect_format, external_files_needed, import_mesh, import_mesh_with, UnitsDoubt, SMALL_SCAN_MM,
+};
 pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
 /// Largest scan file read (bytes). A 20 M triangle binary STL is 1 GB; a
@@ -249,6 +251,9 @@ pub struct ImportedMesh {
     pub warnings: Vec<String>,
     /// For a point cloud, how it was meshed.
     pub cloud: Option<CloudInfo>,
+    /// Set when the scan is so small in the units it was read in that
+    /// they are likely wrong (its warning is among `warnings`).
+    pub units_doubt: Option<UnitsDoubt>,
     /// The external files the scan was read from besides its own bytes (a
     /// `.gltf`'s buffers), by the relative paths it names them with, each
     /// once.

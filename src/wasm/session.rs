@@ -9,7 +9,8 @@ use wasm_bindgen::prelude::*;
 
 use super::{
     arr, check_samples, core_err, from_js, gcode_text, js_err, kind_err, profile, set, set_array,
-    to_js, vec3, HoleView, PickView, RegistrationView, ScanView, TypedArray, PAGE_MAX_DRAWN_MOVES,
+    to_js, vec3, HoleView, PickView, RegistrationView, ScanView, TypedArray, UnitsDoubtView,
+    PAGE_MAX_DRAWN_MOVES,
 };
 use crate::job::{self, InputFile, PreparedScan, RegistrationSettings};
 use crate::mesh::ImportOptions;
@@ -271,6 +272,10 @@ impl Session {
             warnings: &s.warnings,
             cloud: s.cloud,
             cloud_text: s.cloud.map(|c| c.to_string()),
+            units_doubt: s
+                .units_doubt
+                .as_ref()
+                .map(|d| UnitsDoubtView::new(d, &s.file.name)),
             registration: RegistrationView {
                 status: s.registration.status,
                 status_text: s.registration.status.to_string(),

@@ -163,6 +163,7 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
         e @ Error::WholeObjectCloud { .. } => {
             Failure::Input(format!("{e} (--accept-risk writes it anyway)"))
         }
+        e @ Error::UnitsDoubt { .. } => Failure::Input(e.to_string()),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
             inputs.svg_path.display()

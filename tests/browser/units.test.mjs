@@ -1,0 +1,87 @@
+// A scan saved in metres (as many scanners and photogrammetry tools write
+// it) is read as millimetres by default: 80 mm becomes 0.08 mm, and the
+// drawing would be printed a thousand times too small. The page says so
+// in a banner with the units to read it in, and writes no G-code until
+// the user chooses them.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
+
+const env = withPageServer();
+
+// An 80 x 80 mm film with a gentle wave, 5 mm up, written in metres.
+function filmInMetres() {
+  const n = 41;
+  const lines = [];
+  for (let j = 0; j < n; j++) {
+    for (let i = 0; i < n; i++) {
+      const x = i * 2;
+      const y = j * 2;
+      const z = 5 + 0.4 * Math.sin(x / 6) * Math.cos(y / 9);
+      lines.push(`v ${(x / 1000).toFixed(6)} ${(y / 1000).toFixed(6)} ${(z / 1000).toFixed(7)}`);
+    }
+  }
+  for (let j = 0; j + 1 < n; j++) {
+    for (let i = 0; i + 1 < n; i++) {
+      const a = j * n + i + 1;
+      lines.push(`f ${a} ${a + 1} ${a + n + 1}`, `f ${a} ${a + n + 1} ${a + n}`);
+    }
+  }
+  return `${lines.join('\n')}\n`;
+}
+
+const status = (page) => page.textContent('#plan-status');
+
+test('a scan in metres gets the units banner, no G-code, and plans once read in metres', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'film-m.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-m.obj');
+  await waitIdle(page);
+  // The banner names the file, its size as read, and offers metres first.
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
+  assert.match(await page.textContent('#units-banner-text'),
+    /^film-m\.obj is only 0\.080 × 0\.080 × 0\.001 mm read in mm: it was most likely saved in other units/);
+  const buttons = await page.$$eval('#units-banner-btns button', (bs) => bs.map((b) => [b.dataset.units, b.textContent]));
+  assert.deepEqual(buttons, [['m', 'Read in metres (80.0 × 80.0 × 0.8 mm)'], ['mm', 'It is in mm']]);
+  // No G-code: the plan was refused for the units, said once (the banner
+  // says why, so no red panel repeats it).
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.match(await status(page), /^no G-code: choose the scan's units \(see above\)/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+
+  // Read in metres: the banner goes, the Units list says so, and the
+  // drawing is planned on the 80 mm film.
+  await page.click('#units-banner-btns button[data-units="m"]');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'm');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  assert.equal(await page.inputValue('#scan-units'), 'm');
+  assert.match(await status(page), /^planned .* on film-m\.obj/);
+  const bbox = await page.evaluate(() => window.pcpp.state.info.bbox_mm);
+  assert.ok(Math.abs(bbox[1][0] - bbox[0][0] - 80) < 1e-6, JSON.stringify(bbox));
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+
+  // Back to the file's default: the doubt again; "It is in mm" is the
+  // user's word that it really is that small, and it plans.
+  await page.selectOption('#scan-units', '');
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.click('#units-banner-btns button[data-units="mm"]');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'mm'
+    && window.pcpp.state.info.units_doubt && window.pcpp.state.info.units_doubt.given);
+  await waitForPlan(page);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  assert.equal(await page.inputValue('#scan-units'), 'mm');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('the demo part has no units banner', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  assert.equal(await page.evaluate(() => window.pcpp.state.info.units_doubt ?? null), null);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
