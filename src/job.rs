@@ -1007,6 +1007,38 @@ pub fn write_outputs(
                     fit: fit.message,
                 }
             }
+            // The scan inside, the tool path beside it outside: a drawing
+            // up to the edge of a scan that lies against the volume's side
+            // (the nozzle passes beside the edge, and waypoints step off).
+            GcodeError::OutOfVolume {
+                position,
+                ref volume,
+                ..
+            } => {
+                let side = [
+                    (volume.min_mm.x - position.x, "-X"),
+                    (position.x - volume.max_mm.x, "+X"),
+                    (volume.min_mm.y - position.y, "-Y"),
+                    (position.y - volume.max_mm.y, "+Y"),
+                    (volume.min_mm.z - position.z, "-Z"),
+                    (position.z - volume.max_mm.z, "+Z"),
+                ]
+                .into_iter()
+                .fold(
+                    (f64::NEG_INFINITY, ""),
+                    |m, x| if x.0 > m.0 { x } else { m },
+                );
+                Error::OutsideVolume {
+                    source: Box::new(e),
+                    fit: format!(
+                        "the scan lies inside the build volume, but beside it the tool path \
+                         passes {:.3} mm beyond the volume's {} side: move the scan in from \
+                         that side, e.g. place it on the bed (--place-scan bed; in the page, \
+                         'Place on the bed'), or the drawing in from the scan's edge",
+                        side.0, side.1
+                    ),
+                }
+            }
             e => Error::Gcode(e),
         }
     })?;

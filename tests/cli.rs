@@ -1143,6 +1143,45 @@ fn regression_a_scale_given_with_centre_was_overridden_by_the_fit() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The test part lies in the bed's corner (x and y from 0): a drawing
+/// along its edge is planned with the nozzle passing beside the edge, out
+/// of the volume. The error said "check the registration or the profile's
+/// build_volume" of a scan that lies inside; it says how far, past which
+/// side, and what to move.
+#[test]
+fn a_tool_path_beside_a_scan_in_the_beds_corner_says_what_to_move() {
+    let dir = temp_dir("bed-corner");
+    let scan = dir.join("part.ply");
+    std::fs::write(&scan, demo::to_binary_ply(&test_part::test_part())).unwrap();
+    let svg = dir.join("edge.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80"><path d="M 0 0 L 80 0 L 80 80 L 0 80 Z" stroke="black" fill="none"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let o = plan_on(&scan, &svg, &["--place", "0,80", "-o", s(&out)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("lies outside the build volume of profile marlin")
+            && err.contains(
+                "the scan lies inside the build volume, but beside it the tool path passes"
+            )
+            && err.contains("side: move the scan in from that side, e.g. place it on the bed"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // Placed on the bed (centred on it), it plans.
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place", "0,80", "--place-scan", "bed", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Issue 13: a scan still in its scanner's frame (the demo part turned and
 /// moved 800 mm down) with a spiral: the plan fails naming the placement
 /// flag; placed on the bed with the drawing centred, it succeeds, the

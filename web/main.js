@@ -21,7 +21,8 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, requestCentre, showFitNote, unitsBannerShown,
+  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, planOutcome, requestCentre, showFitNote,
+  unitsBannerShown,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -359,6 +360,7 @@ function onWorkerMessage(e) {
       if (st.planMs.length > 1000) { st.planMs.shift(); st.latencyMs.shift(); }
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
+      planOutcome(null);
       if (m.comparison) state.lastComparison = { rows: m.comparison, series: m.series, gen: busy.gen };
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
@@ -475,6 +477,7 @@ function onPlanError(m, busy) {
   // A scan outside the build volume, with the banner on screen offering to
   // place it: the banner says it, with its button; a red panel repeating
   // it would only bury it.
+  if (m.stage === 'plan') planOutcome(message);
   const unitsOffered = m.kind === 'units' && unitsBannerShown();
   const offered = m.stage === 'plan' && (bannerOffers(message) || unitsOffered);
   if (offered) clearError();
@@ -491,7 +494,7 @@ function onPlanError(m, busy) {
   if (unitsOffered) {
     setStatus(`no G-code: choose the scan's units (see above)${state.lastPlan ? '; showing the previous plan' : ''}`, true);
   } else if (offered) {
-    setStatus(`no G-code: the scan lies outside the build volume (see above)${
+    setStatus(`no G-code: the ${/beside it the tool path/.test(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
       state.lastPlan ? '; showing the previous plan' : ''}`, true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }

@@ -30,6 +30,12 @@ let centreTokens = 0;
 const beds = new Map(); // profile key -> its bed (wasm bedOf)
 // The core's sentence the banner shows, while it is shown.
 let banner = null;
+// The last plan's refusal for a tool path beside the scan out of the
+// volume, the scan lying inside it (a drawing up to the edge of a scan in
+// the bed's corner): {key: the scan's, text: the core's sentence}, until a
+// plan succeeds or another scan is read.
+let besideOut = null;
+const BESIDE = /the scan lies inside the build volume, but beside it the tool path passes .*$/;
 
 const finite = (v) => typeof v === 'number' && Number.isFinite(v);
 
@@ -239,9 +245,11 @@ export function showScanPlacement() {
     }
   }
   const outside = !!fit && !fit.inside;
-  $('place-banner').hidden = !(outside && !on && s.fidSource === 'none' && !state.pendingScan);
-  banner = !$('place-banner').hidden && outside ? fit.message : null;
-  $('place-banner-text').textContent = outside ? pageText(capital(fit.message)) : '';
+  const beside = !outside && !!besideOut && !!state.scan && besideOut.key === state.scan.key;
+  $('place-banner').hidden = !((outside || beside) && !on && s.fidSource === 'none' && !state.pendingScan);
+  const sentence = outside ? fit.message : beside ? besideOut.text : null;
+  banner = !$('place-banner').hidden ? sentence : null;
+  $('place-banner-text').textContent = sentence ? pageText(capital(sentence)) : '';
   $('scan-place').hidden = !on;
   if (on) {
     $('bed-name').textContent = `profile ${profile().name}`;
@@ -299,6 +307,16 @@ export function unitsBannerShown() {
 }
 
 const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
+
+// A plan's outcome for the banner: the error message of a refused plan,
+// or null for a plan that succeeded.
+export function planOutcome(message) {
+  const m = message === null ? null : String(message).match(BESIDE);
+  const next = m && state.scan ? { key: state.scan.key, text: m[0] } : null;
+  if (!next && !besideOut) return;
+  besideOut = next;
+  showScanPlacement();
+}
 
 // Whether the banner on screen offers the fix for the planning error
 // `message` (the core's sentence on the scan outside the build volume is

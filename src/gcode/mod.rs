@@ -46,7 +46,7 @@ use glam::DVec3;
 
 pub use profile::{
     BuildVolume, CommentStyle, FeedUnits, MachineProfile, BLOCK_TOKENS, DEFAULT_DECIMALS,
-    DWELL_TOKENS,
+    DWELL_TOKENS, VOLUME_HAIR_MM,
 };
 pub(crate) use read::numbered_lines;
 pub use read::{

@@ -84,10 +84,27 @@ pub struct BuildVolume {
     pub max_mm: DVec3,
 }
 
+/// How far past a face of the build volume a point still counts as on it:
+/// the G-code's resolution (coordinates are written to 0.001 mm). A
+/// registration's rounding or a spline's overshoot at a drawing's corner
+/// on the face puts points a fraction of a micrometre out; the writer
+/// writes them on the face ([`BuildVolume::snap`]).
+pub const VOLUME_HAIR_MM: f64 = 0.001;
+
 impl BuildVolume {
-    /// Inclusive on every face.
+    /// Inclusive on every face, and [`VOLUME_HAIR_MM`] past it.
     pub fn contains(&self, p: DVec3) -> bool {
-        p.cmpge(self.min_mm).all() && p.cmple(self.max_mm).all()
+        p.cmpge(self.min_mm - VOLUME_HAIR_MM).all() && p.cmple(self.max_mm + VOLUME_HAIR_MM).all()
+    }
+
+    /// `p` moved onto the volume where it lies past a face by no more
+    /// than [`VOLUME_HAIR_MM`] (unchanged inside, and further out).
+    pub fn snap(&self, p: DVec3) -> DVec3 {
+        if self.contains(p) {
+            p.clamp(self.min_mm, self.max_mm)
+        } else {
+            p
+        }
     }
 }
 
@@ -611,8 +628,19 @@ mod tests {
         };
         assert!(v.contains(DVec3::ZERO));
         assert!(v.contains(DVec3::splat(10.0)));
-        assert!(!v.contains(DVec3::new(5.0, 10.001, 5.0)));
-        assert!(!v.contains(DVec3::new(-0.001, 5.0, 5.0)));
+        // A hair past a face is on it (the G-code's resolution), more is out.
+        assert!(v.contains(DVec3::new(5.0, 10.0009, 5.0)));
+        assert!(v.contains(DVec3::new(-0.0009, 5.0, 5.0)));
+        assert!(!v.contains(DVec3::new(5.0, 10.0011, 5.0)));
+        assert!(!v.contains(DVec3::new(-0.0011, 5.0, 5.0)));
+        assert_eq!(
+            v.snap(DVec3::new(-0.0009, 10.0009, 5.0)),
+            DVec3::new(0.0, 10.0, 5.0)
+        );
+        assert_eq!(
+            v.snap(DVec3::new(-0.5, 5.0, 5.0)),
+            DVec3::new(-0.5, 5.0, 5.0)
+        );
         assert!(!v.contains(DVec3::new(f64::NAN, 5.0, 5.0)));
         assert_eq!(v.to_string(), "x 0..10, y 0..10, z 0..10 mm");
     }

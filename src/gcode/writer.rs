@@ -112,6 +112,25 @@ pub fn write_program(
     profile.validate(&source)?;
     check_job(job)?;
     let safe_z = checked_safe_height(job, profile)?;
+    // Points a hair past a face of the volume are written on it (every
+    // point is inside once checked; only those out by a hair are copied).
+    let volume = profile.build_volume;
+    let snapped: Vec<Vec<DVec3>>;
+    let snapped_job;
+    let job = if job.toolpaths.iter().flatten().any(|&p| volume.snap(p) != p) {
+        snapped = job
+            .toolpaths
+            .iter()
+            .map(|ps| ps.iter().map(|&p| volume.snap(p)).collect())
+            .collect();
+        snapped_job = GcodeJob {
+            toolpaths: &snapped,
+            ..*job
+        };
+        &snapped_job
+    } else {
+        job
+    };
 
     let mut w = Program::new(job, profile, safe_z);
     w.header(job, safe_z);
@@ -602,6 +621,35 @@ M84
             "{m}"
         );
         assert!(m.contains("x 0..220, y 0..220, z 0..250"), "{m}");
+    }
+
+    /// A drawing's corner on the bed's edge: the spline's overshoot put
+    /// the point 0.6 micrometres past the face, and the plan was refused
+    /// ("point ... at (80.000, -0.001, ...) lies outside the build volume").
+    /// A hair out is written on the face; more is still an error.
+    #[test]
+    fn a_point_a_hair_past_a_face_is_written_on_it() {
+        let paths = vec![vec![
+            DVec3::new(80.0, 10.0, 5.0),
+            DVec3::new(80.0, -0.0006, 5.0),
+            DVec3::new(220.0004, 3.0, 5.0),
+        ]];
+        let p = write_program(&job(&paths, &[]), &marlin()).unwrap();
+        assert!(
+            p.text.contains("G1 X80.000 Y0.000 Z5.000 F300\n"),
+            "{}",
+            p.text
+        );
+        assert!(p.text.contains("G1 X220.000 Y3.000 Z5.000\n"), "{}", p.text);
+        assert!(!p.text.contains("-0.001") && !p.text.contains("220.001"));
+        let out_of = |m: &&WrittenMove| m.to.y < 0.0 || m.to.x > 220.0;
+        assert_eq!(p.moves.iter().find(out_of), None);
+        let out = vec![vec![
+            DVec3::new(80.0, 10.0, 5.0),
+            DVec3::new(80.0, -0.0011, 5.0),
+        ]];
+        let e = write_gcode(&job(&out, &[]), &marlin()).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfVolume { point: 1, .. }), "{e}");
     }
 
     #[test]

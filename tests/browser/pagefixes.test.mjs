@@ -196,3 +196,43 @@ test('a plan refused for the build volume says the plan on screen is the previou
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The demo part lies in the bed's corner (x and y from 0). A drawing along
+// its edge failed for a corner point 0.6 micrometres past the bed's edge
+// (a spline's overshoot), with "check the registration or the profile's
+// build_volume" of a scan inside the volume and nothing to press. Now a
+// hair past the edge is written on it; and where the tool path really
+// passes beside the scan out of the volume (the part taken as scanned:
+// waypoints beside its edge), the banner names the side and offers to
+// place the scan on the bed.
+test('a drawing along the edge of a scan in the bed\'s corner plans, or gets the "Place on the bed" banner', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const edge = '<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80">'
+    + '<path d="M 0 0 L 80 0 L 80 80 L 0 80 Z" stroke="black" fill="none"/></svg>';
+  await page.setInputFiles('#svg-input', { name: 'edge.svg', mimeType: 'image/svg+xml', buffer: Buffer.from(edge) });
+  await waitSettled(page);
+  for (const [id, v] of [['pl-scale', '1'], ['pl-rot', '0'], ['pl-x', '0'], ['pl-y', '80']]) {
+    await page.fill(`#${id}`, v);
+  }
+  await page.waitForTimeout(500);
+  await waitSettled(page);
+  assert.match(await page.textContent('#plan-status'), /^planned edge\.svg on demo-test-part\.ply/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+
+  // Taken as scanned: the waypoints step off the bed beside the edge.
+  await page.selectOption('#fid-source', 'none');
+  await page.waitForFunction(() => !document.getElementById('place-banner').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#place-banner-text'),
+    /^The scan lies inside the build volume, but beside it the tool path passes [0-9.]+ mm beyond the volume's [-+][XY] side: move the scan in from that side, e\.g\. place it on the bed \('Place on the bed'\)/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.match(await page.textContent('#plan-status'), /^no G-code: the tool path lies outside the build volume \(see above\)/);
+  // Placed on the bed, it plans and the banner goes.
+  await page.click('#place-bed-btn');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#place-banner'), true);
+  assert.match(await page.textContent('#plan-status'), /^planned edge\.svg on demo-test-part\.ply/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
