@@ -28,6 +28,8 @@ const TEXT_FILE = /\.txt$/i;
 const GLTF_FILE = /\.(gltf|glb)$/i;
 const SCAN_FILE = /\.(gltf|glb|obj|ply|stl|xyz|csv|txt|asc|pts|pcd)$/i;
 const SVG_FILE = /\.svg$/i;
+// A machine profile (the Machine panel's "Open profile…" reads the same).
+const PROFILE_FILE = /\.json$/i;
 
 // Whether `name` is a scan's by its extension (a file of another kind
 // that could not be read is an error about its kind, not about a scan).
@@ -74,6 +76,7 @@ function textKind(head, cut = false) {
 async function fileKind(file) {
   if (SVG_FILE.test(file.name)) return 'svg';
   if (GCODE_FILE.test(file.name)) return 'gcode';
+  if (PROFILE_FILE.test(file.name)) return 'profile';
   if (!TEXT_FILE.test(file.name)) return 'scan';
   let head;
   try {
@@ -85,8 +88,8 @@ async function fileKind(file) {
   return textKind(head, file.size > SNIFF_BYTES);
 }
 
-// Files opened together (selected at once, or dropped): drawings and
-// G-code programs each on their own; of the others, one is the scan and
+// Files opened together (selected at once, or dropped): drawings, G-code
+// programs and machine profiles (.json) each on their own; of the others, one is the scan and
 // the rest go with it, for the files it names (a .gltf's .bin buffers:
 // the worker reads only those the scan needs). `scans`: chosen through
 // "Open scan…", every file is the scan or goes with it (a .txt there is
@@ -101,6 +104,7 @@ function openFiles(files, scans = false) {
   openKinds(files, files.map((f) => {
     if (scans) return 'scan';
     if (SVG_FILE.test(f.name)) return 'svg';
+    if (PROFILE_FILE.test(f.name)) return 'profile';
     return GCODE_FILE.test(f.name) ? 'gcode' : 'scan';
   }));
 }
@@ -110,6 +114,7 @@ function openKinds(files, kinds) {
   files.forEach((f, i) => {
     if (kinds[i] === 'svg') openSvg(f);
     else if (kinds[i] === 'gcode') checkGcodeFile(f);
+    else if (kinds[i] === 'profile') openProfile(f);
     else rest.push(f);
   });
   if (rest.length === 0) return;

@@ -61,3 +61,27 @@ test('a custom machine profile changes the G-code; a bad one names its field', a
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A profile dropped on the page was taken for a scan ("Could not read the
+// scan lab-printer.json ... not a scan this program reads"): a .json is a
+// machine profile, dropped or opened with others.
+test('a machine profile dropped on the page is used as the profile', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  const good = marlin();
+  good.name = 'dropped-printer';
+  good.start = ['G21', 'G90', 'M117 dropped profile'];
+  await page.evaluate(([name, text]) => {
+    const dt = new DataTransfer();
+    dt.items.add(new File([text], name, { type: 'application/json' }));
+    window.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, cancelable: true }));
+  }, ['dropped-printer.json', JSON.stringify(good)]);
+  await page.waitForFunction(() => document.getElementById('dialect').value === 'custom');
+  await waitIdle(page);
+  await waitForPlan(page);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.equal(await page.textContent('#scan-name'), 'demo-test-part.ply');
+  assert.match((await download(page, 'dl-gcode')).bytes.toString('utf8'), /^M117 dropped profile$/m);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
