@@ -22,7 +22,7 @@ import {
 import { $, hooks, profile, settings, state } from './page.js';
 import {
   bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, planOutcome, requestCentre, showFitNote,
-  unitsBannerShown,
+  showScanPlacement, unitsBannerShown,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -361,6 +361,12 @@ function onWorkerMessage(e) {
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
       planOutcome(null);
+      // Planned: the worker's scan is registered by the settings now (a
+      // failed registration leaves the one before, which these are again).
+      if (state.regFailed) {
+        state.regFailed = false;
+        showScanPlacement();
+      }
       if (m.comparison) state.lastComparison = { rows: m.comparison, series: m.series, gen: busy.gen };
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
@@ -430,12 +436,14 @@ function onPlanError(m, busy) {
   } else if (m.stage === 'scan') {
     // (The registration's messages start 'registration needs ...'.)
     title = m.kind === 'mesh' ? 'Could not read the scan' : `Could not register ${busy.scan.name}`;
+    if (m.kind !== 'mesh') state.regFailed = true;
     if (state.pendingScan && busy.scan === state.pendingScan) {
       // Readable but not registered: it stays loaded until the fiducials fit.
       acceptScan();
       $('scan-name').textContent = state.scan.name;
       dropPlan(busy);
     }
+    showScanPlacement();
   } else if (m.kind === 'svg' && state.pendingSvg && busy.svg === state.pendingSvg) {
     file = state.pendingSvg.name;
     title = `Could not read the SVG ${file}`;

@@ -130,6 +130,9 @@ export const state = {
   interacting: false, // a drag or slider in progress: skip the comparison
   centre: null, // {token}: the next plan centres the drawing on the scan (placement.js)
   info: null, // the scan as the worker read it
+  // Set when the scan's registration failed after `info` was read (the
+  // fiducials do not fit): the header says so instead of the last one.
+  regFailed: false,
   viewer: null,
   redraw: 0,
   frames: 0, // frames the view has drawn (tests read the rate)

@@ -228,8 +228,10 @@ export function showScanPlacement() {
   const status = $('reg-status');
   const line = status.parentElement;
   if (info) {
-    status.textContent = info.registration.status_text;
-    const registered = info.registration.status.kind === 'registered';
+    // A registration that failed since: not the last one's sentence.
+    status.textContent = state.regFailed ? 'not registered: the fiducials do not fit (see the error)'
+      : info.registration.status_text;
+    const registered = !state.regFailed && info.registration.status.kind === 'registered';
     line.classList.toggle('registered', registered);
     line.classList.toggle('unregistered', !registered);
   }

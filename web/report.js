@@ -15,6 +15,7 @@ import {
 
 export function showScan(info, positions, indices, seconds) {
   state.info = info;
+  state.regFailed = false;
   $('scan-name').textContent = info.name;
   const [lo, hi] = info.bbox_mm;
   $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `

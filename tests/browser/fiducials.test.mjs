@@ -4,7 +4,7 @@
 // one ~0 on the demo).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { openPage, waitForPlan, waitIdle, withPageServer } from './helpers.mjs';
+import { openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
 
 const env = withPageServer();
 
@@ -105,6 +105,30 @@ test('the order of the holes paired with the printer points sets the registratio
   }, null, { timeout: 120_000 });
   await waitForPlan(page);
   assert.ok(Number.parseFloat(await page.textContent('#rms')) < 1e-3);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// Printer points that no choice of holes fits (collinear here) left the
+// header saying "registered (lsq, 3 fiducials, RMS residual 0.000 mm)"
+// beside "Could not register": it says the scan is not registered until
+// the points fit again.
+test('the header says the scan is not registered while its fiducials do not fit', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const good = await page.inputValue('#fid-printer');
+  assert.match(await page.textContent('#reg-status'), /^registered \(lsq, 3 fiducials/);
+  await page.fill('#fid-printer', '10, 10, 5\n20, 20, 5\n30, 30, 5');
+  await page.waitForFunction(() => /^Could not register/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#reg-status'), 'not registered: the fiducials do not fit (see the error)');
+  assert.equal(await page.$eval('#reg-status', (e) => e.parentElement.classList.contains('unregistered')), true);
+  // The points back: registered again.
+  await page.fill('#fid-printer', good);
+  await waitSettled(page);
+  assert.match(await page.textContent('#reg-status'), /^registered \(lsq, 3 fiducials/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
 });
