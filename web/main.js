@@ -397,6 +397,9 @@ function onWorkerMessage(e) {
 
 function onPlanError(m, busy) {
   dropPress();
+  // The worker holds another drawing than the page thinks: the next plan
+  // sends it again.
+  if (/did not reach the planner/.test(m.message)) state.sentSvgKey = null;
   let title = 'Planning failed';
   let message = m.message;
   let file; // the file the title names

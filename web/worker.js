@@ -228,13 +228,16 @@ async function plan(m) {
   const { id } = m;
   const key = JSON.stringify([m.scan.key, m.scanSettings, m.registration]);
   let stage = 'scan';
+  // The drawing's bytes are kept first: the page sends them once, and a
+  // scan that fails to load must not lose them (the next plan, on another
+  // scan, would find the drawing before them).
+  if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
   try {
     if (key !== sessionKey) {
       await loadScan(m);
       sessionKey = key;
     }
     stage = 'plan';
-    if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
     if (!svg || svg.key !== m.svg.key) throw new Error(`the drawing ${m.svg.name} did not reach the planner; plan again`);
     if (pathKey !== svg.key) {
       session.setPath(svg.bytes, svg.name);
