@@ -810,6 +810,9 @@ pub fn run_on(
     accept_risk: bool,
 ) -> Result<JobOutput> {
     settings.validate()?;
+    // Before planning: a plan on a scan read in the wrong units fails, if
+    // it fails, for a reason that hides this one (the drawing misses it).
+    refuse_unit_doubt(scan, accept_risk)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
     refuse_uncleared(&plan, accept_risk)?;

@@ -1899,6 +1899,16 @@ fn a_scan_in_metres_read_as_mm_writes_no_gcode_until_its_units_are_given() {
         "{err}"
     );
     assert!(!out.exists());
+    // Refused before planning: the drawing where it lies misses the
+    // 0.08 mm scan, which is not what the user has to fix.
+    let o = plan_on(&scan, &svg, &["-o", s(&out)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("No G-code written: give the scan's units")
+            && !stderr(&o).contains("misses the scan"),
+        "{}",
+        stderr(&o)
+    );
 
     let o = plan_on(
         &scan,

@@ -9,8 +9,9 @@ import { openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './
 
 const env = withPageServer();
 
-// An 80 x 80 mm film with a gentle wave, 5 mm up, written in metres.
-function filmInMetres() {
+// An 80 x 80 mm film with a gentle wave, 5 mm up, written in metres;
+// `hole`: only its 2 mm rim.
+function filmInMetres(hole = false) {
   const n = 41;
   const lines = [];
   for (let j = 0; j < n; j++) {
@@ -24,6 +25,7 @@ function filmInMetres() {
   for (let j = 0; j + 1 < n; j++) {
     for (let i = 0; i + 1 < n; i++) {
       const a = j * n + i + 1;
+      if (hole && i >= 1 && i < 39 && j >= 1 && j < 39) continue;
       lines.push(`f ${a} ${a + 1} ${a + n + 1}`, `f ${a} ${a + n + 1} ${a + n}`);
     }
   }
@@ -82,6 +84,22 @@ test('the demo part has no units banner', async () => {
   await waitSettled(page);
   assert.equal(await page.isHidden('#units-banner'), true);
   assert.equal(await page.evaluate(() => window.pcpp.state.info.units_doubt ?? null), null);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// The drawing centred on the misread scan lies over its hole: the plan
+// failed for that ("no part of the path lies over the scan's surface"),
+// in red, beside the banner. The units come first.
+test('a scan in metres is refused for its units before the drawing is planned on it', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'ring-m.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(true)) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'ring-m.obj');
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
+  assert.match(await status(page), /^no G-code: choose the scan's units \(see above\)/);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
 });
