@@ -196,11 +196,9 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
     let message = if inside {
         format!("the scan lies inside the build volume of profile {profile}")
     } else {
-        format!(
+        let spans = format!(
             "the scan lies outside the build volume of profile {profile} ({volume}): it spans \
-             x {:.1}..{:.1}, y {:.1}..{:.1}, z {:.1}..{:.1} mm, out by up to {:.1} mm; if it is \
-             still in the scanner's frame, place it on the bed (--place-scan bed; in the page, \
-             'Place on the bed') or register it by its fiducials{}",
+             x {:.1}..{:.1}, y {:.1}..{:.1}, z {:.1}..{:.1} mm, out by up to {:.1} mm",
             lo.x,
             hi.x,
             lo.y,
@@ -208,12 +206,25 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             lo.z,
             hi.z,
             outside.max_element(),
-            if fits_on_bed {
-                ""
-            } else {
-                " (it is larger than the volume: check the scan's units)"
-            }
-        )
+        );
+        if fits_on_bed {
+            format!(
+                "{spans}; if it is still in the scanner's frame, place it on the bed \
+                 (--place-scan bed; in the page, 'Place on the bed') or register it by its \
+                 fiducials"
+            )
+        } else {
+            // Placing it cannot help: name the axis it is too large on.
+            let over = size - room;
+            let (axis, k) = [("x", 0), ("y", 1), ("z", 2)]
+                .into_iter()
+                .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
+            format!(
+                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm): \
+                 check the scan's units and up axis, or use a profile whose build volume holds it",
+                size[k], room[k]
+            )
+        }
     };
     VolumeFit {
         inside,
@@ -354,6 +365,22 @@ mod tests {
 
     /// The demo part registered on its fiducials spans x from -1e-13:
     /// "outside the build volume ... out by up to 0.0 mm".
+    /// A scan placed on the bed and still taller than the volume was told
+    /// to "place it on the bed".
+    #[test]
+    fn a_scan_larger_than_the_volume_is_told_which_axis_not_to_place_it() {
+        let bbox = (DVec3::new(30.0, 30.0, 0.0), DVec3::new(90.0, 90.0, 260.4));
+        let fit = volume_fit(bbox, &volume(), "marlin");
+        assert!(!fit.inside && !fit.fits_on_bed);
+        assert!(
+            fit.message
+                .contains("it is larger than the volume (z 260.4 mm, the volume 250.0 mm)")
+                && !fit.message.contains("place it on the bed"),
+            "{}",
+            fit.message
+        );
+    }
+
     #[test]
     fn a_scan_a_hair_past_a_face_is_inside() {
         let hi = DVec3::new(80.0, 80.0, 8.0);

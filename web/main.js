@@ -395,6 +395,9 @@ function onWorkerMessage(e) {
   }
 }
 
+// `text` ended as a sentence, before the page's own line after it.
+const ended = (text) => (/[.!?)]$/.test(text.trim()) ? text : `${text.trimEnd()}.`);
+
 function onPlanError(m, busy) {
   dropPress();
   // The worker holds another drawing than the page thinks: the next plan
@@ -465,18 +468,18 @@ function onPlanError(m, busy) {
     title = 'The path is too long for the page';
   } else if (m.kind === 'touching') {
     title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
-    message += '\nThe settings, the drawing and the previous plan stay as they were.';
+    message = ended(message) + '\nThe settings, the drawing and the previous plan stay as they were.';
   } else if (m.kind === 'whole-object') {
     title = 'The scan is a point cloud of a whole object: no G-code';
-    message += '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
+    message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
-    message += '\nChoose its units in the Scan panel (Units).';
+    message = ended(message) + '\nChoose its units in the Scan panel (Units).';
   } else if (m.kind === 'registration') {
     // Refused at planning: fiducials far off their printer points, or the
     // scan turned upside down (printer points in the other order).
     title = 'The registration puts the scan where the part is not: no G-code';
-    message += '\nCheck the printer points (their order and values); to write it anyway, tick '
+    message = ended(message) + '\nCheck the printer points (their order and values); to write it anyway, tick '
       + '"write G-code even where the nozzle may touch" (Nozzle and process).';
   }
   // A plan refused for its motion still compared the planners on the

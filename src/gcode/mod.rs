@@ -117,9 +117,9 @@ pub enum GcodeError {
     /// The travel height (scan top or highest point, plus the clearance)
     /// is above the build volume: lower the clearance or the part.
     #[error(
-        "safe travel height {safe_z_mm} mm (highest of scan top {scan_top_z_mm} mm and highest \
-         tool-path point, plus clearance {clearance_mm} mm) lies outside the build volume of \
-         profile {profile} ({volume})"
+        "safe travel height {safe_z_mm:.3} mm (highest of scan top {scan_top_z_mm:.3} mm and \
+         highest tool-path point, plus clearance {clearance_mm} mm) lies outside the build \
+         volume of profile {profile} ({volume})"
     )]
     SafeHeightOutOfVolume {
         safe_z_mm: f64,

@@ -368,8 +368,11 @@ impl UnitsDoubt {
     /// The doubt about a mesh read in `units`, `None` when it is large
     /// enough.
     fn of(mesh: &TriMesh, units: ScanUnits, given: bool) -> Option<UnitsDoubt> {
-        // Over the vertices in order (a pass through memory), not through
-        // the triangles: a stray vertex no triangle uses can only hide it.
+        // First over the vertices in order (a pass through memory), then,
+        // for a scan that small, over the triangles' corners: its size is
+        // the one the scan's bounds give (a stray vertex no triangle uses
+        // made it 4 mm where the scan was 1 mm; it can still hide the
+        // doubt of a scan it makes larger than SMALL_SCAN_MM).
         let (lo, hi) = mesh
             .vertices
             .iter()
@@ -379,6 +382,10 @@ impl UnitsDoubt {
         if mesh.triangles.is_empty() || !(lo.is_finite() && hi.is_finite()) {
             return None;
         }
+        if (hi - lo).max_element() >= SMALL_SCAN_MM {
+            return None;
+        }
+        let (lo, hi) = mesh.bbox()?;
         let size_mm = hi - lo;
         (size_mm.max_element() < SMALL_SCAN_MM).then_some(UnitsDoubt {
             size_mm,
@@ -910,6 +917,12 @@ mod tests {
         };
         let m = import_mesh(obj, "film.obj", &opts).unwrap();
         assert!(m.units_doubt.unwrap().given);
+        // Its size is that of the triangles, not of a vertex none uses.
+        let stray = b"v 0 0 0\nv 0.08 0 0\nv 0 0.08 0.004\nv 3 3 0\nf 1 2 3\n";
+        let m = import_mesh(stray, "film.obj", &ImportOptions::DEFAULT).unwrap();
+        let d = m.units_doubt.unwrap();
+        assert_eq!(d.size_mm, DVec3::new(0.08, 0.08, 0.004));
+        assert!(d.message("film.obj").contains("0.080 x 0.080 x 0.004 mm"));
         // Large enough: no doubt.
         let big = b"v 0 0 0\nv 8 0 0\nv 0 8 0.4\nf 1 2 3\n";
         let m = import_mesh(big, "film.obj", &ImportOptions::DEFAULT).unwrap();

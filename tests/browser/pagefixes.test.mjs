@@ -261,3 +261,28 @@ test('a bad drawing then a bad scan leave the next scan planning with the kept d
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The refusal of a whole object's point cloud read "... or accept the risk
+// To write it anyway, tick ...": the core's sentence ends without a full
+// stop, and the page's own line followed it.
+test('the page\'s advice after a refusal follows a finished sentence', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A ball's point cloud, top and underside: a whole object.
+  const rows = [];
+  const n = 6000;
+  for (let k = 0; k < n; k++) {
+    const z = 1 - (2 * (k + 0.5)) / n;
+    const r = Math.sqrt(1 - z * z);
+    const a = k * Math.PI * (3 - Math.sqrt(5));
+    rows.push(`${(40 + 20 * r * Math.cos(a)).toFixed(4)} ${(40 + 20 * r * Math.sin(a)).toFixed(4)} ${(25 + 20 * z).toFixed(4)}`);
+  }
+  await page.setInputFiles('#scan-input', file('ball.xyz', `${rows.join('\n')}\n`));
+  await page.waitForFunction(() => /whole object/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const message = await page.textContent('#error-message');
+  assert.match(message, /or accept the risk\.\nTo write it anyway, tick /);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
