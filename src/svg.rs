@@ -1388,8 +1388,15 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         allow_dtd: true,
         ..Default::default()
     };
-    let doc = roxmltree::Document::parse_with_options(text, opt)
-        .map_err(|e| format!("not well-formed XML: {e}"))?;
+    let doc = roxmltree::Document::parse_with_options(text, opt).map_err(|e| match e {
+        // The one error roxmltree gives no place for.
+        roxmltree::Error::UnexpectedEndOfStream => format!(
+            "not well-formed XML: the file ends at line {} before its elements are closed (is \
+             it cut short?)",
+            text.lines().count().max(1)
+        ),
+        e => format!("not well-formed XML: {e}"),
+    })?;
     let root = doc.root_element();
     if root.tag_name().name() != "svg" {
         return Err(format!(
@@ -2729,6 +2736,17 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("not well-formed XML"), "{e}");
+        // A file cut short: roxmltree names no place; the message does.
+        let e = import_svg(
+            b"<svg xmlns=\"http://www.w3.org/2000/svg\">\n<path d=\"M 0 0 L 5 5\"/>\n<path d=\"M 1",
+            "cut.svg",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("the file ends at line 3 before its elements are closed (is it cut short?)"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -54,6 +54,8 @@ const GCODE_WORD = /[A-Z]\s*[-+]?(\d|\.\d)/i;
 // comments) do not count. With neither it is taken for G-code, whose
 // check names what it cannot read.
 function textKind(head, cut = false) {
+  // A drawing saved as .txt (an SVG's XML).
+  if (/^\uFEFF?\s*<(\?xml|svg|!DOCTYPE svg|!--)/i.test(head)) return 'svg';
   const lines = head.split(/\r?\n|\r/);
   // A head cut from a longer file ends in a partial line.
   if (cut) lines.pop();
@@ -71,8 +73,8 @@ function textKind(head, cut = false) {
   return cloud > gcode ? 'scan' : 'gcode';
 }
 
-// What a dropped or opened file is: 'svg', 'gcode' or 'scan' (a scan, or
-// a file a scan names), a .txt by its first lines.
+// What a dropped or opened file is: 'svg', 'gcode', 'profile' or 'scan'
+// (a scan, or a file a scan names), a .txt by its first lines.
 async function fileKind(file) {
   if (SVG_FILE.test(file.name)) return 'svg';
   if (GCODE_FILE.test(file.name)) return 'gcode';

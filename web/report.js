@@ -13,6 +13,10 @@ import {
   requestDraw, setViewShows, updateDragOffset, updateMarkers,
 } from './view.js';
 
+// A file's size as people read it: a 120 KB glTF was "0.0 MiB".
+const sizeText = (bytes) => (bytes >= (1 << 20) ? `${(bytes / (1 << 20)).toFixed(1)} MiB`
+  : bytes >= 1024 ? `${(bytes / 1024).toFixed(1)} KiB` : `${bytes} bytes`);
+
 export function showScan(info, positions, indices, seconds) {
   state.info = info;
   state.regFailed = false;
@@ -20,7 +24,7 @@ export function showScan(info, positions, indices, seconds) {
   const [lo, hi] = info.bbox_mm;
   $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
     + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
-    + `${(info.bytes / (1 << 20)).toFixed(1)} MiB read in ${fmt(seconds, 1)} s; `
+    + `${sizeText(info.bytes)} read in ${fmt(seconds, 1)} s; `
     + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`
     + (info.cloud_text ? `; ${info.cloud_text}` : '');
   if (state.viewer) {

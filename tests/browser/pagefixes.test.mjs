@@ -64,6 +64,8 @@ test('a .txt point cloud opened with "Open scan…" is read as a scan, not check
   assert.equal(await readOrChecked(page, 'cloud.txt'), 'scan');
   assert.equal(await page.textContent('#scan-name'), 'cloud.txt');
   assert.match(await page.textContent('#scan-info'), /^XYZ, .*point cloud: 1681 points meshed/);
+  // Its size as people read it (it was "0.0 MiB").
+  assert.match(await page.textContent('#scan-info'), /; \d+\.\d KiB read in /);
   // Nothing was checked as a program.
   assert.equal(await page.isHidden('#check-panel'), true, await page.textContent('#check-verdict'));
   assert.equal(await page.evaluate(() => window.pcpp.state.checkId), 0);
@@ -283,6 +285,22 @@ test('the page\'s advice after a refusal follows a finished sentence', async () 
   await waitIdle(page);
   const message = await page.textContent('#error-message');
   assert.match(message, /or accept the risk\.\nTo write it anyway, tick /);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A drawing saved as .txt and dropped was checked as a G-code program
+// ("has no moves ... is it the G-code file the printer runs?").
+test('a dropped .txt holding an SVG is read as the drawing', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const svg = '<?xml version="1.0"?>\n<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="20mm" viewBox="0 0 40 20">'
+    + '<path d="M 2 10 L 38 10" stroke="black" fill="none"/></svg>\n';
+  await drop(page, [['drawing.txt', svg]]);
+  await page.waitForFunction(() => /^planned drawing\.txt on demo-test-part\.ply/.test(document.getElementById('plan-status').textContent),
+    null, { timeout: 120_000 });
+  assert.equal(await page.isHidden('#check-panel'), true, await page.textContent('#check-verdict'));
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
 });
