@@ -661,7 +661,7 @@ M84
         assert!(matches!(e, GcodeError::SafeHeightOutOfVolume { .. }), "{e}");
         assert!(e.to_string().contains("253"), "{e}");
         // Written as a person reads them, not 248.33359999999999.
-        j.scan_top_z_mm = 248.333_599_999_999_99;
+        j.scan_top_z_mm = 248.0 + 0.333_6 + 1e-14;
         let e = write_gcode(&j, &marlin()).unwrap_err().to_string();
         assert!(
             e.starts_with("safe travel height 253.334 mm (highest of scan top 248.334 mm"),
