@@ -129,6 +129,19 @@ export function saveSettings() {
   }
 }
 
+// A typed number field's text as a setting: NaN while it is empty (not
+// 0, which `Number('')` gives), named as empty when planning (`filled`).
+const typedNumber = (v) => (String(v).trim() === '' ? NaN : Number(v));
+
+// A number field's value; an empty field is named as such (it read as 0:
+// "nozzle inner diameter (mm) = 0: must be a number greater than 0").
+function filled(label, v) {
+  if (v === null || v === undefined || Number.isNaN(v) || String(v).trim() === '') {
+    throw new Error(`${label}: the field is empty; type a number`);
+  }
+  return num(v);
+}
+
 // What the library reads: a `job::JobSettings` for planning on `scan`.
 export function jobSettings(scan) {
   const s = settings;
@@ -154,17 +167,20 @@ export function jobSettings(scan) {
       scan_placement: scanPlacementFor(scan),
     },
     plan: {
-      nozzle: { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) },
+      nozzle: {
+        inner_diameter_mm: filled('Inner Ø d (mm)', s.nozzle.id),
+        outer_diameter_mm: filled('Outer Ø do (mm)', s.nozzle.od),
+      },
       process: {
-        tolerance_mm: num(s.process.tol),
-        speed_mm_s: num(s.process.speed),
-        dwell_s: num(s.process.dwell),
+        tolerance_mm: filled('Tolerance (mm)', s.process.tol),
+        speed_mm_s: filled('Speed (mm/s)', s.process.speed),
+        dwell_s: filled('Dwell (s)', s.process.dwell),
       },
       planner: s.planner,
       placement: {
-        offset_mm: [num(s.placement.x), num(s.placement.y)],
-        rotation_deg: num(s.placement.rot),
-        scale: num(s.placement.scale),
+        offset_mm: [filled('Offset X (mm)', s.placement.x), filled('Offset Y (mm)', s.placement.y)],
+        rotation_deg: filled('Rotation (°)', s.placement.rot),
+        scale: filled('Scale', s.placement.scale),
       },
     },
   };
@@ -240,17 +256,17 @@ const FIELDS = [
   ['mp-height', () => settings.monopole.height_mm, (v) => { settings.monopole.height_mm = Number(v); }],
   ['mp-base', () => settings.monopole.base_mm, (v) => { settings.monopole.base_mm = Number(v); }],
   ['mp-feed', () => settings.monopole.feed_mm, (v) => { settings.monopole.feed_mm = Number(v); }],
-  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = Number(v); }, 'typed'],
-  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = Number(v); }, 'typed'],
-  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'typed'],
-  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); settings.fit = null; }, 'typed'],
+  ['pl-x', () => settings.placement.x, (v) => { settings.placement.x = typedNumber(v); }, 'typed'],
+  ['pl-y', () => settings.placement.y, (v) => { settings.placement.y = typedNumber(v); }, 'typed'],
+  ['pl-rot', () => settings.placement.rot, (v) => { settings.placement.rot = typedNumber(v); }, 'typed'],
+  ['pl-scale', () => settings.placement.scale, (v) => { settings.placement.scale = typedNumber(v); settings.fit = null; }, 'typed'],
   ['pl-rot-range', () => settings.placement.rot, (v) => { settings.placement.rot = Number(v); }, 'live'],
   ['pl-scale-range', () => settings.placement.scale, (v) => { settings.placement.scale = Number(v); settings.fit = null; }, 'live'],
-  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = Number(v); }, 'typed'],
-  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = Number(v); }, 'typed'],
-  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = Number(v); }, 'typed'],
-  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = Number(v); }, 'typed'],
-  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = Number(v); }, 'typed'],
+  ['nz-id', () => settings.nozzle.id, (v) => { settings.nozzle.id = typedNumber(v); }, 'typed'],
+  ['nz-od', () => settings.nozzle.od, (v) => { settings.nozzle.od = typedNumber(v); }, 'typed'],
+  ['pr-tol', () => settings.process.tol, (v) => { settings.process.tol = typedNumber(v); }, 'typed'],
+  ['pr-speed', () => settings.process.speed, (v) => { settings.process.speed = typedNumber(v); }, 'typed'],
+  ['pr-dwell', () => settings.process.dwell, (v) => { settings.process.dwell = typedNumber(v); }, 'typed'],
   ['planner', () => settings.planner, (v) => { settings.planner = v; }],
   ['dialect', () => settings.dialect, (v) => { settings.dialect = v; }],
   ['accept-risk', () => settings.acceptRisk, (v) => { settings.acceptRisk = v; }],

@@ -304,3 +304,22 @@ test('a dropped .txt holding an SVG is read as the drawing', async () => {
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// An emptied number field was planned as 0: "invalid parameter nozzle
+// inner diameter (mm) = 0: must be a number greater than 0".
+test('an empty number field is named as empty, not read as 0', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  for (const [id, label] of [['nz-id', 'Inner Ø d \\(mm\\)'], ['pr-speed', 'Speed \\(mm/s\\)'], ['pl-scale', 'Scale']]) {
+    const was = await page.inputValue(`#${id}`);
+    await page.fill(`#${id}`, '');
+    await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 60_000 });
+    assert.match(await page.textContent('#error-message'), new RegExp(`^${label}: the field is empty; type a number`));
+    assert.equal(await page.textContent('#error-title'), 'Cannot plan');
+    await page.fill(`#${id}`, was);
+    await waitSettled(page);
+    assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  }
+  assert.deepEqual(problems, []);
+  await context.close();
+});
