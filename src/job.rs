@@ -1208,13 +1208,13 @@ pub fn check_gcode(
             tol_mm
         ));
     }
-    // When every such move was cleared that way (a pcpp program's start:
-    // rise, then travel above the scan), one note says it all, in place of
-    // the reader's list of them.
+    // These notes place every move the file does not place (a pcpp
+    // program's start: rise, then travel above the scan; or moves left
+    // unchecked), so they stand in place of the reader's list of them.
+    if let Some(i) = program.unknown_start_note {
+        notes.remove(i);
+    }
     if unchecked_lines.is_empty() && !start.is_empty() {
-        if let Some(i) = program.unknown_start_note {
-            notes.remove(i);
-        }
         notes.push(start.join("; then "));
     } else {
         notes.extend(start);
@@ -1222,7 +1222,7 @@ pub fn check_gcode(
     if !unchecked_lines.is_empty() {
         notes.push(format!(
             "{} move(s) could not be checked: the file does not give where they start or end \
-             and they come lower than tol above the scan's top (lines {})",
+             and they come lower than tol above the scan's top ({})",
             unchecked_lines.len(),
             line_list(&unchecked_lines)
         ));
@@ -1241,10 +1241,11 @@ pub fn check_gcode(
     })
 }
 
-/// G-code line numbers as a message lists them: the first ten, then
-/// "...".
+/// G-code line numbers as a message lists them: "line 6", or "lines 6, 9"
+/// with the first ten, then "...".
 pub fn line_list(lines: &[usize]) -> String {
-    let mut s = lines
+    let mut s = String::from(if lines.len() == 1 { "line " } else { "lines " });
+    s += &lines
         .iter()
         .take(10)
         .map(|l| l.to_string())

@@ -579,3 +579,39 @@ fn regression_a_program_without_moves_was_clear() {
     let one = check_gcode(&scan, "G90\nG0 X10 Y10 Z60\n", "one.gcode", &nozzle, 0.1).unwrap();
     assert!(one.is_clear());
 }
+
+/// `X40 Y41 Z2 M3 S100` under a modal G1 (how some laser and spindle
+/// programs turn the tool on) was read as M3's parameters, so `check`
+/// passed a program whose move on that line dives 2.7 mm into the demo
+/// part. The move is checked now, and the line after it, whose start is
+/// not known for sure, is listed as unchecked.
+#[test]
+fn regression_check_passed_a_dive_written_beside_m3() {
+    use pcpp::job::{check_gcode, prepare_scan, RegistrationSettings};
+    use pcpp::mesh::ImportOptions;
+
+    let ply = pcpp::demo::demo_scan_bytes();
+    let scan = prepare_scan(
+        &ply,
+        pcpp::demo::DEMO_SCAN_NAME,
+        &ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )
+    .unwrap();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let text = "G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 F300\nX40 Y41 Z2 M3 S100\nG1 X41 Y41 Z10\n";
+    let check = check_gcode(&scan, text, "laser.nc", &nozzle, 0.1).unwrap();
+    assert!(!check.is_clear());
+    assert_eq!(check.summary.touching_moves, 1, "{:?}", check.summary);
+    assert_eq!(check.summary.min_clearance_line, Some(5));
+    assert_eq!(check.unchecked_lines, [6]);
+    // Each line is explained once: line 3 as the program's first rise, line
+    // 6 as unchecked; not again in a list of "moves before every axis had a
+    // known position".
+    let notes = check.notes.join("\n");
+    assert!(!notes.contains("lines 3, 6"), "{notes}");
+    assert!(
+        notes.contains("could not be checked") && notes.contains("(line 6)"),
+        "{notes}"
+    );
+}

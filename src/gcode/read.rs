@@ -26,7 +26,11 @@
 //!   RS274/NGC homes all axes after the intermediate point, and Marlin's
 //!   `G28 Z` with safe homing moves X and Y first.
 //! - X/Y/Z words on a line with an M-code and no G-code are that M-code's
-//!   parameters (Marlin's `M201 X1000`), not a move.
+//!   parameters when it is one of the settings codes that take them
+//!   (Marlin's `M201 X1000`, [`AXIS_PARAMETER_M_CODES`]). With any other
+//!   M-code, Grbl and LinuxCNC move there in the modal motion (`X40 Z2 M3`)
+//!   while Marlin does not: the move is checked, and every axis it would
+//!   change is unknown after it.
 //! - `G10` with an `L` word sets offsets (LinuxCNC): refused; without one it
 //!   is RepRap firmware retraction, which moves no X/Y/Z axis.
 //! - A number run into a lower-case `e` (`X1e-05`) is refused: that is how
@@ -59,6 +63,18 @@ const QUOTE_CHARS: usize = 40;
 /// M-codes whose rest of line is free text in Marlin (`M117 Hello`,
 /// `M23 file.gco`, `M0 Insert filament`): not read as words.
 const TEXT_M_CODES: &[u32] = &[0, 1, 16, 23, 28, 30, 32, 33, 117, 118, 928];
+
+/// M-codes that take X/Y/Z words as settings, moving nothing: stepper
+/// enable/disable (M17, M18, M84), steps, feed and acceleration limits
+/// (M92, M201-M203, M205, M566), retraction settings (M207, M208), soft
+/// endstops and axis limits (M208, M211), tool, probe and delta geometry
+/// (M218, M665, M666, M669, M671, M851), backlash (M425), endstops and
+/// drives (M574, M584) and motor currents and microsteps (M350, M351, M906,
+/// M907, M913-M915), as Marlin and RepRap firmware document them.
+const AXIS_PARAMETER_M_CODES: &[u32] = &[
+    17, 18, 84, 92, 201, 202, 203, 205, 207, 208, 211, 218, 350, 351, 425, 566, 574, 584, 665, 666,
+    669, 671, 851, 906, 907, 913, 914, 915,
+];
 
 /// One straight move, absolute millimetres, in the frame the program starts
 /// in (the printer frame our writer uses; `G92` offsets are undone).
@@ -124,8 +140,8 @@ pub struct GcodeProgram {
     /// `$DO[0].X = 1`); ...`.
     pub notes: Vec<String>,
     /// Which of `notes` lists the moves made before every axis had a
-    /// known position (a checker that clears them all says so in its own
-    /// words instead).
+    /// known position (a checker that says of each unknown move whether it
+    /// cleared it drops this note for its own).
     pub unknown_start_note: Option<usize>,
     /// Lines in the file (`\n`, `\r\n` or `\r` end a line).
     pub lines: usize,
@@ -856,6 +872,7 @@ enum NoteKind {
     UnknownG,
     UnknownGAxes,
     MAxisParameters,
+    MAxisAmbiguous,
     G92Unknown,
     Retract,
     UnknownStart,
@@ -980,6 +997,12 @@ impl Note {
             }
             NoteKind::MAxisParameters => format!(
                 "{lines}: X/Y/Z words read as parameters of M-codes ({codes}), not as moves"
+            ),
+            NoteKind::MAxisAmbiguous => format!(
+                "{lines}: X/Y/Z words on a line with {codes} and no G-code: Grbl and LinuxCNC \
+                 move there in the modal motion, Marlin does not; the move is checked, and the \
+                 axes it changes are unknown after it until set again (write G1 or G0 on such \
+                 a line to make it a move on every controller)"
             ),
             NoteKind::G92Unknown => format!(
                 "{lines}: G92 set a position that was unknown: the program's coordinates from \
@@ -1366,7 +1389,22 @@ impl<'f> Reader<'f> {
                 }
                 if let Some(code) = m {
                     let name = code.map_or_else(|| "M".to_string(), |c| format!("M{c}"));
-                    self.notes.add(NoteKind::MAxisParameters, n).code(&name);
+                    let settings = code.is_some_and(|c| AXIS_PARAMETER_M_CODES.contains(&c));
+                    match self.motion {
+                        Some(mode) if !settings => {
+                            // Both readings: the move is checked, and where
+                            // it ends is unknown (it may not have been made).
+                            let from = self.position;
+                            self.move_to(n, line, &axes, mode)?;
+                            for (axis, p) in self.position.iter_mut().enumerate() {
+                                if *p != from[axis] {
+                                    *p = None;
+                                }
+                            }
+                            self.notes.add(NoteKind::MAxisAmbiguous, n).code(&name);
+                        }
+                        _ => self.notes.add(NoteKind::MAxisParameters, n).code(&name),
+                    }
                     return Ok(());
                 }
                 match self.motion {
@@ -1953,6 +1991,41 @@ mod tests {
             "{}",
             p.notes[0]
         );
+    }
+
+    /// `X40 Y41 Z2 M3` under a modal G1 is a move on Grbl and LinuxCNC:
+    /// read as M3's parameters, the check passed a program that drove the
+    /// nozzle into the part. It is checked, and what it changes is unknown
+    /// after it; settings codes keep their parameters.
+    #[test]
+    fn axis_words_beside_a_spindle_or_coolant_m_code_are_a_move() {
+        for m in ["M3 S100", "M8", "M600"] {
+            let text = format!("G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 F300\nX40 Y41 Z2 {m}\nG1 X41 Y41 Z10\nG1 X41 Y42\n");
+            let p = read(&text);
+            assert_eq!(p.moves.len(), 3, "{m}: {:?}", p.moves);
+            let dive = p.moves[1];
+            assert_eq!(
+                (dive.line, dive.from, dive.to),
+                (5, DVec3::new(40.0, 40.0, 10.0), DVec3::new(40.0, 41.0, 2.0))
+            );
+            // Y and Z may or may not have moved: line 6 starts unknown
+            // (after line 3, the program's first move), and its absolute
+            // X Y Z make every axis known again.
+            let unknown: Vec<_> = p.unknown_moves.iter().map(|u| (u.line, u.from)).collect();
+            assert_eq!(unknown[1..], [(6, [Some(40.0), None, None])], "{m}");
+            assert!(
+                p.notes
+                    .iter()
+                    .any(|n| n.starts_with("line 5: X/Y/Z words on a line with M")
+                        && n.contains("the move is checked")),
+                "{:?}",
+                p.notes
+            );
+        }
+        let p = read("G90\nG0 X40 Y40 Z20\nG1 Z10\nM201 X1000 Y1000 Z200\nM84 X Y\nG1 X41\n");
+        assert_eq!(p.moves.len(), 2);
+        assert_eq!(p.unknown_moves.len(), 1);
+        assert_eq!(p.moves[1].from, DVec3::new(40.0, 40.0, 10.0));
     }
 
     #[test]

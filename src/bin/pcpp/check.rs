@@ -71,7 +71,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         let lines = &check.unchecked_lines;
         return Err(Failure::Input(format!(
             "{head}; none of those comes closer than tol, but {} move(s) could not be checked \
-             (lines {}): the file does not give where they start or end, and they come lower \
+             ({}): the file does not give where they start or end, and they come lower \
              than tol above the scan's top, so the program is not shown to keep tol; give the \
              position before them (absolute G90 moves from a known point, or G92), or check \
              the program from where it starts printing",
@@ -80,16 +80,17 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         )));
     }
     let mut s = format!(
-        "{head}; {} move(s) come closer than tol:",
+        "{head}; {} move(s) come closer than tol",
         sum.touching_moves
     );
     if !check.unchecked_lines.is_empty() {
         let _ = write!(
             s,
-            " (and {} move(s) could not be checked, see the warning)",
+            " (and {} more could not be checked, see the warnings)",
             check.unchecked_lines.len()
         );
     }
+    s.push(':');
     for t in &sum.touching {
         let _ = write!(s, "\n  {t}");
     }
