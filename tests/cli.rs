@@ -1976,3 +1976,96 @@ fn regression_the_scans_units_hint_was_lost_when_planning_failed() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `-o` and `--report` renamed a temporary file over whatever they named,
+/// so a symbolic link, a named pipe or a device node (as root,
+/// `-o /dev/full` replaced the device) became a regular file, and `-o -`
+/// wrote a file named `-` (found by a QA run). They are written into now,
+/// as a shell's `>` would: the link's target is replaced and the link
+/// stays, a pipe gets the bytes, `-` is standard output (the summary then
+/// goes to standard error); a link to nothing is refused by name.
+#[cfg(unix)]
+#[test]
+fn regression_outputs_replaced_links_pipes_and_devices_with_files() {
+    use std::os::unix::fs::FileTypeExt as _;
+    let dir = temp_dir("outputs-special");
+    let golden = std::fs::read(golden_path("marlin")).unwrap();
+    let plan = |out: &str, more: &[&str]| {
+        let mut flags = vec!["--place", "0,80,0,1", "-o", out];
+        flags.extend(more);
+        plan_on(
+            &demo_file(demo::DEMO_SCAN_NAME),
+            &demo_file(demo::DEMO_PATH_NAME),
+            &flags,
+        )
+    };
+    // A symbolic link: its target takes the G-code, the link stays one.
+    std::fs::write(dir.join("target.gcode"), "old").unwrap();
+    std::os::unix::fs::symlink("target.gcode", dir.join("link.gcode")).unwrap();
+    let o = plan(s(&dir.join("link.gcode")), &[]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let meta = std::fs::symlink_metadata(dir.join("link.gcode")).unwrap();
+    assert!(meta.file_type().is_symlink());
+    assert!(std::fs::read(dir.join("target.gcode")).unwrap() == golden);
+    // A link to nothing: refused by name, nothing created.
+    std::os::unix::fs::symlink("nothere.gcode", dir.join("dangling.gcode")).unwrap();
+    let o = plan(s(&dir.join("dangling.gcode")), &[]);
+    assert_eq!(code(&o), 1);
+    assert!(
+        stderr(&o).contains("dangling.gcode: it is a symbolic link to nothere.gcode"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("nothere.gcode").exists());
+    // A named pipe: a reader gets every byte, the pipe stays a pipe.
+    let fifo = dir.join("pipe");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let o = plan(s(&fifo), &[]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(reader.join().unwrap() == golden);
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    // (A device takes the same path as the pipe; not tried here, where a
+    // regression would replace the machine's /dev/null.)
+    // `-`: the G-code alone on standard output, the summary on stderr.
+    let o = plan("-", &[]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(o.stdout == golden);
+    assert!(
+        stderr(&o).contains("wrote standard output (even"),
+        "{}",
+        stderr(&o)
+    );
+    let report = dir.join("r.json");
+    let o = plan(s(&dir.join("x.gcode")), &["--report", "-"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["program"], "pcpp");
+    assert!(!report.exists());
+    // `check --report -`: the report alone on standard output.
+    let o = check_on_demo(&dir.join("target.gcode"), Some(Path::new("-")));
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(json["summary"].is_object(), "{json}");
+    assert!(stderr(&o).contains("no move comes closer than tol"));
+    let mut names = listing(&dir);
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "dangling.gcode",
+            "link.gcode",
+            "pipe",
+            "target.gcode",
+            "x.gcode"
+        ]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -107,11 +107,11 @@ const PLAN_AFTER_HELP: &str = concat!(
 
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// The G-code to write (not created on failure)
+    /// The G-code to write (not created on failure; - for standard output)
     #[arg(short, long, value_name = "FILE", value_hint = ValueHint::FilePath)]
     pub output: PathBuf,
 
-    /// Also write the JSON report (quality, stats, paths)
+    /// Also write the JSON report (quality, stats, paths; - for standard output)
     #[arg(long, value_name = "FILE.json", value_hint = ValueHint::FilePath)]
     pub report: Option<PathBuf>,
 
@@ -151,7 +151,7 @@ waypoints the guarded planners added.";
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// Also write the comparison as JSON
+    /// Also write the comparison as JSON (- for standard output)
     #[arg(long, value_name = "FILE.json", value_hint = ValueHint::FilePath)]
     pub report: Option<PathBuf>,
 
@@ -179,7 +179,7 @@ pub struct CheckArgs {
     #[arg(long, value_name = "FILE", value_hint = ValueHint::FilePath)]
     pub gcode: PathBuf,
 
-    /// Also write the result as JSON
+    /// Also write the result as JSON (- for standard output)
     #[arg(long, value_name = "FILE.json", value_hint = ValueHint::FilePath)]
     pub report: Option<PathBuf>,
 

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use pcpp::job;
 
 use crate::args::CheckArgs;
-use crate::files::{file_name, in_file, read_text, to_json, write_one};
+use crate::files::{file_name, in_file, is_stdout, read_text, to_json, write_one};
 use crate::outputs::{Flagged, Outputs};
 use crate::plan::load_scan;
 use crate::progress::Progress;
@@ -64,7 +64,13 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         check.tol_mm
     );
     if check.is_clear() {
-        println!("{head}; no move comes closer than tol");
+        let line = format!("{head}; no move comes closer than tol");
+        // Standard output carries the report written there, alone.
+        if a.report.as_deref().is_some_and(is_stdout) {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
         return Ok(());
     }
     if sum.touching_moves == 0 {

@@ -234,21 +234,63 @@ pub fn in_file(path: &Path, name: &str, message: &str) -> String {
 }
 
 /// Outputs staged as temporary files beside their targets, renamed into
-/// place only when all of them were written.
+/// place only when all of them were written. An output that is not a
+/// regular file is written into, as a shell's `>` would, when the rest
+/// were staged: `-` (standard output), a device (`/dev/null`) or a pipe.
+/// A symbolic link to a file is followed and its target replaced; the
+/// link stays. (Renaming over any of these replaced the device, the pipe
+/// or the link itself with a regular file.)
 #[derive(Default)]
 pub struct Staged {
     files: Vec<(PathBuf, PathBuf)>,
+    streams: Vec<(Stream, Vec<u8>)>,
+}
+
+/// An output written into rather than replaced.
+enum Stream {
+    Stdout,
+    /// A device, pipe or socket, as named.
+    Special(PathBuf),
+}
+
+/// Whether `path` (an output) is `-`, standard output.
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
 }
 
 impl Staged {
     pub fn add(&mut self, target: &Path, bytes: &[u8]) -> CliResult<()> {
-        let dir = match target.parent() {
+        let cannot =
+            |why: String| Failure::Input(format!("cannot write {}: {why}", target.display()));
+        if is_stdout(target) {
+            self.streams.push((Stream::Stdout, bytes.to_vec()));
+            return Ok(());
+        }
+        let followed = std::fs::metadata(target);
+        let is_link = std::fs::symlink_metadata(target).is_ok_and(|m| m.file_type().is_symlink());
+        let real = match (&followed, is_link) {
+            (Ok(m), _) if !m.is_file() => {
+                self.streams
+                    .push((Stream::Special(target.to_path_buf()), bytes.to_vec()));
+                return Ok(());
+            }
+            (Ok(_), true) => std::fs::canonicalize(target).map_err(|e| cannot(e.to_string()))?,
+            (Err(_), true) => {
+                let to = std::fs::read_link(target)
+                    .map_or_else(|_| "?".into(), |t| t.display().to_string());
+                return Err(cannot(format!(
+                    "it is a symbolic link to {to}, which does not exist; give the file itself"
+                )));
+            }
+            (_, false) => target.to_path_buf(),
+        };
+        let dir = match real.parent() {
             Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
             _ => PathBuf::from("."),
         };
         let tmp = dir.join(format!(
             ".{}.pcpp-tmp-{}",
-            file_name(target),
+            file_name(&real),
             std::process::id()
         ));
         let result = std::fs::File::create(&tmp).and_then(|mut f| {
@@ -257,16 +299,35 @@ impl Staged {
         });
         if let Err(e) = result {
             let _ = std::fs::remove_file(&tmp);
-            return Err(Failure::Input(format!(
-                "cannot write {}: {e}",
-                target.display()
-            )));
+            return Err(cannot(e.to_string()));
         }
-        self.files.push((tmp, target.to_path_buf()));
+        self.files.push((tmp, real));
         Ok(())
     }
 
+    /// Writes the streams, then, if they all took their bytes, renames the
+    /// staged files into place.
     pub fn commit(mut self) -> CliResult<()> {
+        for (stream, bytes) in std::mem::take(&mut self.streams) {
+            let (name, result) = match &stream {
+                Stream::Stdout => {
+                    let mut out = std::io::stdout().lock();
+                    (
+                        "standard output".to_string(),
+                        out.write_all(&bytes).and_then(|_| out.flush()),
+                    )
+                }
+                Stream::Special(path) => (
+                    path.display().to_string(),
+                    std::fs::OpenOptions::new()
+                        .write(true)
+                        .open(path)
+                        .and_then(|mut f| f.write_all(&bytes)),
+                ),
+            };
+            // Drop removes the staged files.
+            result.map_err(|e| Failure::Input(format!("cannot write {name}: {e}")))?;
+        }
         let files = std::mem::take(&mut self.files);
         let mut failed = None;
         for (tmp, target) in &files {

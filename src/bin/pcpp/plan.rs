@@ -10,7 +10,7 @@ use pcpp::Error;
 
 use crate::args::{CompareArgs, JobArgs, MachineArgs, PlanArgs, ScanArgs};
 use crate::files::{
-    file_name, in_file, read_bytes, read_external, read_scan, to_json, write_one, Staged,
+    file_name, in_file, is_stdout, read_bytes, read_external, read_scan, to_json, write_one, Staged,
 };
 use crate::outputs::{Flagged, Outputs};
 use crate::progress::{thousands, Progress};
@@ -222,7 +222,7 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
     let st = &output.report.stats;
     let mut s = format!(
         "wrote {} ({}, {}): {} piece(s), {} points, {:.3} mm, print time {:.1} s\n",
-        out.display(),
+        shown(out),
         output.report.planner,
         profile.name,
         st.subpaths,
@@ -248,10 +248,24 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
     let _ = writeln!(s, "predicted quality: {}", output.report.quality);
     let _ = writeln!(s, "safe motion: {}", output.report.motion.summary_line());
     if let Some(r) = &a.report {
-        let _ = writeln!(s, "report: {}", r.display());
+        let _ = writeln!(s, "report: {}", shown(r));
     }
-    print!("{s}");
+    // Standard output carries the file written there, alone.
+    if is_stdout(out) || a.report.as_deref().is_some_and(is_stdout) {
+        eprint!("{s}");
+    } else {
+        print!("{s}");
+    }
     Ok(())
+}
+
+/// An output as the summary names it.
+fn shown(path: &Path) -> String {
+    if is_stdout(path) {
+        "standard output".into()
+    } else {
+        path.display().to_string()
+    }
 }
 
 /// The comparison as JSON (the `--report` of `compare`, the demo's file).
@@ -299,6 +313,11 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
     progress.warn(&inputs.prepared.warnings);
     progress.warn(&inputs.prepared.registration.notes);
     progress.warn(&comparison.warnings);
-    print!("{}", job::comparison_table(&rows));
+    let table = job::comparison_table(&rows);
+    if a.report.as_deref().is_some_and(is_stdout) {
+        eprint!("{table}");
+    } else {
+        print!("{table}");
+    }
     Ok(())
 }
