@@ -2069,3 +2069,55 @@ fn regression_outputs_replaced_links_pipes_and_devices_with_files() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// One Latin-1 byte in a comment (`(café)`, as older Windows tools write)
+/// refused the whole program with "gcode is not UTF-8 text (byte 34)". It
+/// is read, with a warning naming its line; outside a comment the reader
+/// names the line as not G-code. A machine profile, which is JSON, is
+/// still refused, at a line and column.
+#[test]
+fn regression_a_latin1_byte_in_a_comment_refused_the_whole_program() {
+    let dir = temp_dir("latin1");
+    let prog = dir.join("cafe.gcode");
+    let mut bytes = std::fs::read(demo_file("demo-even.gcode")).unwrap();
+    bytes.extend(b"G1 X41 (caf\xe9)\n");
+    std::fs::write(&prog, &bytes).unwrap();
+    let o = check_on_demo(&prog, None);
+    let lines = bytes.iter().filter(|&&b| b == b'\n').count();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!(
+            "cafe.gcode, line {lines}, column 12 (byte 0xE9): bytes that are not UTF-8"
+        )),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::write(&prog, b"G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 X\xe9\n").unwrap();
+    let o = check_on_demo(&prog, None);
+    assert_eq!(code(&o), 1);
+    assert!(
+        stderr(&o).contains("cafe.gcode, line 4: unexpected"),
+        "{}",
+        stderr(&o)
+    );
+    let profile = dir.join("machine.json");
+    std::fs::write(&profile, b"{\n  \"name\": \"caf\xe9\"\n}\n").unwrap();
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&demo_file(demo::DEMO_SCAN_NAME)),
+        "--gcode",
+        s(&demo_file("demo-even.gcode")),
+        "--profile",
+        s(&profile),
+    ]);
+    assert_eq!(code(&o), 1);
+    assert!(
+        stderr(&o).contains(
+            "machine.json, line 2, column 15 (byte 0xE9): the machine profile is not UTF-8 text"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

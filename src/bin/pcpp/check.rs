@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use pcpp::job;
 
 use crate::args::CheckArgs;
-use crate::files::{file_name, in_file, is_stdout, read_text, to_json, write_one};
+use crate::files::{file_name, in_file, is_stdout, read_gcode_text, to_json, write_one};
 use crate::outputs::{Flagged, Outputs};
 use crate::plan::load_scan;
 use crate::progress::Progress;
@@ -27,11 +27,11 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     let (settings, _profile) =
         check_settings("check", &a.scan, &a.nozzle, &a.registration, &a.machine)?;
     let gcode_path = &a.gcode;
-    let text = read_text(gcode_path, "gcode")?;
+    let (text, encoding) = read_gcode_text(gcode_path)?;
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
-    let check = job::check_gcode(
+    let mut check = job::check_gcode(
         &prepared,
         &text,
         &name,
@@ -39,6 +39,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         settings.plan.process.tolerance_mm,
     )
     .map_err(|e| Failure::Input(in_file(gcode_path, &name, &e.to_string())))?;
+    check.notes.splice(0..0, encoding);
     if let Some(r) = &a.report {
         write_one(r, to_json(&check)?.as_bytes())?;
     }

@@ -196,11 +196,46 @@ pub fn read_text(path: &Path, what: &str) -> CliResult<String> {
     let bytes = read_bytes(path, what)?;
     String::from_utf8(bytes).map_err(|e| {
         Failure::Input(format!(
-            "{}: {what} is not UTF-8 text (byte {})",
+            "{}, {}: the {what} is not UTF-8 text",
             path.display(),
-            e.utf8_error().valid_up_to()
+            not_utf8_at(e.as_bytes(), e.utf8_error().valid_up_to())
         ))
     })
+}
+
+/// Where the first byte that is not UTF-8 is: "line L, column C (byte
+/// 0xE9)", columns in characters.
+fn not_utf8_at(bytes: &[u8], at: usize) -> String {
+    let before = &bytes[..at];
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    // Valid UTF-8 up to `at`, so this counts characters.
+    let column = std::str::from_utf8(&before[line_start..]).map_or(0, |t| t.chars().count()) + 1;
+    format!("line {line}, column {column} (byte 0x{:02X})", bytes[at])
+}
+
+/// A G-code program as text: bytes that are not UTF-8 (a Latin-1 `é` or
+/// `°` in a comment, written by older Windows tools) are read as U+FFFD,
+/// with a warning naming the first; outside a comment the reader then
+/// names their line as not G-code. (The whole file was refused.)
+pub fn read_gcode_text(path: &Path) -> CliResult<(String, Option<String>)> {
+    let bytes = read_bytes(path, "G-code")?;
+    match String::from_utf8(bytes) {
+        Ok(text) => Ok((text, None)),
+        Err(e) => {
+            let at = not_utf8_at(e.as_bytes(), e.utf8_error().valid_up_to());
+            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+            let note = format!(
+                "{}, {at}: bytes that are not UTF-8 (Latin-1 or another legacy encoding?) read \
+                 as U+FFFD; in a comment they change nothing",
+                path.display()
+            );
+            Ok((text, Some(note)))
+        }
+    }
 }
 
 /// The name the library sees: the file name alone, so that reports and
