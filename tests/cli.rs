@@ -2121,3 +2121,31 @@ fn regression_a_latin1_byte_in_a_comment_refused_the_whole_program() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `plan` said "along all 1444 moves" and `check` of the G-code it wrote
+/// "1443 moves checked": the plan counted the program's first rise, from
+/// wherever the head stands, which neither can follow. They agree now.
+#[test]
+fn regression_plan_and_check_counted_a_programs_moves_differently() {
+    let dir = temp_dir("move-count");
+    let out = dir.join("out.gcode");
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &["--place", "0,80", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let count = |text: &str, before: &str, after: &str| -> usize {
+        let end = text
+            .find(after)
+            .unwrap_or_else(|| panic!("{after:?} in {text}"));
+        let start = text[..end].rfind(before).unwrap() + before.len();
+        text[start..end].trim().parse().unwrap()
+    };
+    let planned = count(&stdout(&o), "along all", " moves;");
+    let c = check_on_demo(&out, None);
+    assert_eq!(code(&c), 0, "{}", stderr(&c));
+    let checked = count(&stdout(&c), ":", " moves checked");
+    assert_eq!(planned, checked);
+    let _ = std::fs::remove_dir_all(&dir);
+}

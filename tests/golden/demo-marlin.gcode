@@ -9,7 +9,7 @@
 ; residuals: [] mm, rms 0.0000 mm
 ; path: 6 piece(s), 1362 points, 457.438 mm, height change 4.504 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 91.5 s
 ; predicted quality: mean |e| 0.0107 mm, mean e- -0.0056 mm, mean e+ 0.0199 mm, contact 0.00%, flattening 0.59%, floating 1.62%
-; safe motion: min clearance 0.101 mm (tol 0.1 mm) along all 1444 moves; 70 waypoint(s) added (+3.615 mm)
+; safe motion: min clearance 0.101 mm (tol 0.1 mm) along all 1443 moves; 70 waypoint(s) added (+3.615 mm)
 ; warnings: 1
 ; profile: marlin
 ; print feed: F300 mm/min (5 mm/s)
