@@ -13,6 +13,7 @@ use sha2::{Digest, Sha256};
 use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
+use crate::gcode::format::{fixed, trimmed};
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{
     CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology,
@@ -741,10 +742,10 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         "placement".into(),
         format!(
             "offset ({}, {}) mm, rotation {} deg, scale {}",
-            s.placement.offset_mm.x,
-            s.placement.offset_mm.y,
-            s.placement.rotation_deg,
-            s.placement.scale
+            trimmed(s.placement.offset_mm.x, 6),
+            trimmed(s.placement.offset_mm.y, 6),
+            trimmed(s.placement.rotation_deg, 6),
+            trimmed(s.placement.scale, 6)
         ),
     ));
     h.push(("planner".into(), report.planner.name().into()));
@@ -755,11 +756,7 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             "{}; G [{}]",
             report.registration.status,
             m.iter()
-                .map(|r| r
-                    .iter()
-                    .map(|v| format!("{v:.6}"))
-                    .collect::<Vec<_>>()
-                    .join(" "))
+                .map(|r| r.iter().map(|&v| fixed(v, 6)).collect::<Vec<_>>().join(" "))
                 .collect::<Vec<_>>()
                 .join("; ")
         ),
@@ -767,15 +764,15 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
     h.push((
         "residuals".into(),
         format!(
-            "[{}] mm, rms {:.4} mm",
+            "[{}] mm, rms {} mm",
             report
                 .registration
                 .residuals_mm
                 .iter()
-                .map(|r| format!("{r:.4}"))
+                .map(|&r| fixed(r, 4))
                 .collect::<Vec<_>>()
                 .join(", "),
-            report.registration.rms_mm
+            fixed(report.registration.rms_mm, 4)
         ),
     ));
     let st = &report.stats;
@@ -1605,6 +1602,55 @@ mod tests {
         let json = serde_json::to_string(&a.report).unwrap();
         let back: Report = serde_json::from_str(&json).unwrap();
         assert_eq!(back.inputs, a.report.inputs);
+    }
+
+    /// The header printed `offset (-6.467586450097912, 51.822655334421455)`
+    /// for a centred drawing, and `-0.000000` in G, `mean e- -0.0000 mm`
+    /// for rounding noise (found by a QA run): placement to 6 decimals
+    /// without trailing zeros, and no negative zero.
+    #[test]
+    fn the_header_rounds_placement_and_writes_no_negative_zero() {
+        let part = crate::demo::parts::DemoPart::SteppedBlock;
+        let glb = crate::demo::to_glb(&part.mesh());
+        let scan = prepare_scan(
+            &glb,
+            "block.glb",
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        let settings = PlanSettings {
+            placement: part.placement(),
+            ..Default::default()
+        };
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let svg = part.svg();
+        let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
+            .unwrap()
+            .report;
+        report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, 51.8);
+        report.settings.placement.scale = 0.8582695662780906;
+        report.settings.placement.rotation_deg = 30.0;
+        report.registration.matrix[0][2] = -1e-9;
+        report.registration.rms_mm = -1e-9;
+        report.quality.mean_negative_error_mm = -1e-7;
+        let header: String = provenance(&report)
+            .iter()
+            .map(|(k, v)| format!("{k}: {v}\n"))
+            .collect();
+        assert!(
+            header.contains(
+                "placement: offset (-6.467586, 51.8) mm, rotation 30 deg, scale 0.85827\n"
+            ),
+            "{header}"
+        );
+        assert!(
+            header.contains("G [1.000000 0.000000 0.000000 "),
+            "{header}"
+        );
+        assert!(header.contains("rms 0.0000 mm"), "{header}");
+        assert!(header.contains("mean e- 0.0000 mm"), "{header}");
+        assert!(!header.contains("-0.0"), "{header}");
     }
 
     #[test]

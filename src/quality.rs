@@ -6,6 +6,7 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::gcode::format::fixed;
 use crate::params::{Nozzle, Process};
 use crate::spline::{LocalGeometry, Spline};
 use crate::surface::Surface;
@@ -55,14 +56,14 @@ impl std::fmt::Display for QualitySummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "mean |e| {:.4} mm, mean e- {:.4} mm, mean e+ {:.4} mm, contact {:.2}%, \
-             flattening {:.2}%, floating {:.2}%",
-            self.mean_abs_error_mm,
-            self.mean_negative_error_mm,
-            self.mean_positive_error_mm,
-            self.contact_pct,
-            self.flattening_pct,
-            self.floating_pct
+            "mean |e| {} mm, mean e- {} mm, mean e+ {} mm, contact {}%, flattening {}%, \
+             floating {}%",
+            fixed(self.mean_abs_error_mm, 4),
+            fixed(self.mean_negative_error_mm, 4),
+            fixed(self.mean_positive_error_mm, 4),
+            fixed(self.contact_pct, 2),
+            fixed(self.flattening_pct, 2),
+            fixed(self.floating_pct, 2)
         )
     }
 }

@@ -36,7 +36,7 @@
 //! assert!(program.contains("G1 X20.000 Y10.000 Z3.000 F300"));
 //! ```
 
-mod format;
+pub(crate) mod format;
 mod profile;
 mod read;
 mod template;
