@@ -230,6 +230,16 @@ fn demo_prints_the_table_and_takes_a_dialect() {
     if std::env::var("PCPP_UPDATE_GOLDEN").is_err() {
         assert!(gcode == std::fs::read_to_string(golden_path("aerotech")).unwrap());
     }
+    // The command it prints plans the demo's drawing on its part (without
+    // `--place` the drawing missed the part: a QA run's first try).
+    let command = out
+        .lines()
+        .find_map(|l| l.strip_prefix("plan the drawing yourself: pcpp "))
+        .unwrap_or_else(|| panic!("no command in:\n{out}"));
+    let args: Vec<&str> = command.split(' ').collect();
+    let o = pcpp_in(&dir, &args);
+    assert_eq!(code(&o), 0, "{command}: {}", stderr(&o));
+    assert!(dir.join("demo.gcode").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

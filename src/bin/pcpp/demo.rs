@@ -203,6 +203,42 @@ pub fn cmd_demo(a: &DemoArgs, progress: &Progress) -> CliResult<()> {
             s.push('\n');
         }
     }
+    // The drawing is placed as the demo placed it: without `--place`, the
+    // SVG's y (which points down) put it off the part.
+    let p = settings.plan.placement;
+    let _ = writeln!(
+        s,
+        "plan the drawing yourself: pcpp plan --scan {} --path {} --place {},{},{},{} -o {}.gcode",
+        shell_word(&out.join(part.scan_name()).display().to_string()),
+        shell_word(&out.join(part.path_name()).display().to_string()),
+        trimmed(p.offset_mm.x),
+        trimmed(p.offset_mm.y),
+        trimmed(p.rotation_deg),
+        trimmed(p.scale),
+        demo_prefix(part)
+    );
     print!("{s}");
     Ok(())
+}
+
+/// `word` as a POSIX shell reads it back: as it is when plain, else in
+/// single quotes.
+fn shell_word(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_./,:=+-@%".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.into()
+    } else {
+        format!("'{}'", word.replace('\'', "'\\''"))
+    }
+}
+
+/// A number as typed: 6 decimals at most, no trailing zeros.
+fn trimmed(v: f64) -> String {
+    let t = format!("{v:.6}");
+    let t = t.trim_end_matches('0').trim_end_matches('.');
+    if t == "-0" {
+        "0".into()
+    } else {
+        t.into()
+    }
 }
