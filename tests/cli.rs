@@ -1904,10 +1904,14 @@ fn a_scan_in_metres_read_as_mm_writes_no_gcode_until_its_units_are_given() {
     assert!(
         err.contains(
             "error: film-m.obj: the scan is only 0.080 x 0.080 x 0.001 mm, read in mm: check its \
-             units; in m it would be 80.0 x 80.0 x 0.8 mm (--scan-units m). No G-code written"
+             units; in metres it would be 80.0 x 80.0 x 0.8 mm (--scan-units m). No G-code written"
         ) && err.contains("--scan-units mm if it really is this small"),
         "{err}"
     );
+    // Said once, by the error, and before the drawing was scaled to the
+    // tiny scan (a warning about that scaling came first, and misled).
+    assert_eq!(err.matches("check its units").count(), 1, "{err}");
+    assert!(!err.contains("scaled by"), "{err}");
     assert!(!out.exists());
     // Refused before planning: the drawing where it lies misses the
     // 0.08 mm scan, which is not what the user has to fix.

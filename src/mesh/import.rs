@@ -415,8 +415,11 @@ impl UnitsDoubt {
             .into_iter()
             .map(|(u, m)| {
                 format!(
-                    "in {u} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
-                    m.x, m.y, m.z
+                    "in {} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
+                    u.words(),
+                    m.x,
+                    m.y,
+                    m.z
                 )
             })
             .collect();
@@ -942,7 +945,7 @@ mod tests {
         let hint = hint.unwrap_or_else(|| panic!("{:?}", m.warnings));
         assert!(
             hint.starts_with("bunny.obj: the scan is only 0.156 x 0.154 x 0.120 mm, read in mm")
-                && hint.contains("in m it would be 156.0 x 154.0 x 120.0 mm (--scan-units m)"),
+                && hint.contains("in metres it would be 156.0 x 154.0 x 120.0 mm (--scan-units m)"),
             "{hint}"
         );
         // Read in metres, it is a bunny: no hint.
@@ -952,7 +955,7 @@ mod tests {
         let small = b"v 0 0 0\nv 0.16 0 0\nv 0 0.1 0\nf 1 2 3\n";
         let m = import_mesh(small, "chip.obj", &opts(Some(ScanUnits::In))).unwrap();
         assert!(
-            m.warnings[0].contains("in m it would be"),
+            m.warnings[0].contains("in metres it would be"),
             "{:?}",
             m.warnings
         );

@@ -128,6 +128,18 @@ pub enum ScanUnits {
 }
 
 impl ScanUnits {
+    /// The units in words, as a sentence names them ("in inches", where
+    /// "in in" would not read).
+    pub fn words(self) -> &'static str {
+        match self {
+            ScanUnits::Mm => "millimetres",
+            ScanUnits::Cm => "centimetres",
+            ScanUnits::M => "metres",
+            ScanUnits::In => "inches",
+            ScanUnits::Ft => "feet",
+        }
+    }
+
     pub fn to_mm(self) -> f64 {
         match self {
             ScanUnits::Mm => 1.0,

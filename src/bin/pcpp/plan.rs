@@ -145,7 +145,17 @@ fn centre_on_scan(
 /// What the scan's import and registration noticed is said first: it may
 /// be the cause (a scan read in the wrong units leaves nothing to print).
 fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
-    progress.warn(&inputs.prepared.warnings);
+    // A warning the error repeats is said once, by the error.
+    let repeated =
+        |w: &String| matches!(&e, Error::UnitsDoubt { message } if message.starts_with(w.as_str()));
+    let warnings: Vec<String> = inputs
+        .prepared
+        .warnings
+        .iter()
+        .filter(|w| !repeated(w))
+        .cloned()
+        .collect();
+    progress.warn(&warnings);
     progress.warn(&inputs.prepared.registration.notes);
     match e {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
@@ -197,6 +207,10 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
     )?;
     let (mut settings, profile) = job_settings("plan", &a.job, a.planner, &a.machine)?;
     let inputs = load_inputs(&a.job, &settings, &outputs, progress)?;
+    // Before the drawing is centred and scaled on a scan whose size is in
+    // doubt (its warning about scaling came first, and misled).
+    job::refuse_unit_doubt(&inputs.prepared, a.accept_risk)
+        .map_err(|e| plan_failure(&inputs, e, progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step(format!("planning ({})...", settings.plan.planner));
     let output = job::run_on(
