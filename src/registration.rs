@@ -209,7 +209,7 @@ pub enum RegistrationError {
         z: f64,
     },
     /// Two fiducials of one set are (nearly) the same point.
-    #[error("{set} fiducials {} and {} coincide ({distance_mm:e} mm apart): each fiducial must be a distinct mark", .first + 1, .second + 1)]
+    #[error("{set} fiducials {} and {} coincide ({}): each fiducial must be a distinct mark", .first + 1, .second + 1, apart(*.distance_mm))]
     Coincident {
         set: PointSet,
         first: usize,
@@ -259,6 +259,18 @@ pub enum RegistrationError {
          up axis (--up-axis); no G-code written"
     )]
     UpsideDown { tilt_deg: f64, rms_mm: f64 },
+}
+
+/// How far apart two coincident fiducials are, as a person reads it: "the
+/// same point", "3.2e-7 mm apart" (it printed "0e0 mm apart").
+fn apart(distance_mm: f64) -> String {
+    if distance_mm == 0.0 {
+        "the same point".into()
+    } else if distance_mm >= 0.001 {
+        format!("{distance_mm:.3} mm apart")
+    } else {
+        format!("{distance_mm:.1e} mm apart")
+    }
 }
 
 fn list_1_based(indices: &[usize]) -> String {

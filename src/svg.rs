@@ -655,8 +655,25 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             })
             .collect();
         let more = points_errors.len().saturating_sub(listed.len());
-        let note = |file: &str| {
-            format!(
+        // Empty `points` only: nothing is "printed up to" anything.
+        let empty: Option<Vec<&str>> = points_errors
+            .iter()
+            .take(MAX_NAMED)
+            .map(|&i| match prepared.shapes.get(i)?.points_read.as_ref()? {
+                (element, read) if read.numbers == 0 && read.error.is_none() => {
+                    Some(element.as_str())
+                }
+                _ => None,
+            })
+            .collect();
+        let note = |file: &str| match &empty {
+            Some(names) if more == 0 => format!(
+                "{} polyline/polygon(s){file} have no points ({}): not printed; give each its \
+                 points or delete it",
+                points_errors.len(),
+                names.join(", ")
+            ),
+            _ => format!(
                 "{} polyline/polygon(s){file} have points SVG draws only in part or not at all \
                  ({}{}): each is printed up to its last whole x,y pair before the problem, as \
                  SVG viewers draw it; correct the points attribute there",
@@ -667,7 +684,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 } else {
                     String::new()
                 }
-            )
+            ),
         };
         points_note = Some((notes.len(), note("")));
         notes.push(note(&format!(" in {file}")));

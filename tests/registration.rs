@@ -294,13 +294,16 @@ fn registration_errors_name_the_points() {
         }
     ));
     assert!(
-        e.to_string().contains("scan fiducials 1 and 4 coincide"),
+        e.to_string()
+            .contains("scan fiducials 1 and 4 coincide (1.7e-9 mm apart)"),
         "{e}"
     );
+    // Not "(0e0 mm apart)", as it was.
     let same = [DVec3::ONE; 3];
     let e = err(&good[..3], &same, lsq);
     assert!(
-        e.to_string().contains("printer fiducials 1 and 2 coincide"),
+        e.to_string()
+            .contains("printer fiducials 1 and 2 coincide (the same point)"),
         "{e}"
     );
 

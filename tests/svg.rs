@@ -1152,8 +1152,10 @@ fn odd_coordinate_count_in_points_dropped_silently() {
 #[test]
 fn points_too_few_to_draw_are_named() {
     let cases = [
-        ("", "'polyline #1': no points; not printed"),
-        ("  ", "'polyline #1': no points; not printed"),
+        // Said as what it is: "printed up to its last whole x,y pair"
+        // does not apply to nothing.
+        ("", "have no points ('polyline #1'): not printed"),
+        ("  ", "have no points ('polyline #1'): not printed"),
         ("5,5", "'polyline #1': only 1 point (5, 5); 2 are needed to draw: not printed"),
         ("a,b", "'polyline #1' at character 1: 'a' is not a number; no point kept: not printed"),
         ("1,2 3", "'polyline #1': 3 numbers, an odd count (the last, 3, is an x with no y); 1 point kept, 2 are needed to draw: not printed"),
