@@ -530,7 +530,7 @@ pub fn check_program(
      default, or pcpp-guarded), or accept the risk (--accept-risk; in the page, the box \
      'write G-code even where the nozzle may touch') to write it anyway",
     count = .summary.touching_moves,
-    first = .summary.touching.iter().take(3).map(|t| t.to_string()).collect::<Vec<_>>().join("; ")
+    first = .summary.touching.iter().take(3).map(|t| format!("G-code {t}")).collect::<Vec<_>>().join("; ")
 )]
 pub struct TouchingMoves {
     pub planner: String,

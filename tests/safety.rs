@@ -162,7 +162,9 @@ fn slope_on_the_stepped_block_is_refused_unless_the_risk_is_accepted() {
     let text = e.to_string();
     assert!(matches!(e, Error::Touching(_)), "{text}");
     assert!(text.contains("G-code move(s) of planner slope"), "{text}");
-    assert!(text.contains("line "), "{text}");
+    // The lines are the unwritten program's (a CLI run printed them after
+    // the drawing's file name, as if they were its lines).
+    assert!(text.contains("; G-code line "), "{text}");
     assert!(text.contains("mm higher there"), "{text}");
     assert!(text.contains("--accept-risk"), "{text}");
     let Error::Touching(t) = &e else {

@@ -163,7 +163,12 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
             "writing G-code for {}: {e}",
             inputs.scan_path.display()
         )),
-        Error::Touching(t) => Failure::Input(format!("{}: {t}", inputs.svg_path.display())),
+        // Its lines are the unwritten G-code's, not the drawing's.
+        Error::Touching(t) => Failure::Input(format!(
+            "{} on {}: {t}",
+            inputs.svg_path.display(),
+            inputs.scan_path.display()
+        )),
         Error::Registration(
             r @ (RegistrationError::TooFarOff { .. } | RegistrationError::UpsideDown { .. }),
         ) => Failure::Input(format!(
