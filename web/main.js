@@ -22,7 +22,7 @@ import {
 import { $, hooks, profile, settings, state } from './page.js';
 import {
   bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, planOutcome, requestCentre, showFitNote,
-  showScanPlacement, unitsBannerShown,
+  showScanPlacement, toolPathOutside, unitsBannerShown,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -508,7 +508,7 @@ function onPlanError(m, busy) {
   if (unitsOffered) {
     setStatus(`no G-code: choose the scan's units (see above)${state.lastPlan ? '; showing the previous plan' : ''}`, true);
   } else if (offered) {
-    setStatus(`no G-code: the ${/beside it the tool path/.test(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
+    setStatus(`no G-code: the ${toolPathOutside(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
       state.lastPlan ? '; showing the previous plan' : ''}`, true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }

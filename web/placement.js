@@ -320,6 +320,10 @@ export function planOutcome(message) {
   showScanPlacement();
 }
 
+// Whether a refusal's `message` is the tool path's, beside a scan inside
+// the build volume (not the scan's own).
+export const toolPathOutside = (message) => BESIDE.test(String(message));
+
 // Whether the banner on screen offers the fix for the planning error
 // `message` (the core's sentence on the scan outside the build volume is
 // part of it): the banner says it better, with its button.

@@ -96,6 +96,19 @@ impl MeshError {
             message: message.into(),
         }
     }
+
+    /// The error with the line it names (if any) mapped by `to_file`: an
+    /// error found in a rewritten text, named at the file's line.
+    pub(crate) fn with_line_mapped(mut self, to_file: impl Fn(usize) -> usize) -> Self {
+        match &mut self {
+            MeshError::Syntax { line, .. } => *line = to_file(*line),
+            MeshError::NonFiniteVertex { line, .. } | MeshError::IndexOutOfRange { line, .. } => {
+                *line = line.map(&to_file);
+            }
+            _ => {}
+        }
+        self
+    }
 }
 
 #[cfg(test)]

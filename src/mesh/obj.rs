@@ -45,42 +45,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         // A joined line's number in the file: one more for each
         // continuation on the joined lines before it.
         let in_file = |l: usize| l + within.iter().filter(|&&w| w < l).count();
-        parse_lines(&joined, file).map_err(|e| match e {
-            MeshError::Syntax {
-                file,
-                line,
-                message,
-            } => MeshError::Syntax {
-                file,
-                line: in_file(line),
-                message,
-            },
-            MeshError::NonFiniteVertex {
-                file,
-                vertex,
-                line,
-                value,
-            } => MeshError::NonFiniteVertex {
-                file,
-                vertex,
-                line: line.map(in_file),
-                value,
-            },
-            MeshError::IndexOutOfRange {
-                file,
-                face,
-                line,
-                index,
-                vertex_count,
-            } => MeshError::IndexOutOfRange {
-                file,
-                face,
-                line: line.map(in_file),
-                index,
-                vertex_count,
-            },
-            e => e,
-        })
+        parse_lines(&joined, file).map_err(|e| e.with_line_mapped(in_file))
     })
 }
 
