@@ -203,6 +203,27 @@ async function openSvg(file) {
   hooks.schedulePlan(0);
 }
 
+// What a .json that pcpp wrote, and that is not a profile, is: a dropped
+// demo folder's report or registration was read as a profile, and refused
+// for a missing field. Null for anything else (the core checks it).
+function otherJson(text) {
+  let v;
+  try {
+    v = JSON.parse(text);
+  } catch {
+    return null;
+  }
+  if (!v || typeof v !== 'object' || Array.isArray(v)) return null;
+  if (v.program === 'pcpp') {
+    return `It is a ${v.planners ? 'comparison' : 'plan report'} that pcpp wrote; the page does not read reports back.`;
+  }
+  if ('printer_points' in v && 'registration' in v) {
+    return 'It is the registration pcpp demo wrote (fiducials and G): type its printer points in '
+      + 'Registration, Printer points P.';
+  }
+  return null;
+}
+
 // A user's machine profile: checked by the core (the error names the file
 // and the field); a bad file changes nothing, the previous dialect stays.
 async function openProfile(file) {
@@ -211,6 +232,12 @@ async function openProfile(file) {
     text = await file.text();
   } catch (e) {
     showError(`Could not read ${file.name}`, e.message);
+    return;
+  }
+  const other = otherJson(text);
+  if (other) {
+    showError(`${file.name} is not a machine profile`,
+      `${other}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`, file.name);
     return;
   }
   let name;

@@ -85,3 +85,31 @@ test('a machine profile dropped on the page is used as the profile', async () =>
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The demo folder's other .json files (a plan report, a comparison, the
+// registration) dropped on the page were read as machine profiles and
+// refused for a missing field; each is named for what it is, and the
+// dialect stays.
+test('a report or registration dropped on the page is named, not read as a profile', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  const cases = [
+    ['demo-even-report.json', { program: 'pcpp', version: '0.1.0', planner: 'even' }, /a plan report that pcpp wrote/],
+    ['demo-comparison.json', { program: 'pcpp', version: '0.1.0', planners: [] }, /a comparison that pcpp wrote/],
+    ['demo-registration.json', { fiducials: 'auto', printer_points: [[4, 4, 5]], registration: {} },
+      /the registration pcpp demo wrote/],
+  ];
+  for (const [name, value, expected] of cases) {
+    await page.evaluate(([n, text]) => {
+      const dt = new DataTransfer();
+      dt.items.add(new File([text], n, { type: 'application/json' }));
+      window.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, cancelable: true }));
+    }, [name, JSON.stringify(value)]);
+    await page.waitForFunction((n) => document.getElementById('error-title').textContent.startsWith(n), name);
+    assert.equal(await page.textContent('#error-title'), `${name} is not a machine profile`);
+    assert.match(await page.textContent('#error-message'), expected);
+    assert.equal(await page.inputValue('#dialect'), 'marlin');
+  }
+  assert.deepEqual(problems, []);
+  await context.close();
+});
