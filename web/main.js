@@ -28,7 +28,7 @@ import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
 } from './preview.js';
 import {
-  clearPlan, showComparison, showErrorPlot, showPlan, showScan,
+  clearPlan, showComparison, showErrorPlot, showPlan, showScan, showScanWarnings,
 } from './report.js';
 import {
   bindForm, currentSvg, jobSettings, loadSettings, saveSettings, writeForm,
@@ -497,6 +497,7 @@ function onPlanError(m, busy) {
   if (offered) clearError();
   else showError(title, message, file, topic);
   if (busy.gen === state.gen && restorePlan()) return;
+  showScanWarnings();
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.
   hideDownloads();

@@ -90,6 +90,18 @@ export function clearPlan() {
   plot.getContext('2d').clearRect(0, 0, plot.width, plot.height);
 }
 
+// With no plan on screen (the plan on a new scan failed), the scan's own
+// warnings (degenerate triangles, points left out of a cloud...): they
+// were shown only with a plan's, so a failed one hid them. The units
+// doubt is left to its banner.
+export function showScanWarnings() {
+  const info = state.info;
+  if (!info || state.lastPlan) return;
+  const doubt = info.units_doubt ? info.units_doubt.message : null;
+  $('warnings').replaceChildren(...(info.warnings || []).filter((w) => w !== doubt)
+    .map((w) => el('li', pageText(w))));
+}
+
 // The plot of the plan on screen: every planner's errors (the last
 // comparison, if it was made for this plan), or one planner's coloured by
 // defect. During a drag only the plan being dragged is drawn.

@@ -29,6 +29,8 @@ function filmInMetres(hole = false) {
       lines.push(`f ${a} ${a + 1} ${a + n + 1}`, `f ${a} ${a + n + 1} ${a + n}`);
     }
   }
+  // One degenerate triangle: a warning of the scan's own.
+  lines.push('f 1 1 2');
   return `${lines.join('\n')}\n`;
 }
 
@@ -51,6 +53,10 @@ test('a scan in metres gets the units banner, no G-code, and plans once read in 
   assert.equal(await page.isHidden('#dl-gcode'), true);
   assert.match(await status(page), /^no G-code: choose the scan's units \(see above\)/);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  // The scan's own warnings are shown without a plan (they came only with
+  // one); the units are left to the banner.
+  assert.deepEqual(await page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent)),
+    ['film-m.obj: skipped 1 degenerate triangle(s) (repeated vertex or zero area)']);
 
   // Read in metres: the banner goes, the Units list says so, and the
   // drawing is planned on the 80 mm film.
