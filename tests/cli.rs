@@ -2163,3 +2163,119 @@ fn regression_plan_and_check_counted_a_programs_moves_differently() {
     assert_eq!(planned, checked);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--path -`, `--scan -` and `--gcode -` read a file named `-` ("cannot
+/// read path -: No such file or directory"); they read standard input now,
+/// named "stdin" in the G-code header and "standard input" in messages,
+/// and two of them at once are a usage error.
+#[test]
+fn regression_a_dash_input_was_not_standard_input() {
+    use std::io::Write as _;
+    use std::process::Stdio;
+    let run = |args: &[&str], input: &[u8]| -> Output {
+        let mut child = Command::new(BIN)
+            .args(args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stdin = child.stdin.take().unwrap();
+        let bytes = input.to_vec();
+        let writer = std::thread::spawn(move || {
+            let _ = stdin.write_all(&bytes);
+        });
+        let out = child.wait_with_output().unwrap();
+        writer.join().unwrap();
+        out
+    };
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let svg = std::fs::read(demo_file(demo::DEMO_PATH_NAME)).unwrap();
+    let golden = std::fs::read_to_string(golden_path("marlin")).unwrap();
+    let o = run(
+        &[
+            "plan",
+            "-q",
+            "--scan",
+            s(&scan),
+            "--path",
+            "-",
+            "--place",
+            "0,80,0,1",
+            "-o",
+            "-",
+        ],
+        &svg,
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let gcode = stdout(&o);
+    let header = |g: &str| -> Vec<String> {
+        g.lines()
+            .filter(|l| !l.starts_with("; path file: "))
+            .map(String::from)
+            .collect()
+    };
+    assert!(header(&gcode) == header(&golden));
+    assert!(
+        gcode.contains("\n; path file: stdin (659 bytes, sha256 "),
+        "{}",
+        &gcode[..400]
+    );
+    // The program back through `check --gcode -`.
+    let o = run(
+        &["check", "--scan", s(&scan), "--gcode", "-"],
+        gcode.as_bytes(),
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stdout(&o).starts_with("standard input: 1443 moves checked"),
+        "{}",
+        stdout(&o)
+    );
+    // The scan from standard input, its format found from its bytes.
+    let o = run(
+        &[
+            "plan",
+            "-q",
+            "--scan",
+            "-",
+            "--path",
+            s(&demo_file(demo::DEMO_PATH_NAME)),
+            "--place",
+            "0,80,0,1",
+            "-o",
+            "-",
+        ],
+        &std::fs::read(&scan).unwrap(),
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("\n; scan file: stdin (6216475 bytes"));
+    let o = run(
+        &["plan", "--scan", "-", "--path", "-", "-o", "x.gcode"],
+        b"",
+    );
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("--scan - and --path - both read standard input"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(
+        &[
+            "plan",
+            "--scan",
+            "-",
+            "--path",
+            s(&demo_file(demo::DEMO_PATH_NAME)),
+            "-o",
+            "-",
+        ],
+        b"junk\n",
+    );
+    assert_eq!(code(&o), 1);
+    assert!(
+        stderr(&o).contains("error: standard input: not a scan"),
+        "{}",
+        stderr(&o)
+    );
+}

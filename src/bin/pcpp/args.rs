@@ -175,7 +175,7 @@ be) and their count, 2 on a usage error.";
 
 #[derive(Debug, Args)]
 pub struct CheckArgs {
-    /// The program to check: ours or another tool's
+    /// The program to check: ours or another tool's (- for standard input)
     #[arg(long, value_name = "FILE", value_hint = ValueHint::FilePath)]
     pub gcode: PathBuf,
 
@@ -308,7 +308,7 @@ pub struct JobArgs {
     #[command(flatten)]
     pub scan: ScanArgs,
 
-    /// The drawn path
+    /// The drawn path (- for standard input)
     #[arg(
         long,
         value_name = "FILE.svg",
@@ -344,7 +344,7 @@ pub struct JobArgs {
 #[command(next_help_heading = "Scan")]
 pub struct ScanArgs {
     /// The scanned surface: a mesh (OBJ, PLY, STL, glTF, GLB) or a point
-    /// cloud (XYZ/CSV/TXT, vertex-only PLY or OBJ, PCD)
+    /// cloud (XYZ/CSV/TXT, vertex-only PLY or OBJ, PCD); - for standard input
     #[arg(long, value_name = "FILE", value_hint = ValueHint::FilePath)]
     pub scan: PathBuf,
 

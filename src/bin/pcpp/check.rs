@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use pcpp::job;
 
 use crate::args::CheckArgs;
-use crate::files::{file_name, in_file, is_stdout, read_gcode_text, to_json, write_one};
+use crate::files::{
+    file_name, in_file, input_shown, is_stdout, read_gcode_text, to_json, write_one,
+};
 use crate::outputs::{Flagged, Outputs};
 use crate::plan::load_scan;
 use crate::progress::Progress;
@@ -58,9 +60,9 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             });
     let head = format!(
         "{}: {} moves checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
-        gcode_path.display(),
+        input_shown(gcode_path),
         sum.moves,
-        a.scan.scan.display(),
+        input_shown(&a.scan.scan),
         check.outer_diameter_mm,
         check.tol_mm
     );

@@ -11,7 +11,34 @@ use crate::outputs::Outputs;
 use crate::{CliResult, Failure};
 
 pub fn read_bytes(path: &Path, what: &str) -> CliResult<Vec<u8>> {
+    if is_stdin(path) {
+        return read_stdin(what);
+    }
     std::fs::read(path).map_err(|e| cannot_read(path, what, e))
+}
+
+/// An input as messages name it: its path, or "standard input" for `-`.
+pub fn input_shown(path: &Path) -> String {
+    if is_stdin(path) {
+        "standard input".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Whether `path` (an input) is `-`, standard input.
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+fn read_stdin(what: &str) -> CliResult<Vec<u8>> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    std::io::stdin()
+        .lock()
+        .read_to_end(&mut bytes)
+        .map_err(|e| Failure::Input(format!("cannot read {what} from standard input: {e}")))?;
+    Ok(bytes)
 }
 
 fn cannot_read(path: &Path, what: &str, e: std::io::Error) -> Failure {
@@ -48,6 +75,9 @@ impl AsRef<[u8]> for ScanBytes {
 /// opened once either way.
 pub fn read_scan(path: &Path, what: &str) -> CliResult<ScanBytes> {
     use std::io::Read as _;
+    if is_stdin(path) {
+        return read_stdin(what).map(ScanBytes::Read);
+    }
     let mut file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
     #[cfg(target_os = "linux")]
     if let Some(m) = mapped::Mapped::of(&file) {
@@ -241,6 +271,9 @@ pub fn read_gcode_text(path: &Path) -> CliResult<(String, Option<String>)> {
 /// The name the library sees: the file name alone, so that reports and
 /// G-code headers do not depend on where the file was read from.
 pub fn file_name(path: &Path) -> String {
+    if is_stdin(path) {
+        return "stdin".into();
+    }
     path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string())
@@ -252,19 +285,20 @@ pub fn file_name(path: &Path) -> String {
 /// "dir/scan.obj, line 12: ..." (the G-code reader's `name, line 12: ...`
 /// already does).
 pub fn in_file(path: &Path, name: &str, message: &str) -> String {
+    let shown = input_shown(path);
     let rest = message.strip_prefix(name);
     if let Some(line) = rest.filter(|r| r.starts_with(", line ")) {
-        return format!("{}{line}", path.display());
+        return format!("{shown}{line}");
     }
     let Some(rest) = rest.and_then(|r| r.strip_prefix(':')) else {
-        return format!("{}: {message}", path.display());
+        return format!("{shown}: {message}");
     };
     let line = rest
         .split_once(':')
         .filter(|(n, _)| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
     match line {
-        Some((n, tail)) => format!("{}, line {n}:{tail}", path.display()),
-        None => format!("{}:{rest}", path.display()),
+        Some((n, tail)) => format!("{shown}, line {n}:{tail}"),
+        None => format!("{shown}:{rest}"),
     }
 }
 

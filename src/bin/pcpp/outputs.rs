@@ -67,7 +67,21 @@ impl<'a> Outputs<'a> {
             }
             checked.files.push((out, id));
         }
+        let mut stdin: Option<Flagged> = None;
         for input in inputs {
+            if input.path.as_os_str() == "-" {
+                if let Some(first) = stdin {
+                    return Err(usage(
+                        command,
+                        format!(
+                            "{} - and {} - both read standard input; give one of them a file",
+                            first.flag, input.flag
+                        ),
+                    ));
+                }
+                stdin = Some(input);
+                continue;
+            }
             checked.refuse_read(input.path, || {
                 format!("{} {}", input.flag, input.path.display())
             })?;

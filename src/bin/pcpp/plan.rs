@@ -10,7 +10,8 @@ use pcpp::Error;
 
 use crate::args::{CompareArgs, JobArgs, MachineArgs, PlanArgs, ScanArgs};
 use crate::files::{
-    file_name, in_file, is_stdout, read_bytes, read_external, read_scan, to_json, write_one, Staged,
+    file_name, in_file, input_shown, is_stdout, read_bytes, read_external, read_scan, to_json,
+    write_one, Staged,
 };
 use crate::outputs::{Flagged, Outputs};
 use crate::progress::{thousands, Progress};
@@ -66,7 +67,7 @@ pub fn load_scan(
     progress: &Progress,
 ) -> CliResult<PreparedScan> {
     let scan_path = &a.scan;
-    progress.step(format!("reading scan {}...", scan_path.display()));
+    progress.step(format!("reading scan {}...", input_shown(scan_path)));
     let scan = read_scan(scan_path, "scan")?;
     let scan_name = file_name(scan_path);
     // A .gltf's buffers in separate files, from its folder.
@@ -81,7 +82,7 @@ pub fn load_scan(
     )
     .map_err(|e| match e {
         Error::Registration(r) => {
-            Failure::Input(format!("registration of {}: {r}", scan_path.display()))
+            Failure::Input(format!("registration of {}: {r}", input_shown(scan_path)))
         }
         other => Failure::Input(
             missing.explain(in_file(scan_path, &scan_name, &other.to_string()), &other),
@@ -161,19 +162,19 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
         e @ Error::OutsideVolume { .. } => Failure::Input(format!(
             "writing G-code for {}: {e}",
-            inputs.scan_path.display()
+            input_shown(&inputs.scan_path)
         )),
         // Its lines are the unwritten G-code's, not the drawing's.
         Error::Touching(t) => Failure::Input(format!(
             "{} on {}: {t}",
-            inputs.svg_path.display(),
-            inputs.scan_path.display()
+            input_shown(&inputs.svg_path),
+            input_shown(&inputs.scan_path)
         )),
         Error::Registration(
             r @ (RegistrationError::TooFarOff { .. } | RegistrationError::UpsideDown { .. }),
         ) => Failure::Input(format!(
             "{}: {r} (--accept-risk writes it anyway)",
-            inputs.scan_path.display()
+            input_shown(&inputs.scan_path)
         )),
         e @ Error::WholeObjectCloud { .. } => {
             Failure::Input(format!("{e} (--accept-risk writes it anyway)"))
@@ -181,15 +182,15 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
         e @ Error::UnitsDoubt { .. } => Failure::Input(e.to_string()),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
-            inputs.svg_path.display()
+            input_shown(&inputs.svg_path)
         )),
         Error::Plan(m) if m.contains("seen edge-on") => {
-            Failure::Input(format!("{}: {m}", inputs.scan_path.display()))
+            Failure::Input(format!("{}: {m}", input_shown(&inputs.scan_path)))
         }
         Error::Plan(m) if m.contains("misses the scan") => Failure::Input(format!(
             "{} on {}: {m}",
-            inputs.svg_path.display(),
-            inputs.scan_path.display()
+            input_shown(&inputs.svg_path),
+            input_shown(&inputs.scan_path)
         )),
         other => Failure::Input(in_file(
             &inputs.svg_path,
