@@ -549,22 +549,25 @@ fn regression_check_did_not_compare_the_programs_header_with_its_scan() {
     );
 }
 
+/// The demo part as `pcpp check` reads it: as scanned, unregistered.
+fn demo_scan() -> pcpp::job::PreparedScan {
+    pcpp::job::prepare_scan(
+        &pcpp::demo::demo_scan_bytes(),
+        pcpp::demo::DEMO_SCAN_NAME,
+        &pcpp::mesh::ImportOptions::DEFAULT,
+        &pcpp::job::RegistrationSettings::default(),
+    )
+    .unwrap()
+}
+
 /// A file without a move (empty, comments only, a point cloud's numbers)
 /// was checked as "clear: none of the 0 moves comes closer than tol"; it
 /// shows nothing, and now says so.
 #[test]
 fn regression_a_program_without_moves_was_clear() {
-    use pcpp::job::{check_gcode, prepare_scan, RegistrationSettings};
-    use pcpp::mesh::ImportOptions;
+    use pcpp::job::check_gcode;
 
-    let ply = pcpp::demo::demo_scan_bytes();
-    let scan = prepare_scan(
-        &ply,
-        pcpp::demo::DEMO_SCAN_NAME,
-        &ImportOptions::DEFAULT,
-        &RegistrationSettings::default(),
-    )
-    .unwrap();
+    let scan = demo_scan();
     let nozzle = pcpp::Nozzle::DEFAULT;
     for text in ["", "; only a comment\n(and another)\n", "G21\nG90\nM82\n"] {
         let e = check_gcode(&scan, text, "empty.gcode", &nozzle, 0.1)
@@ -587,17 +590,9 @@ fn regression_a_program_without_moves_was_clear() {
 /// not known for sure, is listed as unchecked.
 #[test]
 fn regression_check_passed_a_dive_written_beside_m3() {
-    use pcpp::job::{check_gcode, prepare_scan, RegistrationSettings};
-    use pcpp::mesh::ImportOptions;
+    use pcpp::job::check_gcode;
 
-    let ply = pcpp::demo::demo_scan_bytes();
-    let scan = prepare_scan(
-        &ply,
-        pcpp::demo::DEMO_SCAN_NAME,
-        &ImportOptions::DEFAULT,
-        &RegistrationSettings::default(),
-    )
-    .unwrap();
+    let scan = demo_scan();
     let nozzle = pcpp::Nozzle::DEFAULT;
     let text = "G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 F300\nX40 Y41 Z2 M3 S100\nG1 X41 Y41 Z10\n";
     let check = check_gcode(&scan, text, "laser.nc", &nozzle, 0.1).unwrap();
