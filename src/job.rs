@@ -901,6 +901,21 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
     }
 }
 
+/// How far a scan placed on the bed was moved below it (Move Z under 0,
+/// past the G-code's resolution), if it was: a part that stands on the bed
+/// is then planned that much too low (found by a QA run: Move Z -50 wrote
+/// G-code 50 mm into the part, "clear" by the check on the moved scan).
+pub fn below_bed_mm(scan: &PreparedScan) -> Option<f64> {
+    match scan.registration.status {
+        crate::placement::RegistrationStatus::PlacedOnBed { offset_mm, .. }
+            if offset_mm.z < -crate::gcode::VOLUME_HAIR_MM =>
+        {
+            Some(-offset_mm.z)
+        }
+        _ => None,
+    }
+}
+
 /// The refusal of a plan whose guarded planner could not clear some point
 /// (no G-code then), unless the user accepts the risk: the error lists the
 /// first ten points.
@@ -947,6 +962,9 @@ pub fn write_outputs(
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     refuse_whole_object_cloud(scan, accept_risk)?;
     refuse_unit_doubt(scan, accept_risk)?;
+    if let (Some(depth_mm), false) = (below_bed_mm(scan), accept_risk) {
+        return Err(Error::BelowBed { depth_mm });
+    }
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     // What the G-code would have been refused for but for the accepted
@@ -977,6 +995,11 @@ pub fn write_outputs(
             d.units
         ));
     }
+    if let Some(depth) = below_bed_mm(scan) {
+        risks.push(format!(
+            "the scan is placed {depth:.3} mm below the bed (Move Z)"
+        ));
+    }
     if !plan.uncleared.is_empty() {
         risks.push(format!(
             "the nozzle still touches the surface at {} planned point(s)",
@@ -1004,7 +1027,10 @@ pub fn write_outputs(
             {
                 Error::OutsideVolume {
                     source: Box::new(e),
-                    fit: fit.message,
+                    fit: match scan.registration.status {
+                        RegistrationStatus::PlacedOnBed { .. } => fit.placed_message,
+                        _ => fit.message,
+                    },
                 }
             }
             // The scan inside, the tool path beside it outside: a drawing

@@ -179,6 +179,9 @@ pub struct VolumeFit {
     pub fits_on_bed: bool,
     /// One sentence for the user.
     pub message: String,
+    /// The sentence for a scan already placed on the bed (whose offset, not
+    /// a placement, moved it out).
+    pub placed_message: String,
 }
 
 /// Where a scan with bounds `bbox` (printer frame) lies against `volume` of
@@ -193,6 +196,7 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
     let size = hi - lo;
     let room = volume.max_mm - volume.min_mm;
     let fits_on_bed = size.cmple(room).all();
+    let mut placed_message = String::new();
     let message = if inside {
         format!("the scan lies inside the build volume of profile {profile}")
     } else {
@@ -206,6 +210,10 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             lo.z,
             hi.z,
             outside.max_element(),
+        );
+        placed_message = format!(
+            "{spans}; move it back inside (Move X, Y and Z in the page; --place-scan \
+             bed,ROT,DX,DY,DZ)"
         );
         if fits_on_bed {
             format!(
@@ -226,11 +234,15 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             )
         }
     };
+    if placed_message.is_empty() {
+        placed_message.clone_from(&message);
+    }
     VolumeFit {
         inside,
         outside_by_mm: outside,
         fits_on_bed,
         message,
+        placed_message,
     }
 }
 

@@ -90,6 +90,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "whole-object"
     } else if matches!(e, Error::UnitsDoubt { .. }) {
         "units"
+    } else if matches!(e, Error::BelowBed { .. }) {
+        "below-bed"
     } else {
         "other"
     };

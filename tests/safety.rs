@@ -396,3 +396,58 @@ proptest! {
         prop_assert_eq!(out.report.motion.program.touching_moves, 0);
     }
 }
+
+/// A scan placed on the bed and then moved down (Move Z -50 in the page)
+/// wrote G-code 50 mm into a part standing on the bed, "clear" by the
+/// check on the moved scan (found by a QA run). It is refused by name, and
+/// written only with the risk accepted, which its header then says.
+#[test]
+fn regression_a_scan_moved_below_the_bed_wrote_gcode_into_the_part() {
+    use pcpp::placement::{Bed, ScanPlacement};
+    let bytes = pcpp::demo::to_binary_ply(&test_part::test_part());
+    let on_bed = |dz: f64| RegistrationSettings {
+        scan_placement: ScanPlacement::OnBed {
+            bed: Bed::of_profile(&marlin()),
+            rotation_deg: 0.0,
+            offset_mm: DVec3::new(0.0, 0.0, dz),
+        },
+        ..RegistrationSettings::default()
+    };
+    let settings = PlanSettings {
+        // The demo drawing on the part, which the bed's middle now holds.
+        placement: Placement {
+            offset_mm: pcpp::DVec2::new(70.0, 150.0),
+            ..test_part::placement()
+        },
+        ..PlanSettings::default()
+    };
+    let run = |dz: f64, accept_risk: bool| {
+        let scan = prepare_scan(&bytes, "part.ply", &ImportOptions::DEFAULT, &on_bed(dz)).unwrap();
+        let svg = test_part::test_part_svg();
+        run_on(
+            &scan,
+            svg.as_bytes(),
+            "lines.svg",
+            &settings,
+            &marlin(),
+            accept_risk,
+        )
+    };
+    // On the bed, or raised: planned as before.
+    for dz in [0.0, 2.0] {
+        let out = run(dz, false).unwrap();
+        assert!(out.report.motion.accepted_risks.is_empty());
+    }
+    let e = run(-0.5, false)
+        .err()
+        .expect("G-code written below the bed");
+    assert!(matches!(e, Error::BelowBed { .. }), "{e}");
+    assert!(e.to_string().contains("moved 0.500 mm down"), "{e}");
+    let out = run(-0.5, true).unwrap();
+    assert!(
+        out.gcode
+            .contains("the scan is placed 0.500 mm below the bed (Move Z)"),
+        "{}",
+        &out.gcode[..1500]
+    );
+}

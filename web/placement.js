@@ -257,7 +257,8 @@ export function showScanPlacement() {
     $('bed-name').textContent = `profile ${profile().name}`;
     const note = $('bed-note');
     const shown = info && info.registration.status.kind === 'placed-on-bed';
-    note.textContent = shown && outside ? pageText(capital(fit.message)) : '';
+    // Placed already: the way back in is the placement's own offsets.
+    note.textContent = shown && outside ? pageText(capital(fit.placed_message)) : '';
     note.classList.toggle('bad-note', shown && outside);
   }
   writeFields(null);

@@ -164,6 +164,21 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
   const g2 = (await download(page, 'dl-gcode')).bytes.toString('utf8');
   assert.ok(g2.includes('; registration: unregistered, placed on the bed (turned 0 deg, moved (5, 0, 0) mm)'));
 
+  // Moved below the bed (Move Z -50): refused by name, no download (it
+  // wrote G-code 50 mm into a part standing on the bed); the bed note
+  // says how to move it back, not to place it on the bed.
+  await page.fill('#bed-dz', '-50');
+  await page.waitForSelector('#error-panel:not([hidden])', { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'The scan is moved below the bed: no G-code');
+  assert.match(await page.textContent('#error-message'), /moved 50\.000 mm down/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.match(await page.textContent('#bed-note'), /move it back inside \(Move X, Y and Z/);
+  assert.doesNotMatch(await page.textContent('#bed-note'), /place it on the bed/);
+  await page.fill('#bed-dz', '0');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+
   // A reload keeps the scan, its placement on the bed and the drawing's.
   await waitKept(page);
   await page.reload();

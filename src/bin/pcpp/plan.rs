@@ -180,6 +180,10 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
             Failure::Input(format!("{e} (--accept-risk writes it anyway)"))
         }
         e @ Error::UnitsDoubt { .. } => Failure::Input(e.to_string()),
+        e @ Error::BelowBed { .. } => Failure::Input(format!(
+            "{}: {e} (--accept-risk)",
+            input_shown(&inputs.scan_path)
+        )),
         Error::Plan(m) if m.contains("no G-code written") => Failure::Input(format!(
             "{}: {m} (--accept-risk writes it anyway)",
             input_shown(&inputs.svg_path)
