@@ -13,7 +13,7 @@ use sha2::{Digest, Sha256};
 use crate::error::{Error, Result};
 use crate::fiducials::find_fiducials_in;
 use crate::fiducials::Fiducial;
-use crate::gcode::format::{fixed, trimmed};
+use crate::gcode::format::fixed;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{
     CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology,
@@ -707,6 +707,18 @@ pub fn report(
     }
 }
 
+/// A number as its shortest text that reads back the same, never `-0`:
+/// the header's placement, which re-planned with `--place` must give the
+/// same G-code (rounded to 6 decimals, a page's scale 0.0850632 read back
+/// as 0.085063 moved 3 waypoints; found by a QA run).
+fn exact(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else {
+        v.to_string()
+    }
+}
+
 /// The provenance header of the G-code (spec section 9).
 pub fn provenance(report: &Report) -> Vec<(String, String)> {
     let s = &report.settings;
@@ -742,10 +754,10 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         "placement".into(),
         format!(
             "offset ({}, {}) mm, rotation {} deg, scale {}",
-            trimmed(s.placement.offset_mm.x, 6),
-            trimmed(s.placement.offset_mm.y, 6),
-            trimmed(s.placement.rotation_deg, 6),
-            trimmed(s.placement.scale, 6)
+            exact(s.placement.offset_mm.x),
+            exact(s.placement.offset_mm.y),
+            exact(s.placement.rotation_deg),
+            exact(s.placement.scale)
         ),
     ));
     h.push(("planner".into(), report.planner.name().into()));
@@ -1630,10 +1642,10 @@ mod tests {
         assert_eq!(back.inputs, a.report.inputs);
     }
 
-    /// The header printed `offset (-6.467586450097912, 51.822655334421455)`
-    /// for a centred drawing, and `-0.000000` in G, `mean e- -0.0000 mm`
-    /// for rounding noise (found by a QA run): placement to 6 decimals
-    /// without trailing zeros, and no negative zero.
+    /// The header printed `-0.000000` in G and `mean e- -0.0000 mm` for
+    /// rounding noise (found by a QA run). The placement is written exactly
+    /// (shortest round trip), so that `--place` with it plans the same
+    /// G-code, and without a negative zero.
     #[test]
     fn the_header_rounds_placement_and_writes_no_negative_zero() {
         let part = crate::demo::parts::DemoPart::SteppedBlock;
@@ -1654,7 +1666,7 @@ mod tests {
         let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
             .unwrap()
             .report;
-        report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, 51.8);
+        report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, -0.0);
         report.settings.placement.scale = 0.8582695662780906;
         report.settings.placement.rotation_deg = 30.0;
         report.registration.matrix[0][2] = -1e-9;
@@ -1666,7 +1678,8 @@ mod tests {
             .collect();
         assert!(
             header.contains(
-                "placement: offset (-6.467586, 51.8) mm, rotation 30 deg, scale 0.85827\n"
+                "placement: offset (-6.467586450097912, 0) mm, rotation 30 deg, scale \
+                 0.8582695662780906\n"
             ),
             "{header}"
         );

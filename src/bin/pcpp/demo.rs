@@ -232,13 +232,12 @@ fn shell_word(word: &str) -> String {
     }
 }
 
-/// A number as typed: 6 decimals at most, no trailing zeros.
+/// A number as typed, exactly (shortest round trip, never `-0`): the
+/// command plans what the demo planned.
 fn trimmed(v: f64) -> String {
-    let t = format!("{v:.6}");
-    let t = t.trim_end_matches('0').trim_end_matches('.');
-    if t == "-0" {
+    if v == 0.0 {
         "0".into()
     } else {
-        t.into()
+        v.to_string()
     }
 }
