@@ -805,8 +805,25 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
     h.push(("predicted quality".into(), report.quality.to_string()));
     h.push(("safe motion".into(), report.motion.summary_line()));
     h.push(("warnings".into(), report.warnings.len().to_string()));
+    // Their text, where the operator reads the program ("warnings: 2" hid
+    // "dispense 86 mm above the surface ... expect floating filament").
+    for (i, w) in report.warnings.iter().take(HEADER_WARNINGS).enumerate() {
+        h.push((format!("warning {}", i + 1), w.clone()));
+    }
+    if report.warnings.len() > HEADER_WARNINGS {
+        h.push((
+            "warnings not listed".into(),
+            format!(
+                "{} more (the report lists them)",
+                report.warnings.len() - HEADER_WARNINGS
+            ),
+        ));
+    }
     h
 }
+
+/// Warnings whose text the G-code header gives.
+const HEADER_WARNINGS: usize = 10;
 
 /// Plans on a prepared scan and writes the G-code. Refuses (no G-code) when
 /// the guarded planner could not clear some point, unless `accept_risk`.

@@ -11,6 +11,7 @@
 ' predicted quality: mean |e| 0.0107 mm, mean e- -0.0056 mm, mean e+ 0.0199 mm, contact 0.00%, flattening 0.59%, floating 1.62%
 ' safe motion: min clearance 0.101 mm (tol 0.1 mm) along all 1443 moves; 70 waypoint(s) added (+3.615 mm)
 ' warnings: 1
+' warning 1: even: 20 point(s) of the tool path lifted where the nozzle (outer diameter 0.908 mm) is wider than the feature it must pass, or rising over one between points, dispense more than 1.206 mm (2 d) above the surface right under the tip; the highest, 3.102 mm above it, is at (60.556, 16.000, 8.102): expect floating filament there
 ' profile: aerotech
 ' print feed: F5 mm/s (5 mm/s)
 ' safe travel height: 13.603 mm
