@@ -956,6 +956,8 @@ fn regression_check_passed_a_program_none_of_whose_moves_it_could_check() {
         err.contains("0 moves checked") && err.contains("4 move(s) could not be checked"),
         "{err}"
     );
+    // Not "none of those comes closer than tol" of no move.
+    assert!(!err.contains("none of those"), "{err}");
     assert!(
         err.contains("not shown to keep tol") && err.contains("G92"),
         "{err}"

@@ -68,8 +68,9 @@ export function onCheck(m) {
     ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
     : sum.touching_moves === 0
       ? `not shown clear: ${c.unchecked_lines.length} move(s) could not be checked (the file does not `
-        + `give where they start or end, and they come lower than tol above the scan's top); none of `
-        + `the ${sum.moves} checked moves comes closer than tol; ${against}`
+        + `give where they start or end, and they come lower than tol above the scan's top); `
+        + `${sum.moves === 0 ? 'no move could be checked' : sum.moves === 1 ? 'the 1 checked move does not come closer than tol'
+          : `none of the ${sum.moves} checked moves comes closer than tol`}; ${against}`
       : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];

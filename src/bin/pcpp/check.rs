@@ -78,9 +78,14 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     }
     if sum.touching_moves == 0 {
         let lines = &check.unchecked_lines;
+        // ("none of those comes closer" of 0 moves read as a pass.)
+        let checked = match sum.moves {
+            0 => "",
+            1 => "; it does not come closer than tol",
+            _ => "; none of those comes closer than tol",
+        };
         return Err(Failure::Input(format!(
-            "{head}; none of those comes closer than tol, but {} move(s) could not be checked \
-             ({}): the file does not give where they start or end, and they come lower \
+            "{head}{checked}, but {} move(s) could not be checked ({}): the file does not give where they start or end, and they come lower \
              than tol above the scan's top, so the program is not shown to keep tol; give the \
              position before them (absolute G90 moves from a known point, or G92), or check \
              the program from where it starts printing",
