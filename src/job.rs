@@ -180,11 +180,26 @@ fn best_auto_match(
     method: RegistrationMethod,
 ) -> Result<Registration> {
     let k = printer.len();
-    if k < 3 {
-        return Err(Error::Registration(RegistrationError::TooFew(k)));
-    }
     // The candidates that could be dots at all; all holes if too few are.
     let likely = found.iter().filter(|f| f.is_candidate()).count();
+    // Said for "auto" (it read "registration needs at least 3 fiducials,
+    // got 0: pick or type at least 3 points in each frame" of a scan with
+    // no hole at all; found by a QA run).
+    let holes = match likely {
+        0 => "no hole was found in the scan (a fiducial dot shows as a small round hole in \
+              the scanned surface): pick or type the scan points instead"
+            .to_string(),
+        n => format!("the scan has {n} hole(s) that could be fiducials"),
+    };
+    if k < 3 {
+        return Err(Error::Plan(format!(
+            "fiducials auto: {k} printer point(s) P given, at least 3 needed (each dot's \
+             position on the printer, one per line); {holes}"
+        )));
+    }
+    if likely == 0 && found.is_empty() {
+        return Err(Error::Plan(format!("fiducials auto: {holes}")));
+    }
     let cands: Vec<DVec3> = found
         .iter()
         .filter(|f| likely < k || f.is_candidate())
@@ -1554,6 +1569,26 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// "auto" on a scan without holes, or without printer points, said
+    /// "registration needs at least 3 fiducials, got 0: pick or type at
+    /// least 3 points in each frame" (found by a QA run on a bunny).
+    #[test]
+    fn auto_fiducials_say_what_is_missing() {
+        let lsq = RegistrationMethod::Lsq;
+        let p = test_part::FIDUCIALS_MM.to_vec();
+        let e = best_auto_match(&[], &p, lsq).unwrap_err().to_string();
+        assert!(
+            e.starts_with("fiducials auto: no hole was found in the scan"),
+            "{e}"
+        );
+        let e = best_auto_match(&[], &[], lsq).unwrap_err().to_string();
+        assert!(
+            e.starts_with("fiducials auto: 0 printer point(s) P given, at least 3 needed")
+                && e.contains("no hole was found"),
+            "{e}"
+        );
     }
 
     #[test]
