@@ -248,7 +248,11 @@ export function showScanPlacement() {
   }
   const outside = !!fit && !fit.inside;
   const beside = !outside && !!besideOut && !!state.scan && besideOut.key === state.scan.key;
-  $('place-banner').hidden = !((outside || beside) && !on && s.fidSource === 'none' && !state.pendingScan);
+  // The units come first: a scan read in the wrong ones is in the wrong
+  // place too, and both banners at once asked two questions.
+  const unitsAsked = !!info && !!info.units_doubt && !info.units_doubt.given;
+  $('place-banner').hidden = !((outside || beside) && !on && s.fidSource === 'none' && !state.pendingScan
+    && !unitsAsked);
   const sentence = outside ? fit.message : beside ? besideOut.text : null;
   banner = !$('place-banner').hidden ? sentence : null;
   $('place-banner-text').textContent = sentence ? pageText(capital(sentence)) : '';

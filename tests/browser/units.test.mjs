@@ -11,12 +11,12 @@ const env = withPageServer();
 
 // An 80 x 80 mm film with a gentle wave, 5 mm up, written in metres;
 // `hole`: only its 2 mm rim.
-function filmInMetres(hole = false) {
+function filmInMetres(hole = false, dx = 0) {
   const n = 41;
   const lines = [];
   for (let j = 0; j < n; j++) {
     for (let i = 0; i < n; i++) {
-      const x = i * 2;
+      const x = i * 2 + dx;
       const y = j * 2;
       const z = 5 + 0.4 * Math.sin(x / 6) * Math.cos(y / 9);
       lines.push(`v ${(x / 1000).toFixed(6)} ${(y / 1000).toFixed(6)} ${(z / 1000).toFixed(7)}`);
@@ -106,6 +106,26 @@ test('a scan in metres is refused for its units before the drawing is planned on
   await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
   assert.match(await status(page), /^no G-code: choose the scan's units \(see above\)/);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A scan in metres that also lies off the bed showed both banners at once,
+// "Place on the bed" above the units question (a QA run's bunny): the
+// units come first, then the placement.
+test('the units are asked before the placement on the bed', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'off-m.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(false, -50)) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'off-m.obj');
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
+  assert.equal(await page.isHidden('#place-banner'), true);
+  await page.click('#units-banner-btns button[data-units="m"]');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'm');
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('place-banner').hidden);
+  assert.equal(await page.isHidden('#units-banner'), true);
   assert.deepEqual(problems, []);
   await context.close();
 });
