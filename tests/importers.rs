@@ -1168,3 +1168,38 @@ fn regression_a_misnamed_scan_was_diagnosed_as_its_names_format() {
     .to_string();
     assert!(e.starts_with("junk.stl: ") && !e.contains("rename"), "{e}");
 }
+
+/// A web page saved under a scan's name (GitHub's page for a .glb, saved
+/// from the browser) read "not a valid glTF 2.0 file: expected value at
+/// line 7 column 1" (a QA run); as .obj it would have been "no triangles".
+/// It is named as what it is, whatever the extension.
+#[test]
+fn regression_a_web_page_saved_as_a_scan_was_read_as_one() {
+    let page = b"\xEF\xBB\xBF\n  <!DOCTYPE html>\n<html lang=\"en\"><head><title>DamagedHelmet.glb</title></head></html>\n";
+    for name in [
+        "DamagedHelmet.glb",
+        "bunny.obj",
+        "part.stl",
+        "scan.ply",
+        "noext",
+    ] {
+        let e = import_mesh(page, name, &ImportOptions::DEFAULT)
+            .err()
+            .unwrap_or_else(|| panic!("{name} read"))
+            .to_string();
+        assert!(
+            e.starts_with(&format!(
+                "{name}: the file is a web page (HTML), not a scan"
+            )),
+            "{name}: {e}"
+        );
+    }
+    let e = import_mesh(
+        b"<HTML><body>404</body></HTML>",
+        "x.glb",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("web page (HTML)"), "{e}");
+}

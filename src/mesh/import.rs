@@ -153,11 +153,30 @@ pub fn import_mesh_with(
             "the file is UTF-16 text; save it as UTF-8 or ASCII (OBJ, PLY and STL text must be)",
         ));
     }
+    if is_html(bytes) {
+        // A download link saved as its web page ("not a valid glTF 2.0
+        // file: expected value at line 7 column 1" of a GitHub page saved
+        // as .glb; found by a QA run).
+        return Err(MeshError::invalid(
+            file,
+            "the file is a web page (HTML), not a scan: the browser saved the page that links \
+             to the file; download the file itself (on GitHub, its \"raw\" or download link)",
+        ));
+    }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
     let (parsed, external_files) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
     finish_import(parsed, format, file, options, external_files)
+}
+
+/// Whether the bytes are an HTML page: `<!DOCTYPE html` or `<html` first,
+/// in any case, after a BOM and white space.
+fn is_html(bytes: &[u8]) -> bool {
+    let head = skip_bom_and_space(bytes);
+    let head = &head[..head.len().min(16)];
+    let lower = head.to_ascii_lowercase();
+    lower.starts_with(b"<!doctype html") || lower.starts_with(b"<html")
 }
 
 /// The file read as `format`, and the external files it read (a glTF's).
