@@ -65,7 +65,11 @@ export function showFiducials() {
       : 'No holes found in the scan.';
   }
   const r = info.registration;
-  if (r.residuals_mm.length === 0) {
+  if (state.regFailed) {
+    // The last registration's residuals are not this one's (a perfect
+    // 0.0000 beside "fiducials 1, 2, 3 are collinear"; found by a QA run).
+    res.textContent = 'No residuals: the registration failed (see the error).';
+  } else if (r.residuals_mm.length === 0) {
     res.textContent = 'No registration by fiducials.';
   } else {
     const d = Number(s.nozzle.id);

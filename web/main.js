@@ -13,7 +13,7 @@ import { onCheck, syncCheckButton } from './check.js';
 import {
   bindDownloads, downloadFollows, dropPress, hideDownloads, offerDownloads, pressReplans,
 } from './downloads.js';
-import { initFiducials } from './fiducials.js';
+import { initFiducials, showFiducials } from './fiducials.js';
 import { loadWasm, startWorker } from './engine.js';
 import {
   acceptScan, bindFiles, demoScanEntry, dropCentre, dropPendingScan, dropPendingSvg, endRestoring, isScanName, keep,
@@ -366,6 +366,7 @@ function onWorkerMessage(e) {
       if (state.regFailed) {
         state.regFailed = false;
         showScanPlacement();
+        if (state.info) showFiducials();
       }
       if (m.comparison) state.lastComparison = { rows: m.comparison, series: m.series, gen: busy.gen };
       showPlan(state.lastPlan);
@@ -442,7 +443,10 @@ function onPlanError(m, busy) {
   } else if (m.stage === 'scan') {
     // (The registration's messages start 'registration needs ...'.)
     title = m.kind === 'mesh' ? 'Could not read the scan' : `Could not register ${busy.scan.name}`;
-    if (m.kind !== 'mesh') state.regFailed = true;
+    if (m.kind !== 'mesh') {
+      state.regFailed = true;
+      if (state.info) showFiducials();
+    }
     if (state.pendingScan && busy.scan === state.pendingScan) {
       // Readable but not registered: it stays loaded until the fiducials fit.
       acceptScan();

@@ -124,10 +124,14 @@ test('the header says the scan is not registered while its fiducials do not fit'
   await waitIdle(page);
   assert.equal(await page.textContent('#reg-status'), 'not registered: the fiducials do not fit (see the error)');
   assert.equal(await page.$eval('#reg-status', (e) => e.parentElement.classList.contains('unregistered')), true);
+  // Nor the last registration's residuals (a perfect 0.0000 beside the
+  // error).
+  assert.equal(await page.textContent('#fid-residuals'), 'No residuals: the registration failed (see the error).');
   // The points back: registered again.
   await page.fill('#fid-printer', good);
   await waitSettled(page);
   assert.match(await page.textContent('#reg-status'), /^registered \(lsq, 3 fiducials/);
+  assert.match(await page.textContent('#fid-residuals'), /^Residuals: /);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
