@@ -87,6 +87,20 @@ pub enum Error {
          scan is not on the printer (a scanned base or table), accept the risk"
     )]
     BelowBed { depth_mm: f64 },
+    /// G-code refused for a tool path that dispenses far above the surface
+    /// ([`crate::pipeline::REFUSED_HEIGHT_PER_D`]).
+    #[error(
+        "the tool path would dispense {height_mm:.3} mm above the surface right under the tip, \
+         at ({:.3}, {:.3}, {:.3}) (more than {limit_mm:.3} mm, {per_d} d): the nozzle is lifted \
+         there to pass a feature it is wider than, or the drawing crosses a wall, and the \
+         filament would fall that far; no G-code written. Move the drawing off that feature, \
+         or accept the risk", .at[0], .at[1], .at[2], per_d = crate::pipeline::REFUSED_HEIGHT_PER_D
+    )]
+    FarAbove {
+        height_mm: f64,
+        at: [f64; 3],
+        limit_mm: f64,
+    },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -945,6 +945,13 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
     }
 }
 
+/// The plan's highest dispensing point above the surface, if it is past
+/// [`pipeline::REFUSED_HEIGHT_PER_D`] d.
+fn far_above(plan: &Plan, settings: &PlanSettings) -> Option<(f64, DVec3)> {
+    let limit = pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm;
+    plan.highest_floating.filter(|&(h, _)| h > limit)
+}
+
 /// How far a scan placed on the bed was moved below it (Move Z under 0,
 /// past the G-code's resolution), if it was: a part that stands on the bed
 /// is then planned that much too low (found by a QA run: Move Z -50 wrote
@@ -1009,6 +1016,13 @@ pub fn write_outputs(
     if let (Some(depth_mm), false) = (below_bed_mm(scan), accept_risk) {
         return Err(Error::BelowBed { depth_mm });
     }
+    if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
+        return Err(Error::FarAbove {
+            height_mm,
+            at: at.to_array(),
+            limit_mm: pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm,
+        });
+    }
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     // What the G-code would have been refused for but for the accepted
@@ -1037,6 +1051,12 @@ pub fn write_outputs(
             "the scan is only {:.3} mm across, read in {} without its units given",
             d.size_mm.max_element(),
             d.units
+        ));
+    }
+    if let Some((height, at)) = far_above(plan, settings) {
+        risks.push(format!(
+            "the tool path dispenses {height:.3} mm above the surface at ({:.3}, {:.3}, {:.3})",
+            at.x, at.y, at.z
         ));
     }
     if let Some(depth) = below_bed_mm(scan) {

@@ -92,6 +92,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "units"
     } else if matches!(e, Error::BelowBed { .. }) {
         "below-bed"
+    } else if matches!(e, Error::FarAbove { .. }) {
+        "far-above"
     } else {
         "other"
     };

@@ -544,6 +544,70 @@ fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
     }
 }
 
+/// A drawing over a scanned bunny wrote G-code that dispensed 86 mm above
+/// the surface (the nozzle lifted over a feature narrower than it), with a
+/// warning only (a QA run). Past 10 d (6.03 mm for the default nozzle) the
+/// G-code is refused unless the risk is accepted, which its header then
+/// says; a 5 mm fin (5 mm of floating) is planned as before.
+#[test]
+fn regression_gcode_dispensing_far_above_the_surface_was_written() {
+    use pcpp::job::{prepare_scan, run_on, RegistrationSettings};
+    let mut xs = range(0.0, 20.0, 100);
+    xs.extend([9.85, 10.15]);
+    xs.sort_by(f64::total_cmp);
+    let ys = range(0.0, 10.0, 50);
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="10mm" viewBox="0 0 20 10"><path d="M5 5 H15" fill="none" stroke="black"/></svg>"#;
+    let settings = PlanSettings {
+        placement: pcpp::svg::Placement {
+            offset_mm: DVec2::new(0.0, 10.0),
+            ..pcpp::svg::Placement::IDENTITY
+        },
+        ..Default::default()
+    };
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    let run = |fin_mm: f64, accept_risk: bool| {
+        let mesh = height_field(&xs, &ys, |x, _| {
+            1.0 + if (x - 10.0).abs() <= 0.15 + 1e-9 {
+                fin_mm
+            } else {
+                0.0
+            }
+        });
+        let bytes = pcpp::demo::to_binary_ply(&mesh);
+        let scan = prepare_scan(
+            &bytes,
+            "fin.ply",
+            &pcpp::mesh::ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        run_on(
+            &scan,
+            svg.as_bytes(),
+            "line.svg",
+            &settings,
+            &profile,
+            accept_risk,
+        )
+    };
+    let out = run(5.0, false).unwrap();
+    assert!(out.report.motion.accepted_risks.is_empty());
+    let e = run(20.0, false).err().expect("G-code written 20 mm above");
+    assert!(matches!(e, pcpp::Error::FarAbove { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("the tool path would dispense 20.")
+            && msg.contains("(more than 6.030 mm, 10 d)"),
+        "{msg}"
+    );
+    let out = run(20.0, true).unwrap();
+    assert!(
+        out.gcode.contains("the tool path dispenses 20."),
+        "{}",
+        &out.gcode[..2000]
+    );
+}
+
 /// Every planner on a level plate 40 mm square at z = 5 (`pcpp compare`)
 /// with the drawing `svg`, a 40 mm square document laid onto the plate
 /// (its y runs down), and the settings used.

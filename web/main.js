@@ -476,6 +476,9 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'whole-object') {
     title = 'The scan is a point cloud of a whole object: no G-code';
     message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
+  } else if (m.kind === 'far-above') {
+    title = 'The nozzle would dispense far above the surface: no G-code';
+    message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
   } else if (m.kind === 'below-bed') {
     title = 'The scan is moved below the bed: no G-code';
     message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
