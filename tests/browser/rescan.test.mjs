@@ -169,6 +169,9 @@ test('new units or up axis for the scan centre the drawing again from the user\'
   await page.selectOption('#scan-up', 'y');
   await page.waitForFunction((b) => JSON.stringify(window.pcpp.state.info.bbox_mm) !== b
     && !window.pcpp.state.busy && !window.pcpp.state.queued, bbox, { timeout: 120_000 });
+  // (The demo drawing over the upright bunny dispenses far above its
+  // flanks: written only with the risk accepted.)
+  await page.check('#accept-risk');
   await page.click('#place-bed-btn');
   await waitSettled(page);
   assert.equal(await scale(page), 1);
