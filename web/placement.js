@@ -251,8 +251,10 @@ export function showScanPlacement() {
   // The units come first: a scan read in the wrong ones is in the wrong
   // place too, and both banners at once asked two questions.
   const unitsAsked = !!info && !!info.units_doubt && !info.units_doubt.given;
-  $('place-banner').hidden = !((outside || beside) && !on && s.fidSource === 'none' && !state.pendingScan
-    && !unitsAsked);
+  // Offered only where it helps: a scan larger than the volume does not fit
+  // on the bed either (a 1 m cube was offered it, and the click failed).
+  $('place-banner').hidden = !(((outside && fit.fits_on_bed) || beside) && !on && s.fidSource === 'none'
+    && !state.pendingScan && !unitsAsked);
   const sentence = outside ? fit.message : beside ? besideOut.text : null;
   banner = !$('place-banner').hidden ? sentence : null;
   $('place-banner-text').textContent = sentence ? pageText(capital(sentence)) : '';

@@ -323,3 +323,28 @@ test('an empty number field is named as empty, not read as 0', async () => {
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A scan larger than the build volume (a 1 m cube from a glTF sample) was
+// offered "Place on the bed", which cannot help, and the click failed with
+// a long doubled message (a QA run). The error says it is larger than the
+// volume; no banner.
+test('a scan larger than the build volume is not offered "Place on the bed"', async () => {
+  const lines = [];
+  for (let j = 0; j <= 10; j++) for (let i = 0; i <= 10; i++) lines.push(`v ${i * 30 - 150} ${j * 30 - 150} ${5 + ((i + j) % 2)}`);
+  for (let j = 0; j < 10; j++) {
+    for (let i = 0; i < 10; i++) {
+      const a = j * 11 + i + 1;
+      lines.push(`f ${a} ${a + 1} ${a + 12}`, `f ${a} ${a + 12} ${a + 11}`);
+    }
+  }
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', { name: 'big.obj', mimeType: 'text/plain', buffer: Buffer.from(`${lines.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'big.obj');
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#place-banner'), true);
+  await page.waitForSelector('#error-panel:not([hidden])', { timeout: 120_000 });
+  assert.match(await page.textContent('#error-message'), /larger than the volume \(x 300\.0 mm, the volume 220\.0 mm\)/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
