@@ -192,13 +192,13 @@ fn best_auto_match(
         n => format!("the scan has {n} hole(s) that could be fiducials"),
     };
     if k < 3 {
-        return Err(Error::Plan(format!(
-            "fiducials auto: {k} printer point(s) P given, at least 3 needed (each dot's \
-             position on the printer, one per line); {holes}"
-        )));
+        return Err(Error::Registration(RegistrationError::Auto(format!(
+            "{k} printer point(s) P given, at least 3 needed (each dot's position on the \
+             printer, one per line); {holes}"
+        ))));
     }
     if likely == 0 && found.is_empty() {
-        return Err(Error::Plan(format!("fiducials auto: {holes}")));
+        return Err(Error::Registration(RegistrationError::Auto(holes)));
     }
     let cands: Vec<DVec3> = found
         .iter()

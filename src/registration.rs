@@ -196,6 +196,10 @@ pub enum RegistrationError {
     /// Fewer than three fiducials: pick or type at least three in each frame.
     #[error("registration needs at least 3 fiducials, got {0}: pick or type at least 3 points in each frame")]
     TooFew(usize),
+    /// `auto` fiducials that cannot be chosen: too few printer points, or
+    /// too few holes in the scan (the sentence says which).
+    #[error("fiducials auto: {0}")]
+    Auto(String),
     /// The two sets have different sizes: every scan fiducial needs its printer point.
     #[error("{scan} scan fiducials but {printer} printer fiducials: give the same points, in the same order, in both frames")]
     CountMismatch { scan: usize, printer: usize },
