@@ -399,6 +399,14 @@ function onWorkerMessage(e) {
 // `text` ended as a sentence, before the page's own line after it.
 const ended = (text) => (/[.!?)]$/.test(text.trim()) ? text : `${text.trimEnd()}.`);
 
+// The refusals that accepting the risk lifts, by the core's error kind,
+// with the error panel's title for each.
+const RISKS = {
+  'whole-object': 'The scan is a point cloud of a whole object: no G-code',
+  'far-above': 'The nozzle would dispense far above the surface: no G-code',
+  'below-bed': 'The scan is moved below the bed: no G-code',
+};
+
 function onPlanError(m, busy) {
   dropPress();
   // The worker holds another drawing than the page thinks: the next plan
@@ -473,14 +481,9 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'touching') {
     title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
     message = ended(message) + '\nThe settings, the drawing and the previous plan stay as they were.';
-  } else if (m.kind === 'whole-object') {
-    title = 'The scan is a point cloud of a whole object: no G-code';
-    message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
-  } else if (m.kind === 'far-above') {
-    title = 'The nozzle would dispense far above the surface: no G-code';
-    message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
-  } else if (m.kind === 'below-bed') {
-    title = 'The scan is moved below the bed: no G-code';
+  } else if (RISKS[m.kind]) {
+    // Refused unless the risk is accepted: the box that accepts it.
+    title = RISKS[m.kind];
     message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
