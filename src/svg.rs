@@ -268,8 +268,19 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             "the file is UTF-16 text; save it as UTF-8 (every SVG editor can)".into(),
         ));
     }
-    let text = std::str::from_utf8(bytes)
-        .map_err(|e| parse_err(format!("not UTF-8 text ({e}); SVG is an XML text file")))?;
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        // A binary scan chosen as the drawing, named as one.
+        let kind = if bytes.starts_with(b"glTF") {
+            "; it looks like a binary glTF (GLB) scan"
+        } else if bytes.starts_with(b"ply") {
+            "; it looks like a binary PLY scan"
+        } else {
+            ""
+        };
+        parse_err(format!(
+            "not UTF-8 text ({e}); SVG is an XML text file{kind}"
+        ))
+    })?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
 
     // A document that uses an editor's prefix without declaring it is read
@@ -1400,7 +1411,48 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
     (out, declared)
 }
 
+/// What a file that is not XML at all looks like, by its first word: a
+/// scan or a program chosen as the drawing (an OBJ read "not well-formed
+/// XML: unknown token at 1:1"; found by a QA run).
+fn not_xml(text: &str) -> Option<String> {
+    let head = text.trim_start_matches('\u{feff}').trim_start();
+    if head.starts_with('<') {
+        return None;
+    }
+    // The first word past comment lines (OBJ's `#`, G-code's `;`).
+    let first = head
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with(';'))
+        .and_then(|l| l.split_whitespace().next())
+        .unwrap_or("");
+    let kind = match first {
+        "v" | "vn" | "vt" | "f" | "o" | "g" | "mtllib" | "usemtl" => Some("a Wavefront OBJ scan"),
+        "ply" => Some("a PLY scan"),
+        "solid" => Some("an STL scan"),
+        _ if head.starts_with("glTF") || head.starts_with("{\"asset\"") => Some("a glTF scan"),
+        _ if [
+            "G0", "G1", "G21", "G28", "G90", "G91", "M82", "M104", "M107", "M140",
+        ]
+        .iter()
+        .any(|g| first.eq_ignore_ascii_case(g)) =>
+        {
+            Some("a G-code program")
+        }
+        _ => None,
+    };
+    Some(match kind {
+        Some(k) => format!("not an SVG: it looks like {k}; choose the drawing's .svg file"),
+        None => "not an SVG: it does not start with '<' (an SVG is XML text); choose the \
+                 drawing's .svg file"
+            .into(),
+    })
+}
+
 fn prepare(text: &str) -> Result<Prepared, String> {
+    if let Some(e) = not_xml(text) {
+        return Err(e);
+    }
     let opt = roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
