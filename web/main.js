@@ -100,7 +100,12 @@ function runPlan() {
   const id = ++state.planId;
   const compare = !state.interacting;
   const centre = centreRequest();
-  state.busy = { id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now() };
+  // The status it replaces, for a request that ends with nothing new (a
+  // scan file not read).
+  const was = [$('plan-status').textContent, $('plan-status').classList.contains('stale')];
+  state.busy = {
+    id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now(), was,
+  };
   state.queued = false;
   laterProgress('starting');
   if (!state.interacting) setStatus('planning…');
@@ -416,6 +421,7 @@ function onPlanError(m, busy) {
   let message = m.message;
   let file; // the file the title names
   let topic = null; // what the error is about (status.js)
+  let notRead = false; // a scan file not read: the previous scan's state stands
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -435,6 +441,7 @@ function onPlanError(m, busy) {
   } else if (m.stage === 'scan' && (m.kind === 'mesh' || m.kind === 'limit' || m.kind === 'other')
     && state.pendingScan && busy.scan === state.pendingScan) {
     // The file could not be read: keep working with the previous scan.
+    notRead = true;
     file = state.pendingScan.name;
     title = `Could not read the scan ${file}`;
     if (state.pendingScan.restored) {
@@ -524,6 +531,10 @@ function onPlanError(m, busy) {
   } else if (offered) {
     setStatus(`no G-code: the ${toolPathOutside(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
       state.lastPlan ? '; showing the previous plan' : ''}`, true);
+  } else if (notRead) {
+    // The scan still used, and its status, stand (it said "plan failed"
+    // where nothing had been planned).
+    setStatus(...busy.was);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 

@@ -348,3 +348,33 @@ test('a scan larger than the build volume is not offered "Place on the bed"', as
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A scan file that could not be read, after a scan whose plan was refused
+// (nothing planned), set the status to "plan failed" (a QA run): the scan
+// still used, and its status, stand.
+test('a scan not read leaves the status of the scan still used', async () => {
+  const lines = [];
+  for (let j = 0; j <= 4; j++) for (let i = 0; i <= 4; i++) lines.push(`v ${i * 20 - 300} ${j * 20} ${5 + ((i + j) % 2)}`);
+  for (let j = 0; j < 4; j++) {
+    for (let i = 0; i < 4; i++) {
+      const a = j * 5 + i + 1;
+      lines.push(`f ${a} ${a + 1} ${a + 6}`, `f ${a} ${a + 6} ${a + 5}`);
+    }
+  }
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', { name: 'off.obj', mimeType: 'text/plain', buffer: Buffer.from(`${lines.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'off.obj');
+  await waitIdle(page);
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /^no G-code: the scan lies outside the build volume \(see above\)$/);
+  await page.setInputFiles('#scan-input', { name: 'broken.stl', mimeType: 'application/octet-stream',
+    buffer: Buffer.from('solid broken\nfacet normal 0 0 1\n outer loop\n  vertex 1 2\n') });
+  await page.waitForSelector('#error-panel:not([hidden])');
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-title'), /^Could not read the scan broken\.stl/);
+  assert.equal(await page.textContent('#scan-name'), 'off.obj');
+  assert.equal(await page.textContent('#plan-status'), status);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
