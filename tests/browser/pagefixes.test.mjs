@@ -324,22 +324,27 @@ test('an empty number field is named as empty, not read as 0', async () => {
   await context.close();
 });
 
+// An OBJ of n x n cells `step` mm wide from (x0, y0), z alternating 5 and 6.
+function gridObj(n, step, x0, y0) {
+  const lines = [];
+  for (let j = 0; j <= n; j++) for (let i = 0; i <= n; i++) lines.push(`v ${x0 + i * step} ${y0 + j * step} ${5 + ((i + j) % 2)}`);
+  for (let j = 0; j < n; j++) {
+    for (let i = 0; i < n; i++) {
+      const a = j * (n + 1) + i + 1;
+      lines.push(`f ${a} ${a + 1} ${a + n + 2}`, `f ${a} ${a + n + 2} ${a + n + 1}`);
+    }
+  }
+  return `${lines.join('\n')}\n`;
+}
+
 // A scan larger than the build volume (a 1 m cube from a glTF sample) was
 // offered "Place on the bed", which cannot help, and the click failed with
 // a long doubled message (a QA run). The error says it is larger than the
 // volume; no banner.
 test('a scan larger than the build volume is not offered "Place on the bed"', async () => {
-  const lines = [];
-  for (let j = 0; j <= 10; j++) for (let i = 0; i <= 10; i++) lines.push(`v ${i * 30 - 150} ${j * 30 - 150} ${5 + ((i + j) % 2)}`);
-  for (let j = 0; j < 10; j++) {
-    for (let i = 0; i < 10; i++) {
-      const a = j * 11 + i + 1;
-      lines.push(`f ${a} ${a + 1} ${a + 12}`, `f ${a} ${a + 12} ${a + 11}`);
-    }
-  }
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
-  await page.setInputFiles('#scan-input', { name: 'big.obj', mimeType: 'text/plain', buffer: Buffer.from(`${lines.join('\n')}\n`) });
+  await page.setInputFiles('#scan-input', { name: 'big.obj', mimeType: 'text/plain', buffer: Buffer.from(gridObj(10, 30, -150, -150)) });
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'big.obj');
   await waitIdle(page);
   assert.equal(await page.isHidden('#place-banner'), true);
@@ -353,17 +358,9 @@ test('a scan larger than the build volume is not offered "Place on the bed"', as
 // (nothing planned), set the status to "plan failed" (a QA run): the scan
 // still used, and its status, stand.
 test('a scan not read leaves the status of the scan still used', async () => {
-  const lines = [];
-  for (let j = 0; j <= 4; j++) for (let i = 0; i <= 4; i++) lines.push(`v ${i * 20 - 300} ${j * 20} ${5 + ((i + j) % 2)}`);
-  for (let j = 0; j < 4; j++) {
-    for (let i = 0; i < 4; i++) {
-      const a = j * 5 + i + 1;
-      lines.push(`f ${a} ${a + 1} ${a + 6}`, `f ${a} ${a + 6} ${a + 5}`);
-    }
-  }
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);
-  await page.setInputFiles('#scan-input', { name: 'off.obj', mimeType: 'text/plain', buffer: Buffer.from(`${lines.join('\n')}\n`) });
+  await page.setInputFiles('#scan-input', { name: 'off.obj', mimeType: 'text/plain', buffer: Buffer.from(gridObj(4, 20, -300, 0)) });
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'off.obj');
   await waitIdle(page);
   const status = await page.textContent('#plan-status');
