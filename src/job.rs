@@ -726,7 +726,7 @@ pub fn report(
 /// the header's placement, which re-planned with `--place` must give the
 /// same G-code (rounded to 6 decimals, a page's scale 0.0850632 read back
 /// as 0.085063 moved 3 waypoints; found by a QA run).
-fn exact(v: f64) -> String {
+pub fn exact(v: f64) -> String {
     if v == 0.0 {
         "0".into()
     } else {

@@ -211,10 +211,10 @@ pub fn cmd_demo(a: &DemoArgs, progress: &Progress) -> CliResult<()> {
         "plan the drawing yourself: pcpp plan --scan {} --path {} --place {},{},{},{} -o {}.gcode",
         shell_word(&out.join(part.scan_name()).display().to_string()),
         shell_word(&out.join(part.path_name()).display().to_string()),
-        trimmed(p.offset_mm.x),
-        trimmed(p.offset_mm.y),
-        trimmed(p.rotation_deg),
-        trimmed(p.scale),
+        job::exact(p.offset_mm.x),
+        job::exact(p.offset_mm.y),
+        job::exact(p.rotation_deg),
+        job::exact(p.scale),
         demo_prefix(part)
     );
     print!("{s}");
@@ -229,15 +229,5 @@ fn shell_word(word: &str) -> String {
         word.into()
     } else {
         format!("'{}'", word.replace('\'', "'\\''"))
-    }
-}
-
-/// A number as typed, exactly (shortest round trip, never `-0`): the
-/// command plans what the demo planned.
-fn trimmed(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else {
-        v.to_string()
     }
 }

@@ -26,7 +26,8 @@ pub fn input_shown(path: &Path) -> String {
     }
 }
 
-/// Whether `path` (an input) is `-`, standard input.
+/// Whether `path` (an input) is `-`, standard input (and an output `-`,
+/// standard output: [`is_stdout`]).
 pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
@@ -261,7 +262,7 @@ pub fn read_gcode_text(path: &Path) -> CliResult<(String, Option<String>)> {
             let note = format!(
                 "{}, {at}: bytes that are not UTF-8 (Latin-1 or another legacy encoding?) read \
                  as U+FFFD; in a comment they change nothing",
-                path.display()
+                input_shown(path)
             );
             Ok((text, Some(note)))
         }
@@ -324,7 +325,7 @@ enum Stream {
 
 /// Whether `path` (an output) is `-`, standard output.
 pub fn is_stdout(path: &Path) -> bool {
-    path.as_os_str() == "-"
+    is_stdin(path)
 }
 
 impl Staged {

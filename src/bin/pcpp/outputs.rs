@@ -69,7 +69,7 @@ impl<'a> Outputs<'a> {
         }
         let mut stdin: Option<Flagged> = None;
         for input in inputs {
-            if input.path.as_os_str() == "-" {
+            if crate::files::is_stdin(input.path) {
                 if let Some(first) = stdin {
                     return Err(usage(
                         command,
