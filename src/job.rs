@@ -532,49 +532,67 @@ pub fn prepare_scan_owned_with(
     let read = bytes.as_ref();
     // The provenance hash off the critical path (issue 15): natively on a
     // second thread while the scan is read.
-    let (imported, (file, digests)) = crate::parallel::join(
-        || pipeline::load_scan_with(read, name, scan, &external),
+    let (unwelded, (file, digests)) = crate::parallel::join(
+        || crate::mesh::import_mesh_unwelded(read, name, scan, &external),
         || {
             let digests: Vec<[u8; 32]> = external.iter().map(|(_, b)| sha256(b)).collect();
             (InputFile::new(name, read), digests)
         },
     );
     drop(bytes);
-    let imported = imported?;
-    let file = file.with_external_files(InputFile::external_of(&imported, &external, &digests));
+    let unwelded = unwelded?;
+    let file = file.with_external_files(InputFile::external_of(
+        unwelded.imported(),
+        &external,
+        &digests,
+    ));
     drop(external);
-    let mesh = &imported.mesh;
     let dot = registration.dot_diameter_mm;
     // Only `auto` fiducials register with the holes. Without them, and
     // with the scan staying where it is (the registration moves no
-    // vertex), the index is built on this mesh while its topology and
-    // holes are found (natively on a second thread).
+    // vertex), the index is built on this mesh while it is welded and its
+    // topology and holes are found (natively on a second thread): the index
+    // needs only the triangles' positions, which the weld does not change
+    // (issue 15: the weld off the critical path).
     let holes_needed = matches!(registration.fiducials, FiducialSource::Auto)
         && !matches!(registration.scan_placement, ScanPlacement::OnBed { .. });
     let early = if holes_needed {
         None
     } else {
-        Some(registration_for_scan(&imported, &[], registration)?)
+        Some(registration_for_scan(
+            unwelded.imported(),
+            &[],
+            registration,
+        )?)
+    };
+    let holes = |mesh: &TriMesh| {
+        let topology = Topology::of(mesh);
+        let fiducials = find_fiducials_in(mesh, &topology, dot);
+        (topology, fiducials)
     };
     if let Some(reg) = early.clone() {
         if reg.matrix == glam::DMat4::IDENTITY {
-            let ((topology, fiducials), indexed) = crate::parallel::join(
+            let ((map, found), indexed) = crate::parallel::join(
                 || {
-                    let topology = Topology::of(mesh);
-                    let fiducials = find_fiducials_in(mesh, &topology, dot);
-                    (topology, fiducials)
+                    let map = unwelded.weld_map();
+                    // Nothing to merge: the mesh is the welded one already.
+                    let found = map.is_none().then(|| holes(&unwelded.imported().mesh));
+                    (map, found)
                 },
-                || Indexed::build(mesh, SpatialIndex::Auto),
+                || Indexed::build(&unwelded.imported().mesh, SpatialIndex::Auto),
             );
             let indexed = indexed?;
+            let imported = unwelded.finish(map);
+            let (topology, fiducials) = found.unwrap_or_else(|| holes(&imported.mesh));
             return PreparedScan::new(file, imported, fiducials, reg, registration.method, |m| {
                 Surface::from_index(m, indexed, topology)
             });
         }
     }
+    let imported = unwelded.welded();
+    let mesh = &imported.mesh;
     // One pass over the edges for the holes and the index.
-    let topology = Topology::of(mesh);
-    let fiducials = find_fiducials_in(mesh, &topology, dot);
+    let (topology, fiducials) = holes(mesh);
     let reg = match early {
         Some(reg) => reg,
         None => registration_for_scan(&imported, &fiducials, registration)?,
@@ -1548,7 +1566,28 @@ mod tests {
 
     #[test]
     fn index_built_beside_the_topology_gives_what_the_stages_give() {
-        let bytes = crate::demo::to_binary_ply(&test_part::test_part());
+        let part = test_part::test_part();
+        let bytes = crate::demo::to_binary_ply(&part);
+        // The same part with each triangle's corners a vertex of their own
+        // (as an STL exported to PLY): the weld, run beside the index,
+        // merges them, and the holes are those of the welded mesh.
+        let mut split = TriMesh {
+            vertices: Vec::new(),
+            triangles: Vec::new(),
+        };
+        for i in 0..part.triangles.len() {
+            let n = split.vertices.len() as u32;
+            split.vertices.extend(part.triangle(i));
+            split.triangles.push([n, n + 1, n + 2]);
+        }
+        // And a triangle two of whose corners are one position: skipped.
+        let n = split.vertices.len() as u32;
+        split
+            .vertices
+            .extend([part.vertices[0], part.vertices[0], part.vertices[1]]);
+        split.triangles.push([n, n + 1, n + 2]);
+        let split = crate::demo::to_binary_ply(&split);
+        let whole = bytes.clone();
         let scan = ImportOptions::DEFAULT;
         let bed = ScanPlacement::OnBed {
             bed: crate::placement::Bed::of_profile(&MachineProfile::builtin("marlin").unwrap()),
@@ -1557,21 +1596,32 @@ mod tests {
         };
         // As scanned (the index beside the topology), and placed on the
         // bed (one after the other, the mesh moved first).
-        for placement in [ScanPlacement::AsScanned, bed] {
+        for (bytes, placement) in [
+            (&bytes, ScanPlacement::AsScanned),
+            (&split, ScanPlacement::AsScanned),
+            (&bytes, bed),
+        ] {
             let settings = RegistrationSettings {
                 scan_placement: placement,
                 ..Default::default()
             };
             let got = prepare_scan_owned(bytes.clone(), "part.ply", &scan, &settings).unwrap();
-            let imported = pipeline::load_scan(&bytes, "part.ply", &scan).unwrap();
+            let imported = pipeline::load_scan(bytes, "part.ply", &scan).unwrap();
+            // The split part welds back to the part's vertices (those its
+            // triangles use).
+            let whole = pipeline::load_scan(&whole, "part.ply", &scan).unwrap().mesh;
+            assert!(imported.mesh.vertices.len() <= whole.vertices.len());
+            assert_eq!(imported.mesh.triangles.len(), whole.triangles.len());
             let topology = Topology::of(&imported.mesh);
             let holes = find_fiducials_in(&imported.mesh, &topology, settings.dot_diameter_mm);
             let reg = registration_for_scan(&imported, &holes, &settings).unwrap();
-            let file = InputFile::new("part.ply", &bytes);
+            let file = InputFile::new("part.ply", bytes);
             let want =
                 PreparedScan::assemble(file, imported, topology, holes, reg, settings.method)
                     .unwrap();
             assert_eq!(got.file, want.file);
+            assert_eq!(got.warnings, want.warnings);
+            assert!(!want.fiducials.is_empty());
             assert_eq!(got.fiducials, want.fiducials);
             assert_eq!(got.registration, want.registration);
             assert_eq!(got.surface.mesh(), want.surface.mesh());

@@ -143,6 +143,17 @@ pub fn import_mesh_with(
     options: &ImportOptions,
     external: &ExternalFiles,
 ) -> Result<ImportedMesh, MeshError> {
+    Ok(import_mesh_unwelded(bytes, file, options, external)?.welded())
+}
+
+/// [`import_mesh_with`] up to the weld, which the caller finishes
+/// ([`Unwelded`]), so that it can build the index meanwhile.
+pub fn import_mesh_unwelded(
+    bytes: &[u8],
+    file: &str,
+    options: &ImportOptions,
+    external: &ExternalFiles,
+) -> Result<Unwelded, MeshError> {
     check_scan_size(bytes.len(), file)?;
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(MeshError::invalid(file, "the file is empty"));
@@ -247,7 +258,7 @@ fn finish_import(
     file: &str,
     options: &ImportOptions,
     external_files: Vec<String>,
-) -> Result<ImportedMesh, MeshError> {
+) -> Result<Unwelded, MeshError> {
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
     // A PLY or OBJ with vertices and no faces is a point cloud too
@@ -260,26 +271,86 @@ fn finish_import(
         _ => false,
     };
     if cloud {
-        return import_cloud(parsed, file, format, options, units, up_axis);
+        return import_cloud(parsed, file, format, options, units, up_axis).map(|imported| {
+            Unwelded {
+                imported,
+                weld: false,
+            }
+        });
     }
     // STL and glTF parsers weld as they read; OBJ and PLY files from
     // exporters often split vertices at UV seams too (a Blender PLY cube has
     // 24 vertices), which would turn every seam into fake holes for the
-    // fiducial detector, so they are welded here.
+    // fiducial detector, so they are welded after this ([`Unwelded`]).
     let weld = matches!(format, MeshFormat::Obj | MeshFormat::Ply);
-    let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis, weld)?;
+    let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis)?;
     let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
     warnings.extend(units_doubt.map(|d| d.message(file)));
-    Ok(ImportedMesh {
-        mesh,
-        format,
-        units,
-        up_axis,
-        warnings,
-        cloud: None,
-        units_doubt,
-        external_files,
+    Ok(Unwelded {
+        imported: ImportedMesh {
+            mesh,
+            format,
+            units,
+            up_axis,
+            warnings,
+            cloud: None,
+            units_doubt,
+            external_files,
+        },
+        weld,
     })
+}
+
+/// A scan read ([`import_mesh_unwelded`]) whose bit-identical positions
+/// are not merged yet: its triangles (which ones, in which order, and
+/// their corners' positions) and its vertices' positions are final; only
+/// which vertex a corner names, and the vertices' count, change when it is
+/// welded. What needs the positions alone, the surface index, can be
+/// built on it while the weld runs (issue 15: the weld is then off the
+/// critical path of `pcpp plan`), and is valid for the welded mesh.
+#[derive(Debug, Clone)]
+pub struct Unwelded {
+    imported: ImportedMesh,
+    /// Whether the format is welded here (OBJ and PLY; the other parsers
+    /// weld as they read).
+    weld: bool,
+}
+
+/// Which vertex each vertex merges into ([`Unwelded::weld_map`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeldMap(Vec<u32>);
+
+impl Unwelded {
+    /// The scan as read, not welded.
+    pub fn imported(&self) -> &ImportedMesh {
+        &self.imported
+    }
+
+    /// The weld's map, found without changing the mesh: `None` when no two
+    /// vertices share a position (or the format needs no weld here), and
+    /// then the mesh is final as it is.
+    pub fn weld_map(&self) -> Option<WeldMap> {
+        if !self.weld {
+            return None;
+        }
+        weld_map(&self.imported.mesh.vertices).map(WeldMap)
+    }
+
+    /// The welded scan, given this mesh's [`Self::weld_map`].
+    pub fn finish(self, map: Option<WeldMap>) -> ImportedMesh {
+        let mut imported = self.imported;
+        if let Some(WeldMap(map)) = map {
+            let mesh = &mut imported.mesh;
+            apply_weld(&mut mesh.vertices, &mut mesh.triangles, map);
+        }
+        imported
+    }
+
+    /// The welded scan.
+    pub fn welded(self) -> ImportedMesh {
+        let map = self.weld_map();
+        self.finish(map)
+    }
 }
 
 /// A file named as a text format (OBJ, XYZ) that holds binary data: an
@@ -521,7 +592,6 @@ fn finish(
     file: &str,
     scale: f64,
     up_axis: UpAxis,
-    weld: bool,
 ) -> Result<(TriMesh, Vec<String>), MeshError> {
     let Parsed {
         mut vertices,
@@ -530,14 +600,10 @@ fn finish(
     } = parsed;
     check_finite(&vertices, file)?;
     let n = vertices.len();
-    // remap[i]: the welded index of vertex i (bit-identical positions merge).
-    let remap = if weld {
-        weld_in_place(&mut vertices)
-    } else {
-        None
-    };
     // The kept triangles move to the front of the array they were read
-    // into (no second array of them).
+    // into (no second array of them). A triangle two of whose corners the
+    // weld would merge has those corners at one position, so it has zero
+    // area here already: the same triangles are kept welded or not.
     let mut kept = 0usize;
     for face in 0..triangles.len() {
         let tri = triangles[face];
@@ -550,10 +616,6 @@ fn finish(
                 vertex_count: n,
             });
         }
-        let tri = match &remap {
-            Some(r) => tri.map(|i| r[i as usize]),
-            None => tri,
-        };
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
         if !(tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c)) {
             triangles[kept] = tri;
@@ -660,22 +722,29 @@ impl WeldTable {
             self.grow(kept);
         }
         let k = key(p);
-        self.find_or_add_hashed(k, key_hash(k), kept)
+        self.find_or_add_hashed_at(k, key_hash(k), kept, kept.len())
     }
 
-    /// [`Self::find_or_add`] of the key `k` whose hash is `hash`, in a
-    /// table with room for one more.
+    /// The vertex holding the key `k` (whose hash is `hash`) in a table
+    /// with room for one more, or `None` after adding vertex `index` for
+    /// it. The table's vertices are indices into `positions`.
     #[inline]
-    fn find_or_add_hashed(&mut self, k: [u64; 3], hash: u64, kept: &[DVec3]) -> Option<u32> {
+    fn find_or_add_hashed_at(
+        &mut self,
+        k: [u64; 3],
+        hash: u64,
+        positions: &[DVec3],
+        index: usize,
+    ) -> Option<u32> {
         let mask = self.slots.len() - 1;
         let mut at = hash as usize & mask;
         loop {
             match self.slots[at] {
                 FREE => {
-                    self.slots[at] = Self::slot(hash, kept.len());
+                    self.slots[at] = Self::slot(hash, index);
                     return None;
                 }
-                s if (s ^ hash) >> 32 == 0 && key(kept[s as u32 as usize]) == k => {
+                s if (s ^ hash) >> 32 == 0 && key(positions[s as u32 as usize]) == k => {
                     return Some(s as u32);
                 }
                 _ => at = (at + 1) & mask,
@@ -753,20 +822,19 @@ impl Welder {
     }
 }
 
-/// Welds `vertices` in place (the kept ones move to the front, in order of
-/// first appearance): the welded index of each vertex, or `None` when all
-/// are distinct (and `vertices` is as it was).
-fn weld_in_place(vertices: &mut Vec<DVec3>) -> Option<Vec<u32>> {
+/// The weld of `vertices`, found without moving them: the first vertex
+/// with each one's position (bit-identical, -0 and 0 alike), or `None`
+/// when all are distinct.
+fn weld_map(vertices: &[DVec3]) -> Option<Vec<u32>> {
     let n = vertices.len();
     if n >= EMPTY as usize {
         return None;
     }
     let mut table = WeldTable::with_capacity(n);
-    // Made at the first repeat (until then every vertex is kept where it
-    // is): a scan whose vertices are all distinct, as most are, never
-    // fills it (4 MB of fresh memory for 1 M vertices).
-    let mut remap: Option<Vec<u32>> = None;
-    let mut kept = 0usize;
+    // Made at the first repeat (until then each vertex maps to itself): a
+    // scan whose vertices are all distinct, as most are, never fills it
+    // (4 MB of fresh memory for 1 M vertices).
+    let mut map: Option<Vec<u32>> = None;
     // In batches: the batch's slots are fetched before any is probed.
     const BATCH: usize = 16;
     let mut keys = [([0u64; 3], 0u64); BATCH];
@@ -779,26 +847,43 @@ fn weld_in_place(vertices: &mut Vec<DVec3>) -> Option<Vec<u32>> {
         }
         for (i, &(k, hash)) in (start..end).zip(&keys) {
             // The table has room for all n vertices: it never grows here.
-            match table.find_or_add_hashed(k, hash, &vertices[..kept]) {
-                Some(j) => remap
-                    .get_or_insert_with(|| {
-                        let mut r = Vec::with_capacity(n);
-                        r.extend(0..i as u32);
-                        r
-                    })
-                    .push(j),
-                None => {
-                    vertices[kept] = vertices[i];
-                    if let Some(r) = &mut remap {
-                        r.push(kept as u32);
-                    }
-                    kept += 1;
+            // It holds the first vertex of each position, by its index in
+            // `vertices` (the kept ones are not moved to the front).
+            let first = table.find_or_add_hashed_at(k, hash, vertices, i);
+            match (&mut map, first) {
+                (Some(m), first) => m.push(first.unwrap_or(i as u32)),
+                (None, Some(first)) => {
+                    let mut m = Vec::with_capacity(n);
+                    m.extend(0..i as u32);
+                    m.push(first);
+                    map = Some(m);
                 }
+                (None, None) => {}
             }
         }
     }
+    map
+}
+
+/// Welds by `map` ([`weld_map`]): the kept vertices (the first of each
+/// position) move to the front in order, and the triangles name them.
+fn apply_weld(vertices: &mut Vec<DVec3>, triangles: &mut [[u32; 3]], mut map: Vec<u32>) {
+    let mut kept = 0usize;
+    for i in 0..map.len() {
+        let first = map[i] as usize;
+        if first == i {
+            vertices[kept] = vertices[i];
+            map[i] = kept as u32;
+            kept += 1;
+        } else {
+            // The first is before i: its new index is already in place.
+            map[i] = map[first];
+        }
+    }
     vertices.truncate(kept);
-    remap
+    for t in triangles {
+        *t = t.map(|k| map[k as usize]);
+    }
 }
 
 #[cfg(test)]
@@ -886,7 +971,7 @@ mod tests {
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
             warnings: vec![],
         };
-        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z, false).unwrap();
+        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z).unwrap();
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
@@ -992,7 +1077,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             warnings: vec![],
         };
-        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y, false).unwrap();
+        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
         assert_eq!(mesh.vertices[2], DVec3::new(0.0, 0.0, 2.0));
     }
 
@@ -1034,17 +1119,40 @@ mod tests {
     }
 
     #[test]
-    fn welding_in_place_keeps_first_appearances_in_order() {
+    fn welding_keeps_first_appearances_in_order() {
         let original = repeating(5_000, 700);
+        let map = weld_map(&original).expect("repeats were merged");
+        // Each vertex maps to the first with its position.
+        for (i, &first) in map.iter().enumerate() {
+            let first = first as usize;
+            assert!(first <= i);
+            assert_eq!(super::key(original[first]), super::key(original[i]));
+            assert_eq!(
+                original[..first]
+                    .iter()
+                    .position(|&p| super::key(p) == super::key(original[i])),
+                None
+            );
+        }
+        // Applied, as the welder that welds while reading does it.
         let mut v = original.clone();
-        let remap = weld_in_place(&mut v).expect("repeats were merged");
+        let mut tris: Vec<[u32; 3]> = (0..original.len() as u32 - 2)
+            .map(|i| [i, i + 1, i + 2])
+            .collect();
+        apply_weld(&mut v, &mut tris, map);
         let mut w = Welder::default();
         let expected: Vec<u32> = original.iter().map(|&p| w.index(p).unwrap()).collect();
-        assert_eq!(remap, expected);
         assert_eq!(v, w.vertices);
-        // All distinct: nothing to remap, the vertices untouched.
-        let mut distinct = vec![DVec3::ZERO, DVec3::X, DVec3::new(-0.5, 0.0, 1.0)];
-        assert_eq!(weld_in_place(&mut distinct), None);
-        assert_eq!(distinct.len(), 3);
+        for (i, t) in tris.iter().enumerate() {
+            assert_eq!(*t, [expected[i], expected[i + 1], expected[i + 2]]);
+        }
+        // All distinct: nothing to map.
+        let distinct = vec![DVec3::ZERO, DVec3::X, DVec3::new(-0.5, 0.0, 1.0)];
+        assert_eq!(weld_map(&distinct), None);
+        // -0 and 0 are one position.
+        assert_eq!(
+            weld_map(&[DVec3::new(0.0, 1.0, 2.0), DVec3::new(-0.0, 1.0, 2.0)]),
+            Some(vec![0, 0])
+        );
     }
 }

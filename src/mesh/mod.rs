@@ -33,7 +33,8 @@ pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use external::{ExternalFiles, ExternalRef};
 pub use import::{
-    detect_format, external_files_needed, import_mesh, import_mesh_with, UnitsDoubt, SMALL_SCAN_MM,
+    detect_format, external_files_needed, import_mesh, import_mesh_unwelded, import_mesh_with,
+    UnitsDoubt, Unwelded, WeldMap, SMALL_SCAN_MM,
 };
 pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
