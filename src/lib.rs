@@ -53,6 +53,7 @@ pub mod registration;
 #[cfg(target_arch = "wasm32")]
 pub mod render;
 pub mod sampling;
+pub mod spacing;
 pub mod spline;
 pub mod stats;
 pub mod surface;

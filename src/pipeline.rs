@@ -25,6 +25,7 @@ use crate::projection::project_subpath;
 use crate::quality::{predict, summarize, PointQuality, QualitySummary};
 use crate::registration::Registration;
 use crate::sampling::try_sample_subpath;
+use crate::spacing::{close_lines, Line};
 use crate::spline::{local_geometry, LocalGeometry};
 use crate::stats::{path_stats, PathStats};
 use crate::surface::Surface;
@@ -131,6 +132,8 @@ pub fn surface_path(
     let mut dots: Vec<String> = Vec::new();
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    // Each subpath's samples as placed, for `close_lines`.
+    let mut sampled: Vec<(&str, Vec<DVec2>, bool)> = Vec::with_capacity(drawn.len());
     for sub in drawn {
         // Sampled after placement so the spacing is d/2 in printer mm.
         let placed = placement.apply_subpath(sub);
@@ -170,6 +173,19 @@ pub fn surface_path(
                 geometry,
             });
         }
+        sampled.push((sub.source.as_str(), samples, placed.closed));
+    }
+    // Lines closer together than the filament is wide merge (`spacing`).
+    let lines: Vec<Line> = sampled
+        .iter()
+        .map(|(source, points, closed)| Line {
+            source,
+            points,
+            closed: *closed,
+        })
+        .collect();
+    if let Some(close) = close_lines(&lines, nozzle.inner_diameter_mm) {
+        warnings.push(close.message(nozzle.inner_diameter_mm));
     }
     if pieces.is_empty() {
         let (slo, shi) = surface.bbox();

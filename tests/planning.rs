@@ -825,3 +825,60 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
         "{e}"
     );
 }
+
+/// The page's Hilbert loop of order 7 at 20 mm has lines 0.16 mm apart,
+/// a quarter of the filament's width: it was planned into one merged
+/// band (a short circuit for the antenna) without a word. The plan now
+/// warns, in the report and the G-code header; order 4 (1.33 mm apart) is
+/// planned as before, without it.
+#[test]
+fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
+    use pcpp::job::{prepare_scan, run_on, RegistrationSettings};
+    let xs = range(0.0, 30.0, 150);
+    let ys = range(0.0, 30.0, 150);
+    let mesh = height_field(&xs, &ys, |x, y| {
+        1.0 + 0.2 * (0.3 * x).sin() * (0.2 * y).cos()
+    });
+    let bytes = pcpp::demo::to_binary_ply(&mesh);
+    let scan = prepare_scan(
+        &bytes,
+        "film.ply",
+        &pcpp::mesh::ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )
+    .unwrap();
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    for (order, merged) in [(4, false), (7, true)] {
+        let svg = pcpp::demo::antennas::hilbert_loop_svg(order, 20.0).unwrap();
+        let mut settings = PlanSettings::default();
+        settings.placement.offset_mm = DVec2::new(5.0, 25.0);
+        let out = run_on(
+            &scan,
+            svg.as_bytes(),
+            "hilbert.svg",
+            &settings,
+            &profile,
+            false,
+        )
+        .unwrap_or_else(|e| panic!("order {order}: {e}"));
+        let warning = out
+            .report
+            .warnings
+            .iter()
+            .find(|w| w.contains("their filaments will merge"));
+        assert_eq!(
+            warning.is_some(),
+            merged,
+            "order {order}: {:?}",
+            out.report.warnings
+        );
+        if let Some(w) = warning {
+            assert!(
+                w.starts_with("lines of the drawing come within 0.15")
+                    && w.contains("less than the nozzle's inner diameter (0.603 mm"),
+                "{w}"
+            );
+            assert!(out.gcode.contains("their filaments will merge"));
+        }
+    }
+}

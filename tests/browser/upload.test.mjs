@@ -167,6 +167,18 @@ test('a built-in antenna plans on an uploaded scan, centred on it', async () => 
   const mid = (v) => (Math.min(...v) + Math.max(...v)) / 2;
   assert.ok(Math.abs(mid(xs) - 20) < 1 && Math.abs(mid(ys) - 20) < 1, `centre ${mid(xs)}, ${mid(ys)} (offset ${x}, ${y})`);
   assert.equal(json.inputs[1].name, 'antenna-hilbert.svg');
+  const merged = async () => (await page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent)))
+    .filter((w) => w.includes('their filaments will merge'));
+  assert.deepEqual(await merged(), []);
+  // Order 7 at 16 mm: lines 0.13 mm apart, a fifth of the filament's
+  // width, were planned into one band without a word.
+  await page.fill('#hb-order', '7');
+  await page.dispatchEvent('#hb-order', 'change');
+  await waitIdle(page);
+  await waitForPlan(page);
+  const warned = await merged();
+  assert.equal(warned.length, 1, JSON.stringify(warned));
+  assert.match(warned[0], /^lines of the drawing come within 0\.12\d mm of each other/);
   assert.deepEqual(problems, []);
   await context.close();
 });
