@@ -144,7 +144,7 @@ pub struct SafePath {
 /// points would come closer than `clearance` allows (spec section 6f):
 /// at the worst place of the move, raised to the lowest safe height there,
 /// then the two halves checked again. A move that needs more than
-/// [`MAX_WAYPOINTS_PER_MOVE`] rises over its whole footprint at once
+/// `MAX_WAYPOINTS_PER_MOVE` rises over its whole footprint at once
 /// (vertical rise, level move, vertical descent), which is always safe
 /// when its two ends are.
 pub fn insert_waypoints(surface: &Surface, planned: &[DVec3], clearance: &Clearance) -> SafePath {

@@ -135,9 +135,9 @@ pub struct GcodeProgram {
     /// a known safe height from an unknown X/Y) may still be judged.
     pub unknown_moves: Vec<UnknownMove>,
     /// What was skipped or assumed, one sentence per kind, in order of first
-    /// appearance, each naming its first lines, e.g. `lines 3-5, 9: not
+    /// appearance, each naming its first lines, e.g. "lines 3-5, 9: not
     /// G-code words, skipped (controller statements or macros such as
-    /// `$DO[0].X = 1`); ...`.
+    /// `$DO[0].X = 1`); ...".
     pub notes: Vec<String>,
     /// Which of `notes` lists the moves made before every axis had a
     /// known position (a checker that says of each unknown move whether it

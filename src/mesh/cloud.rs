@@ -145,7 +145,7 @@ impl HasPosition for Vertex {
 /// Meshes `points` (mm, printer axes, all finite) as a height field over
 /// XY: duplicates in XY merged keeping the highest (a height field has one
 /// height per XY, and the nozzle must clear the highest), the points under
-/// the surface seen from above left out ([`hidden_points`]), a Delaunay
+/// the surface seen from above left out (`hidden_points`), a Delaunay
 /// triangulation of the rest, and the triangles with an XY edge longer
 /// than `max_edge_mm` (default [`EDGE_LIMIT_PER_SPACING`] times the median
 /// nearest-neighbour spacing) left out. Triangles are counter-clockwise

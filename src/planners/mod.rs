@@ -6,7 +6,7 @@
 //! - `pcpp`: the paper's one-pass correction (Algorithm 4, eq. 6-14).
 //! - `pcpp-guarded` (beyond the paper, section 6d): `pcpp`, then re-tested
 //!   until the nozzle clears the surface by at least tol.
-//! - `even` (ours, section 6e, [`even`]): the filament thickness of
+//! - `even` (ours, section 6e, module `even`): the filament thickness of
 //!   section 7 as close to d as the surface allows, with no contact along
 //!   any move and a tool path that always progresses.
 //!
