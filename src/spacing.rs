@@ -90,12 +90,10 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
     }
     let nx = ((ext.x / cell).ceil() as usize).max(1);
     let ny = ((ext.y / cell).ceil() as usize).max(1);
+    // (Not negative: `lo` is the least; `as` truncates, a floor here.)
     let at = |p: DVec2| {
-        let c = ((p - lo) / cell).floor();
-        (
-            (c.x.max(0.0) as usize).min(nx - 1),
-            (c.y.max(0.0) as usize).min(ny - 1),
-        )
+        let c = (p - lo) / cell;
+        ((c.x as usize).min(nx - 1), (c.y as usize).min(ny - 1))
     };
     // Segments (line, first point) by cell: counted, then placed.
     let mut count = vec![0u32; nx * ny + 1];

@@ -94,8 +94,9 @@ impl Spline {
         let mut a = vec![0.0; n * w];
         let mut rhs = q.to_vec();
         let mut basis = [0.0; 4];
+        let hint = std::cell::Cell::new(usize::MAX);
         for k in 0..n {
-            let span = self.find_span(self.params[k]);
+            let span = self.span_near(self.params[k], &hint);
             self.basis_funs(span, self.params[k], &mut basis);
             for (r, &b) in basis.iter().enumerate().take(p + 1) {
                 let col = span - p + r;
@@ -270,20 +271,7 @@ impl Spline {
     pub fn eval_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> DVec3 {
         let u = u.clamp(0.0, 1.0);
         let p = self.degree;
-        let n = self.ctrl.len().max(self.params.len()) - 1;
-        let h = hint.get();
-        let inside =
-            |k: usize| k >= p && k <= n && u >= self.knots[k] && (u < self.knots[k + 1] || k == n);
-        let span = if inside(h) {
-            h
-        } else if h < n && inside(h + 1) {
-            h + 1
-        } else if h > p && h != usize::MAX && inside(h - 1) {
-            h - 1
-        } else {
-            self.find_span(u)
-        };
-        hint.set(span);
+        let span = self.span_near(u, hint);
         let mut basis = [0.0; 4];
         self.basis_funs(span, u, &mut basis);
         let ctrl = &self.ctrl[span - p..=span];
@@ -300,11 +288,40 @@ impl Spline {
             .fold(DVec3::ZERO, |acc, (c, w)| acc + *c * *w)
     }
 
+    /// The knot span of `u` in [0, 1] ([`Self::find_span`]'s), trying the
+    /// one in `hint` and its neighbours first, and left there. The span
+    /// holding u is unique (the one whose interval [u_k, u_k+1) is not
+    /// empty and holds it, or an end's), so the hint changes no result.
+    fn span_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> usize {
+        let p = self.degree;
+        let n = self.ctrl.len().max(self.params.len()) - 1;
+        let h = hint.get();
+        let inside =
+            |k: usize| k >= p && k <= n && u >= self.knots[k] && (u < self.knots[k + 1] || k == n);
+        let span = if inside(h) {
+            h
+        } else if h < n && inside(h + 1) {
+            h + 1
+        } else if h > p && h != usize::MAX && inside(h - 1) {
+            h - 1
+        } else {
+            self.find_span(u)
+        };
+        hint.set(span);
+        span
+    }
+
     /// C(u), C'(u), C''(u).
     pub fn derivs(&self, u: f64) -> [DVec3; 3] {
+        self.derivs_near(u, &std::cell::Cell::new(usize::MAX))
+    }
+
+    /// [`Self::derivs`] with a span hint, as [`Self::eval_near`]: the
+    /// points' parameters, taken in order, step a span at a time.
+    pub fn derivs_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> [DVec3; 3] {
         let u = u.clamp(0.0, 1.0);
         let p = self.degree;
-        let span = self.find_span(u);
+        let span = self.span_near(u, hint);
         let d = self.ders_basis_funs(span, u);
         let mut out = [DVec3::ZERO; 3];
         for (k, o) in out.iter_mut().enumerate() {
@@ -382,11 +399,12 @@ pub fn geometry_of(spline: &Spline) -> Vec<LocalGeometry> {
     let mut out: Vec<LocalGeometry> = Vec::with_capacity(spline.params.len());
     let mut vertical = Vec::new();
     // C' and C'' at each u_j, evaluated once for both passes.
+    let hint = std::cell::Cell::new(usize::MAX);
     let ders: Vec<[DVec3; 2]> = spline
         .params
         .iter()
         .map(|&u| {
-            let [_, d1, d2] = spline.derivs(u);
+            let [_, d1, d2] = spline.derivs_near(u, &hint);
             [d1, d2]
         })
         .collect();
@@ -479,6 +497,31 @@ const CUSP: f64 = 1e-9;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The span hint changes no bit: every parameter and knot, in order,
+    /// backwards and from a hint far off, gives `find_span`'s span.
+    #[test]
+    fn a_span_hint_gives_the_searched_span() {
+        let pts: Vec<DVec3> = (0..40)
+            .map(|i| {
+                let x = i as f64 * 0.25;
+                DVec3::new(x, (x * 0.7).cos(), 0.05 * x * x)
+            })
+            .collect();
+        let s = Spline::interpolate(&pts).unwrap();
+        let mut us: Vec<f64> = s.params().to_vec();
+        us.extend(s.knots.iter().copied());
+        us.extend((0..=100).map(|i| i as f64 / 100.0));
+        for order in [us.clone(), us.iter().rev().copied().collect()] {
+            let hint = std::cell::Cell::new(usize::MAX);
+            for &u in &order {
+                assert_eq!(s.span_near(u, &hint), s.find_span(u), "u {u}");
+                let far = std::cell::Cell::new(3);
+                assert_eq!(s.span_near(u, &far), s.find_span(u), "u {u}");
+                assert_eq!(s.derivs_near(u, &hint), s.derivs(u));
+            }
+        }
+    }
 
     #[test]
     fn interpolates_its_points() {
