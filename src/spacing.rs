@@ -143,9 +143,21 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
     let mut length = 0.0;
     let mut closest = f64::INFINITY;
     for (k, line) in lines.iter().enumerate() {
-        let total = arcs[k].last().copied().unwrap_or(0.0);
+        let arc = &arcs[k];
+        let total = arc.last().copied().unwrap_or(0.0);
+        // The segments lo..hi of this line lie wholly within 3 d of the
+        // sample along it (arc[lo] >= s - 3 d, arc[hi] <= s + 3 d): its
+        // neighbours, passed over on their index alone (most of what a
+        // sample finds near it; the closure's are left to the test below).
+        let (mut lo, mut hi) = (0usize, 0usize);
         for (i, &p) in line.points.iter().enumerate() {
-            let s = arcs[k][i];
+            let s = arc[i];
+            while arc[lo] < s - apart {
+                lo += 1;
+            }
+            while hi + 1 < arc.len() && arc[hi + 1] <= s + apart {
+                hi += 1;
+            }
             let (cx, cy) = at(p);
             // Every sample stops at the first other line within d, but the
             // first flagged ones and every 16th after them look at all, for
@@ -158,6 +170,9 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
                     let c = y * nx + x;
                     for &(k2, j) in &items[start[c] as usize..start[c + 1] as usize] {
                         let (k2, j) = (k2 as usize, j as usize);
+                        if k2 == k && j >= lo && j < hi {
+                            continue;
+                        }
                         let pts = lines[k2].points;
                         let (a, b) = (pts[j], pts[j + 1]);
                         let ab = b - a;
@@ -190,7 +205,6 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
             }
             if near < limit {
                 samples += 1;
-                let arc = &arcs[k];
                 length += 0.5 * (arc[(i + 1).min(arc.len() - 1)] - arc[i.saturating_sub(1)]);
                 closest = closest.min(near);
                 found.get_or_insert_with(|| CloseLines {
