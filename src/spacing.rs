@@ -145,18 +145,18 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
     for (k, line) in lines.iter().enumerate() {
         let arc = &arcs[k];
         let total = arc.last().copied().unwrap_or(0.0);
-        // The segments lo..hi of this line lie wholly within 3 d of the
-        // sample along it (arc[lo] >= s - 3 d, arc[hi] <= s + 3 d): its
+        // The segments from..to of this line lie wholly within 3 d of the
+        // sample along it (arc[from] >= s - 3 d, arc[to] <= s + 3 d): its
         // neighbours, passed over on their index alone (most of what a
         // sample finds near it; the closure's are left to the test below).
-        let (mut lo, mut hi) = (0usize, 0usize);
+        let (mut from, mut to) = (0usize, 0usize);
         for (i, &p) in line.points.iter().enumerate() {
             let s = arc[i];
-            while arc[lo] < s - apart {
-                lo += 1;
+            while arc[from] < s - apart {
+                from += 1;
             }
-            while hi + 1 < arc.len() && arc[hi + 1] <= s + apart {
-                hi += 1;
+            while to + 1 < arc.len() && arc[to + 1] <= s + apart {
+                to += 1;
             }
             let (cx, cy) = at(p);
             // Every sample stops at the first other line within d, but the
@@ -170,7 +170,7 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
                     let c = y * nx + x;
                     for &(k2, j) in &items[start[c] as usize..start[c + 1] as usize] {
                         let (k2, j) = (k2 as usize, j as usize);
-                        if k2 == k && j >= lo && j < hi {
+                        if k2 == k && j >= from && j < to {
                             continue;
                         }
                         let pts = lines[k2].points;

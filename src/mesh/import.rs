@@ -336,8 +336,15 @@ impl Unwelded {
         weld_map(&self.imported.mesh.vertices).map(WeldMap)
     }
 
-    /// The welded scan, given this mesh's [`Self::weld_map`].
+    /// The welded scan, given this mesh's [`Self::weld_map`] (a map of
+    /// another length is not this mesh's: the weld is then found again).
     pub fn finish(self, map: Option<WeldMap>) -> ImportedMesh {
+        if map
+            .as_ref()
+            .is_some_and(|m| m.0.len() != self.imported.mesh.vertices.len())
+        {
+            return self.welded();
+        }
         let mut imported = self.imported;
         if let Some(WeldMap(map)) = map {
             let mesh = &mut imported.mesh;
@@ -1116,6 +1123,52 @@ mod tests {
         let distinct: std::collections::HashSet<[u64; 3]> =
             points.iter().map(|&p| super::key(p)).collect();
         assert_eq!(w.vertices.len(), distinct.len());
+    }
+
+    /// A PLY square of two triangles, each with corners of its own: the
+    /// weld merges the shared diagonal's.
+    fn split_square_ply(size: f64) -> Vec<u8> {
+        let v = [
+            (0.0, 0.0),
+            (size, 0.0),
+            (size, size),
+            (0.0, 0.0),
+            (size, size),
+            (0.0, size),
+        ];
+        let mut ply = String::from(
+            "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n\
+             property float z\nelement face 2\nproperty list uchar int vertex_indices\n\
+             end_header\n",
+        );
+        for (x, y) in v {
+            ply.push_str(&format!("{x} {y} 1\n"));
+        }
+        ply.push_str("3 0 1 2\n3 3 4 5\n");
+        ply.into_bytes()
+    }
+
+    #[test]
+    fn an_unwelded_scan_welds_to_what_the_import_gives() {
+        let opts = ImportOptions::DEFAULT;
+        let none = ExternalFiles::new();
+        let bytes = split_square_ply(10.0);
+        let u = import_mesh_unwelded(&bytes, "sq.ply", &opts, &none).unwrap();
+        // Not welded yet: positions final, corners still apart.
+        assert_eq!(u.imported().mesh.vertices.len(), 6);
+        let want = import_mesh(&bytes, "sq.ply", &opts).unwrap().mesh;
+        assert_eq!(want.vertices.len(), 4);
+        let map = u.weld_map();
+        assert!(map.is_some());
+        assert_eq!(u.clone().finish(map).mesh, want);
+        assert_eq!(u.clone().welded().mesh, want);
+        // Another mesh's map (another length) is not taken.
+        let wrong = Some(WeldMap(vec![0, 1, 2]));
+        assert_eq!(u.finish(wrong).mesh, want);
+        // A format welded while read is final as it is.
+        let stl = b"solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
+        let u = import_mesh_unwelded(stl, "t.stl", &opts, &none).unwrap();
+        assert_eq!(u.weld_map(), None);
     }
 
     #[test]
