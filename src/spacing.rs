@@ -47,13 +47,20 @@ pub struct CloseLines {
 impl CloseLines {
     /// The plan's warning.
     pub fn message(&self, d: f64) -> String {
+        // Under the G-code's resolution, "within 0.000 mm" would read as
+        // nothing: lines that cross, touch or lie on each other.
+        let how = if self.closest_mm < 5e-4 {
+            "meet (cross, touch or lie on each other)".to_string()
+        } else {
+            format!("come within {:.3} mm of each other", self.closest_mm)
+        };
         format!(
-            "lines of the drawing come within {:.3} mm of each other, less than the nozzle's \
-             inner diameter ({d:.3} mm, the filament's width), along about {:.1} mm of the \
-             path, the first at ({:.3}, {:.3}) in '{}': their filaments will merge there (for \
-             an antenna or a sensor, a short circuit); draw the lines further apart, or scale \
-             the drawing up, unless the area is meant to be filled",
-            self.closest_mm, self.length_mm, self.first.x, self.first.y, self.source
+            "lines of the drawing {how}, less than the nozzle's inner diameter ({d:.3} mm, the \
+             filament's width) apart, along about {:.1} mm of the path, the first at ({:.3}, \
+             {:.3}) in '{}': their filaments will merge there (for an antenna or a sensor, a \
+             short circuit); draw the lines further apart, or scale the drawing up, unless \
+             the area is meant to be filled",
+            self.length_mm, self.first.x, self.first.y, self.source
         )
     }
 }
@@ -342,6 +349,17 @@ mod tests {
         assert_eq!(got.source, "a");
         assert!((got.closest_mm - 0.4).abs() < 1e-12);
         assert_eq!(close_lines(&[line(&a, false), line(&far, false)], d), None);
+        // Two lines that cross: they meet.
+        let x1 = sampled(&[DVec2::new(-5.0, 0.0), DVec2::new(5.0, 0.0)], d / 2.0);
+        let x2 = sampled(&[DVec2::new(0.0, -5.0), DVec2::new(0.0, 5.0)], d / 2.0);
+        let got = close_lines(&[line(&x1, false), line(&x2, false)], d).expect("crossing");
+        assert_eq!(got.closest_mm, 0.0);
+        let m = got.message(d);
+        assert!(
+            m.starts_with("lines of the drawing meet (cross, touch or lie on each other), less")
+                && m.contains("their filaments will merge"),
+            "{m}"
+        );
         // A single line, a single point, nothing: nothing.
         assert_eq!(close_lines(&[line(&a, false)], d), None);
         assert_eq!(close_lines(&[line(&a[..1], false)], d), None);
