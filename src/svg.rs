@@ -270,12 +270,9 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     }
     let text = std::str::from_utf8(bytes).map_err(|e| {
         // A binary scan chosen as the drawing, named as one.
-        let kind = if bytes.starts_with(b"glTF") {
-            "; it looks like a binary glTF (GLB) scan"
-        } else if bytes.starts_with(b"ply") {
-            "; it looks like a binary PLY scan"
-        } else {
-            ""
+        let kind = match scan_kind(bytes) {
+            Some(k) => format!("; it looks like a binary {k}"),
+            None => String::new(),
         };
         parse_err(format!(
             "not UTF-8 text ({e}); SVG is an XML text file{kind}"
@@ -1411,35 +1408,47 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
     (out, declared)
 }
 
-/// What a file that is not XML at all looks like, by its first word: a
-/// scan or a program chosen as the drawing (an OBJ read "not well-formed
-/// XML: unknown token at 1:1"; found by a QA run).
+/// The scan format `bytes` look like, by the importers' own sniffing
+/// (`mesh::detect_format`): a scan chosen as the drawing. A text point
+/// cloud is not told from other text that is not SVG.
+fn scan_kind(bytes: &[u8]) -> Option<&'static str> {
+    use crate::mesh::{detect_format, MeshFormat};
+    Some(match detect_format(bytes, "")? {
+        MeshFormat::Obj => "Wavefront OBJ scan",
+        MeshFormat::Ply => "PLY scan",
+        MeshFormat::Stl => "STL scan",
+        MeshFormat::Gltf | MeshFormat::Glb => "glTF scan",
+        MeshFormat::Pcd => "PCD point cloud",
+        MeshFormat::Xyz => return None,
+    })
+}
+
+/// What a file that is not XML at all looks like: a scan or a program
+/// chosen as the drawing (an OBJ read "not well-formed XML: unknown token
+/// at 1:1"; found by a QA run).
 fn not_xml(text: &str) -> Option<String> {
     let head = text.trim_start_matches('\u{feff}').trim_start();
     if head.starts_with('<') {
         return None;
     }
-    // The first word past comment lines (OBJ's `#`, G-code's `;`).
+    // G-code's first word past its comment lines.
     let first = head
         .lines()
         .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with(';'))
+        .find(|l| !l.is_empty() && !l.starts_with(';'))
         .and_then(|l| l.split_whitespace().next())
         .unwrap_or("");
-    let kind = match first {
-        "v" | "vn" | "vt" | "f" | "o" | "g" | "mtllib" | "usemtl" => Some("a Wavefront OBJ scan"),
-        "ply" => Some("a PLY scan"),
-        "solid" => Some("an STL scan"),
-        _ if head.starts_with("glTF") || head.starts_with("{\"asset\"") => Some("a glTF scan"),
-        _ if [
-            "G0", "G1", "G21", "G28", "G90", "G91", "M82", "M104", "M107", "M140",
-        ]
-        .iter()
-        .any(|g| first.eq_ignore_ascii_case(g)) =>
-        {
-            Some("a G-code program")
-        }
-        _ => None,
+    let gcode = [
+        "G0", "G1", "G21", "G28", "G90", "G91", "M82", "M104", "M107", "M140",
+    ]
+    .iter()
+    .any(|g| first.eq_ignore_ascii_case(g));
+    let kind = match scan_kind(head.as_bytes()) {
+        Some(k) => Some(format!(
+            "a{} {k}",
+            if k.starts_with("STL") { "n" } else { "" }
+        )),
+        None => gcode.then(|| "a G-code program".to_string()),
     };
     Some(match kind {
         Some(k) => format!("not an SVG: it looks like {k}; choose the drawing's .svg file"),
