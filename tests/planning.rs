@@ -14,6 +14,18 @@ fn height_field(xs: &[f64], ys: &[f64], f: impl Fn(f64, f64) -> f64) -> TriMesh 
     TriMesh::height_field(xs, ys, f)
 }
 
+/// `mesh` as a binary PLY named `name`, prepared as the CLI prepares a
+/// scan (taken as it is, no fiducials).
+fn prepared_ply(mesh: &TriMesh, name: &str) -> pcpp::job::PreparedScan {
+    pcpp::job::prepare_scan(
+        &pcpp::demo::to_binary_ply(mesh),
+        name,
+        &pcpp::mesh::ImportOptions::DEFAULT,
+        &pcpp::job::RegistrationSettings::default(),
+    )
+    .unwrap()
+}
+
 fn range(from: f64, to: f64, n: usize) -> Vec<f64> {
     (0..=n)
         .map(|i| from + (to - from) * i as f64 / n as f64)
@@ -551,7 +563,7 @@ fn a_lift_over_a_fin_narrower_than_the_nozzle_is_named_where_it_floats() {
 /// says; a 5 mm fin (5 mm of floating) is planned as before.
 #[test]
 fn regression_gcode_dispensing_far_above_the_surface_was_written() {
-    use pcpp::job::{prepare_scan, run_on, RegistrationSettings};
+    use pcpp::job::run_on;
     let mut xs = range(0.0, 20.0, 100);
     xs.extend([9.85, 10.15]);
     xs.sort_by(f64::total_cmp);
@@ -573,14 +585,7 @@ fn regression_gcode_dispensing_far_above_the_surface_was_written() {
                 0.0
             }
         });
-        let bytes = pcpp::demo::to_binary_ply(&mesh);
-        let scan = prepare_scan(
-            &bytes,
-            "fin.ply",
-            &pcpp::mesh::ImportOptions::DEFAULT,
-            &RegistrationSettings::default(),
-        )
-        .unwrap();
+        let scan = prepared_ply(&mesh, "fin.ply");
         run_on(
             &scan,
             svg.as_bytes(),
@@ -833,20 +838,13 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
 /// planned as before, without it.
 #[test]
 fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
-    use pcpp::job::{prepare_scan, run_on, RegistrationSettings};
+    use pcpp::job::run_on;
     let xs = range(0.0, 30.0, 150);
     let ys = range(0.0, 30.0, 150);
     let mesh = height_field(&xs, &ys, |x, y| {
         1.0 + 0.2 * (0.3 * x).sin() * (0.2 * y).cos()
     });
-    let bytes = pcpp::demo::to_binary_ply(&mesh);
-    let scan = prepare_scan(
-        &bytes,
-        "film.ply",
-        &pcpp::mesh::ImportOptions::DEFAULT,
-        &RegistrationSettings::default(),
-    )
-    .unwrap();
+    let scan = prepared_ply(&mesh, "film.ply");
     let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
     for (order, merged) in [(4, false), (7, true)] {
         let svg = pcpp::demo::antennas::hilbert_loop_svg(order, 20.0).unwrap();
