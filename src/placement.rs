@@ -364,9 +364,93 @@ pub fn carry_drawing(
     }
 }
 
+/// The drawing's placement after the registration of its scan (scanner
+/// frame to printer frame, row-major as the report gives it) changes from
+/// `from` to `to`: the printer points of the fiducials were typed again, or
+/// the holes paired with them another way, so the scan now stands elsewhere
+/// on the printer, and the drawing goes with it to stay on the same part of
+/// it, as in [`carry_drawing`]. `z_mm` is the height the drawing lies at
+/// before the change (the scan's middle): a change that tilts the scan
+/// moves a point at that height, and only the change's turn about z turns
+/// the drawing, which stays flat. The drawing as it was when `from` cannot
+/// be undone (a singular matrix).
+pub fn carry_drawing_by(
+    drawing: &Placement,
+    z_mm: f64,
+    from: &[[f64; 4]; 4],
+    to: &[[f64; 4]; 4],
+) -> Placement {
+    let g = |m: &[[f64; 4]; 4]| DMat4::from_cols_array_2d(m).transpose();
+    let (from, to) = (g(from), g(to));
+    let det = from.determinant();
+    if !det.is_finite() || det.abs() < 1e-12 || from == to {
+        return *drawing;
+    }
+    let m = to * from.inverse();
+    if !m.is_finite() {
+        return *drawing;
+    }
+    // The turn read back from the matrix, to a billionth of a degree: a
+    // fit's rounding (1e-17 of a turn on a pure move) is not shown as a
+    // rotation of 0.0000000000000006 degrees.
+    let turn = libm::atan2(m.x_axis.y, m.x_axis.x).to_degrees();
+    let turn = (turn * 1e9).round() / 1e9;
+    Placement {
+        offset_mm: m
+            .transform_point3(drawing.offset_mm.extend(z_mm))
+            .truncate(),
+        rotation_deg: drawing.rotation_deg + turn,
+        scale: drawing.scale,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn row_major(m: DMat4) -> [[f64; 4]; 4] {
+        m.transpose().to_cols_array_2d()
+    }
+
+    /// A registration moved and turned the scan: every point of the
+    /// drawing lands where the change takes the point of the part it lay
+    /// on, and a pure move leaves the rotation as typed.
+    #[test]
+    fn a_drawing_goes_with_its_scan_when_the_registration_changes() {
+        let drawing = Placement {
+            offset_mm: DVec2::new(10.0, 20.0),
+            rotation_deg: 5.0,
+            scale: 1.5,
+        };
+        let from = DMat4::from_translation(DVec3::new(-3.0, 7.0, 1.0))
+            * DMat4::from_rotation_z(12f64.to_radians());
+        let change = DMat4::from_translation(DVec3::new(60.0, 45.0, 2.0))
+            * DMat4::from_rotation_z(30f64.to_radians());
+        let to = change * from;
+        let carried = carry_drawing_by(&drawing, 4.0, &row_major(from), &row_major(to));
+        assert!((carried.rotation_deg - 35.0).abs() < 1e-9, "{carried:?}");
+        assert_eq!(carried.scale, 1.5);
+        for p in [DVec2::ZERO, DVec2::new(40.0, -3.0), DVec2::new(-8.0, 25.0)] {
+            let want = change
+                .transform_point3(drawing.apply(p).extend(4.0))
+                .truncate();
+            let got = carried.apply(p);
+            assert!(got.distance(want) < 1e-9, "{p}: {got} vs {want}");
+        }
+        // A pure move: the rotation stays 5 exactly.
+        let moved = DMat4::from_translation(DVec3::new(60.0, 45.0, 0.0)) * from;
+        let carried = carry_drawing_by(&drawing, 4.0, &row_major(from), &row_major(moved));
+        assert_eq!(carried.rotation_deg, 5.0);
+        assert!(carried.offset_mm.distance(DVec2::new(70.0, 65.0)) < 1e-9);
+        // The same registration, or one that cannot be undone: unchanged.
+        let same = carry_drawing_by(&drawing, 4.0, &row_major(from), &row_major(from));
+        assert_eq!(same, drawing);
+        let flat = row_major(DMat4::from_scale(DVec3::new(1.0, 1.0, 0.0)));
+        assert_eq!(
+            carry_drawing_by(&drawing, 4.0, &flat, &row_major(to)),
+            drawing
+        );
+    }
 
     fn volume() -> BuildVolume {
         BuildVolume {

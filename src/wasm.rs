@@ -528,6 +528,27 @@ pub fn carry_drawing(
     to_js(&placement::carry_drawing(&drawing, bbox, &from, &to))
 }
 
+/// The drawing's placement after the scan's registration (`matrix` of
+/// the session's info, row-major) changes from `from` to `to`, the drawing
+/// lying at height `z_mm` ([`placement::carry_drawing_by`]).
+#[wasm_bindgen(js_name = carryDrawingBy)]
+pub fn carry_drawing_by(
+    drawing: JsValue,
+    z_mm: f64,
+    from: JsValue,
+    to: JsValue,
+) -> Result<JsValue, JsError> {
+    let drawing: Placement = from_js("drawing placement", drawing)?;
+    let from: [[f64; 4]; 4] = from_js("registration matrix", from)?;
+    let to: [[f64; 4]; 4] = from_js("registration matrix", to)?;
+    if !z_mm.is_finite() || !from.iter().chain(&to).flatten().all(|v| v.is_finite()) {
+        return Err(JsError::new(
+            "the registration matrices and the height must be finite numbers",
+        ));
+    }
+    to_js(&placement::carry_drawing_by(&drawing, z_mm, &from, &to))
+}
+
 /// Three finite numbers from the page, or an error naming `what`.
 fn vec3(what: &str, v: &[f64]) -> Result<DVec3, JsError> {
     match v {

@@ -21,7 +21,7 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  bannerOffers, cancelCentre, centreRequest, initPlacement, onCentred, planOutcome, requestCentre, showFitNote,
+  bannerOffers, cancelCentre, centreRequest, initPlacement, onCarried, onCentred, planOutcome, requestCentre, showFitNote,
   showScanPlacement, toolPathOutside, unitsBannerShown,
 } from './placement.js';
 import {
@@ -346,6 +346,9 @@ function onWorkerMessage(e) {
       break;
     case 'centred':
       onCentred(m, busy);
+      break;
+    case 'carried':
+      onCarried(m, busy);
       break;
     case 'result': {
       if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {

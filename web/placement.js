@@ -185,6 +185,22 @@ export function onCentred(m, busy) {
   ctx.writeForm();
 }
 
+// The scan was registered anew (its fiducials' printer points changed) and
+// the worker carried the drawing with it (core carry_drawing_by): taken
+// into the settings unless the user placed the drawing since the request.
+export function onCarried(m, busy) {
+  if (!busy) return;
+  const s = settings;
+  const sent = busy.job.plan.placement;
+  const shown = [s.placement.x, s.placement.y, s.placement.rot].map(Number);
+  if (shown[0] !== sent.offset_mm[0] || shown[1] !== sent.offset_mm[1] || shown[2] !== sent.rotation_deg) return;
+  s.placement = { ...s.placement, x: m.placement.offset_mm[0], y: m.placement.offset_mm[1], rot: m.placement.rotation_deg };
+  // What was sent is what the worker plans: the request matches again.
+  busy.job.plan.placement = m.placement;
+  ctx.saveSettings();
+  ctx.writeForm();
+}
+
 // How many times the user placed the drawing: a drawing read meanwhile is
 // not centred over their placement (inputs.js).
 let placedByUser = 0;

@@ -10,7 +10,7 @@
 // holds it whole. The files opened with it (`external`) are read the same
 // way, only those the scan names (a .gltf's .bin buffers). Results go back
 // as typed arrays whose buffers are transferred, not copied.
-import { initSync, initPanicHook, memoryBytes, ScanBuffer, Sha256Stream } from '../pkg/pcpp.js';
+import { carryDrawingBy, initSync, initPanicHook, memoryBytes, ScanBuffer, Sha256Stream } from '../pkg/pcpp.js';
 
 // Slices of the file read per step: progress every 8 MiB.
 const CHUNK = 8 << 20;
@@ -21,6 +21,11 @@ const FREE_FIRST_BYTES = 64 << 20;
 
 let session = null;
 let sessionKey = null;
+// The session's scan, read how (its key without the registration's fiducials),
+// and its info (bounds, registration matrix): a plan that registers the same
+// scan anew carries the drawing from the one to the other.
+let sessionScanKey = null;
+let sessionInfo = null;
 // The last drawing the page sent {key, name, bytes}, and the key of the
 // one set on the session.
 let svg = null;
@@ -131,6 +136,7 @@ async function loadScan(m) {
     session.free();
     session = null;
     sessionKey = null;
+    sessionInfo = null;
   }
   let buf;
   let missing = [];
@@ -190,6 +196,7 @@ async function loadScan(m) {
         session.free();
         session = null;
         sessionKey = null;
+        sessionInfo = null;
       }
       throw err;
     }
@@ -204,6 +211,7 @@ async function loadScan(m) {
   progress(id, 'done', `done: ${name}, ${info.triangles.toLocaleString('en')} triangles in ${seconds.toFixed(1)} s`, 1);
   post({ type: 'scan', id, key: m.scan.key, info, seconds, memory: memoryBytes(), positions, indices },
     [positions.buffer, indices.buffer]);
+  return info;
 }
 
 // The centred placement as the page shows it in its fields and plans it.
@@ -234,8 +242,27 @@ async function plan(m) {
   if (m.svg.bytes) svg = { key: m.svg.key, name: m.svg.name, bytes: m.svg.bytes };
   try {
     if (key !== sessionKey) {
-      await loadScan(m);
+      // The same scan, read the same way and not placed on the bed by hand
+      // (the page carries the drawing for that itself), registered anew:
+      // the fiducials' printer points were typed again, so the scan stands
+      // elsewhere on the printer. The drawing goes with it (below).
+      const scanKey = JSON.stringify([m.scan.key, m.scanSettings, m.registration.scan_placement]);
+      const was = session && sessionInfo && scanKey === sessionScanKey ? sessionInfo : null;
+      const info = await loadScan(m);
       sessionKey = key;
+      sessionScanKey = scanKey;
+      sessionInfo = info;
+      if (was && !m.centre) {
+        const [lo, hi] = was.bbox_mm;
+        const c = carryDrawingBy(m.plan.placement, (lo[2] + hi[2]) / 2, was.registration.matrix, info.registration.matrix);
+        const placement = shownPlacement(c, m.plan.placement.scale);
+        const sent = m.plan.placement;
+        if (placement.offset_mm[0] !== sent.offset_mm[0] || placement.offset_mm[1] !== sent.offset_mm[1]
+          || placement.rotation_deg !== sent.rotation_deg) {
+          post({ type: 'carried', id, placement });
+          m.plan.placement = placement;
+        }
+      }
     }
     stage = 'plan';
     if (!svg || svg.key !== m.svg.key) throw new Error(`the drawing ${m.svg.name} did not reach the planner; plan again`);

@@ -136,3 +136,51 @@ test('the header says the scan is not registered while its fiducials do not fit'
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The part sits elsewhere on the printer than where it was scanned, and
+// turned: typed printer points move the registered scan, and the drawing
+// placed on it stayed where it was, so the next plan printed the few lines
+// still over the part and warned that the others missed it. The drawing
+// goes with the scan (as when the scan is placed on the bed by hand) and
+// stays on the same spot of the part.
+test('a registration that moves the scan carries the drawing with it', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const before = await page.evaluate(() => ({
+    placement: { ...window.pcpp.settings.placement },
+    printer: window.pcpp.settings.fidPrinterText,
+    points: window.pcpp.state.lastPlan.summary.quality.points,
+  }));
+  assert.match(await page.textContent('#reg-status'), /^registered \(lsq, 3 fiducials/);
+  // The part a quarter turn anticlockwise and moved: (x, y) -> (150 - y, 20 + x).
+  const move = ([x, y]) => [150 - y, 20 + x];
+  const typed = before.printer.split('\n').filter((l) => l.trim())
+    .map((l) => l.split(',').map(Number)).map(([x, y, z]) => `${move([x, y]).join(', ')}, ${z}`).join('\n');
+  await page.fill('#fid-printer', typed);
+  await page.waitForFunction(() => {
+    const info = window.pcpp.state.info;
+    return info && info.bbox_mm[1][0] > 140;
+  }, null, { timeout: 120_000 });
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  const after = await page.evaluate(() => ({
+    placement: { ...window.pcpp.settings.placement },
+    planned: window.pcpp.state.lastPlan.summary.settings.placement,
+    points: window.pcpp.state.lastPlan.summary.quality.points,
+    warnings: document.getElementById('warnings').textContent,
+  }));
+  const want = move([before.placement.x, before.placement.y]);
+  const p = after.placement;
+  const says = `${JSON.stringify(before.placement)} -> ${JSON.stringify(p)}`;
+  assert.ok(Math.abs(p.x - want[0]) < 1e-3 && Math.abs(p.y - want[1]) < 1e-3, says);
+  assert.equal(Number(p.rot), Number(before.placement.rot) + 90, says);
+  assert.equal(Number(p.scale), Number(before.placement.scale));
+  // What was planned is the carried drawing, all of it, shown in the fields.
+  assert.deepEqual(after.planned.offset_mm, [p.x, p.y]);
+  assert.equal(after.points, before.points);
+  assert.doesNotMatch(after.warnings, /misses the scan|off the scan/);
+  assert.equal(Number(await page.inputValue('#pl-x')), Number(p.x));
+  assert.equal(await page.isVisible('#dl-gcode'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
