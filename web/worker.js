@@ -21,11 +21,15 @@ const FREE_FIRST_BYTES = 64 << 20;
 
 let session = null;
 let sessionKey = null;
-// The session's scan, read how (its key without the registration's fiducials),
-// and its info (bounds, registration matrix): a plan that registers the same
-// scan anew carries the drawing from the one to the other.
+// The session's scan and how it is read (its key without the fiducials'
+// registration), and the registration the drawing's placement was last
+// made on (`frame`: the registered bounds and matrix): a plan that
+// registers the same scan anew carries the drawing from that one to the
+// new one. A registration too far off its printer points to plan on (a
+// mistyped point, the holes paired wrongly) carries nothing: the drawing
+// is carried from the last good one once the points are right.
 let sessionScanKey = null;
-let sessionInfo = null;
+let frame = null;
 // The last drawing the page sent {key, name, bytes}, and the key of the
 // one set on the session.
 let svg = null;
@@ -136,7 +140,7 @@ async function loadScan(m) {
     session.free();
     session = null;
     sessionKey = null;
-    sessionInfo = null;
+    frame = null;
   }
   let buf;
   let missing = [];
@@ -196,7 +200,7 @@ async function loadScan(m) {
         session.free();
         session = null;
         sessionKey = null;
-        sessionInfo = null;
+        frame = null;
       }
       throw err;
     }
@@ -247,14 +251,18 @@ async function plan(m) {
       // the fiducials' printer points were typed again, so the scan stands
       // elsewhere on the printer. The drawing goes with it (below).
       const scanKey = JSON.stringify([m.scan.key, m.scanSettings, m.registration.scan_placement]);
-      const was = session && sessionInfo && scanKey === sessionScanKey ? sessionInfo : null;
+      const was = session && frame && scanKey === sessionScanKey ? frame : null;
       const info = await loadScan(m);
       sessionKey = key;
       sessionScanKey = scanKey;
-      sessionInfo = info;
-      if (was && !m.centre) {
-        const [lo, hi] = was.bbox_mm;
-        const c = carryDrawingBy(m.plan.placement, (lo[2] + hi[2]) / 2, was.registration.matrix, info.registration.matrix);
+      const now = { bbox: info.bbox_mm, matrix: info.registration.matrix };
+      const good = info.registration.rms_mm <= m.plan.nozzle.inner_diameter_mm;
+      if (!was || m.centre) {
+        frame = now;
+      } else if (good) {
+        frame = now;
+        const [lo, hi] = was.bbox;
+        const c = carryDrawingBy(m.plan.placement, (lo[2] + hi[2]) / 2, was.matrix, now.matrix);
         const placement = shownPlacement(c, m.plan.placement.scale);
         const sent = m.plan.placement;
         if (placement.offset_mm[0] !== sent.offset_mm[0] || placement.offset_mm[1] !== sent.offset_mm[1]

@@ -154,9 +154,18 @@ test('a registration that moves the scan carries the drawing with it', async () 
   assert.match(await page.textContent('#reg-status'), /^registered \(lsq, 3 fiducials/);
   // The part a quarter turn anticlockwise and moved: (x, y) -> (150 - y, 20 + x).
   const move = ([x, y]) => [150 - y, 20 + x];
-  const typed = before.printer.split('\n').filter((l) => l.trim())
-    .map((l) => l.split(',').map(Number)).map(([x, y, z]) => `${move([x, y]).join(', ')}, ${z}`).join('\n');
-  await page.fill('#fid-printer', typed);
+  const points = before.printer.split('\n').filter((l) => l.trim()).map((l) => l.split(',').map(Number));
+  const typed = points.map(([x, y, z]) => `${move([x, y]).join(', ')}, ${z}`);
+  // First with one point mistyped by 5 mm: registered far off its printer
+  // points, so no plan, and the drawing is not carried there (nor back).
+  const wrong = [...typed];
+  wrong[2] = wrong[2].replace(/^(-?[\d.]+)/, (x) => String(Number(x) + 5));
+  await page.fill('#fid-printer', wrong.join('\n'));
+  await page.waitForFunction(() => /^The registration puts the scan/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.deepEqual(await page.evaluate(() => ({ ...window.pcpp.settings.placement })), before.placement);
+  await page.fill('#fid-printer', typed.join('\n'));
   await page.waitForFunction(() => {
     const info = window.pcpp.state.info;
     return info && info.bbox_mm[1][0] > 140;
