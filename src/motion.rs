@@ -73,9 +73,12 @@ impl Clearance {
     }
 
     /// Whether the straight move `a` -> `b` stays clear (the first
-    /// contact found answers it: no smallest clearance is sought).
+    /// contact found answers it: no smallest clearance is sought, and the
+    /// triangles are tried as their bounds let them through,
+    /// [`Surface::nozzle_touches`]).
     pub fn is_clear(&self, surface: &Surface, a: DVec3, b: DVec3) -> bool {
-        self.touching_until(surface, a, b, |_| true).is_none()
+        let limit = self.tol_mm - TIE_MM;
+        !surface.nozzle_touches(a, b, self.radius_mm, self.tol_mm, limit)
     }
 
     /// The gap of the move `a` -> `b` if it is below tol.

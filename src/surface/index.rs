@@ -366,10 +366,17 @@ impl Grid {
         reach: f64,
         inv_cell: f64,
     ) -> Option<(usize, usize)> {
-        let a = ((lo - reach - origin) * inv_cell).floor();
-        let b = ((hi + reach - origin) * inv_cell).floor();
+        // The cells' indices are the floors of these, but no `floor` is
+        // taken: it is a call to libm on x86-64 without SSE4.1 (four a
+        // query, 1.5 M on W3: 0.8 % of its instructions), and for the tests
+        // and conversions here truncation does as well. floor(b) >= 0
+        // exactly when b >= 0, floor(a) <= n - 1 exactly when a < n (n is
+        // far below 2^53), and `as usize` truncates a non-negative value,
+        // which is its floor (saturating past usize, as the floor did).
+        let a = (lo - reach - origin) * inv_cell;
+        let b = (hi + reach - origin) * inv_cell;
         // NaN fails both tests and so visits nothing.
-        if !(b >= 0.0 && a <= (n - 1) as f64) {
+        if !(b >= 0.0 && a < n as f64) {
             return None;
         }
         Some((a.max(0.0) as usize, (b as usize).min(n - 1)))

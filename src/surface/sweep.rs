@@ -119,10 +119,47 @@ impl Surface {
     /// smallest, to the last bit and the reported place.
     ///
     /// For the questions the planners ask many times over about points
-    /// that touch: whether a point clears at all (`|_| true`: the first
-    /// contact found answers it) and whether a rise is more than some
-    /// amount.
+    /// that touch: whether a rise is more than some amount, and whether a
+    /// point clears at all (`|_| true`: the first contact found answers
+    /// it; [`Self::nozzle_touches`] answers that one for less).
     pub fn nozzle_gap_until(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        radius: f64,
+        tol: f64,
+        limit: f64,
+        enough: &dyn Fn(f64) -> bool,
+    ) -> Option<SweepGap> {
+        self.query::<false>(a, b, radius, tol, limit, enough)
+    }
+
+    /// Whether [`Self::nozzle_gap`] finds a clearance below `limit`: the
+    /// question the planners ask most about points that touch
+    /// ([`Self::nozzle_gap_until`] with `|_| true` answers it too).
+    ///
+    /// The answer does not depend on the order the triangles are tried
+    /// in (a triangle with a contact below the limit has a bound below it
+    /// too, and is tried, in either order, unless another contact is found
+    /// first), so each is tried as soon as its bound lets it through, in
+    /// the index's order, rather than queued lowest bound first: the first
+    /// contact found stops the query before the bounds of the triangles
+    /// after it are taken. On W3 the even planner's slide search (points
+    /// slid back along the path, low over the surface: 14,201 queries) had
+    /// 51 triangles handed over and 31 queued a query, and 97 % found a
+    /// contact, by the 2nd or 3rd triangle tried: trying them at once took
+    /// its queries from 256 M instructions to 112 M, and W3's plan from
+    /// 4.22 G to 4.04 G (W2's from 67.0 M to 63.2 M), with the same G-code.
+    pub fn nozzle_touches(&self, a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> bool {
+        self.query::<true>(a, b, radius, tol, limit, &|_| true)
+            .is_some()
+    }
+
+    /// [`Self::nozzle_gap_until`], trying each triangle at once when
+    /// `EAGER` (only for `enough` always true, see
+    /// [`Self::nozzle_touches`]).
+    #[inline(always)]
+    fn query<const EAGER: bool>(
         &self,
         a: DVec3,
         b: DVec3,
@@ -134,9 +171,9 @@ impl Surface {
         let sweep = Sweep::new(a, b, radius, tol, limit);
         let q = &sweep.q;
         let mut best = sweep.start();
-        // Set once `enough` holds for the best clearance found: nothing
-        // more is tried.
-        let mut done = false;
+        // Set once `enough` holds for the best clearance found (when
+        // `EAGER`, once a contact is found): nothing more is tried.
+        let done = std::cell::Cell::new(false);
         QUEUE.with_borrow_mut(|queue| {
             queue.clear();
             // How many triangles the index has handed over: the next one's
@@ -146,7 +183,13 @@ impl Surface {
             // A cell all of whose triangles are bounded above the value a
             // finding must beat is left out whole.
             let start = best.gap;
-            let keep = |b: &Box32| sweep.box_bound(b).is_some_and(|low| low <= start);
+            // Once done, every cell left is left out: the rest of the walk
+            // reads only the cells' z ranges and XY boxes (on W3 the eager
+            // queries of `nozzle_touches` stop at their first contact,
+            // which most find; leaving out the cells after it took 0.9 %
+            // of the instructions off).
+            let keep =
+                |b: &Box32| !done.get() && sweep.box_bound(b).is_some_and(|low| low <= start);
             // Inlined into the index's loop over a cell's triangles, with
             // the bound and its box part: called once per triangle handed
             // over (about 24 a query), a call's entry and exit cost more
@@ -156,7 +199,7 @@ impl Surface {
                 keep,
                 #[inline(always)]
                 |i| {
-                    if done {
+                    if done.get() {
                         return;
                     }
                     let rank = handed;
@@ -172,13 +215,21 @@ impl Surface {
                     if low > best.gap {
                         return;
                     }
+                    if EAGER {
+                        // Nothing found yet (else `done`): `best` still
+                        // holds the limit, as when the triangle is queued.
+                        best.trying = rank;
+                        sweep.visit(t, self.owned[i], &mut best);
+                        done.set(best.found.is_some());
+                        return;
+                    }
                     if queue.len() == QUEUE_LEN {
-                        done = self.drain(&sweep, queue, &mut best, enough);
+                        done.set(self.drain(&sweep, queue, &mut best, enough));
                     }
                     queue.push(Reverse(queued(low, i as u32, rank)));
                 },
             );
-            if !done {
+            if !EAGER && !done.get() {
                 self.drain(&sweep, queue, &mut best, enough);
             }
         });
@@ -1210,6 +1261,9 @@ mod tests {
                     // Whether there is any clearance below the limit.
                     let any = surf.nozzle_gap_until(a, b, 0.45, 0.1, limit, &|_| true);
                     assert_eq!(any.is_some(), full.is_some(), "{a} -> {b}");
+                    // And the eager query that answers only that.
+                    let touches = surf.nozzle_touches(a, b, 0.45, 0.1, limit);
+                    assert_eq!(touches, full.is_some(), "{a} -> {b}");
                     let Some(f) = full else { continue };
                     found += 1;
                     let x = any.unwrap();
