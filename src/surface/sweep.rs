@@ -131,7 +131,7 @@ impl Surface {
         limit: f64,
         enough: &dyn Fn(f64) -> bool,
     ) -> Option<SweepGap> {
-        self.query::<false>(a, b, radius, tol, limit, enough)
+        self.query::<false>(&Sweep::new(a, b, radius, tol, limit), enough)
     }
 
     /// Whether [`Self::nozzle_gap`] finds a clearance below `limit`: the
@@ -151,24 +151,19 @@ impl Surface {
     /// its queries from 256 M instructions to 112 M, and W3's plan from
     /// 4.22 G to 4.04 G (W2's from 67.0 M to 63.2 M), with the same G-code.
     pub fn nozzle_touches(&self, a: DVec3, b: DVec3, radius: f64, tol: f64, limit: f64) -> bool {
-        self.query::<true>(a, b, radius, tol, limit, &|_| true)
-            .is_some()
+        let sweep = Sweep::new(a, b, radius, tol, limit);
+        self.query::<true>(&sweep, &|_| true).is_some()
     }
 
-    /// [`Self::nozzle_gap_until`], trying each triangle at once when
-    /// `EAGER` (only for `enough` always true, see
+    /// [`Self::nozzle_gap_until`] of the move `sweep`, trying each
+    /// triangle at once when `EAGER` (only for `enough` always true, see
     /// [`Self::nozzle_touches`]).
     #[inline(always)]
     fn query<const EAGER: bool>(
         &self,
-        a: DVec3,
-        b: DVec3,
-        radius: f64,
-        tol: f64,
-        limit: f64,
+        sweep: &Sweep,
         enough: &dyn Fn(f64) -> bool,
     ) -> Option<SweepGap> {
-        let sweep = Sweep::new(a, b, radius, tol, limit);
         let q = &sweep.q;
         let mut best = sweep.start();
         // Set once `enough` holds for the best clearance found (when
@@ -224,13 +219,13 @@ impl Surface {
                         return;
                     }
                     if queue.len() == QUEUE_LEN {
-                        done.set(self.drain(&sweep, queue, &mut best, enough));
+                        done.set(self.drain(sweep, queue, &mut best, enough));
                     }
                     queue.push(Reverse(queued(low, i as u32, rank)));
                 },
             );
             if !EAGER && !done.get() {
-                self.drain(&sweep, queue, &mut best, enough);
+                self.drain(sweep, queue, &mut best, enough);
             }
         });
         sweep.finish(best)
