@@ -251,7 +251,7 @@ async function plan(m) {
       // the fiducials' printer points were typed again, so the scan stands
       // elsewhere on the printer. The drawing goes with it (below).
       const scanKey = JSON.stringify([m.scan.key, m.scanSettings, m.registration.scan_placement]);
-      const was = session && frame && scanKey === sessionScanKey ? frame : null;
+      const was = frame && scanKey === sessionScanKey ? frame : null;
       const info = await loadScan(m);
       sessionKey = key;
       sessionScanKey = scanKey;
