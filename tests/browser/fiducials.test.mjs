@@ -190,6 +190,20 @@ test('a registration that moves the scan carries the drawing with it', async () 
   assert.doesNotMatch(after.warnings, /misses the scan|off the scan/);
   assert.equal(Number(await page.inputValue('#pl-x')), Number(p.x));
   assert.equal(await page.isVisible('#dl-gcode'), true);
+
+  // No fiducials: the scan is back where it was scanned, and so is the
+  // drawing.
+  await page.selectOption('#fid-source', 'none');
+  await page.waitForFunction(() => {
+    const info = window.pcpp.state.info;
+    return info && info.bbox_mm[1][0] < 100;
+  }, null, { timeout: 120_000 });
+  await waitSettled(page);
+  const back = await page.evaluate(() => ({ ...window.pcpp.settings.placement }));
+  assert.ok(Math.abs(back.x - before.placement.x) < 1e-3 && Math.abs(back.y - before.placement.y) < 1e-3,
+    `${JSON.stringify(before.placement)} -> ${JSON.stringify(back)}`);
+  assert.equal(Number(back.rot), Number(before.placement.rot));
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
 });
