@@ -157,13 +157,25 @@ function currentInputs() {
   }
 }
 
-// The status line of a plan offered for download.
+// The core's projection warnings for a drawing path that leaves the scan
+// (spec section 4: not printed there), naming the path.
+const OFF_SCAN = /^path '(.*)'(?:: its .* lies off the scan; not printed| misses the scan entirely)/;
+
+// The status line of a plan offered for download. Paths of the drawing
+// that leave the scan are said there too, where the user looks after a
+// plan, not only in the list under Path statistics: a drawing placed
+// partly off the part was "planned" while most of it was not printed.
 function plannedStatus(plan) {
   const touching = plan.summary.motion.program.touching_moves;
-  return touching > 0
-    ? [`planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}: ${touching} move(s) touch the part; `
-      + 'the G-code downloads only after a confirmation', true]
-    : [`planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}`, false];
+  const head = `planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}`;
+  const off = new Set(plan.summary.warnings.map((w) => OFF_SCAN.exec(w)).filter(Boolean).map((m) => m[1])).size;
+  const offText = off
+    ? `${off} path(s) of the drawing leave the scan and are not printed there (listed under Path statistics)` : '';
+  if (touching > 0) {
+    return [`${head}: ${touching} move(s) touch the part; the G-code downloads only after a confirmation`
+      + (off ? `; ${offText}` : ''), true];
+  }
+  return off ? [`${head}: ${offText}`, true] : [head, false];
 }
 
 // After a request that failed without changing anything the plan on

@@ -375,3 +375,30 @@ test('a scan not read leaves the status of the scan still used', async () => {
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The drawing moved partly off the part: each of the demo's six lines ends
+// off the scan, and the page said "planned ..." as for a whole drawing,
+// the paths cut short listed only under Path statistics. The status says
+// how many paths leave the scan (and is marked), until the drawing is back.
+test('a drawing partly off the scan is said in the status line, not only in the warnings list', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  assert.match(await page.textContent('#plan-status'), /with even$/);
+  await page.fill('#pl-x', '55');
+  await page.waitForFunction(() => /leave the scan/.test(document.getElementById('plan-status').textContent),
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /^planned demo-test-part-lines\.svg on demo-test-part\.ply with even: 6 path\(s\) of the drawing leave the scan and are not printed there/);
+  assert.equal(await page.$eval('#plan-status', (e) => e.classList.contains('stale')), true);
+  // Six lines, one warning each (their ends), named in the list.
+  const listed = await page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent).filter((t) => /off the scan/.test(t)));
+  assert.equal(listed.length, 6, listed.join('\n'));
+  // Back on the part: the plain status.
+  await page.fill('#pl-x', '0');
+  await page.waitForFunction(() => /with even$/.test(document.getElementById('plan-status').textContent),
+    null, { timeout: 120_000 });
+  assert.equal(await page.$eval('#plan-status', (e) => e.classList.contains('stale')), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
