@@ -77,8 +77,13 @@ impl Clearance {
     /// triangles are tried as their bounds let them through,
     /// [`Surface::nozzle_touches`]).
     pub fn is_clear(&self, surface: &Surface, a: DVec3, b: DVec3) -> bool {
-        let limit = self.tol_mm - TIE_MM;
-        !surface.nozzle_touches(a, b, self.radius_mm, self.tol_mm, limit)
+        !surface.nozzle_touches(a, b, self.radius_mm, self.tol_mm, self.touch_limit())
+    }
+
+    /// The clearance below which a move touches: tol, less a hair so an
+    /// exact tie with rounding is not a contact.
+    fn touch_limit(&self) -> f64 {
+        self.tol_mm - TIE_MM
     }
 
     /// The gap of the move `a` -> `b` if it is below tol.
@@ -96,7 +101,7 @@ impl Clearance {
         b: DVec3,
         enough: impl Fn(f64) -> bool,
     ) -> Option<SweepGap> {
-        let limit = self.tol_mm - TIE_MM;
+        let limit = self.touch_limit();
         surface.nozzle_gap_until(a, b, self.radius_mm, self.tol_mm, limit, &enough)
     }
 
@@ -185,9 +190,9 @@ pub fn insert_waypoints_capped(
             // chunks is the same as over one.
             let gap = clearance.gap(surface, p, q, min.min(cap).max(clearance.tol_mm));
             if let Some(g) = gap {
-                min = min.min(g.gap_mm.max(clearance.tol_mm - TIE_MM));
+                min = min.min(g.gap_mm.max(clearance.touch_limit()));
             }
-            if gap.is_none_or(|g| g.gap_mm >= clearance.tol_mm - TIE_MM) {
+            if gap.is_none_or(|g| g.gap_mm >= clearance.touch_limit()) {
                 continue;
             }
             let mut added = Vec::new();
@@ -463,7 +468,7 @@ pub fn check_moves_capped(
                 s.min_clearance_at = Some(arr(at));
                 s.min_clearance_line = line;
             }
-            if g.gap_mm < clearance.tol_mm - TIE_MM {
+            if g.gap_mm < clearance.touch_limit() {
                 s.touching_moves += 1;
                 if s.touching.len() < MAX_LISTED {
                     s.touching.push(Touch {
@@ -647,7 +652,7 @@ pub(crate) mod tests {
             .map(|&(a, b, _)| c.gap(&s, a, b, f64::INFINITY))
             .collect();
         let touching: Vec<usize> = (0..moves.len())
-            .filter(|&i| gaps[i].is_some_and(|g| g.gap_mm < c.tol_mm - TIE_MM))
+            .filter(|&i| gaps[i].is_some_and(|g| g.gap_mm < c.touch_limit()))
             .collect();
         assert!(touching.len() > MAX_LISTED, "{}", touching.len());
         assert!(touching[0] > 0 && *touching.last().unwrap() > 2500);
