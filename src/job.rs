@@ -482,7 +482,9 @@ pub struct PreparedScan {
     pub cloud: Option<CloudInfo>,
     /// Set when the scan is so small that its units are likely wrong.
     pub units_doubt: Option<UnitsDoubt>,
-    /// Fiducial candidates, scanner frame, smallest/roundest first.
+    /// Fiducial candidates, scanner frame, smallest/roundest first (empty
+    /// when prepared with [`Candidates::ForRegistration`] and registered
+    /// otherwise than by them).
     pub fiducials: Vec<Fiducial>,
     pub registration: Registration,
     pub method: RegistrationMethod,
@@ -514,19 +516,41 @@ pub fn prepare_scan_owned(
     scan: &ImportOptions,
     registration: &RegistrationSettings,
 ) -> Result<PreparedScan> {
-    prepare_scan_owned_with(bytes, name, ExternalFiles::new(), scan, registration)
+    prepare_scan_owned_with(
+        bytes,
+        name,
+        ExternalFiles::new(),
+        scan,
+        registration,
+        Candidates::Listed,
+    )
+}
+
+/// Whether [`prepare_scan_owned_with`] lists the scan's fiducial
+/// candidates ([`PreparedScan::fiducials`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Candidates {
+    /// Always: the page shows them to pick from.
+    Listed,
+    /// Only where the registration matches them (fiducials `auto`);
+    /// otherwise the list is left empty. A caller that never shows them
+    /// (`pcpp plan`, `pcpp check`) spares the boundary-loop search
+    /// (issue 15: it was on the critical path of `pcpp plan`).
+    ForRegistration,
 }
 
 /// [`prepare_scan_owned`] of a scan with the external files it refers to
 /// (a `.gltf`'s buffers, [`crate::mesh::external_files_needed`]), freed
 /// with the scan's bytes; those it read are recorded with their SHA-256 in
-/// [`InputFile::external_files`].
+/// [`InputFile::external_files`]. `candidates` says whether the fiducial
+/// candidates are listed when the registration does not use them.
 pub fn prepare_scan_owned_with(
     bytes: impl AsRef<[u8]>,
     name: &str,
     external: ExternalFiles,
     scan: &ImportOptions,
     registration: &RegistrationSettings,
+    candidates: Candidates,
 ) -> Result<PreparedScan> {
     registration.validate()?;
     let read = bytes.as_ref();
@@ -565,9 +589,15 @@ pub fn prepare_scan_owned_with(
             registration,
         )?)
     };
+    let listed =
+        candidates == Candidates::Listed || matches!(registration.fiducials, FiducialSource::Auto);
     let holes = |mesh: &TriMesh| {
         let topology = Topology::of(mesh);
-        let fiducials = find_fiducials_in(mesh, &topology, dot);
+        let fiducials = if listed {
+            find_fiducials_in(mesh, &topology, dot)
+        } else {
+            Vec::new()
+        };
         (topology, fiducials)
     };
     if let Some(reg) = early.clone() {
@@ -1661,6 +1691,39 @@ mod tests {
         );
     }
 
+    /// `plan` and `check` prepare the scan without listing its holes
+    /// unless the registration matches them: the same surface and
+    /// registration, no candidates where they are not used, the same
+    /// candidates where they are.
+    #[test]
+    fn candidates_for_registration_only_are_left_out_unless_registering() {
+        let part = test_part::test_part();
+        let bytes = crate::demo::to_binary_ply(&part);
+        let auto = RegistrationSettings {
+            fiducials: FiducialSource::Auto,
+            printer_points: test_part::FIDUCIALS_MM.to_vec(),
+            ..Default::default()
+        };
+        for settings in [RegistrationSettings::default(), auto] {
+            let prepare = |candidates| {
+                let (files, opts) = (ExternalFiles::new(), &ImportOptions::DEFAULT);
+                prepare_scan_owned_with(&bytes, "part.ply", files, opts, &settings, candidates)
+                    .unwrap()
+            };
+            let listed = prepare(Candidates::Listed);
+            let spared = prepare(Candidates::ForRegistration);
+            assert!(!listed.fiducials.is_empty());
+            if settings.fiducials == FiducialSource::Auto {
+                assert_eq!(spared.fiducials, listed.fiducials);
+            } else {
+                assert!(spared.fiducials.is_empty(), "{:?}", spared.fiducials);
+            }
+            assert_eq!(spared.registration, listed.registration);
+            assert_eq!(spared.surface.mesh(), listed.surface.mesh());
+            assert_eq!(spared.warnings, listed.warnings);
+        }
+    }
+
     #[test]
     fn auto_fiducials_find_the_demo_holes_in_any_order() {
         let mut mesh = test_part::test_part();
@@ -1720,9 +1783,15 @@ mod tests {
         };
         let reg = RegistrationSettings::default();
         let files = ExternalFiles::new().with("block mesh.bin", bin.clone());
-        let separate =
-            prepare_scan_owned_with(gltf, "block.gltf", files, &ImportOptions::DEFAULT, &reg)
-                .unwrap();
+        let separate = prepare_scan_owned_with(
+            gltf,
+            "block.gltf",
+            files,
+            &ImportOptions::DEFAULT,
+            &reg,
+            Candidates::Listed,
+        )
+        .unwrap();
         let want = vec![InputFile::new("block mesh.bin", &bin)];
         assert_eq!(separate.file.external_files, want);
         let one = prepare_scan(&glb, "block.glb", &ImportOptions::DEFAULT, &reg).unwrap();

@@ -79,6 +79,8 @@ pub fn load_scan(
         files,
         &settings.scan,
         &settings.registration,
+        // Neither `plan` nor `check` lists the holes.
+        job::Candidates::ForRegistration,
     )
     .map_err(|e| match e {
         Error::Registration(r) => {
