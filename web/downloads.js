@@ -11,8 +11,22 @@ let press = null;
 const PRESS_KEPT_MS = 30_000;
 
 const GCODE_LABEL = 'Download G-code';
-const RISKY_LABEL = 'Download G-code (the nozzle touches the part)…';
-const CONFIRM_LABEL = 'Download anyway (the nozzle touches the part)';
+// G-code written only because the risk was accepted: the labels name the
+// risk, moves that touch the part or another refusal (dispensing far above
+// the surface, a scan below the bed, ...: the report's accepted risks).
+const RISKY = {
+  touching: {
+    head: 'The nozzle touches the part.',
+    label: 'Download G-code (the nozzle touches the part)…',
+    confirm: 'Download anyway (the nozzle touches the part)',
+  },
+  other: {
+    head: 'Written only because you accepted the risk.',
+    label: 'Download G-code (at your risk)…',
+    confirm: 'Download anyway (at your risk)',
+  },
+};
+const riskOf = (motion) => RISKY[motion.program.touching_moves > 0 ? 'touching' : 'other'];
 const REPORT_LABEL = 'Download report';
 const WRITING_LABEL = 'Writing the report…';
 
@@ -59,11 +73,13 @@ export function offerDownloads(plan) {
   const motion = plan.summary.motion;
   if (motion.risk_accepted) {
     const g = $('dl-gcode');
-    state.risky = { plan, name: gcodeName };
-    g.textContent = RISKY_LABEL;
+    const risk = riskOf(motion);
+    state.risky = { plan, name: gcodeName, confirm: risk.confirm };
+    g.textContent = risk.label;
     g.classList.add('risky');
     g.tabIndex = 0;
     g.hidden = false;
+    $('risk-warning-head').textContent = risk.head;
     $('risk-warning-text').textContent = `safe motion: ${plan.summary.motion_line}`;
     $('risk-warning').hidden = false;
   } else {
@@ -113,7 +129,7 @@ export function onGcodeClick(e) {
   if (!r || g.classList.contains('armed')) return;
   e.preventDefault();
   linkBytes(g, r.plan.gcodeBytes, 'text/plain', r.name);
-  g.textContent = CONFIRM_LABEL;
+  g.textContent = r.confirm;
   g.classList.add('armed');
 }
 

@@ -175,6 +175,13 @@ function plannedStatus(plan) {
     return [`${head}: ${touching} move(s) touch the part; the G-code downloads only after a confirmation`
       + (off ? `; ${offText}` : ''), true];
   }
+  // Written only because another refusal was overridden (the box that
+  // accepts the risk): named here too, not as touching.
+  const risks = plan.summary.motion.accepted_risks || [];
+  if (risks.length > 0) {
+    return [`${head}: written only because the risk was accepted (${risks.join('; ')}); `
+      + 'the G-code downloads only after a confirmation' + (off ? `; ${offText}` : ''), true];
+  }
   return off ? [`${head}: ${offText}`, true] : [head, false];
 }
 
@@ -506,7 +513,7 @@ function onPlanError(m, busy) {
   } else if (RISKS[m.kind]) {
     // Refused unless the risk is accepted: the box that accepts it.
     title = RISKS[m.kind];
-    message = ended(message) + '\nTo write it anyway, tick "write G-code even where the nozzle may touch" (Nozzle and process).';
+    message = ended(message) + '\nTo write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';
@@ -515,7 +522,7 @@ function onPlanError(m, busy) {
     // scan turned upside down (printer points in the other order).
     title = 'The registration puts the scan where the part is not: no G-code';
     message = ended(message) + '\nCheck the printer points (their order and values); to write it anyway, tick '
-      + '"write G-code even where the nozzle may touch" (Nozzle and process).';
+      + '"write G-code even where it is refused (at my risk)" (Nozzle and process).';
   }
   // A plan refused for its motion still compared the planners on the
   // settings that failed: the table shows why.

@@ -284,3 +284,49 @@ test('the demo menu loads each generated part with its drawing and placement', a
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// Two closed boxes as OBJ text: an 80 x 80 x 2 mm plate and a 20 mm post
+// standing on its middle.
+function platePostObj() {
+  const lines = [];
+  const faces = [];
+  const box = ([x0, y0, z0], [x1, y1, z1]) => {
+    const base = lines.length;
+    for (const z of [z0, z1]) for (const [x, y] of [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]) lines.push(`v ${x} ${y} ${z}`);
+    const q = (a, b, c, d) => faces.push(`f ${base + a} ${base + b} ${base + c}`, `f ${base + a} ${base + c} ${base + d}`);
+    q(1, 4, 3, 2); q(5, 6, 7, 8);
+    q(1, 2, 6, 5); q(2, 3, 7, 6); q(3, 4, 8, 7); q(4, 1, 5, 8);
+  };
+  box([0, 0, 0], [80, 80, 2]);
+  box([30, 30, 2], [50, 50, 22]);
+  return `${lines.join('\n')}\n${faces.join('\n')}\n`;
+}
+
+test('G-code written at the user\'s risk for another refusal than touching names that risk, not touching', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // The demo drawing across a post far narrower than the drawing's lines
+  // are long: the tool path would dispense far above the plate beside it.
+  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-panel'), /dispense far above the surface/);
+  await page.check('#accept-risk');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true);
+  assert.equal(await page.isHidden('#risk-warning'), false);
+  // No move touches: the warning, the button and the status say what was
+  // accepted instead.
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.summary.motion.program.touching_moves), 0);
+  assert.equal(await page.textContent('#risk-warning-head'), 'Written only because you accepted the risk.');
+  assert.match(await page.textContent('#risk-warning-text'), /written only because the risk was accepted: the tool path dispenses \d+\.\d{3} mm above the surface/);
+  assert.equal(await page.textContent('#dl-gcode'), 'Download G-code (at your risk)…');
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /^planned .* on plate-post\.obj with even: written only because the risk was accepted \(the tool path dispenses \d+\.\d{3} mm above the surface .*\); the G-code downloads only after a confirmation/);
+  assert.doesNotMatch(status + await page.textContent('#risk-warning'), /touch/);
+  await page.click('#dl-gcode');
+  assert.equal(await page.textContent('#dl-gcode'), 'Download anyway (at your risk)');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
