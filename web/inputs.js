@@ -149,6 +149,16 @@ function openScan(file, external) {
   };
   $('scan-note').textContent = '';
   state.pendingScan = entry;
+  // Units and an up axis chosen for the scan loaded before belong to that
+  // file: another file is read in its own defaults (a scan read in inches
+  // last time is not the next one's unit), and the choice is dropped once
+  // it is read (kept while a file that cannot be read changes nothing).
+  // One chosen while the demo part was shown is taken as meant for this
+  // file (the demo is the page's part, not the user's).
+  const prev = state.scan;
+  if ((settings.scanUnits || settings.scanUp) && prev && !prev.part) {
+    entry.fileDefaults = { units: settings.scanUnits, up: settings.scanUp, from: prev.name };
+  }
   // The demo's fiducials belong to the demo part: a new scan is read
   // unregistered until the user sets its fiducials (the settings change
   // only once the scan is read, so a bad file changes nothing).
@@ -409,6 +419,17 @@ export function acceptScan(info) {
     settings.fidPrinterText = '';
     saveSettings();
     writeForm();
+  }
+  if (scan.fileDefaults) {
+    const { units, up, from } = scan.fileDefaults;
+    delete scan.fileDefaults;
+    settings.scanUnits = '';
+    settings.scanUp = '';
+    saveSettings();
+    writeForm();
+    const chosen = [units && `units ${units}`, up && `up axis +${up.toUpperCase()}`].filter(Boolean).join(' and ');
+    $('scan-note').textContent = `Read in the file's own units and up axis: ${chosen} were chosen for ${from} `
+      + '(Units and Up axis above set them for this file).';
   }
   if (scan.asScanned) {
     // A new scan is read as it is; the banner offers to place it.

@@ -155,8 +155,9 @@ export function jobSettings(scan) {
   if (!(dot > 0)) throw new Error('fiducial dot diameter: type a diameter in mm, greater than 0 (default 1)');
   return {
     scan: {
-      units: s.scanUnits || null,
-      up_axis: s.scanUp || null,
+      // A new file is read in its own defaults (inputs.js, openScan).
+      units: (scan && scan.fileDefaults) ? null : s.scanUnits || null,
+      up_axis: (scan && scan.fileDefaults) ? null : s.scanUp || null,
       max_edge_mm: String(s.scanMaxEdge ?? '').trim() === '' ? null : num(s.scanMaxEdge),
     },
     registration: {

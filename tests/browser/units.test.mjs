@@ -10,8 +10,8 @@ import { openPage, waitForPlan, waitIdle, waitSettled, withPageServer } from './
 const env = withPageServer();
 
 // An 80 x 80 mm film with a gentle wave, 5 mm up, written in metres;
-// `hole`: only its 2 mm rim.
-function filmInMetres(hole = false, dx = 0) {
+// `hole`: only its 2 mm rim; `per`: mm to the file's unit.
+function filmInMetres(hole = false, dx = 0, per = 1000) {
   const n = 41;
   const lines = [];
   for (let j = 0; j < n; j++) {
@@ -19,7 +19,7 @@ function filmInMetres(hole = false, dx = 0) {
       const x = i * 2 + dx;
       const y = j * 2;
       const z = 5 + 0.4 * Math.sin(x / 6) * Math.cos(y / 9);
-      lines.push(`v ${(x / 1000).toFixed(6)} ${(y / 1000).toFixed(6)} ${(z / 1000).toFixed(7)}`);
+      lines.push(`v ${(x / per).toFixed(6)} ${(y / per).toFixed(6)} ${(z / per).toFixed(7)}`);
     }
   }
   for (let j = 0; j + 1 < n; j++) {
@@ -126,6 +126,53 @@ test('the units are asked before the placement on the bed', async () => {
   await waitIdle(page);
   await page.waitForFunction(() => !document.getElementById('place-banner').hidden);
   assert.equal(await page.isHidden('#units-banner'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// Units chosen for one file were applied to the next, another scanner's
+// file in mm, with nothing said: 80 mm read in metres, 80 m across.
+test('units chosen for one scan file are not applied to the next file; chosen on the demo they are', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const open = async (name, text) => {
+    await page.setInputFiles('#scan-input', { name, mimeType: 'text/plain', buffer: Buffer.from(text) });
+    await page.waitForFunction((n) => window.pcpp.state.info && window.pcpp.state.info.name === n, name,
+      { timeout: 120_000 });
+    await waitIdle(page);
+  };
+  const width = () => page.evaluate(() => {
+    const b = window.pcpp.state.info.bbox_mm;
+    return b[1][0] - b[0][0];
+  });
+  // Chosen while the demo part is shown: meant for the file opened next,
+  // which is read in it.
+  await page.selectOption('#scan-units', 'm');
+  await waitIdle(page);
+  await open('film-m.obj', filmInMetres());
+  assert.equal(await page.evaluate(() => window.pcpp.state.info.units), 'm');
+  assert.ok(Math.abs(await width() - 80) < 1e-6);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  assert.equal(await page.textContent('#scan-note'), '');
+  await waitSettled(page);
+  // Another file: its own default (mm), and the page says what it dropped.
+  await open('film-mm.obj', filmInMetres(false, 0, 1));
+  await waitSettled(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.info.units), 'mm');
+  assert.ok(Math.abs(await width() - 80) < 1e-6);
+  assert.equal(await page.inputValue('#scan-units'), '');
+  assert.match(await page.textContent('#scan-note'),
+    /^Read in the file's own units and up axis: units m were chosen for film-m\.obj/);
+  assert.match(await status(page), /^planned .* on film-mm\.obj/);
+  // A file that cannot be read changes nothing: the choice stays with the
+  // scan still used.
+  await page.selectOption('#scan-up', 'y');
+  await waitIdle(page);
+  await page.setInputFiles('#scan-input', { name: 'broken.obj', mimeType: 'text/plain', buffer: Buffer.from('v 1 2\nf 1 2 3\n') });
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.inputValue('#scan-up'), 'y');
+  assert.equal(await page.evaluate(() => window.pcpp.state.info.name), 'film-mm.obj');
   assert.deepEqual(problems, []);
   await context.close();
 });
