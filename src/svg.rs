@@ -808,6 +808,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             reason,
         });
     }
+    if prepared.px_scale != 1.0 {
+        // About the page's origin, as a larger px would have mapped it.
+        for p in out.iter_mut().flat_map(|s| s.points.iter_mut()) {
+            *p *= prepared.px_scale;
+        }
+    }
     Ok(SvgImport {
         subpaths: out,
         notes,
@@ -880,6 +886,8 @@ struct Prepared {
     empty_viewbox: Option<String>,
     has_viewbox: bool,
     percent_size: Vec<String>,
+    /// [`RootSize::px_scale`].
+    px_scale: f64,
 }
 
 /// Elements whose content is only drawn where something refers to it.
@@ -1106,11 +1114,47 @@ struct RootSize {
     /// `width`/`height` written as percentages (of a window the file does
     /// not have), e.g. `width="100%"`.
     percent: Vec<String>,
+    /// Why the size in mm is not known: a `width`/`height` that is no
+    /// length, or one set in CSS.
+    unreadable: Vec<String>,
+    /// The factor on the drawing's size in mm for an editor that drew in
+    /// other px than CSS's 96 per inch (Inkscape before 0.92: 90), said in
+    /// `notes`; 1 otherwise.
+    px_scale: f64,
     notes: Vec<String>,
 }
 
+/// Inkscape's namespace: its `inkscape:version` on the root names the
+/// release that wrote the file.
+const INKSCAPE_NS: &str = "http://www.inkscape.org/namespaces/inkscape";
+
+/// Whether user units are CSS px for the root's size: no viewBox, or a
+/// `width`/`height` in px, unitless, a percentage or missing.
+fn px_user_units(root: roxmltree::Node, has_viewbox: bool) -> bool {
+    use svgtypes::LengthUnit as U;
+    !has_viewbox
+        || ["width", "height"].into_iter().any(|name| {
+            root.attribute(name)
+                .and_then(root_length)
+                .is_none_or(|l| matches!(l.unit, U::None | U::Px | U::Percent))
+        })
+}
+
+/// Inkscape before 0.92 (the `inkscape:version` it writes, e.g. `0.48.4
+/// r9939`) drew at 90 px per inch.
+fn legacy_inkscape<'a>(root: roxmltree::Node<'a, '_>) -> Option<&'a str> {
+    let version = root.attribute((INKSCAPE_NS, "version"))?;
+    let mut parts = version.split(|c: char| !c.is_ascii_digit());
+    let major: u32 = parts.next()?.parse().ok()?;
+    let minor: u32 = parts.next()?.parse().ok()?;
+    (major == 0 && minor < 92).then_some(version)
+}
+
 fn root_size(root: roxmltree::Node) -> RootSize {
-    let mut size = RootSize::default();
+    let mut size = RootSize {
+        px_scale: 1.0,
+        ..Default::default()
+    };
     if let Some(vb) = root.attribute("viewBox") {
         let numbers: Vec<f64> = svg_numbers(vb).take(4).collect();
         match vb.parse::<svgtypes::ViewBox>() {
@@ -1138,11 +1182,115 @@ fn root_size(root: roxmltree::Node) -> RootSize {
         .into_iter()
         .filter_map(|name| {
             let value = root.attribute(name)?;
-            let length = value.parse::<svgtypes::Length>().ok()?;
+            let length = root_length(value)?;
             (length.unit == svgtypes::LengthUnit::Percent).then(|| format!("{name}=\"{value}\""))
         })
         .collect();
+    // A size that is no length, or one given in CSS (which browsers take
+    // and usvg does not): the drawing's size in mm is not known, and a
+    // guess prints it at another size with nothing said. Refused.
+    let bad: Vec<String> = ["width", "height"]
+        .into_iter()
+        .filter_map(|name| {
+            let value = root.attribute(name).filter(|v| root_length(v).is_none())?;
+            Some(format!("{name}=\"{value}\""))
+        })
+        .collect();
+    if !bad.is_empty() {
+        size.unreadable.push(format!(
+            "the root <svg>'s {} {} (a number and then, with no space, a unit: mm, cm, in, pt, \
+             pc, px or Q, e.g. width=\"50mm\"; sizes relative to a window, vw or vh, have none \
+             here), so the drawing's size in mm is not known: write {} so",
+            bad.join(" and "),
+            if bad.len() == 1 {
+                "is not a length"
+            } else {
+                "are not lengths"
+            },
+            if bad.len() == 1 { "it" } else { "them" },
+        ));
+    }
+    // Editors whose px are not CSS's: their drawings' user units in px
+    // come out at another size than they had there.
+    if px_user_units(root, size.has_viewbox) {
+        if let Some(version) = legacy_inkscape(root) {
+            size.px_scale = 96.0 / 90.0;
+            size.notes.push(format!(
+                "written by Inkscape {version}, which drew at 90 px per inch (Inkscape 0.92 and \
+                 later, and browsers, use 96): read at 90, so the drawing has the size it had in \
+                 that Inkscape (a browser shows it 0.9375 times as large)"
+            ));
+        } else if root
+            .parent()
+            .into_iter()
+            .flat_map(|doc| doc.children())
+            .any(|n| n.is_comment() && n.text().is_some_and(|t| t.contains("Adobe Illustrator")))
+        {
+            size.notes.push(
+                "made by Adobe Illustrator, which writes its points (72 per inch) as px: read at \
+                 96 px per inch as browsers show it, the drawing is 0.75 times its size in \
+                 Illustrator; to print it at that size, scale it by 1.3333 in the placement, or \
+                 export it with width and height in mm"
+                    .to_string(),
+            );
+        }
+    }
+    if let Some(style) = root.attribute("style") {
+        let sized: Vec<&str> = style
+            .split(';')
+            .filter_map(|d| d.split_once(':'))
+            .map(|(k, _)| k.trim())
+            .filter(|k| k.eq_ignore_ascii_case("width") || k.eq_ignore_ascii_case("height"))
+            .collect();
+        if !sized.is_empty() {
+            size.unreadable.push(format!(
+                "the root <svg>'s style=\"{style}\" sets its {}, which this reader does not take \
+                 from CSS, so the drawing's size in mm is not known: give it as attributes \
+                 instead (e.g. width=\"50mm\" height=\"50mm\")",
+                sized.join(" and ")
+            ));
+        }
+    }
     size
+}
+
+/// The root `<svg>`'s `width` or `height` as CSS reads it: white space
+/// around it, units in any case (`50MM`), and the quarter-millimetre `Q`
+/// (CSS Values 3) are taken, which svgtypes refuses (usvg then ignored the
+/// size and took the page as 100 px: a drawing drawn 50 mm wide printed
+/// 26.46 mm wide). `None` when it is no length at all (`50 mm`, `50vw`).
+fn root_length(value: &str) -> Option<svgtypes::Length> {
+    let trimmed = value.trim_matches(|c: char| c.is_ascii_whitespace());
+    if let Ok(l) = trimmed.parse::<svgtypes::Length>() {
+        return Some(l);
+    }
+    let lower = trimmed.to_ascii_lowercase();
+    if let Ok(l) = lower.parse::<svgtypes::Length>() {
+        return Some(l);
+    }
+    let quarters: f64 = lower.strip_suffix('q')?.parse().ok()?;
+    Some(svgtypes::Length::new(
+        quarters / 4.0,
+        svgtypes::LengthUnit::Mm,
+    ))
+}
+
+/// A length as svgtypes writes and reads it (`50mm`).
+fn length_text(l: svgtypes::Length) -> String {
+    use svgtypes::LengthUnit as U;
+    let unit = match l.unit {
+        U::None => "",
+        U::Em => "em",
+        U::Ex => "ex",
+        U::Px => "px",
+        U::In => "in",
+        U::Cm => "cm",
+        U::Mm => "mm",
+        U::Pt => "pt",
+        U::Pc => "pc",
+        U::Percent => "%",
+    };
+    format!("{}{unit}", l.number)
 }
 
 /// Millimetres in one unit of a CSS length at 96 px per inch (CSS
@@ -1171,10 +1319,9 @@ fn mm_per_unit(unit: svgtypes::LengthUnit) -> Option<f64> {
 /// size is font-relative (`em`, `ex`) or the root has a `transform-origin`:
 /// usvg's matrix is then used as it is.
 fn root_user_to_mm(root: roxmltree::Node) -> Option<DAffine2> {
-    let length = |name: &str| {
-        root.attribute(name)
-            .and_then(|v| v.parse::<svgtypes::Length>().ok())
-    };
+    // As usvg reads them once `prepare` has written them out (see
+    // [`root_length`]).
+    let length = |name: &str| root.attribute(name).and_then(root_length);
     let (width, height) = (length("width"), length("height"));
     // (usvg keeps the viewBox in f32: a size that rounds to 0 is none.)
     let view_box = root
@@ -1775,6 +1922,21 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     }
 
     let root_size = root_size(root);
+    if !root_size.unreadable.is_empty() {
+        return Err(root_size.unreadable.join("; "));
+    }
+    // A size CSS reads and svgtypes does not (`50MM`, ` 5cm `, `200Q`) is
+    // written out as usvg reads it (as `root_user_to_mm` reads it too).
+    for name in ["width", "height"] {
+        if let Some(attr) = root.attribute_node(name) {
+            let range = attr.range_value();
+            let fixed = root_length(attr.value())
+                .filter(|_| attr.value().parse::<svgtypes::Length>().is_err());
+            if let (Some(l), Some(_)) = (fixed, text.get(range.clone())) {
+                edits.push((range.start, range.len(), length_text(l)));
+            }
+        }
+    }
     let mut notes = root_size.notes;
     if texts > 0 {
         notes.push(format!(
@@ -1813,6 +1975,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         empty_viewbox: root_size.empty_viewbox,
         has_viewbox: root_size.has_viewbox,
         percent_size: root_size.percent,
+        px_scale: root_size.px_scale,
     })
 }
 

@@ -1687,3 +1687,118 @@ fn a_scan_or_program_chosen_as_the_drawing_is_named() {
         );
     }
 }
+
+/// A root size CSS reads and svgtypes did not (white space around it, the
+/// unit in capitals, the quarter-millimetre Q) was ignored: the page taken
+/// as 100 px, a 50 mm line printed 26.46 mm long with nothing said.
+#[test]
+fn root_sizes_as_css_writes_them_give_the_size_in_mm() {
+    for size in ["5.0cm ", " 50mm", "50MM", "5CM", "200Q", "200q", "50mm"] {
+        let text = doc(
+            &format!(r#"width="{size}" height="{size}" viewBox="0 0 100 100""#),
+            r#"<path d="M0,50 H100" stroke="black"/>"#,
+        );
+        let (subs, notes) = notes_of(&text);
+        assert!(
+            (subs[0].length_mm() - 50.0).abs() < 1e-9,
+            "{size:?}: {}",
+            subs[0].length_mm()
+        );
+        assert!(notes.is_empty(), "{size:?}: {notes:?}");
+    }
+}
+
+/// A root size that is no length, or one set in CSS, leaves the size in
+/// mm unknown: refused, naming the attribute, not printed at a guess.
+#[test]
+fn root_sizes_that_are_no_length_are_refused_by_name() {
+    for (size, named) in [
+        (
+            r#"width="50 mm" height="50mm""#,
+            r#"width="50 mm" is not a length"#,
+        ),
+        (
+            r#"width="50vw" height="50vw""#,
+            r#"width="50vw" and height="50vw" are not lengths"#,
+        ),
+        (
+            r#"style="width:50mm;height:50mm""#,
+            "sets its width and height",
+        ),
+    ] {
+        let text = doc(
+            &format!(r#"{size} viewBox="0 0 100 100""#),
+            r#"<path d="M0,50 H100" stroke="black"/>"#,
+        );
+        let e = import_svg(text.as_bytes(), "size.svg")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("size.svg: the root <svg>'s "), "{e}");
+        assert!(
+            e.contains(named) && e.contains("e.g. width=\"50mm\""),
+            "{e}"
+        );
+    }
+}
+
+/// Inkscape before 0.92 drew at 90 px per inch: its files are read at 90
+/// (a 40 mm line stays 40 mm), said in a note; Inkscape 1.x's are not, nor
+/// a legacy file whose size is in mm through a viewBox. Illustrator's
+/// points-as-px get a note and are read as browsers read them.
+#[test]
+fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_is_named() {
+    let ink = |version: &str, size: &str| {
+        format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" inkscape:version="{version}" {size}><path d="m 70.866142,70.866142 141.732288,0" stroke="black"/></svg>"#
+        )
+    };
+    let a4_px = r#"width="744.09448819" height="1052.3622047""#;
+    let (subs, notes) = notes_of(&ink("0.48.4 r9939", a4_px));
+    assert!(
+        (subs[0].length_mm() - 40.0).abs() < 1e-5,
+        "{}",
+        subs[0].length_mm()
+    );
+    assert!(
+        (subs[0].points[0].x - 20.0).abs() < 1e-5,
+        "{}",
+        subs[0].points[0]
+    );
+    let note = note_with(&notes, "Inkscape 0.48.4");
+    assert!(note.contains("90 px per inch"), "{note}");
+    for (version, size) in [
+        ("1.3 (0e150ed6c4, 2023-07-21)", a4_px),
+        (
+            "0.48.4 r9939",
+            r#"width="210mm" height="297mm" viewBox="0 0 744.09448819 1052.3622047""#,
+        ),
+    ] {
+        let (subs, notes) = notes_of(&ink(version, size));
+        // 141.73 user units: 210 / 744.09 mm each through the viewBox, else
+        // CSS px.
+        let want = if size.contains("mm") { 40.0 } else { 37.5 };
+        assert!(
+            (subs[0].length_mm() - want).abs() < 1e-5,
+            "{version}: {}",
+            subs[0].length_mm()
+        );
+        assert!(
+            notes.iter().all(|n| !n.contains("90 px")),
+            "{version}: {notes:?}"
+        );
+    }
+    let ai = r#"<?xml version="1.0" encoding="utf-8"?>
+<!-- Generator: Adobe Illustrator 27.0.0, SVG Export Plug-In . SVG Version: 6.00 Build 0)  -->
+<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 170.08 113.39"><path d="M0,10 H72" stroke="black"/></svg>"#;
+    let (subs, notes) = notes_of(ai);
+    assert!(
+        (subs[0].length_mm() - 72.0 * 25.4 / 96.0).abs() < 1e-5,
+        "{}",
+        subs[0].length_mm()
+    );
+    let note = note_with(&notes, "Adobe Illustrator");
+    assert!(
+        note.contains("0.75 times") && note.contains("1.3333"),
+        "{note}"
+    );
+}
