@@ -307,11 +307,132 @@ impl MachineProfile {
                 check_template(source, &format!("{field}[{i}]"), line, BLOCK_TOKENS)?;
             }
         }
+        self.check_frame(source)?;
         if self.dwell.trim().is_empty() {
             return Err(bad("dwell", "must not be empty".into()));
         }
         check_template(source, "dwell", &self.dwell, DWELL_TOKENS)
     }
+}
+
+impl MachineProfile {
+    /// The writer's moves are millimetres, absolute, in the frame the scan
+    /// was placed in (spec section 6f checks them as written): a `start`
+    /// that leaves the controller in inches or relative moves, or moves its
+    /// frame (G92, a work offset, machine coordinates), and a dispense
+    /// command that does any of that or moves an axis, would make the
+    /// controller go elsewhere than the moves checked. Refused, naming the
+    /// line. (`end` runs after the last move and may do as it likes, e.g.
+    /// G91 and a lift.)
+    fn check_frame(&self, source: &str) -> Result<(), GcodeError> {
+        let bad = |field: String, message: String| GcodeError::ProfileField {
+            file: source.into(),
+            field,
+            message,
+        };
+        let (mut inches, mut relative) = (None::<(String, f64)>, None::<(String, f64)>);
+        let blocks = [
+            ("start", &self.start),
+            ("dispense_on", &self.dispense_on),
+            ("dispense_off", &self.dispense_off),
+        ];
+        for (name, lines) in blocks {
+            for (i, line) in lines.iter().enumerate() {
+                let field = format!("{name}[{i}]");
+                for g in g_words(line, &self.comment) {
+                    let what = match g {
+                        20.0 | 70.0 if name == "start" => {
+                            inches = Some((field.clone(), g));
+                            continue;
+                        }
+                        21.0 | 71.0 if name == "start" => {
+                            inches = None;
+                            continue;
+                        }
+                        91.0 if name == "start" => {
+                            relative = Some((field.clone(), g));
+                            continue;
+                        }
+                        90.0 if name == "start" => {
+                            relative = None;
+                            continue;
+                        }
+                        4.0 => continue,
+                        92.0 | 92.1 | 92.2 | 92.3 => "sets the position to other coordinates",
+                        53.0 => "moves in machine coordinates",
+                        g if (54.0..60.0).contains(&g) => "switches to another work offset",
+                        20.0 | 70.0 => "switches to inches",
+                        91.0 => "switches to relative moves",
+                        _ if name == "start" => continue,
+                        _ => "is a G-code inside the dispense command (a move, or a mode change)",
+                    };
+                    return Err(bad(
+                        field,
+                        format!(
+                            "G{g} {what}, so the controller would not go where pcpp's moves \
+                             (millimetres, absolute, in the frame the scan was placed in) were \
+                             checked to go: remove it"
+                        ),
+                    ));
+                }
+            }
+        }
+        let left = |state: Option<(String, f64)>, what: &str, back: &str| match state {
+            Some((field, g)) => Err(bad(
+                field,
+                format!(
+                    "G{g} leaves the controller in {what} after the start, but pcpp writes its \
+                     moves in millimetres, absolute: remove it, or end the start with {back}"
+                ),
+            )),
+            None => Ok(()),
+        };
+        left(inches, "inches", "G21")?;
+        left(relative, "relative moves", "G90")
+    }
+}
+
+/// The numbers of the G words of one template line (`G91`, `g1`, `G0 1`
+/// counts as G0), outside its comments (the profile's style, and `;` and
+/// parentheses): a G word is a `G` that does not continue a name.
+fn g_words(line: &str, comment: &CommentStyle) -> Vec<f64> {
+    let mut code = line;
+    for start in [comment.prefix.as_str(), ";"] {
+        if let Some(at) = code.find(start).filter(|_| !start.is_empty()) {
+            code = &code[..at];
+        }
+    }
+    let code: String = {
+        let mut depth = 0usize;
+        code.chars()
+            .filter(|&c| {
+                match c {
+                    '(' => depth += 1,
+                    ')' => depth = depth.saturating_sub(1),
+                    _ => return depth == 0,
+                }
+                false
+            })
+            .collect()
+    };
+    let chars: Vec<char> = code.chars().collect();
+    let mut out = Vec::new();
+    for (i, &c) in chars.iter().enumerate() {
+        let continues = i > 0
+            && (chars[i - 1].is_ascii_alphanumeric() || matches!(chars[i - 1], '_' | '$' | '.'));
+        if !matches!(c, 'G' | 'g') || continues {
+            continue;
+        }
+        let number: String = chars[i + 1..]
+            .iter()
+            .skip_while(|c| **c == ' ')
+            .take_while(|c| c.is_ascii_digit() || **c == '.')
+            .collect();
+        if let Ok(g) = number.parse::<f64>() {
+            out.push(g);
+        }
+    }
+    out
 }
 
 /// One template line: a single line (a line break would split one command
@@ -483,6 +604,70 @@ mod tests {
         assert!(!p.rapid_feed_word);
         assert_eq!(p.decimals, DEFAULT_DECIMALS);
         assert_eq!(p.comment.suffix, "");
+    }
+
+    /// A start that leaves inches or relative moves, a frame moved (G92,
+    /// a work offset) or a G-code inside a dispense command would send the
+    /// controller elsewhere than the moves checked: refused by line. Set
+    /// back within the start, in comments, dwells and the end block, they
+    /// are not.
+    #[test]
+    fn blocks_that_change_units_mode_or_frame_are_refused_by_line() {
+        let block = |field: &str, lines: &[&str]| {
+            let mut v = marlin_json();
+            v.as_object_mut()
+                .unwrap()
+                .insert(field.into(), serde_json::json!(lines));
+            load(&v).map(|_| ()).map_err(|e| e.to_string())
+        };
+        for (field, lines, named, says) in [
+            ("start", &["G20", "G90"][..], "`start[0]`", "inches"),
+            (
+                "start",
+                &["G21", "G91", "G1 Z5"][..],
+                "`start[1]`",
+                "relative moves",
+            ),
+            (
+                "start",
+                &["G21", "G90", "G92 X0 Y0"][..],
+                "`start[2]`",
+                "other coordinates",
+            ),
+            ("start", &["G21 G55"][..], "`start[0]`", "work offset"),
+            (
+                "dispense_on",
+                &["G1 Z200", "M106 S255"][..],
+                "`dispense_on[0]`",
+                "inside the dispense",
+            ),
+            (
+                "dispense_off",
+                &["M107", "g91"][..],
+                "`dispense_off[1]`",
+                "relative",
+            ),
+        ] {
+            let e = block(field, lines).unwrap_err();
+            assert!(e.contains(named) && e.contains(says), "{lines:?}: {e}");
+        }
+        for (field, lines) in [
+            (
+                "start",
+                &["G20", "G91", "G28", "G1 Z5", "G21", "G90", "M107"][..],
+            ),
+            (
+                "start",
+                &["G21 ; G91 G92 in a comment", "G90 (not G20)"][..],
+            ),
+            ("dispense_on", &["M106 S255", "G4 P50"][..]),
+            ("end", &["G91", "G1 Z10", "G90", "M84"][..]),
+        ] {
+            assert_eq!(block(field, lines), Ok(()), "{lines:?}");
+        }
+        for name in MachineProfile::builtin_names() {
+            MachineProfile::builtin(name).unwrap();
+        }
     }
 
     #[test]
