@@ -68,13 +68,19 @@ pub enum Error {
         hidden: usize,
         points: usize,
     },
-    /// G-code refused for a scan so small that its units are likely wrong
-    /// ([`crate::mesh::UnitsDoubt`]), none given.
+    /// G-code refused for a scan so small or so large that its units are
+    /// likely wrong ([`crate::mesh::UnitsDoubt`]), none given.
     #[error(
-        "{message}. No G-code written: give the scan's units (--scan-units mm if it really \
-         is this small)"
+        "{message}. No G-code written: give the scan's units (--scan-units {units} if it \
+         really is this {size})"
     )]
-    UnitsDoubt { message: String },
+    UnitsDoubt {
+        message: String,
+        /// The units it was read in.
+        units: crate::mesh::ScanUnits,
+        /// "small" or "large".
+        size: &'static str,
+    },
     /// G-code refused for a scan placed on the bed and then moved down
     /// (Move Z below 0): if the part stands on the bed, every move is that
     /// much too low, and the clearance checked against the scan does not

@@ -988,6 +988,8 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
     match scan.units_doubt {
         Some(d) if !d.given && !accept_risk => Err(Error::UnitsDoubt {
             message: d.message(&scan.file.name),
+            units: d.units,
+            size: if d.too_large { "large" } else { "small" },
         }),
         _ => Ok(()),
     }
@@ -1096,7 +1098,8 @@ pub fn write_outputs(
     }
     if let Some(d) = scan.units_doubt.filter(|d| !d.given) {
         risks.push(format!(
-            "the scan is only {:.3} mm across, read in {} without its units given",
+            "the scan is {}{:.3} mm across, read in {} without its units given",
+            if d.too_large { "" } else { "only " },
             d.size_mm.max_element(),
             d.units
         ));
@@ -1610,7 +1613,8 @@ mod tests {
             split.vertices.extend(part.triangle(i));
             split.triangles.push([n, n + 1, n + 2]);
         }
-        // And a triangle two of whose corners are one position: skipped.
+        // And a triangle two of whose corners are one position: a segment,
+        // kept (as one of the part's own triangles would be).
         let n = split.vertices.len() as u32;
         split
             .vertices
@@ -1641,7 +1645,12 @@ mod tests {
             // triangles use).
             let whole = pipeline::load_scan(&whole, "part.ply", &scan).unwrap().mesh;
             assert!(imported.mesh.vertices.len() <= whole.vertices.len());
-            assert_eq!(imported.mesh.triangles.len(), whole.triangles.len());
+            // (The split part has the segment besides.)
+            let segment = usize::from(std::ptr::eq(bytes, &split));
+            assert_eq!(
+                imported.mesh.triangles.len(),
+                whole.triangles.len() + segment
+            );
             let topology = Topology::of(&imported.mesh);
             let holes = find_fiducials_in(&imported.mesh, &topology, settings.dot_diameter_mm);
             let reg = registration_for_scan(&imported, &holes, &settings).unwrap();

@@ -647,6 +647,8 @@ struct UnitsDoubtView {
     size_mm: [f64; 3],
     units: crate::mesh::ScanUnits,
     given: bool,
+    /// Too large for its units rather than too small.
+    too_large: bool,
     /// The core's warning, naming the file.
     message: String,
     /// The units it may be in, each with the size it would have.
@@ -665,6 +667,7 @@ impl UnitsDoubtView {
             size_mm: d.size_mm.to_array(),
             units: d.units,
             given: d.given,
+            too_large: d.too_large,
             message: d.message(file),
             offers: d
                 .offers()

@@ -641,13 +641,14 @@ fn warnings_but_units(m: &ImportedMesh) -> Vec<&String> {
 }
 
 #[test]
-fn degenerate_triangles_are_skipped_with_one_warning() {
+fn degenerate_triangles_are_kept_with_one_warning() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\nf 1 2 4\n";
     let m = import(obj, "d.obj", &ImportOptions::DEFAULT);
-    assert_eq!(m.mesh.triangle_count(), 1);
+    // Kept: the segments they are are surface the nozzle must clear.
+    assert_eq!(m.mesh.triangle_count(), 3);
     assert_eq!(warnings_but_units(&m).len(), 1);
     assert!(
-        m.warnings[0].contains("skipped 2 degenerate"),
+        m.warnings[0].contains("2 degenerate triangle(s)") && m.warnings[0].contains("kept"),
         "{:?}",
         m.warnings
     );

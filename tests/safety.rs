@@ -451,3 +451,85 @@ fn regression_a_scan_moved_below_the_bed_wrote_gcode_into_the_part() {
         &out.gcode[..1500]
     );
 }
+
+/// A needle modelled as triangles of no area (a vertical segment, as
+/// three collinear corners, and as a repeated corner) was dropped at
+/// import: the nozzle was driven through it with a clearance of 0.603 mm
+/// reported. Kept as the segments they are, the moves pass over it, by the
+/// oracle, which measures the needle as the triangles the file gives.
+#[test]
+fn regression_a_needle_of_zero_area_triangles_is_cleared() {
+    // Around (50, 50), inside the build volume.
+    let corner = |x: f64, y: f64| DVec3::new(50.0 + x, 50.0 + y, 0.0);
+    let (a, b, c, d) = (
+        corner(-20.0, -20.0),
+        corner(20.0, -20.0),
+        corner(20.0, 20.0),
+        corner(-20.0, 20.0),
+    );
+    let mut triangles = vec![[a, b, c], [a, c, d]];
+    let tip = DVec3::new(50.3, 50.05, 3.0);
+    triangles.push([
+        DVec3::new(50.3, 50.05, 0.0),
+        DVec3::new(50.3, 50.05, 1.5),
+        tip,
+    ]);
+    let post = DVec3::new(46.0, 49.95, 2.0);
+    let foot = DVec3::new(46.0, 49.95, 0.0);
+    triangles.push([foot, foot, post]);
+    let mesh = TriMesh {
+        vertices: triangles.iter().flatten().copied().collect(),
+        triangles: (0..triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect(),
+    };
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="2mm" viewBox="0 0 20 2"><path d="M0,1 H20" stroke="black" fill="none"/></svg>"#;
+    let placement = Placement {
+        offset_mm: pcpp::DVec2::new(40.0, 51.0),
+        ..Placement::default()
+    };
+    for planner in [PlannerKind::Even, PlannerKind::PcppGuarded] {
+        let out = plan(&mesh, svg, placement, planner, false)
+            .unwrap_or_else(|e| panic!("{planner}: {e}"));
+        let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+        assert_eq!(oracle.too_close, 0, "{planner}: {}", describe(&oracle));
+        assert!(
+            out.report
+                .warnings
+                .iter()
+                .any(|w| w.contains("2 degenerate triangle(s)")),
+            "{:?}",
+            out.report.warnings
+        );
+        // Over the needle: every move that crosses its x does so at its
+        // tip's height plus tol at least (its lower end, in a straight
+        // line over).
+        let points: Vec<(f64, f64)> = out
+            .gcode
+            .lines()
+            .filter(|l| l.starts_with("G1 ") || l.starts_with("G0 "))
+            .filter_map(|l| {
+                let word = |c: char| {
+                    l.split_whitespace()
+                        .find_map(|w| w.strip_prefix(c)?.parse::<f64>().ok())
+                };
+                Some((word('X')?, word('Z')?))
+            })
+            .collect();
+        let crossing: Vec<f64> = points
+            .windows(2)
+            .filter(|w| w[0].0.min(w[1].0) <= tip.x && tip.x <= w[0].0.max(w[1].0))
+            .map(|w| w[0].1.min(w[1].1))
+            .collect();
+        assert!(
+            !crossing.is_empty(),
+            "{planner}: no move crosses the needle"
+        );
+        for z in crossing {
+            assert!(
+                z >= tip.z + TOL,
+                "{planner}: a move crosses the needle at z {z}"
+            );
+        }
+    }
+}

@@ -66,7 +66,7 @@ const PAGE_WORDS = [
   [/\(--up-axis y or z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
   [/\(--up-axis\)/g, '(Up axis)'],
   [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
-  [/\(--scan-units mm if it really is this small\)/g, '(Units: mm if it really is this small)'],
+  [/\(--scan-units (\w+) if it really is this (small|large)\)/g, '(Units: $1 if it really is this $2)'],
   [/\(--max-edge\)/g, '(Cloud max edge)'],
   [/\(--accept-risk; in the page, (the box '[^']*')\)/g, '($1)'],
   [/keep it next to \S+ \(command line\) or select both files together \(page\)/g, 'select both files together'],

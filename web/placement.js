@@ -306,8 +306,11 @@ function showUnitsBanner(info) {
     $('units-banner-text').textContent = '';
     return;
   }
-  $('units-banner-text').textContent = `${info.name} is only ${sizeText(d.size_mm, 3)} mm read in `
-    + `${UNIT_NAMES[d.units]}: it was most likely saved in other units. No G-code until you choose them.`;
+  $('units-banner-text').textContent = d.too_large
+    ? `${info.name} is ${sizeText(d.size_mm, 1)} mm read in ${UNIT_NAMES[d.units]}, larger than any `
+      + 'printer: it was most likely saved in other units. No G-code until you choose them.'
+    : `${info.name} is only ${sizeText(d.size_mm, 3)} mm read in `
+      + `${UNIT_NAMES[d.units]}: it was most likely saved in other units. No G-code until you choose them.`;
   const offer = (units, text, primary) => {
     const b = document.createElement('button');
     b.type = 'button';

@@ -446,9 +446,15 @@ fn import_cloud(
 /// likely a file in metres or inches read as millimetres.
 pub const SMALL_SCAN_MM: f64 = 5.0;
 
-/// A scan so small in the units it was read in (less than
-/// [`SMALL_SCAN_MM`] across) that they are likely wrong: a file in metres
-/// or inches read as millimetres.
+/// A scan whose largest extent is above this (mm) is larger than any
+/// printer's stage: most likely a file in millimetres read as metres (a
+/// glTF, whose unit is the metre, written by a CAD tool in mm) or inches.
+pub const LARGE_SCAN_MM: f64 = 2000.0;
+
+/// A scan so small or so large in the units it was read in (less than
+/// [`SMALL_SCAN_MM`] or more than [`LARGE_SCAN_MM`] across) that they are
+/// likely wrong: a file in metres or inches read as millimetres, or one
+/// in millimetres read as metres.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UnitsDoubt {
     /// Its extent in mm, as read.
@@ -459,6 +465,8 @@ pub struct UnitsDoubt {
     /// the size is theirs, and the doubt only a warning; otherwise
     /// [`crate::job::refuse_unit_doubt`] writes no G-code.
     pub given: bool,
+    /// Too large rather than too small.
+    pub too_large: bool,
 }
 
 impl UnitsDoubt {
@@ -479,28 +487,38 @@ impl UnitsDoubt {
         if mesh.triangles.is_empty() || !(lo.is_finite() && hi.is_finite()) {
             return None;
         }
-        if (hi - lo).max_element() >= SMALL_SCAN_MM {
+        let across = (hi - lo).max_element();
+        if (SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&across) {
             return None;
         }
         let (lo, hi) = mesh.bbox()?;
         let size_mm = hi - lo;
-        (size_mm.max_element() < SMALL_SCAN_MM).then_some(UnitsDoubt {
+        let across = size_mm.max_element();
+        (!(SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&across)).then_some(UnitsDoubt {
             size_mm,
             units,
             given,
+            too_large: across > LARGE_SCAN_MM,
         })
     }
 
-    /// The larger units the scan may be in (metres, inches), each with the
-    /// size it would have in them (mm): those in which it would no longer
-    /// be too small.
+    /// The units the scan may be in, each with the size it would have in
+    /// them (mm): larger ones (metres, inches) for a scan too small,
+    /// smaller ones (mm, cm, inches) for one too large; those in which it
+    /// would be neither.
     pub fn offers(&self) -> Vec<(ScanUnits, DVec3)> {
         let as_read = self.units.to_mm();
-        [ScanUnits::M, ScanUnits::In]
-            .into_iter()
-            .filter(|&u| u != self.units && u.to_mm() > as_read)
+        let candidates: &[ScanUnits] = if self.too_large {
+            &[ScanUnits::Mm, ScanUnits::Cm, ScanUnits::In]
+        } else {
+            &[ScanUnits::M, ScanUnits::In]
+        };
+        candidates
+            .iter()
+            .copied()
+            .filter(|&u| u != self.units && (u.to_mm() < as_read) == self.too_large)
             .map(|u| (u, self.size_mm * (u.to_mm() / as_read)))
-            .filter(|(_, size)| size.max_element() >= SMALL_SCAN_MM)
+            .filter(|(_, size)| (SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&size.max_element()))
             .collect()
     }
 
@@ -520,11 +538,24 @@ impl UnitsDoubt {
                 )
             })
             .collect();
+        let (only, digits, larger) = if self.too_large {
+            ("", 1, ", larger than any printer's stage")
+        } else {
+            ("only ", 3, "")
+        };
+        // (A fuzzed file's 1e299 mm in 300 digits said nothing more.)
+        let mm = |v: f64| {
+            if v.abs() < 1e7 {
+                format!("{v:.digits$}")
+            } else {
+                format!("{v:.3e}")
+            }
+        };
         format!(
-            "{file}: the scan is only {:.3} x {:.3} x {:.3} mm, read in {}: check its units{}{}",
-            s.x,
-            s.y,
-            s.z,
+            "{file}: the scan is {only}{} x {} x {} mm, read in {}{larger}: check its units{}{}",
+            mm(s.x),
+            mm(s.y),
+            mm(s.z),
             self.units,
             if others.is_empty() { "" } else { "; " },
             others.join(", ")
@@ -593,7 +624,15 @@ fn check_triangle_count(n: usize, file: &str) -> Result<(), MeshError> {
 
 /// The shared steps after parsing. Parsers already report bad values with
 /// their line or element; these checks are the backstop that guarantees the
-/// invariants downstream stages rely on (finite, in range, non-degenerate).
+/// invariants downstream stages rely on (finite, in range, some area).
+///
+/// Degenerate triangles (a repeated vertex, or zero area) are kept: each
+/// is the segment or point it collapses to, and that is surface the nozzle
+/// must clear (spec section 6f: a needle modelled as a flat triangle, 3 mm
+/// tall, was left out, and the nozzle was driven through it with a
+/// clearance of 0.603 mm reported). The queries that need area (the
+/// projection, the facet contact) find none in them; the swept clearance
+/// tries their corners and edges.
 fn finish(
     parsed: Parsed,
     file: &str,
@@ -602,18 +641,16 @@ fn finish(
 ) -> Result<(TriMesh, Vec<String>), MeshError> {
     let Parsed {
         mut vertices,
-        mut triangles,
+        triangles,
         mut warnings,
     } = parsed;
     check_finite(&vertices, file)?;
     let n = vertices.len();
-    // The kept triangles move to the front of the array they were read
-    // into (no second array of them). A triangle two of whose corners the
-    // weld would merge has those corners at one position, so it has zero
-    // area here already: the same triangles are kept welded or not.
-    let mut kept = 0usize;
-    for face in 0..triangles.len() {
-        let tri = triangles[face];
+    // A triangle two of whose corners the weld would merge has those
+    // corners at one position, so it has zero area here already: counted
+    // the same welded or not.
+    let mut degenerate = 0usize;
+    for (face, &tri) in triangles.iter().enumerate() {
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(MeshError::IndexOutOfRange {
                 file: file.into(),
@@ -624,19 +661,18 @@ fn finish(
             });
         }
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
-        if !(tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c)) {
-            triangles[kept] = tri;
-            kept += 1;
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c) {
+            degenerate += 1;
         }
     }
-    let degenerate = triangles.len() - kept;
-    triangles.truncate(kept);
     if degenerate > 0 {
         warnings.push(format!(
-            "{file}: skipped {degenerate} degenerate triangle(s) (repeated vertex or zero area)"
+            "{file}: {degenerate} degenerate triangle(s) (repeated vertex or zero area), kept as \
+             the segments and points they are: the nozzle keeps clear of them, nothing is \
+             printed on them"
         ));
     }
-    if triangles.is_empty() {
+    if degenerate == triangles.len() {
         return Err(MeshError::Empty { file: file.into() });
     }
     check_triangle_count(triangles.len(), file)?;
@@ -971,17 +1007,29 @@ mod tests {
         assert_eq!(detect_format(b"{\"a\":1}", "x"), None);
     }
 
+    /// Degenerate triangles are kept (the segments and points they are,
+    /// which the nozzle must clear), counted in one warning; a mesh of
+    /// nothing else has no surface.
     #[test]
-    fn degenerate_triangles_are_counted_in_one_warning() {
-        let parsed = Parsed {
+    fn degenerate_triangles_are_kept_and_counted_in_one_warning() {
+        let parsed = || Parsed {
             vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(2.0, 0.0, 0.0)],
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
             warnings: vec![],
         };
-        let (mesh, warnings) = finish(parsed, "t", 1.0, UpAxis::Z).unwrap();
-        assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        let (mesh, warnings) = finish(parsed(), "t", 1.0, UpAxis::Z).unwrap();
+        assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]]);
         assert_eq!(warnings.len(), 1);
-        assert!(warnings[0].contains("2 degenerate"), "{warnings:?}");
+        assert!(
+            warnings[0].contains("2 degenerate") && warnings[0].contains("kept"),
+            "{warnings:?}"
+        );
+        let mut only = parsed();
+        only.triangles.remove(0);
+        assert!(matches!(
+            finish(only, "t", 1.0, UpAxis::Z),
+            Err(MeshError::Empty { .. })
+        ));
     }
 
     /// Survey and LiDAR clouds come in feet (the real-world sweep's Autzen
@@ -1041,6 +1089,46 @@ mod tests {
         let big = b"v 0 0 0\nv 8 0 0\nv 0 8 0.4\nf 1 2 3\n";
         let m = import_mesh(big, "film.obj", &ImportOptions::DEFAULT).unwrap();
         assert_eq!(m.units_doubt, None);
+    }
+
+    /// A glTF written in mm by a CAD tool is read in metres, its unit: 60
+    /// m across. The doubt offers the smaller units it fits in, and is
+    /// the user's word once they are given.
+    #[test]
+    fn a_scan_too_large_for_its_units_gets_a_hint() {
+        let obj = b"v 0 0 0\nv 60 0 0\nv 0 60 6\nf 1 2 3\n";
+        let opts = |units| ImportOptions {
+            units,
+            ..ImportOptions::DEFAULT
+        };
+        let m = import_mesh(obj, "dome.obj", &opts(Some(ScanUnits::M))).unwrap();
+        let d = m.units_doubt.unwrap();
+        assert!(d.too_large && d.given);
+        let offers: Vec<ScanUnits> = d.offers().into_iter().map(|(u, _)| u).collect();
+        assert_eq!(offers, [ScanUnits::Mm, ScanUnits::Cm, ScanUnits::In]);
+        let message = d.message("dome.obj");
+        assert!(
+            message.starts_with(
+                "dome.obj: the scan is 60000.0 x 60000.0 x 6000.0 mm, read in m, larger than any \
+                 printer's stage: check its units; in millimetres it would be 60.0 x 60.0 x 6.0 \
+                 mm (--scan-units mm)"
+            ),
+            "{message}"
+        );
+        // Read in mm as the file has it: no doubt; 3 m in mm: only mm's
+        // smaller units would fit, and mm is what it was read in.
+        assert_eq!(
+            import_mesh(obj, "dome.obj", &opts(None))
+                .unwrap()
+                .units_doubt,
+            None
+        );
+        let wide = b"v 0 0 0\nv 3000 0 0\nv 0 60 6\nf 1 2 3\n";
+        let d = import_mesh(wide, "wide.obj", &opts(None))
+            .unwrap()
+            .units_doubt
+            .unwrap();
+        assert!(d.too_large && !d.given && d.offers().is_empty());
     }
 
     #[test]

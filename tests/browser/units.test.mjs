@@ -56,7 +56,8 @@ test('a scan in metres gets the units banner, no G-code, and plans once read in 
   // The scan's own warnings are shown without a plan (they came only with
   // one); the units are left to the banner.
   assert.deepEqual(await page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent)),
-    ['film-m.obj: skipped 1 degenerate triangle(s) (repeated vertex or zero area)']);
+    ['film-m.obj: 1 degenerate triangle(s) (repeated vertex or zero area), kept as the segments and points '
+      + 'they are: the nozzle keeps clear of them, nothing is printed on them']);
 
   // Read in metres: the banner goes, the Units list says so, and the
   // drawing is planned on the 80 mm film.
@@ -173,6 +174,75 @@ test('units chosen for one scan file are not applied to the next file; chosen on
   await waitIdle(page);
   assert.equal(await page.inputValue('#scan-up'), 'y');
   assert.equal(await page.evaluate(() => window.pcpp.state.info.name), 'film-mm.obj');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A glTF (unit: the metre) whose numbers are millimetres, as CAD tools
+// write them: an 80 mm film read as 80 m. Y is up in glTF.
+function filmGltfInMm() {
+  const n = 21;
+  const pos = new Float32Array(n * n * 3);
+  for (let j = 0; j < n; j++) {
+    for (let i = 0; i < n; i++) {
+      const k = 3 * (j * n + i);
+      pos[k] = i * 4;
+      pos[k + 1] = 5 + 0.4 * Math.sin(i / 2);
+      pos[k + 2] = -j * 4;
+    }
+  }
+  const idx = [];
+  for (let j = 0; j + 1 < n; j++) {
+    for (let i = 0; i + 1 < n; i++) {
+      const a = j * n + i;
+      idx.push(a, a + 1, a + n + 1, a, a + n + 1, a + n);
+    }
+  }
+  const ind = new Uint32Array(idx);
+  const bin = Buffer.concat([Buffer.from(pos.buffer), Buffer.from(ind.buffer)]);
+  const lo = [0, 5 - 0.4, -(n - 1) * 4];
+  const hi = [(n - 1) * 4, 5 + 0.4, 0];
+  return JSON.stringify({
+    asset: { version: '2.0' },
+    buffers: [{ byteLength: bin.length, uri: `data:application/octet-stream;base64,${bin.toString('base64')}` }],
+    bufferViews: [
+      { buffer: 0, byteOffset: 0, byteLength: pos.byteLength },
+      { buffer: 0, byteOffset: pos.byteLength, byteLength: ind.byteLength },
+    ],
+    accessors: [
+      { bufferView: 0, componentType: 5126, count: n * n, type: 'VEC3', min: lo, max: hi },
+      { bufferView: 1, componentType: 5125, count: ind.length, type: 'SCALAR' },
+    ],
+    meshes: [{ primitives: [{ attributes: { POSITION: 0 }, indices: 1 }] }],
+    nodes: [{ mesh: 0 }],
+    scenes: [{ nodes: [0] }],
+    scene: 0,
+  });
+}
+
+// Too large for its units got no banner: "Planning failed: subpath 0,
+// point 0 ... outside the build volume", blaming the plan.
+test('a scan far too large for its units gets the units banner, offering mm', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'film-cad.gltf', mimeType: 'model/gltf+json', buffer: Buffer.from(filmGltfInMm()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-cad.gltf',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
+  assert.match(await page.textContent('#units-banner-text'),
+    /^film-cad\.gltf is 80000\.0 × 80000\.0 × \d+\.\d mm read in metres, larger than any printer: it was most likely saved in other units/);
+  const buttons = await page.$$eval('#units-banner-btns button', (bs) => bs.map((b) => b.dataset.units));
+  // (In inches it would be 2.03 m across: not offered.)
+  assert.deepEqual(buttons, ['mm', 'cm', 'm']);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  await page.click('#units-banner-btns button[data-units="mm"]');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'mm');
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  const bbox = await page.evaluate(() => window.pcpp.state.info.bbox_mm);
+  assert.ok(Math.abs(bbox[1][0] - bbox[0][0] - 80) < 1e-3, JSON.stringify(bbox));
   assert.deepEqual(problems, []);
   await context.close();
 });

@@ -149,8 +149,7 @@ fn centre_on_scan(
 /// be the cause (a scan read in the wrong units leaves nothing to print).
 fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
     // A warning the error repeats is said once, by the error.
-    let repeated =
-        |w: &String| matches!(&e, Error::UnitsDoubt { message } if message.starts_with(w.as_str()));
+    let repeated = |w: &String| matches!(&e, Error::UnitsDoubt { message, .. } if message.starts_with(w.as_str()));
     let warnings: Vec<String> = inputs
         .prepared
         .warnings
