@@ -533,3 +533,66 @@ fn regression_a_needle_of_zero_area_triangles_is_cleared() {
         }
     }
 }
+
+/// A profile's blocks were written as they were, and the header claimed the
+/// planned moves' clearance: an `end` with `G1 Z0` drove the nozzle into
+/// the part after the print, a dispense command with `G1 Z-0.5` at every
+/// path start. The end block's moves are checked with the program's; a
+/// dispense command that moves is refused.
+#[test]
+fn regression_profile_blocks_that_move_into_the_part_are_refused() {
+    let mesh = test_part::test_part();
+    let bytes = pcpp::demo::to_binary_ply(&mesh);
+    let scan = prepare_scan(
+        &bytes,
+        "part.ply",
+        &ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )
+    .unwrap();
+    let settings = PlanSettings {
+        placement: test_part::placement(),
+        ..PlanSettings::default()
+    };
+    let svg = test_part::test_part_svg();
+    let run = |profile: &MachineProfile, accept_risk: bool| {
+        run_on(
+            &scan,
+            svg.as_bytes(),
+            "lines.svg",
+            &settings,
+            profile,
+            accept_risk,
+        )
+    };
+    let mut end = marlin();
+    end.end = vec!["M107".into(), "G1 Z0".into(), "M84".into()];
+    let e = run(&end, false)
+        .err()
+        .expect("an end block into the part written");
+    let Error::Touching(t) = &e else {
+        panic!("{e}")
+    };
+    let line = t.summary.touching[0].line.expect("the end block's line");
+    let out = run(&end, true).unwrap();
+    assert_eq!(out.gcode.lines().nth(line - 1), Some("G1 Z0"));
+    let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+    assert!(oracle.too_close > 0, "{}", describe(&oracle));
+    // Lifted and parked at the safe height: clear, by the oracle too.
+    end.end = vec![
+        "M107".into(),
+        "G91".into(),
+        "G1 Z5".into(),
+        "G90".into(),
+        "G0 X0 Y0".into(),
+    ];
+    let out = run(&end, false).unwrap();
+    let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
+    assert_eq!(oracle.too_close, 0, "{}", describe(&oracle));
+    let mut dispense = marlin();
+    dispense.dispense_on = vec!["G1 Z-0.5".into(), "M106 S255".into()];
+    let e = run(&dispense, true)
+        .err()
+        .expect("a dispense command that moves written");
+    assert!(e.to_string().contains("`dispense_on[0]`"), "{e}");
+}

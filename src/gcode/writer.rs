@@ -45,6 +45,9 @@ pub enum MoveKind {
     Print,
     /// The lift back to the safe height.
     Lift,
+    /// A move of the profile's `end` block (followed by the G-code reader
+    /// from where the program left the head).
+    End,
 }
 
 /// One straight move as written: coordinates exactly as the controller
@@ -102,8 +105,12 @@ pub fn write_gcode(job: &GcodeJob, profile: &MachineProfile) -> Result<String, G
 }
 
 /// [`write_gcode`], with every move it commands (what the motion check of
-/// spec section 6f follows; moves in the profile's own start and end
-/// blocks are the machine's business and not listed).
+/// spec section 6f follows). The moves of the profile's `end` block are
+/// followed from where the program leaves the head (a `G1 Z0` there drove
+/// the nozzle into the part after a print checked clear); one that goes
+/// where the program does not say (homing Z) below the safe height is
+/// refused. The `start` block runs before the first move, from wherever
+/// the head stands, as the program's first rise does: not listed.
 pub fn write_program(
     job: &GcodeJob,
     profile: &MachineProfile,
@@ -150,12 +157,77 @@ pub fn write_program(
         }
         w.print(index, points, dwell.as_deref())?;
     }
+    let end_start = (w.out.len(), w.lines);
     w.block("end", &profile.end)?;
+    if let Some(at) = w.at {
+        let safe = w.read_back(safe_z);
+        let end = follow_end(&w.out[end_start.0..], at, end_start.1, safe, &source)?;
+        w.moves.extend(end);
+    }
     Ok(WrittenProgram {
         text: w.out,
         moves: w.moves,
         header,
     })
+}
+
+/// The moves of the `end` block's text (filled), the head at `at` when it
+/// starts on line `after + 1`: read by the G-code reader (units, modes and
+/// G92 as it follows them) from a known position. A move it cannot place
+/// that is not wholly at or above `safe_z` (homing Z, probing, machine
+/// coordinates) is an error naming the block's line.
+fn follow_end(
+    text: &str,
+    at: DVec3,
+    after: usize,
+    safe_z: f64,
+    source: &str,
+) -> Result<Vec<WrittenMove>, GcodeError> {
+    if text.is_empty() {
+        return Ok(Vec::new());
+    }
+    const PREFIX_LINES: usize = 3;
+    let program = format!("G21\nG90\nG0 X{:?} Y{:?} Z{:?}\n{text}", at.x, at.y, at.z);
+    let field = |line: usize| format!("end[{}]", line - PREFIX_LINES - 1);
+    let read = super::read_gcode(&program, source).map_err(|e| GcodeError::ProfileField {
+        file: source.into(),
+        field: "end".into(),
+        message: format!("cannot be followed: {e}"),
+    })?;
+    if let Some(u) = read.unknown_moves.iter().find(|u| {
+        u.line > PREFIX_LINES
+            && ![u.from[2], u.to[2]]
+                .iter()
+                .all(|z| z.is_some_and(|z| z >= safe_z))
+    }) {
+        return Err(GcodeError::ProfileField {
+            file: source.into(),
+            field: field(u.line),
+            message: format!(
+                "moves the head where the program does not say ({}), which pcpp cannot check \
+                 against the part (homing may lower the nozzle onto it, or cross it): park at a \
+                 position the line gives instead, e.g. G0 X0 Y200 at the safe height, or \
+                 remove it",
+                match u.kind {
+                    super::read::UnknownMoveKind::Homing => "homing or a stored position",
+                    super::read::UnknownMoveKind::Probing => "probing",
+                    super::read::UnknownMoveKind::MachineCoordinates => "machine coordinates",
+                    _ => "a move from or to an unknown position",
+                }
+            ),
+        });
+    }
+    Ok(read
+        .moves
+        .iter()
+        .filter(|m| m.line > PREFIX_LINES)
+        .map(|m| WrittenMove {
+            line: after + m.line - PREFIX_LINES,
+            from: Some(m.from),
+            to: m.to,
+            kind: MoveKind::End,
+        })
+        .collect())
 }
 
 fn check_job(job: &GcodeJob) -> Result<(), GcodeError> {
@@ -556,6 +628,58 @@ M84
                 2,
                 "{name}\n{text}"
             );
+        }
+    }
+
+    /// The end block's moves are followed from the last lift and listed
+    /// for the motion check, with their lines; a move it cannot place
+    /// below the safe height (homing Z) is refused by its line.
+    #[test]
+    fn end_block_moves_are_followed_for_the_check() {
+        let paths = line_path();
+        let mut p = marlin();
+        p.end = vec![
+            "M107".into(),
+            "G91 ; lift".into(),
+            "G1 Z10".into(),
+            "G90".into(),
+            "G0 X0 Y200".into(),
+            "G1 Z0".into(),
+            "M84".into(),
+        ];
+        let w = write_program(&job(&paths, &[]), &p).unwrap();
+        let end: Vec<&WrittenMove> = w.moves.iter().filter(|m| m.kind == MoveKind::End).collect();
+        let lines: Vec<&str> = w.text.lines().collect();
+        let at = |m: &WrittenMove| lines[m.line - 1];
+        assert_eq!(end.len(), 3, "{end:?}");
+        assert_eq!(
+            (at(end[0]), end[0].to),
+            ("G1 Z10", DVec3::new(12.0, 20.0, 25.0))
+        );
+        let last_lift = w
+            .moves
+            .iter()
+            .rfind(|m| m.kind == MoveKind::Lift)
+            .unwrap()
+            .to;
+        assert_eq!(end[0].from, Some(last_lift));
+        assert_eq!(
+            (at(end[1]), end[1].to),
+            ("G0 X0 Y200", DVec3::new(0.0, 200.0, 25.0))
+        );
+        assert_eq!(
+            (at(end[2]), end[2].to),
+            ("G1 Z0", DVec3::new(0.0, 200.0, 0.0))
+        );
+        // Homing leaves the head where the file does not say (the reader
+        // takes every axis as unknown after it: G28 may pass an
+        // intermediate point, or lower Z first).
+        for homing in ["G28", "G28 X Y"] {
+            p.end = vec!["M107".into(), homing.into(), "M84".into()];
+            let e = write_program(&job(&paths, &[]), &p)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("`end[1]`") && e.contains("homing"), "{e}");
         }
     }
 
