@@ -167,7 +167,12 @@ const OFF_SCAN = /^path '(.*)'(?:: its .* lies off the scan; not printed| misses
 // partly off the part was "planned" while most of it was not printed.
 function plannedStatus(plan) {
   const touching = plan.summary.motion.program.touching_moves;
-  const head = `planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}`;
+  // A drawing the page shrank to fit the scan is printed at that size: a
+  // trace or an antenna 6.7 times smaller is another part, said here, not
+  // only in the Placement panel's note.
+  const fit = settings.fit ? ` (the drawing scaled ×${Number(settings.placement.scale).toPrecision(3)} to fit `
+    + 'the scan; Placement sets its scale)' : '';
+  const head = `planned ${plan.svgName} on ${plan.scanName} with ${plan.planner}${fit}`;
   const off = new Set(plan.summary.warnings.map((w) => OFF_SCAN.exec(w)).filter(Boolean).map((m) => m[1])).size;
   const offText = off
     ? `${off} path(s) of the drawing leave the scan and are not printed there (listed under Path statistics)` : '';

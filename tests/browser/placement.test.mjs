@@ -108,6 +108,10 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
   assert.equal(await page.isHidden('#place-banner'), true);
   assert.equal(await page.isVisible('#scan-place'), true);
   assert.equal(await page.textContent('#reg-status'), 'unregistered, placed on the bed');
+  // The drawing printed smaller than drawn is said where the user looks
+  // after a plan, not only in the Placement panel's note.
+  assert.match(await page.textContent('#plan-status'),
+    /^planned .* with even \(the drawing scaled ×0\.\d+ to fit the scan; Placement sets its scale\)$/);
 
   const gcode = await download(page, 'dl-gcode');
   const text = gcode.bytes.toString('utf8');
