@@ -880,3 +880,37 @@ fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
         }
     }
 }
+
+/// Most of a drawing beside the scan printed its fragment with nothing
+/// but a warning per part: the share printed is said first, once, and not
+/// for a drawing wholly on the scan.
+#[test]
+fn the_share_of_the_drawing_printed_is_said_when_part_of_it_is_lost() {
+    let settings = PlanSettings::default();
+    let flat = Surface::new(height_field(
+        &range(0.0, 40.0, 4),
+        &range(0.0, 40.0, 4),
+        |_, _| 1.0,
+    ))
+    .unwrap();
+    // 30 mm on the 40 mm plate, then 90 mm beside it.
+    let half = vec![line(DVec2::new(10.0, 20.0), DVec2::new(130.0, 20.0))];
+    let plan = pipeline::plan(&flat, &half, &settings).unwrap();
+    let first = &plan.warnings[0];
+    assert!(
+        // (The last sample over the plate lies within d/2 of its edge.)
+        first.starts_with("only 29.")
+            && first.contains(" of the drawing's 120.0 mm (25 %) lie over the scan"),
+        "{:?}",
+        plan.warnings
+    );
+    let whole = vec![line(DVec2::new(10.0, 20.0), DVec2::new(30.0, 20.0))];
+    let plan = pipeline::plan(&flat, &whole, &settings).unwrap();
+    assert!(
+        plan.warnings
+            .iter()
+            .all(|w| !w.contains("of the drawing's")),
+        "{:?}",
+        plan.warnings
+    );
+}
