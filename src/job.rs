@@ -899,9 +899,12 @@ pub fn run_on(
     accept_risk: bool,
 ) -> Result<JobOutput> {
     settings.validate()?;
-    // Before planning: a plan on a scan read in the wrong units fails, if
-    // it fails, for a reason that hides this one (the drawing misses it).
+    // Before planning: a plan on a scan read in the wrong units, or
+    // registered far off its printer points, fails, if it fails, for a
+    // reason that hides this one (the drawing misses it: "no part of the
+    // path lies over the scan's surface" for a 5 mm RMS registration).
     refuse_unit_doubt(scan, accept_risk)?;
+    refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
     refuse_uncleared(&plan, accept_risk)?;

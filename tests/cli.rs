@@ -2281,3 +2281,50 @@ fn regression_a_dash_input_was_not_standard_input() {
         stderr(&o)
     );
 }
+
+/// Printer points mirrored (their distances all match): the fiducials lie
+/// 5 mm RMS from them. `register` printed it with no word, and `plan` said
+/// "no part of the path lies over the scan's surface" before the real
+/// cause; both name the registration now.
+#[test]
+fn a_registration_far_off_is_named_first_by_register_and_plan() {
+    let (scan_points, printer_points) =
+        ("0,0,0;10,0,0;0,10,0;0,0,10", "0,0,0;-10,0,0;0,10,0;0,0,10");
+    let o = pcpp(&[
+        "register",
+        "--scan-points",
+        scan_points,
+        "--printer-points",
+        printer_points,
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the fiducials lie 5.000 mm RMS from the printer points"),
+        "{}",
+        stderr(&o)
+    );
+    let dir = temp_dir("reg-far-off");
+    let out = dir.join("x.gcode");
+    let o = plan_on(
+        &demo_file("demo-test-part.ply"),
+        &demo_file("antenna-spiral.svg"),
+        &[
+            "--fiducials",
+            scan_points,
+            "--printer-points",
+            printer_points,
+            "--place",
+            "20,60",
+            "-o",
+            s(&out),
+        ],
+    );
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("the registration leaves the fiducials 5.000 mm RMS"),
+        "{e}"
+    );
+    assert!(!e.contains("no part of the path"), "{e}");
+    assert!(!out.exists());
+}

@@ -73,5 +73,16 @@ pub fn cmd_register(a: &RegisterArgs, progress: &Progress) -> CliResult<()> {
     let _ = writeln!(s, "rms: {:.4} mm", r.rms_mm);
     print!("{s}");
     progress.warn(&r.notes);
+    // `plan` refuses G-code on a registration this far off (more than the
+    // nozzle's inner diameter d): said here too, where it is first seen.
+    let d = pcpp::Nozzle::DEFAULT.inner_diameter_mm;
+    if r.rms_mm > d {
+        progress.warn(&[format!(
+            "the fiducials lie {:.3} mm RMS from the printer points, more than the default \
+             nozzle's inner diameter d = {d} mm: check the points and their order (plan \
+             refuses G-code on this registration unless the risk is accepted)",
+            r.rms_mm
+        )]);
+    }
     Ok(())
 }
