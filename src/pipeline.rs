@@ -130,6 +130,11 @@ pub fn surface_path(
     let mut any_sample = false;
     // The subpaths too small to print, and whether any was large enough.
     let mut dots: Vec<String> = Vec::new();
+    // Per source, its warning's index and how many of its subpaths were
+    // too small: one warning a path, not one a piece (an Inkscape path of
+    // hundreds of 0.0015 mm pieces gave 300 near-identical warnings).
+    let mut dot_warnings: std::collections::HashMap<String, (usize, usize, DVec2, f64)> =
+        std::collections::HashMap::new();
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
     // Each subpath's samples as placed, for `close_lines`.
@@ -150,14 +155,21 @@ pub fn surface_path(
         if let [dot] = samples[..] {
             // A dot, a zero-length segment, or a shape far smaller than
             // the nozzle: its samples d/2 apart are one point.
-            warnings.push(format!(
-                "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to print with \
-                 samples {spacing:.4} mm apart; it is not printed",
-                sub.source,
-                dot.x,
-                dot.y,
-                placed.length_mm()
-            ));
+            match dot_warnings.get_mut(&sub.source) {
+                Some((_, count, ..)) => *count += 1,
+                None => {
+                    let first = (warnings.len(), 1, dot, placed.length_mm());
+                    dot_warnings.insert(sub.source.clone(), first);
+                    warnings.push(format!(
+                        "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to \
+                         print with samples {spacing:.4} mm apart; it is not printed",
+                        sub.source,
+                        dot.x,
+                        dot.y,
+                        placed.length_mm()
+                    ));
+                }
+            }
             dots.push(sub.source.clone());
             continue;
         }
@@ -181,6 +193,16 @@ pub fn surface_path(
             });
         }
         sampled.push((sub.source.as_str(), samples, placed.closed));
+    }
+    for (source, &(at, count, dot, length)) in &dot_warnings {
+        if count > 1 {
+            warnings[at] = format!(
+                "path '{source}': {count} of its pieces are too small to print with samples \
+                 {spacing:.4} mm apart (the first at ({:.3}, {:.3}), {length:.4} mm long as \
+                 placed); they are not printed",
+                dot.x, dot.y
+            );
+        }
     }
     // Lines closer together than the filament is wide merge (`spacing`).
     let lines: Vec<Line> = sampled

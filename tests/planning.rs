@@ -914,3 +914,46 @@ fn the_share_of_the_drawing_printed_is_said_when_part_of_it_is_lost() {
         plan.warnings
     );
 }
+
+/// An Inkscape path of many pieces too small to print gave a warning a
+/// piece (328 on the page for one drawing): one warning for the path,
+/// with the count; other paths keep their own.
+#[test]
+fn pieces_too_small_to_print_are_one_warning_a_path() {
+    let flat = Surface::new(height_field(
+        &range(0.0, 40.0, 4),
+        &range(0.0, 40.0, 4),
+        |_, _| 1.0,
+    ))
+    .unwrap();
+    let mut drawing: Vec<pcpp::svg::Subpath2> = (0..40)
+        .map(|i| {
+            let x = 5.0 + 0.5 * i as f64;
+            let mut s = line(DVec2::new(x, 10.0), DVec2::new(x + 0.001, 10.0));
+            s.source = "path #263".into();
+            s
+        })
+        .collect();
+    let mut dot = line(DVec2::new(30.0, 30.0), DVec2::new(30.0, 30.0));
+    dot.source = "pad".into();
+    drawing.push(dot);
+    drawing.push(line(DVec2::new(5.0, 20.0), DVec2::new(35.0, 20.0)));
+    let plan = pipeline::plan(&flat, &drawing, &PlanSettings::default()).unwrap();
+    let small: Vec<&String> = plan
+        .warnings
+        .iter()
+        .filter(|w| w.contains("too small to print"))
+        .collect();
+    assert_eq!(small.len(), 2, "{small:?}");
+    assert!(
+        small[0].starts_with("path 'path #263': 40 of its pieces are too small to print")
+            && small[0].contains("(the first at (5.001, 10.000), 0.0010 mm long as placed)"),
+        "{}",
+        small[0]
+    );
+    assert!(
+        small[1].starts_with("path 'pad' at (30.000, 30.000)"),
+        "{}",
+        small[1]
+    );
+}
