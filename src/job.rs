@@ -1239,6 +1239,51 @@ impl GcodeCheck {
     pub fn is_clear(&self) -> bool {
         self.summary.touching_moves == 0 && self.unchecked_lines.is_empty()
     }
+
+    /// A note on the moves that leave `profile`'s build volume (the scan
+    /// says nothing of the bed beside it: a program driving the nozzle to
+    /// Z -5 beside the part passed clear), or `None`. A note, not a
+    /// failure: the profile may not be the program's machine.
+    pub fn outside_volume(&self, profile: &MachineProfile) -> Option<String> {
+        let v = &profile.build_volume;
+        let out: Vec<&crate::gcode::GcodeMove> = self
+            .moves
+            .iter()
+            .filter(|m| !(v.contains(m.from) && v.contains(m.to)))
+            .collect();
+        let first = out.first()?;
+        let at = if v.contains(first.from) {
+            first.to
+        } else {
+            first.from
+        };
+        let below = self
+            .moves
+            .iter()
+            .any(|m| m.from.z.min(m.to.z) < v.min_mm.z - crate::gcode::VOLUME_HAIR_MM);
+        Some(format!(
+            "{} move(s) leave the build volume of profile {} (x {}..{}, y {}..{}, z {}..{} mm), \
+             the first at line {} at ({:.3}, {:.3}, {:.3}){}: the stage cannot go there if the \
+             program is for this machine (if it is for another, give its --dialect or --profile)",
+            out.len(),
+            profile.name,
+            v.min_mm.x,
+            v.max_mm.x,
+            v.min_mm.y,
+            v.max_mm.y,
+            v.min_mm.z,
+            v.max_mm.z,
+            first.line,
+            at.x,
+            at.y,
+            at.z,
+            if below {
+                "; some go below the bed, where the nozzle would drive into it"
+            } else {
+                ""
+            }
+        ))
+    }
 }
 
 /// Checks any G-code program against a prepared scan (printer frame): every

@@ -2328,3 +2328,30 @@ fn a_registration_far_off_is_named_first_by_register_and_plan() {
     assert!(!e.contains("no part of the path"), "{e}");
     assert!(!out.exists());
 }
+
+/// `check` passed a program driving the nozzle to Z -5 beside the part and
+/// to X 500 on a 220 mm bed ("no move comes closer than tol"): the scan
+/// says nothing of the bed. The moves leaving the profile's build volume
+/// are named in a warning (the profile may not be the program's machine).
+#[test]
+fn check_names_moves_that_leave_the_build_volume() {
+    let dir = temp_dir("check-volume");
+    let gcode = dir.join("below.gcode");
+    let program = "G21\nG90\nG0 X40 Y40 Z20\nG0 X150 Y150 Z20\nG1 X150 Y150 Z-5 F300\nG0 Z20\n";
+    std::fs::write(&gcode, program).unwrap();
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let o = pcpp(&["check", "--gcode", s(&gcode), "--scan", s(&scan)]);
+    let e = stderr(&o);
+    assert!(
+        e.contains("2 move(s) leave the build volume of profile marlin")
+            && e.contains(
+                "the first at line 5 at (150.000, 150.000, -5.000); some go below the bed"
+            ),
+        "{e}"
+    );
+    // Inside the volume: no such warning.
+    std::fs::write(&gcode, "G21\nG90\nG0 X40 Y40 Z20\nG0 X150 Y150 Z20\n").unwrap();
+    let o = pcpp(&["check", "--gcode", s(&gcode), "--scan", s(&scan)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(!stderr(&o).contains("build volume"), "{}", stderr(&o));
+}

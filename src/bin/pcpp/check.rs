@@ -26,7 +26,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     ];
     let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
     let outputs = Outputs::check("check", report, read.into_iter().flatten())?;
-    let (settings, _profile) =
+    let (settings, profile) =
         check_settings("check", &a.scan, &a.nozzle, &a.registration, &a.machine)?;
     let gcode_path = &a.gcode;
     let (text, encoding) = read_gcode_text(gcode_path)?;
@@ -42,6 +42,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     )
     .map_err(|e| Failure::Input(in_file(gcode_path, &name, &e.to_string())))?;
     check.notes.splice(0..0, encoding);
+    check.notes.extend(check.outside_volume(&profile));
     if let Some(r) = &a.report {
         write_one(r, to_json(&check)?.as_bytes())?;
     }
