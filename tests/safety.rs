@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use pcpp::demo::parts::DemoPart;
 use pcpp::demo::test_part;
 use pcpp::gcode::MachineProfile;
-use pcpp::job::{prepare_scan, run_on, JobOutput, RegistrationSettings};
+use pcpp::job::{prepare_scan, run_on, JobOutput, PreparedScan, RegistrationSettings};
 use pcpp::mesh::{ImportOptions, TriMesh};
 use pcpp::pipeline::PlanSettings;
 use pcpp::planners::PlannerKind;
@@ -24,6 +24,17 @@ fn marlin() -> MachineProfile {
     MachineProfile::builtin("marlin").expect("marlin profile")
 }
 
+/// `mesh` (already in the printer frame) prepared as a PLY file.
+fn prepared(mesh: &TriMesh) -> Result<PreparedScan, Error> {
+    let bytes = pcpp::demo::to_binary_ply(mesh);
+    prepare_scan(
+        &bytes,
+        "part.ply",
+        &ImportOptions::DEFAULT,
+        &RegistrationSettings::default(),
+    )
+}
+
 /// Plans `svg` on `mesh` (already in the printer frame) with `planner`.
 fn plan(
     mesh: &TriMesh,
@@ -32,13 +43,7 @@ fn plan(
     planner: PlannerKind,
     accept_risk: bool,
 ) -> Result<JobOutput, Error> {
-    let bytes = pcpp::demo::to_binary_ply(mesh);
-    let scan = prepare_scan(
-        &bytes,
-        "part.ply",
-        &ImportOptions::DEFAULT,
-        &RegistrationSettings::default(),
-    )?;
+    let scan = prepared(mesh)?;
     let settings = PlanSettings {
         placement,
         planner,
@@ -542,14 +547,7 @@ fn regression_a_needle_of_zero_area_triangles_is_cleared() {
 #[test]
 fn regression_profile_blocks_that_move_into_the_part_are_refused() {
     let mesh = test_part::test_part();
-    let bytes = pcpp::demo::to_binary_ply(&mesh);
-    let scan = prepare_scan(
-        &bytes,
-        "part.ply",
-        &ImportOptions::DEFAULT,
-        &RegistrationSettings::default(),
-    )
-    .unwrap();
+    let scan = prepared(&mesh).unwrap();
     let settings = PlanSettings {
         placement: test_part::placement(),
         ..PlanSettings::default()
