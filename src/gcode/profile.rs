@@ -322,8 +322,8 @@ impl MachineProfile {
     /// frame (G92, a work offset, machine coordinates), and a dispense
     /// command that does any of that or moves an axis, would make the
     /// controller go elsewhere than the moves checked. Refused, naming the
-    /// line. (`end` runs after the last move and may do as it likes, e.g.
-    /// G91 and a lift.)
+    /// line. (`end` runs after the last move: the writer follows it and
+    /// its moves are checked with the program's, `writer::follow_end`.)
     fn check_frame(&self, source: &str) -> Result<(), GcodeError> {
         let bad = |field: String, message: String| GcodeError::ProfileField {
             file: source.into(),

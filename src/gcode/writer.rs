@@ -187,7 +187,9 @@ fn follow_end(
         return Ok(Vec::new());
     }
     const PREFIX_LINES: usize = 3;
-    let program = format!("G21\nG90\nG0 X{:?} Y{:?} Z{:?}\n{text}", at.x, at.y, at.z);
+    // (Display writes every f64 in full, never in exponent notation, which
+    // the reader refuses.)
+    let program = format!("G21\nG90\nG0 X{} Y{} Z{}\n{text}", at.x, at.y, at.z);
     let field = |line: usize| format!("end[{}]", line - PREFIX_LINES - 1);
     let read = super::read_gcode(&program, source).map_err(|e| GcodeError::ProfileField {
         file: source.into(),
