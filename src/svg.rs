@@ -260,7 +260,9 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     }
     if bytes.starts_with(&[0x1f, 0x8b]) {
         return Err(parse_err(
-            "compressed SVG (.svgz) is not supported; unzip it first".into(),
+            "a compressed SVG (.svgz), which is not read: save it as plain SVG (Inkscape: \
+             Save As, Plain SVG) or unzip it (gunzip)"
+                .into(),
         ));
     }
     if bytes.starts_with(&[0xFE, 0xFF]) || bytes.starts_with(&[0xFF, 0xFE]) {

@@ -27,7 +27,8 @@ const TEXT_FILE = /\.txt$/i;
 // other files, its buffers in .bin files).
 const GLTF_FILE = /\.(gltf|glb)$/i;
 const SCAN_FILE = /\.(gltf|glb|obj|ply|stl|xyz|csv|txt|asc|pts|pcd)$/i;
-const SVG_FILE = /\.svg$/i;
+// (.svgz: Inkscape's compressed SVG, a drawing the core names as such.)
+const SVG_FILE = /\.svgz?$/i;
 // A machine profile (the Machine panel's "Open profile…" reads the same).
 const PROFILE_FILE = /\.json$/i;
 

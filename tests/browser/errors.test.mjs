@@ -414,3 +414,25 @@ test('a click on Download that ends the edit of a field downloads the plan for t
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// Inkscape's compressed SVG opened with "Open SVG…" was called "not a scan
+// this program reads": it is a drawing, named as compressed, the demo's
+// drawing and plan kept.
+test('a compressed .svgz opened as the drawing is named as such, not taken for a scan', async () => {
+  const { gzipSync } = await import('node:zlib');
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitForPlan(page);
+  const svg = '<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20"><path d="M2 10 H18" stroke="black"/></svg>';
+  await page.setInputFiles('#svg-input', { name: 'drawing.svgz', mimeType: 'image/svg+xml', buffer: gzipSync(Buffer.from(svg)) });
+  await page.waitForSelector('#error-panel:not([hidden])');
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-title'), /drawing\.svgz/);
+  const message = await page.textContent('#error-message');
+  assert.match(message, /a compressed SVG \(\.svgz\), which is not read: save it as plain SVG/);
+  assert.doesNotMatch(message, /not a scan/);
+  assert.equal(await page.inputValue('#path-source'), 'demo');
+  assert.match(await page.textContent('#plan-status'), /^planned demo-test-part-lines\.svg/);
+  assert.equal(await page.isVisible('#dl-gcode'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
