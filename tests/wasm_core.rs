@@ -1281,6 +1281,7 @@ fn a_gltf_with_a_separate_bin_imports_with_it_and_names_it_without() {
         files,
         &settings.scan,
         &settings.registration,
+        job::Candidates::Listed,
     )
     .unwrap();
     let profile = MachineProfile::builtin("marlin").unwrap();
