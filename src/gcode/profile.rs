@@ -330,7 +330,7 @@ impl MachineProfile {
             field,
             message,
         };
-        let (mut inches, mut relative) = (None::<(String, f64)>, None::<(String, f64)>);
+        let (mut inches, mut relative) = (None::<(String, u32)>, None::<(String, u32)>);
         let blocks = [
             ("start", &self.start),
             ("dispense_on", &self.dispense_on),
@@ -339,50 +339,53 @@ impl MachineProfile {
         for (name, lines) in blocks {
             for (i, line) in lines.iter().enumerate() {
                 let field = format!("{name}[{i}]");
-                for g in g_words(line, &self.comment) {
+                // (G codes times ten, as the G-code reader reads them.)
+                for g in super::read::g_codes(line) {
                     let what = match g {
-                        20.0 | 70.0 if name == "start" => {
+                        200 | 700 if name == "start" => {
                             inches = Some((field.clone(), g));
                             continue;
                         }
-                        21.0 | 71.0 if name == "start" => {
+                        210 | 710 if name == "start" => {
                             inches = None;
                             continue;
                         }
-                        91.0 if name == "start" => {
+                        910 if name == "start" => {
                             relative = Some((field.clone(), g));
                             continue;
                         }
-                        90.0 if name == "start" => {
+                        900 if name == "start" => {
                             relative = None;
                             continue;
                         }
-                        4.0 => continue,
-                        92.0 | 92.1 | 92.2 | 92.3 => "sets the position to other coordinates",
-                        53.0 => "moves in machine coordinates",
-                        g if (54.0..60.0).contains(&g) => "switches to another work offset",
-                        20.0 | 70.0 => "switches to inches",
-                        91.0 => "switches to relative moves",
+                        40 => continue,
+                        920..=923 => "sets the position to other coordinates",
+                        530 => "moves in machine coordinates",
+                        540..600 => "switches to another work offset",
+                        200 | 700 => "switches to inches",
+                        910 => "switches to relative moves",
                         _ if name == "start" => continue,
                         _ => "is a G-code inside the dispense command (a move, or a mode change)",
                     };
                     return Err(bad(
                         field,
                         format!(
-                            "G{g} {what}, so the controller would not go where pcpp's moves \
+                            "{} {what}, so the controller would not go where pcpp's moves \
                              (millimetres, absolute, in the frame the scan was placed in) were \
-                             checked to go: remove it"
+                             checked to go: remove it",
+                            super::read::g_name(g)
                         ),
                     ));
                 }
             }
         }
-        let left = |state: Option<(String, f64)>, what: &str, back: &str| match state {
+        let left = |state: Option<(String, u32)>, what: &str, back: &str| match state {
             Some((field, g)) => Err(bad(
                 field,
                 format!(
-                    "G{g} leaves the controller in {what} after the start, but pcpp writes its \
-                     moves in millimetres, absolute: remove it, or end the start with {back}"
+                    "{} leaves the controller in {what} after the start, but pcpp writes its \
+                     moves in millimetres, absolute: remove it, or end the start with {back}",
+                    super::read::g_name(g)
                 ),
             )),
             None => Ok(()),
@@ -390,49 +393,6 @@ impl MachineProfile {
         left(inches, "inches", "G21")?;
         left(relative, "relative moves", "G90")
     }
-}
-
-/// The numbers of the G words of one template line (`G91`, `g1`, `G0 1`
-/// counts as G0), outside its comments (the profile's style, and `;` and
-/// parentheses): a G word is a `G` that does not continue a name.
-fn g_words(line: &str, comment: &CommentStyle) -> Vec<f64> {
-    let mut code = line;
-    for start in [comment.prefix.as_str(), ";"] {
-        if let Some(at) = code.find(start).filter(|_| !start.is_empty()) {
-            code = &code[..at];
-        }
-    }
-    let code: String = {
-        let mut depth = 0usize;
-        code.chars()
-            .filter(|&c| {
-                match c {
-                    '(' => depth += 1,
-                    ')' => depth = depth.saturating_sub(1),
-                    _ => return depth == 0,
-                }
-                false
-            })
-            .collect()
-    };
-    let chars: Vec<char> = code.chars().collect();
-    let mut out = Vec::new();
-    for (i, &c) in chars.iter().enumerate() {
-        let continues = i > 0
-            && (chars[i - 1].is_ascii_alphanumeric() || matches!(chars[i - 1], '_' | '$' | '.'));
-        if !matches!(c, 'G' | 'g') || continues {
-            continue;
-        }
-        let number: String = chars[i + 1..]
-            .iter()
-            .skip_while(|c| **c == ' ')
-            .take_while(|c| c.is_ascii_digit() || **c == '.')
-            .collect();
-        if let Ok(g) = number.parse::<f64>() {
-            out.push(g);
-        }
-    }
-    out
 }
 
 /// One template line: a single line (a line break would split one command

@@ -803,7 +803,23 @@ fn classify(code: u32, has_l: bool, has_s: bool) -> G {
     }
 }
 
-fn g_name(code: u32) -> String {
+/// The G codes of one line as the reader reads them (times ten, see
+/// [`g_code`]; comments dropped): none for a line of another language or
+/// one that does not read as G-code words. For the profile's checks of
+/// its own blocks.
+pub(crate) fn g_codes(line: &str) -> Vec<u32> {
+    let mut words = Vec::new();
+    match scan(line, &mut words) {
+        Ok((Shape::Words, _)) => words
+            .iter()
+            .filter(|w| w.letter == b'G')
+            .filter_map(|w| g_code(line, w).ok())
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+pub(crate) fn g_name(code: u32) -> String {
     match code % 10 {
         0 => format!("G{}", code / 10),
         minor => format!("G{}.{minor}", code / 10),
