@@ -1078,6 +1078,16 @@ pub fn write_outputs(
     }
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
+    // Spec 6(f): every move is checked but those that start where nothing
+    // says; the header names the first rise, this the profile's own.
+    if let Some(line) = crate::gcode::start_block_motion(profile) {
+        report.warnings.push(format!(
+            "profile {}: its start block moves the head ({line} first) before the program's \
+             first rise, from wherever the head stands, so pcpp cannot check those moves \
+             against the scan: make sure they clear the part",
+            profile.name
+        ));
+    }
     // What the G-code would have been refused for but for the accepted
     // risk, known before it is written: said in its header (one line, so
     // the header's length does not change) and in the report.
@@ -1888,6 +1898,54 @@ mod tests {
         let json = serde_json::to_string(&a.report).unwrap();
         let back: Report = serde_json::from_str(&json).unwrap();
         assert_eq!(back.inputs, a.report.inputs);
+    }
+
+    /// A profile whose start block moves the head (homing, then a move
+    /// down) gets a warning naming its line, in the report and the
+    /// header: those moves run before the program's first rise, from
+    /// wherever the head stands, unchecked (spec 6(f); safety audit,
+    /// finding 4). The built-in profile gets none, and every header says
+    /// that the first rise is not checked.
+    #[test]
+    fn a_start_block_that_moves_the_head_is_named() {
+        let part = crate::demo::parts::DemoPart::SteppedBlock;
+        let glb = crate::demo::to_glb(&part.mesh());
+        let scan = prepare_scan(
+            &glb,
+            "block.glb",
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        let settings = PlanSettings {
+            placement: part.placement(),
+            ..Default::default()
+        };
+        let svg = part.svg();
+        let marlin = MachineProfile::builtin("marlin").unwrap();
+        let mut homing = marlin.clone();
+        homing.start = ["G21", "G90", "G28", "G1 Z5 F{travel_f}"]
+            .map(String::from)
+            .to_vec();
+        let warned = |p: &MachineProfile| {
+            let out = run_on(&scan, svg.as_bytes(), "p.svg", &settings, p, false).unwrap();
+            assert!(out.gcode.contains("; first move: a rise to the safe travel height from wherever the head stands, which pcpp cannot check"), "{}", &out.gcode[..1500]);
+            let w: Vec<String> = out
+                .report
+                .warnings
+                .iter()
+                .filter(|w| w.contains("start block"))
+                .cloned()
+                .collect();
+            for w in &w {
+                assert!(out.gcode.contains(w.as_str()), "{w}");
+            }
+            w
+        };
+        assert!(warned(&marlin).is_empty());
+        let w = warned(&homing);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("start[2] `G28` first"), "{}", w[0]);
     }
 
     /// The header printed `-0.000000` in G and `mean e- -0.0000 mm` for

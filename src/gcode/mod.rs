@@ -53,7 +53,9 @@ pub use read::{
     read_gcode, GcodeLineProblem, GcodeMove, GcodeProgram, GcodeReadError, UnknownMove,
     UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,
 };
-pub use writer::{write_gcode, write_program, GcodeJob, MoveKind, WrittenMove, WrittenProgram};
+pub use writer::{
+    start_block_motion, write_gcode, write_program, GcodeJob, MoveKind, WrittenMove, WrittenProgram,
+};
 
 /// Why a profile cannot be loaded or a job cannot be written. Each variant
 /// names the file and field, or the subpath and point, at fault.

@@ -171,6 +171,51 @@ pub fn write_program(
     })
 }
 
+/// The header's note on the program's first move, which no check covers.
+const FIRST_RISE_NOTE: &str = "first move: a rise to the safe travel height from wherever the \
+     head stands, which pcpp cannot check (start with the nozzle above the part)";
+
+/// The first line of `profile`'s `start` block that moves the head (a
+/// move, homing, probing), as written: the block runs before the program's
+/// first rise, from wherever the head stands, so pcpp can no more check
+/// those moves against the scan than that rise (spec 6(f); safety audit,
+/// finding 4). `None` when the block moves nothing. A block the G-code
+/// reader cannot follow is taken to move the head. The block's tokens are
+/// filled with stand-in values: a line moves the head or not whatever
+/// they are.
+pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
+    // Which profile line each line of the text comes from (a profile
+    // line may hold several).
+    let mut text = String::new();
+    let mut from = Vec::new();
+    for (i, line) in profile.start.iter().enumerate() {
+        let filled = template::fill(line, |token| {
+            BLOCK_TOKENS.contains(&token).then(|| "100".to_string())
+        })
+        .unwrap_or_else(|_| line.clone());
+        for part in filled.lines() {
+            text.push_str(part);
+            text.push('\n');
+            from.push(i);
+        }
+    }
+    if text.trim().is_empty() {
+        return None;
+    }
+    let read = match super::read_gcode(&text, &profile.name) {
+        Ok(read) => read,
+        Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
+    };
+    let first = read
+        .moves
+        .iter()
+        .map(|m| m.line)
+        .chain(read.unknown_moves.iter().map(|u| u.line))
+        .min()?;
+    let i = from.get(first - 1).copied().unwrap_or_default();
+    Some(format!("start[{i}] `{}`", profile.start[i].trim()))
+}
+
 /// The moves of the `end` block's text (filled), the head at `at` when it
 /// starts on line `after + 1`: read by the G-code reader (units, modes and
 /// G92 as it follows them) from a known position. A move it cannot place
@@ -385,6 +430,10 @@ impl<'p> Program<'p> {
         );
         self.comment(&print);
         self.comment(&format!("safe travel height: {} mm", fixed(safe_z, 3)));
+        // Spec 6(f): safety is a property of every move, and the first one
+        // starts where nothing in the program says (safety audit, finding
+        // 4): the header names the one move the clearance line leaves out.
+        self.comment(FIRST_RISE_NOTE);
     }
 
     fn fill(&self, field: &str, line: &str, extra: &[(&str, &str)]) -> Result<String, GcodeError> {
@@ -595,6 +644,7 @@ mod tests {
 ; profile: marlin
 ; print feed: F300 mm/min (5 mm/s)
 ; safe travel height: 15.000 mm
+; {FIRST_RISE_NOTE}
 G21
 G90
 M107
@@ -682,6 +732,32 @@ M84
                 .unwrap_err()
                 .to_string();
             assert!(e.contains("`end[1]`") && e.contains("homing"), "{e}");
+        }
+    }
+
+    #[test]
+    fn start_blocks_that_move_the_head_are_named() {
+        for name in MachineProfile::builtin_names() {
+            let p = MachineProfile::builtin(name).unwrap();
+            assert_eq!(start_block_motion(&p), None, "{name}");
+        }
+        let mut p = marlin();
+        for (start, named) in [
+            (
+                vec!["G21", "G90", "G28", "G0 Z{safe_z}"],
+                Some("start[2] `G28`"),
+            ),
+            (
+                vec!["G21", "G1 Z{safe_z} F{travel_f}"],
+                Some("start[1] `G1 Z{safe_z} F{travel_f}`"),
+            ),
+            (vec!["G21", "G29 ; level"], Some("start[1] `G29 ; level`")),
+            (vec!["G21\nG0 X10", "M107"], Some("start[0] `G21\nG0 X10`")),
+            (vec!["G21", "M107", "G4 P100"], None),
+            (vec![], None),
+        ] {
+            p.start = start.iter().map(|l| l.to_string()).collect();
+            assert_eq!(start_block_motion(&p).as_deref(), named, "{start:?}");
         }
     }
 

@@ -15,6 +15,7 @@
 ' profile: aerotech
 ' print feed: F5 mm/s (5 mm/s)
 ' safe travel height: 13.603 mm
+' first move: a rise to the safe travel height from wherever the head stands, which pcpp cannot check (start with the nozzle above the part)
 G71
 G76
 G90
