@@ -139,6 +139,51 @@ export function requestCentre(drawing = false) {
   state.centre = { token: ++centreTokens, fresh };
 }
 
+// The drawing's placement in each reading of the scan (its units and up
+// axis) the user left: read back in that way, the scan is that scan again,
+// and the drawing goes back where it was (found by QA: typed at (70, 150),
+// switched to cm and back to mm, it was centred anew at (45.2, 154.8)).
+// Kept per scan and drawing: another file is another placement.
+const readings = new Map();
+// The units each scan was read in by default ("file default" and the
+// units it stands for are one reading).
+const defaultUnits = new Map();
+
+function readingKey() {
+  const scan = state.pendingScan || state.scan;
+  const key = scan ? scan.key : null;
+  const drawing = settings.pathSource === 'file'
+    ? (state.pendingSvg || state.svgFile || {}).key : settings.pathSource;
+  const units = settings.scanUnits || defaultUnits.get(key) || '';
+  return JSON.stringify([key, drawing, units, settings.scanUp]);
+}
+
+// Before the scan's units or up axis change: where the drawing lies in
+// this reading (not while a centring is on its way: that one is stale).
+export function leaveReading() {
+  const scan = state.pendingScan || state.scan;
+  if (!settings.scanUnits && scan && !state.pendingScan && state.info) {
+    defaultUnits.set(scan.key, state.info.units);
+  }
+  if (state.centre) readings.delete(readingKey());
+  else readings.set(readingKey(), { placement: { ...settings.placement }, fit: settings.fit });
+}
+
+// After they changed: the placement this reading had, or the drawing
+// centred on the scan as now read (the scale fitted to another reading
+// says nothing of this one).
+export function enterReading() {
+  const kept = readings.get(readingKey());
+  if (!kept) {
+    requestCentre();
+    return;
+  }
+  settings.placement = { ...kept.placement };
+  settings.fit = kept.fit;
+  cancelCentre();
+  showFitNote();
+}
+
 // The user placed the drawing: nothing is centred over it.
 export function cancelCentre() {
   state.centre = null;

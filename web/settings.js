@@ -8,8 +8,8 @@ import {
 import { fmtPoints, pointsEdited } from './fiducials.js';
 import { $, hooks, num, settings, state } from './page.js';
 import {
-  SCAN_PLACE_DEFAULT, moveScan, requestCentre, sanitizeFit, sanitizeScanPlace, scanPlacementFor,
-  showScanPlacement, userPlaced,
+  SCAN_PLACE_DEFAULT, enterReading, leaveReading, moveScan, requestCentre, sanitizeFit, sanitizeScanPlace,
+  scanPlacementFor, showScanPlacement, userPlaced,
 } from './placement.js';
 
 const STORE_KEY = 'pcpp.settings.v1';
@@ -360,6 +360,8 @@ export function bindForm() {
       // Turned or sized here, the drawing keeps its middle where it is.
       const pivot = PIVOTED.has(id) ? pivotNow() : null;
       const value = el.type === 'checkbox' ? el.checked : el.value;
+      const reread = id === 'scan-units' || id === 'scan-up';
+      if (reread) leaveReading();
       // A new profile has its own bed: a scan placed on it moves, and the
       // drawing with it.
       if (id === 'dialect') moveScan(() => set(value));
@@ -385,8 +387,13 @@ export function bindForm() {
       }
       // Read in other units or turned up another way, the scan is another
       // scan for the drawing: where it lay and the scale fitted to the
-      // misread scan say nothing of this one.
-      if (id === 'scan-units' || id === 'scan-up' || refit) requestCentre();
+      // misread scan say nothing of this one, unless it was read this way
+      // before (the placement it had then).
+      if (reread) {
+        enterReading();
+        writeForm();
+        saveSettings();
+      } else if (refit) requestCentre();
       if (mode === 'live') {
         state.interacting = true;
         hooks.planNow();

@@ -246,3 +246,43 @@ test('a scan far too large for its units gets the units banner, offering mm', as
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// Found by QA: Offset typed at (70, 150), Units set to cm and back to mm:
+// the drawing was centred anew at (45.2, 154.8), the typed placement
+// silently lost. A reading of the scan the user comes back to brings
+// back the placement it had; a reading never had is centred on.
+test('switching the units away and back brings back the typed placement', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'film-mm.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(false, 0, 1)) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-mm.obj',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  const offset = () => page.evaluate(() => [window.pcpp.settings.placement.x, window.pcpp.settings.placement.y].map(Number));
+  await page.fill('#pl-x', '30');
+  await page.fill('#pl-y', '45');
+  await waitSettled(page);
+  assert.deepEqual(await offset(), [30, 45]);
+  // Read in cm (800 mm across): centred on the scan as now read.
+  await page.selectOption('#scan-units', 'cm');
+  await waitIdle(page);
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'cm', null, { timeout: 120_000 });
+  await waitIdle(page);
+  const inCm = await offset();
+  assert.notDeepEqual(inCm, [30, 45]);
+  // Back to mm (the file's default, chosen by name): the typed placement,
+  // planned there.
+  await page.selectOption('#scan-units', 'mm');
+  await waitSettled(page);
+  assert.deepEqual(await offset(), [30, 45]);
+  assert.equal(await page.inputValue('#pl-x'), '30');
+  assert.equal(await page.inputValue('#pl-y'), '45');
+  const planned = await page.evaluate(() => window.pcpp.state.lastPlan.summary.settings.placement.offset_mm);
+  assert.deepEqual(planned, [30, 45]);
+  // And cm again: where it was in cm.
+  await page.selectOption('#scan-units', 'cm');
+  await waitIdle(page);
+  assert.deepEqual(await offset(), inCm);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
