@@ -65,6 +65,7 @@ const PAGE_WORDS = [
     "('Centre on scan' puts the drawing on the scan's footprint)"],
   [/\(--up-axis y or z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
   [/\(--up-axis\)/g, '(Up axis)'],
+  [/\(--up-axis ([yz])\)/g, (_, a) => `(Up axis: +${a.toUpperCase()})`],
   [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
   [/\(--scan-units (\w+) if it really is this (small|large)\)/g, '(Units: $1 if it really is this $2)'],
   [/\(--max-edge\)/g, '(Cloud max edge)'],

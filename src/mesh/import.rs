@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::{cloud, gltf, obj, pcd, ply, stl, xyz};
+use super::{cloud, gltf, obj, pcd, ply, stl, upright, xyz};
 use super::{ExternalFiles, ExternalRef};
 use super::{ImportOptions, ImportedMesh, MeshError, MeshFormat, ScanUnits, TriMesh, UpAxis};
 
@@ -286,6 +286,9 @@ fn finish_import(
     let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis)?;
     let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
     warnings.extend(units_doubt.map(|d| d.message(file)));
+    if options.up_axis.is_none() {
+        warnings.extend(upright::note(&mesh.vertices, up_axis, file));
+    }
     Ok(Unwelded {
         imported: ImportedMesh {
             mesh,
@@ -410,10 +413,16 @@ fn import_cloud(
     } = parsed;
     check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
+    let upright_note = options
+        .up_axis
+        .is_none()
+        .then(|| upright::note(&vertices, up_axis, file))
+        .flatten();
     let (mesh, info) = cloud::triangulate(vertices, options.max_edge_mm, file)?;
     check_triangle_count(mesh.triangle_count(), file)?;
     let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
     warnings.extend(units_doubt.map(|d| d.message(file)));
+    warnings.extend(upright_note);
     if info.merged > 0 {
         warnings.push(format!(
             "{file}: {} point(s) shared their XY with another; the highest of each was kept",

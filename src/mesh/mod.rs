@@ -27,6 +27,7 @@ mod pcd;
 mod ply;
 mod stl;
 pub(crate) mod topology;
+mod upright;
 mod xyz;
 
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};

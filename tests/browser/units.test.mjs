@@ -286,3 +286,43 @@ test('switching the units away and back brings back the typed placement', async 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A +Y-up OBJ (Blender's and many scanner apps' default) was shown lying
+// on its side with nothing said (QA: the Stanford bunny, a cow). An animal
+// on four legs, saved +Y up: the page names the up axis to try, and the
+// note goes once it is read +Y up.
+function animalYUp() {
+  // Standing on -Z: a rounded body over four thin legs 40 x 20 mm apart.
+  const pts = [[20, 10, 10], [20, 10, 25], [2, 10, 17.5], [38, 10, 17.5], [20, 2, 17.5], [20, 18, 17.5]];
+  for (const [x, y] of [[0, 0], [39, 0], [0, 19], [39, 19]]) {
+    for (const [dx, dy] of [[0, 0], [1, 0], [0, 1], [1, 1]]) pts.push([x + dx, y + dy, 0]);
+  }
+  // Saved +Y up: the file's (x, y, z) is the standing animal's (x, z, -y).
+  const lines = pts.map(([x, y, z]) => `v ${x} ${z} ${-y}`);
+  // The body's faces and each leg's two triangles down to the body's bottom.
+  lines.push('f 1 3 5', 'f 1 5 4', 'f 1 4 6', 'f 1 6 3', 'f 2 5 3', 'f 2 4 5', 'f 2 6 4', 'f 2 3 6');
+  for (let k = 0; k < 4; k++) {
+    const a = 7 + 4 * k;
+    lines.push(`f ${a} ${a + 1} 1`, `f ${a + 2} ${a + 3} 1`);
+  }
+  return `${lines.join('\n')}\n`;
+}
+
+test('a scan saved +Y up gets a note naming the up axis, gone once read +Y up', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'animal.obj', mimeType: 'text/plain', buffer: Buffer.from(animalYUp()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'animal.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const notes = () => page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent).filter((t) => /rests on its/.test(t)));
+  assert.deepEqual(await notes(), ['animal.obj: read +Z up, it rests on its -Y side (its outermost points spread far '
+    + 'wider there than on any other side): it was likely saved with +Y up; if it is shown lying on its side, read it '
+    + '+Y up (Up axis: +Y)']);
+  await page.selectOption('#scan-up', 'y');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.bbox_mm[1][2] > 20, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.deepEqual(await notes(), []);
+  assert.deepEqual(problems, []);
+  await context.close();
+});

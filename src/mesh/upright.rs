@@ -1,0 +1,237 @@
+//! Whether a scan read with its format's default up axis looks like it was
+//! saved with the other one (spec section 2: the scan is placed in the
+//! printer's frame with +Z up).
+//!
+//! OBJ, PLY and STL carry no up axis; we read them +Z up (scanners'
+//! convention), but Blender's and many scanner apps' OBJ and STL exports are
+//! +Y up, and such a scan is shown, placed on the bed and planned lying on
+//! its side, with nothing said (found by QA: the Stanford bunny and a cow,
+//! both +Y up, shown on their backs). An object rests on the side it was
+//! scanned standing on: the side whose outermost points spread widest
+//! (the bunny's base, the cow's four hooves; a film's lowest points, spread
+//! over its whole footprint). When, as read, that is clearly the -Y side
+//! (+Y when read +Y up: then +Z was up), the scan gets a note naming the
+//! up axis to try. It is only a note: the reading stays the one asked for.
+
+use glam::{DVec2, DVec3};
+
+#[cfg(test)]
+use super::TriMesh;
+use super::UpAxis;
+
+/// The most vertices looked at (evenly spread): the sides' spread does not
+/// need every vertex of a 2 M triangle scan.
+const SAMPLES: usize = 100_000;
+
+/// How far in from a side its outermost points may lie, as a share of the
+/// scan's largest extent.
+const SLAB: f64 = 0.01;
+
+/// How much wider the side it rests on must spread than any other side.
+const MARGIN: f64 = 2.0;
+
+/// The least spread, as a share of the largest extent squared, that says
+/// anything (a cube or a sliver spreads alike, or not at all, everywhere).
+const LEAST: f64 = 0.02;
+
+/// A note when the scan's `vertices` (a mesh's or a cloud's), read with
+/// `up` (the format's default, not the user's choice), rest clearly on a
+/// side that says the other axis was up.
+pub(crate) fn note(vertices: &[DVec3], up: UpAxis, file: &str) -> Option<String> {
+    let stride = vertices.len().div_ceil(SAMPLES).max(1);
+    let sample: Vec<DVec3> = vertices.iter().step_by(stride).copied().collect();
+    let spread = side_spreads(&sample)?;
+    // [-X, +X, -Y, +Y, -Z, +Z]: read +Z up, a +Y-up scan rests on -Y; read
+    // +Y up, a +Z-up one rests on +Y (its -Z turned to +Y).
+    let (side, name, other, flag) = match up {
+        UpAxis::Z => (2, "-Y", "+Y", "y"),
+        UpAxis::Y => (3, "+Y", "+Z", "z"),
+    };
+    let rest = spread[side];
+    let next = (0..6)
+        .filter(|&i| i != side)
+        .map(|i| spread[i])
+        .fold(0.0, f64::max);
+    if rest < LEAST || rest < MARGIN * next {
+        return None;
+    }
+    let read = match up {
+        UpAxis::Z => "+Z up",
+        UpAxis::Y => "+Y up (glTF's convention)",
+    };
+    Some(format!(
+        "{file}: read {read}, it rests on its {name} side (its outermost points spread far \
+         wider there than on any other side): it was likely saved with {other} up; if it is \
+         shown lying on its side, read it {other} up (--up-axis {flag})"
+    ))
+}
+
+/// For each side of the box of `points` (-X, +X, -Y, +Y, -Z, +Z): the area
+/// of the convex hull of the points within `SLAB` of it, seen along its
+/// axis, over the largest extent squared. `None` for a degenerate box.
+fn side_spreads(points: &[DVec3]) -> Option<[f64; 6]> {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for &p in points {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let size = (hi - lo).max_element();
+    if !(size.is_finite() && size > 0.0) {
+        return None;
+    }
+    let eps = SLAB * size;
+    let mut out = [0.0; 6];
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (k, at_low) in [(0, true), (1, false)] {
+            let slab: Vec<DVec2> = points
+                .iter()
+                .filter(|p| {
+                    if at_low {
+                        p[axis] <= lo[axis] + eps
+                    } else {
+                        p[axis] >= hi[axis] - eps
+                    }
+                })
+                .map(|p| DVec2::new(p[u], p[v]))
+                .collect();
+            out[2 * axis + k] = hull_area(slab) / (size * size);
+        }
+    }
+    Some(out)
+}
+
+/// The area of the convex hull of `points` (Andrew's monotone chain).
+fn hull_area(mut points: Vec<DVec2>) -> f64 {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return 0.0;
+    }
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * points.len());
+    for pass in [false, true] {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &DVec2>> = if pass {
+            Box::new(points.iter().rev())
+        } else {
+            Box::new(points.iter())
+        };
+        for &p in ordered {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        // The chain's last point starts the other one.
+        hull.pop();
+    }
+    let n = hull.len();
+    0.5 * (0..n)
+        .map(|i| hull[i].perp_dot(hull[(i + 1) % n]))
+        .sum::<f64>()
+        .abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An animal: a body on four thin legs 40 x 20 mm apart, standing on
+    /// -Z, turned by `turn`.
+    fn stand(turn: impl Fn(DVec3) -> DVec3) -> TriMesh {
+        // The body, rounded: its outermost points on each side but the
+        // bottom are single points, inside the legs' footprint.
+        let mut vertices = vec![
+            DVec3::new(20.0, 10.0, 10.0),
+            DVec3::new(20.0, 10.0, 25.0),
+            DVec3::new(2.0, 10.0, 17.5),
+            DVec3::new(38.0, 10.0, 17.5),
+            DVec3::new(20.0, 2.0, 17.5),
+            DVec3::new(20.0, 18.0, 17.5),
+        ];
+        // Four legs down to 0 at its corners, 1 mm wide.
+        for &(x, y) in &[(0.0, 0.0), (39.0, 0.0), (0.0, 19.0), (39.0, 19.0)] {
+            for &(dx, dy) in &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                vertices.push(DVec3::new(x + dx, y + dy, 0.0));
+            }
+        }
+        let n = vertices.len() as u32;
+        TriMesh {
+            vertices: vertices.into_iter().map(turn).collect(),
+            triangles: (0..n - 2).map(|i| [i, i + 1, i + 2]).collect(),
+        }
+    }
+
+    #[test]
+    fn a_scan_standing_on_minus_y_read_z_up_gets_the_y_note() {
+        // Saved +Y up: the file's (x, y, z) is the standing part's (x, z, -y).
+        let yup = stand(|p| DVec3::new(p.x, p.z, -p.y));
+        let note = note(&yup.vertices, UpAxis::Z, "cow.stl").expect("a note");
+        assert!(
+            note.starts_with("cow.stl: read +Z up, it rests on its -Y side"),
+            "{note}"
+        );
+        assert!(note.ends_with("read it +Y up (--up-axis y)"), "{note}");
+        // Standing on -Z as read: nothing to say.
+        assert_eq!(
+            super::note(&stand(|p| p).vertices, UpAxis::Z, "cow.stl"),
+            None
+        );
+    }
+
+    #[test]
+    fn a_z_up_scan_read_y_up_gets_the_z_note() {
+        // glTF read +Y up turns (x, y, z) to (x, -z, y): a part standing on
+        // -Z in the file rests on +Y.
+        let turned = stand(|p| DVec3::new(p.x, -p.z, p.y));
+        let note = note(&turned.vertices, UpAxis::Y, "cad.glb").expect("a note");
+        assert!(note.contains("rests on its +Y side"), "{note}");
+        assert!(note.ends_with("read it +Z up (--up-axis z)"), "{note}");
+    }
+
+    #[test]
+    fn a_cube_a_flat_film_and_a_sliver_get_no_note() {
+        let cube = TriMesh {
+            vertices: (0..8)
+                .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64))
+                .collect(),
+            triangles: vec![[0, 1, 2], [4, 5, 6]],
+        };
+        assert_eq!(note(&cube.vertices, UpAxis::Z, "c"), None);
+        // A film 0.2 mm thick lying flat: it rests on -Z (and +Z alike).
+        let film = TriMesh {
+            vertices: (0..400)
+                .map(|i| {
+                    let (x, y) = ((i % 20) as f64, (i / 20) as f64);
+                    DVec3::new(x, y, 0.1 * (x * 0.7).sin() * (y * 0.5).cos())
+                })
+                .collect(),
+            triangles: vec![[0, 1, 20]],
+        };
+        assert_eq!(note(&film.vertices, UpAxis::Z, "f"), None);
+        let sliver = TriMesh {
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)],
+            triangles: vec![[0, 1, 2]],
+        };
+        assert_eq!(note(&sliver.vertices, UpAxis::Z, "s"), None);
+    }
+
+    #[test]
+    fn hull_area_of_a_square_with_inner_and_repeated_points() {
+        let pts = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 2.0),
+            (0.0, 2.0),
+            (1.0, 1.0),
+            (2.0, 0.0),
+            (1.0, 0.0),
+        ]
+        .map(|(x, y)| DVec2::new(x, y))
+        .to_vec();
+        assert!((hull_area(pts) - 4.0).abs() < 1e-12);
+    }
+}
