@@ -592,13 +592,15 @@ pub fn prepare_scan_owned_with(
     let listed =
         candidates == Candidates::Listed || matches!(registration.fiducials, FiducialSource::Auto);
     let holes = |mesh: &TriMesh| {
-        let topology = Topology::of(mesh);
-        let fiducials = if listed {
-            find_fiducials_in(mesh, &topology, dot)
+        if listed {
+            let topology = Topology::of(mesh);
+            let fiducials = find_fiducials_in(mesh, &topology, dot);
+            (topology, fiducials)
         } else {
-            Vec::new()
-        };
-        (topology, fiducials)
+            // The surface needs only the owners (issue 15: the boundary
+            // edges' count skipped on `pcpp plan`'s critical path).
+            (Topology::owners(mesh), Vec::new())
+        }
     };
     if let Some(reg) = early.clone() {
         if reg.matrix == glam::DMat4::IDENTITY {

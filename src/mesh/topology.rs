@@ -52,6 +52,18 @@ impl Topology {
     /// [`MAX_TOPOLOGY_TRIANGLES`] triangles (callers check; past it, this
     /// panics).
     pub fn of(mesh: &TriMesh) -> Topology {
+        Topology::build::<true>(mesh)
+    }
+
+    /// [`Topology::of`] without the boundary edges (left empty): the
+    /// owners alone, all a surface needs when no fiducial hole is looked
+    /// for (`pcpp plan` without `auto` fiducials: the count of each edge's
+    /// valid triangles is then not taken).
+    pub fn owners(mesh: &TriMesh) -> Topology {
+        Topology::build::<false>(mesh)
+    }
+
+    fn build<const BOUNDARY: bool>(mesh: &TriMesh) -> Topology {
         let n = mesh.vertices.len();
         let tris = &mesh.triangles;
         assert!(
@@ -60,9 +72,13 @@ impl Topology {
         );
         let mut owned = vec![0u8; tris.len()];
 
-        // A vertex's owner: the first triangle to hold it.
+        // A vertex's owner: the first triangle to hold it. (And whether
+        // every in-range triangle has three distinct corners, as nearly
+        // every scan's do: then no edge needs its triangle checked again.)
         let mut seen = vec![0u64; n.div_ceil(64)];
+        let mut all_valid = true;
         for (t, tri) in tris.iter().enumerate().filter(|(_, t)| in_range(t, n)) {
+            all_valid &= distinct(tri);
             for (k, &v) in tri.iter().enumerate() {
                 let (word, bit) = (v as usize / 64, 1u64 << (v % 64));
                 if seen[word] & bit == 0 {
@@ -73,34 +89,108 @@ impl Topology {
         }
         drop(seen);
 
-        // Edge `k` of triangle `t` is `3 t + k`, bucketed by its lower end.
+        // Edge `k` of triangle `t` is `3 t + k`, bucketed by its lower end,
+        // in edge order within a bucket (the counting sort keeps it).
         let by_lower = edges_by_lower(n, tris);
         let mut boundary_edges = Vec::new();
-        // A bucket's edges as (higher end, edge), sorted: by the higher end,
-        // then in triangle order, as edge numbers grow with the triangle.
-        // (Each entry carries whether its triangle is valid, so the
-        // triangle is read once.)
+        // A bucket's edges' higher ends and whether their triangles are
+        // valid; all valid when every triangle is.
+        let mut his = [0u32; SMALL_RUN];
+        let mut valid = [true; SMALL_RUN];
         let mut run: Vec<(u32, u32, bool)> = Vec::new();
         for lo in 0..n as u32 {
-            run.clear();
-            run.extend(by_lower.get(lo).iter().map(|&e| {
+            let edges = by_lower.get(lo);
+            if edges.len() > SMALL_RUN {
+                let boundary = BOUNDARY.then_some(&mut boundary_edges);
+                big_run(lo, edges, (tris, n), &mut run, &mut owned, boundary);
+                continue;
+            }
+            for (j, &e) in edges.iter().enumerate() {
                 let tri = &tris[e as usize / 3];
                 let k = e as usize % 3;
-                (tri[k].max(tri[(k + 1) % 3]), e, valid_triangle(tri, n))
-            }));
-            run.sort_unstable_by_key(|&(hi, e, _)| (hi, e));
-            for edge in run.chunk_by(|a, b| a.0 == b.0) {
-                let (hi, first, _) = edge[0];
-                owned[first as usize / 3] |= 8 << (first % 3);
-                let mut valid = edge.iter().filter(|&&(_, _, valid)| valid);
-                if valid.next().is_some() && valid.next().is_none() {
+                his[j] = tri[k].max(tri[if k == 2 { 0 } else { k + 1 }]);
+                if !all_valid {
+                    valid[j] = distinct(tri);
+                }
+            }
+            // An edge's first entry is its lowest-numbered triangle, the
+            // owner; an edge of exactly one valid triangle is a boundary
+            // edge. (A few entries a bucket: comparing them all costs less
+            // than sorting them.)
+            let listed = boundary_edges.len();
+            let m = edges.len();
+            'entries: for j in 0..m {
+                let hi = his[j];
+                for &earlier in &his[..j] {
+                    if earlier == hi {
+                        continue 'entries;
+                    }
+                }
+                let e = edges[j];
+                owned[e as usize / 3] |= 8 << (e % 3);
+                if !BOUNDARY {
+                    continue;
+                }
+                let mut holders = 0;
+                for i in j..m {
+                    holders += usize::from(his[i] == hi && valid[i]);
+                }
+                if holders == 1 {
                     boundary_edges.push([lo, hi]);
                 }
+            }
+            // Listed by lower, then higher end.
+            if boundary_edges.len() > listed + 1 {
+                boundary_edges[listed..].sort_unstable();
             }
         }
         Topology {
             owned,
             boundary_edges,
+        }
+    }
+}
+
+/// The most edges at a vertex [`Topology::of`] compares pairwise; a
+/// vertex with more (a fan's centre, a cloud's mesh) has its edges sorted
+/// ([`big_run`]).
+const SMALL_RUN: usize = 16;
+
+/// Whether a triangle's corners are distinct (an in-range one is then
+/// valid, [`valid_triangle`]).
+fn distinct(t: &[u32; 3]) -> bool {
+    t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+}
+
+/// [`Topology::of`] for the edges of a bucket too large to compare
+/// pairwise: sorted by (higher end, edge), a run of equal higher ends is
+/// one undirected edge, its first entry the owner.
+/// The mesh is given as its triangles and vertex count; `boundary_edges`
+/// only where the boundary edges are wanted.
+fn big_run(
+    lo: u32,
+    edges: &[u32],
+    (tris, n): (&[[u32; 3]], usize),
+    run: &mut Vec<(u32, u32, bool)>,
+    owned: &mut [u8],
+    mut boundary_edges: Option<&mut Vec<[u32; 2]>>,
+) {
+    run.clear();
+    run.extend(edges.iter().map(|&e| {
+        let tri = &tris[e as usize / 3];
+        let k = e as usize % 3;
+        (tri[k].max(tri[(k + 1) % 3]), e, valid_triangle(tri, n))
+    }));
+    run.sort_unstable_by_key(|&(hi, e, _)| (hi, e));
+    for edge in run.chunk_by(|a, b| a.0 == b.0) {
+        let (hi, first, _) = edge[0];
+        owned[first as usize / 3] |= 8 << (first % 3);
+        let Some(boundary_edges) = boundary_edges.as_deref_mut() else {
+            continue;
+        };
+        let mut valid = edge.iter().filter(|&&(_, _, valid)| valid);
+        if valid.next().is_some() && valid.next().is_none() {
+            boundary_edges.push([lo, hi]);
         }
     }
 }
@@ -205,6 +295,7 @@ mod tests {
         m.triangles.push([5, 5, 12]);
         let got = Topology::of(&m);
         assert_eq!(got, by_brute_force(&m));
+        assert_eq!(Topology::owners(&m).owned, got.owned);
         // The grid's rim (24 edges) but edge 0-1, which the grid and the
         // two fins hold (non-manifold, not listed); the hole (4); the fins'
         // free edges (4).
@@ -212,5 +303,38 @@ mod tests {
         assert!(!got.boundary_edges.contains(&[0, 1]));
         // The out-of-range triangle owns nothing.
         assert_eq!(got.owned[m.triangles.len() - 2], 0);
+    }
+
+    /// A vertex with more edges than are compared pairwise (a fan's
+    /// centre: sorted instead), with and without an invalid triangle
+    /// elsewhere, and a mesh whose triangles are all valid.
+    #[test]
+    fn fans_and_all_valid_meshes_agree_with_the_brute_force() {
+        for (spokes, bad) in [(5, false), (SMALL_RUN + 7, false), (SMALL_RUN + 7, true)] {
+            let mut m = TriMesh::default();
+            m.vertices.push(DVec3::ZERO);
+            for i in 0..spokes {
+                let a = i as f64 / spokes as f64 * std::f64::consts::TAU;
+                m.vertices.push(DVec3::new(a.cos(), a.sin(), 0.0));
+            }
+            let s = spokes as u32;
+            // The fan, one spoke left open (a boundary through the centre),
+            // each wedge twice in a row: a doubled edge at every spoke.
+            for i in 1..s {
+                m.triangles.push([0, i, i + 1]);
+                if i % 3 == 0 {
+                    m.triangles.push([i + 1, 0, i]);
+                }
+            }
+            if bad {
+                m.triangles.push([1, 2, 2]);
+            }
+            let got = Topology::of(&m);
+            assert_eq!(got, by_brute_force(&m), "{spokes} spokes, bad {bad}");
+            assert!(!got.boundary_edges.is_empty());
+            let owners = Topology::owners(&m);
+            assert_eq!(owners.owned, got.owned);
+            assert!(owners.boundary_edges.is_empty());
+        }
     }
 }
