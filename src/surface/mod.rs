@@ -131,26 +131,41 @@ impl Surface {
     /// What the surface's queries rely on (triangles, finite vertices,
     /// indices in range, not too many to number their edges): the bounds.
     fn check(mesh: &TriMesh) -> Result<(DVec3, DVec3)> {
-        // One pass: each triangle's indices checked before they are read.
+        // Each triangle's indices checked before any vertex is read; then
+        // the vertices the triangles use, in vertex order (a pass over the
+        // corners, gathering a vertex each, cost 184 M instructions on a
+        // 2 M triangle scan; marking them and reading the vertices in
+        // order, a fifth of that: issue 15).
         let n = mesh.vertices.len();
+        let corners = mesh.triangles.as_flattened();
+        let past = corners.iter().copied().max().unwrap_or_default();
+        if past as usize >= n {
+            let i = mesh
+                .triangles
+                .iter()
+                .position(|t| t.iter().any(|&k| k as usize >= n))
+                .unwrap_or_default();
+            return Err(Error::Plan(format!(
+                "triangle {i} refers to a vertex past the {n} the scan has"
+            )));
+        }
+        let mut used = vec![false; n];
+        for &k in corners {
+            used[k as usize] = true;
+        }
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for (i, t) in mesh.triangles.iter().enumerate() {
-            if t.iter().any(|&k| k as usize >= n) {
+        for (k, &v) in mesh.vertices.iter().enumerate() {
+            if !used[k] {
+                continue;
+            }
+            if !v.is_finite() {
                 return Err(Error::Plan(format!(
-                    "triangle {i} refers to a vertex past the {n} the scan has"
+                    "vertex {k} of the scan has a non-finite coordinate"
                 )));
             }
-            for &k in t {
-                let v = mesh.vertices[k as usize];
-                if !v.is_finite() {
-                    return Err(Error::Plan(format!(
-                        "vertex {k} of the scan has a non-finite coordinate"
-                    )));
-                }
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
+            lo = lo.min(v);
+            hi = hi.max(v);
         }
         if mesh.triangles.is_empty() {
             return Err(Error::Plan("the scan has no triangles".into()));
@@ -666,6 +681,12 @@ pub(crate) mod tests {
         nan.vertices[k as usize].z = f64::NAN;
         let e = Surface::new(nan).unwrap_err().to_string();
         assert!(e.contains(&format!("vertex {k} ")), "{e}");
+        // Vertices no triangle uses bound nothing, even non-finite ones.
+        let mut spare = good.clone();
+        spare.vertices.push(DVec3::splat(1000.0));
+        spare.vertices.push(DVec3::splat(f64::NAN));
+        let bbox = Surface::new(spare).unwrap().bbox;
+        assert_eq!(bbox, Surface::new(good.clone()).unwrap().bbox);
         // A topology of another mesh.
         let other = Topology::of(&grid(4, 1.0, |_, _| 0.0));
         let e = Surface::with_topology(good.clone(), other)
