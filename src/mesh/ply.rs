@@ -1,10 +1,11 @@
 //! Stanford PLY: ascii, binary_little_endian and binary_big_endian.
 //!
-//! Only `vertex` x/y/z and the `face` index list are read; every other
-//! property and element (normals, colours, confidence, range grids, edges) is
-//! skipped by its declared type, so scanner-specific extras never stop an
-//! import. Declared counts are checked against the bytes that follow the
-//! header before anything is allocated from them.
+//! Only `vertex` x/y/z, the `face` index list and the `tristrips` index
+//! list (the triangle strips of the Stanford and Georgia Tech scans) are
+//! read; every other property and element (normals, colours, confidence,
+//! range grids, edges) is skipped by its declared type, so scanner-specific
+//! extras never stop an import. Declared counts are checked against the
+//! bytes that follow the header before anything is allocated from them.
 
 use glam::DVec3;
 
@@ -223,6 +224,9 @@ enum Role {
     Skip,
     Axis(usize),
     FaceIndices,
+    /// The index list of a `tristrips` element, which the Stanford and
+    /// Georgia Tech scans use instead of `face` (see [`Body::push_strip`]).
+    StripIndices,
 }
 
 fn roles(element: &Element, file: &str) -> Result<Vec<Role>, MeshError> {
@@ -234,6 +238,9 @@ fn roles(element: &Element, file: &str) -> Result<Vec<Role>, MeshError> {
             ("vertex", "y", Kind::Scalar(_)) => Role::Axis(1),
             ("vertex", "z", Kind::Scalar(_)) => Role::Axis(2),
             ("face", "vertex_indices" | "vertex_index", Kind::List { .. }) => Role::FaceIndices,
+            ("tristrips", "vertex_indices" | "vertex_index", Kind::List { .. }) => {
+                Role::StripIndices
+            }
             _ => Role::Skip,
         })
         .collect();
@@ -248,12 +255,19 @@ fn roles(element: &Element, file: &str) -> Result<Vec<Role>, MeshError> {
             }
         }
     }
-    if element.name == "face" && element.count > 0 && !roles.contains(&Role::FaceIndices) {
-        return Err(MeshError::Syntax {
-            file: file.into(),
-            line: element.line,
-            message: "element 'face' has no list property 'vertex_indices'".into(),
-        });
+    // Without its index list a surface element would be skipped, and the
+    // scan silently read as a point cloud.
+    for (name, role) in [
+        ("face", Role::FaceIndices),
+        ("tristrips", Role::StripIndices),
+    ] {
+        if element.name == name && element.count > 0 && !roles.contains(&role) {
+            return Err(MeshError::Syntax {
+                file: file.into(),
+                line: element.line,
+                message: format!("element '{name}' has no list property 'vertex_indices'"),
+            });
+        }
     }
     Ok(roles)
 }
@@ -377,6 +391,54 @@ impl Body<'_> {
         }
     }
 
+    /// The triangles of one strip of a `tristrips` list, in its order. A
+    /// strip's k-th triangle is (s[k], s[k+1], s[k+2]) with its first two
+    /// corners swapped for odd k, so that every triangle winds as the first
+    /// does (the strips of the Stanford and Georgia Tech PLY scans, as
+    /// OpenGL's GL_TRIANGLE_STRIP). Triangles with a repeated index, which
+    /// strips use to turn, are kept as `face` triangles are: the import
+    /// counts degenerate triangles and keeps them. A strip of fewer than 3
+    /// indices has no triangle.
+    fn push_strip(&mut self, strip: &[u32]) {
+        for (k, w) in strip.windows(3).enumerate() {
+            self.triangles.push(if k % 2 == 0 {
+                [w[0], w[1], w[2]]
+            } else {
+                [w[1], w[0], w[2]]
+            });
+        }
+    }
+
+    /// One index `value` of the surface list `role` of record `i`, onto
+    /// `polygon` (the face, or the strip so far); in a `tristrips` list -1
+    /// ends a strip and starts the next (PLY's tristrips convention), any
+    /// other value must be a vertex, as in a face.
+    fn push_index(
+        &mut self,
+        role: Role,
+        polygon: &mut Vec<u32>,
+        i: usize,
+        value: i64,
+        line: Option<usize>,
+    ) -> Result<(), MeshError> {
+        if role == Role::StripIndices && value == -1 {
+            self.push_strip(polygon);
+            polygon.clear();
+            return Ok(());
+        }
+        polygon.push(self.index(i, value, line)?);
+        Ok(())
+    }
+
+    /// The triangles of a surface list `role` read up to its end.
+    fn end_list(&mut self, role: Role, polygon: &[u32]) {
+        match role {
+            Role::FaceIndices => self.push_polygon(polygon),
+            Role::StripIndices => self.push_strip(polygon),
+            Role::Skip | Role::Axis(_) => {}
+        }
+    }
+
     /// One record of `element` (index `i`) read field by field.
     fn read_record(
         &mut self,
@@ -414,13 +476,13 @@ impl Body<'_> {
                             ),
                         )
                     })?;
-                    if *role == Role::FaceIndices {
+                    if matches!(role, Role::FaceIndices | Role::StripIndices) {
                         polygon.clear();
                         for _ in 0..n {
                             let v = r.index(item).ok_or_else(|| truncated(i))?;
-                            polygon.push(self.index(i, v, None)?);
+                            self.push_index(*role, polygon, i, v, None)?;
                         }
-                        self.push_polygon(polygon);
+                        self.end_list(*role, polygon);
                     } else {
                         let len = n.checked_mul(item.size()).ok_or_else(|| truncated(i))?;
                         r.skip(len).ok_or_else(|| truncated(i))?;
@@ -622,15 +684,15 @@ impl Body<'_> {
                             let n = ascii_int(token)
                                 .and_then(|n| usize::try_from(n).ok())
                                 .ok_or_else(|| not_number(&t, token))?;
-                            if *role == Role::FaceIndices {
+                            if matches!(role, Role::FaceIndices | Role::StripIndices) {
                                 polygon.clear();
                                 for _ in 0..n {
                                     let token = t.next().ok_or_else(|| missing(&t))?;
                                     let v =
                                         ascii_int(token).ok_or_else(|| not_number(&t, token))?;
-                                    polygon.push(self.index(i, v, Some(t.line))?);
+                                    self.push_index(*role, &mut polygon, i, v, Some(t.line))?;
                                 }
-                                self.push_polygon(&polygon);
+                                self.end_list(*role, &polygon);
                             } else {
                                 for _ in 0..n {
                                     t.next().ok_or_else(|| missing(&t))?;
@@ -886,6 +948,7 @@ impl BinReader<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::ImportOptions;
 
     const ASCII: &str = "ply\nformat ascii 1.0\ncomment made by hand\nobj_info x\n\
         element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
@@ -1155,5 +1218,199 @@ mod tests {
         assert_eq!(ahead(&nan), Some((1, 48)));
         let e = parse(&nan, "a.ply").unwrap_err().to_string();
         assert!(e.contains("vertex 1"), "{e}");
+    }
+
+    /// Six vertices in a 3 x 2 grid, then `surface` (element declarations)
+    /// and `records` (their ascii lines).
+    fn ascii_strips(surface: &str, records: &str) -> String {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n\
+             property float z\n{surface}end_header\n\
+             0 0 0\n0 1 0\n1 0 0\n1 1 0\n2 0 0\n2 1 0\n{records}"
+        )
+    }
+
+    const STRIPS: &str = "element tristrips 2\nproperty int flags\n\
+        property list int int vertex_indices\n";
+
+    #[test]
+    fn ascii_tristrips_alternate_winding_and_restart_at_minus_one() {
+        // Record 0: a strip of five, one that turns on a repeated index, a
+        // strip of two, an empty one and one of one; record 1: one triangle whose
+        // indices are written as floats.
+        let text = ascii_strips(
+            STRIPS,
+            "7 16 0 1 2 3 4 -1 3 4 5 5 -1 0 1 -1 -1 2\n0 3 1.0 3 4.0\n",
+        );
+        let p = parse(text.as_bytes(), "s.ply").unwrap();
+        assert_eq!(p.vertices.len(), 6);
+        assert_eq!(
+            p.triangles,
+            vec![
+                [0, 1, 2],
+                [2, 1, 3],
+                [2, 3, 4],
+                [3, 4, 5],
+                [5, 4, 5],
+                [1, 3, 4]
+            ]
+        );
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+        // Every triangle of the first strip winds as its first does
+        // (clockwise seen from +z); the second strip starts its own, and
+        // its turn has no area.
+        let z = |t: [u32; 3]| {
+            let [a, b, c] = t.map(|i| p.vertices[i as usize]);
+            (b - a).cross(c - a).z
+        };
+        let winding: Vec<f64> = p.triangles[..5].iter().map(|&t| z(t)).collect();
+        assert_eq!(winding, [-1.0, -1.0, -1.0, 1.0, 0.0]);
+        // A surface, not a point cloud: the strip's turn is kept and
+        // counted as the import counts degenerate faces.
+        let m =
+            crate::mesh::import_mesh(text.as_bytes(), "s.ply", &ImportOptions::DEFAULT).unwrap();
+        assert!(m.cloud.is_none());
+        assert_eq!(m.mesh.triangles.len(), 6);
+        assert!(
+            m.warnings.iter().any(|w| w.contains("1 degenerate")),
+            "{:?}",
+            m.warnings
+        );
+        // `vertex_index` names the list too.
+        let text = ascii_strips(
+            "element tristrips 1\nproperty list uchar int vertex_index\n",
+            "4 0 1 2 3\n",
+        );
+        let p = parse(text.as_bytes(), "s.ply").unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [2, 1, 3]]);
+    }
+
+    /// A binary PLY of the grid's six vertices and one `tristrips` record
+    /// of `indices`, its list declared `list {count} {item}`.
+    fn binary_strips(indices: &[i64], big: bool, count: &str, item: &str) -> Vec<u8> {
+        let order = if big { "big" } else { "little" };
+        let mut b = format!(
+            "ply\nformat binary_{order}_endian 1.0\nelement vertex 6\n\
+             property float x\nproperty float y\nproperty float z\n\
+             element tristrips 1\nproperty list {count} {item} vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        let put = |b: &mut Vec<u8>, mut v: Vec<u8>| {
+            if big {
+                v.reverse();
+            }
+            b.extend(v);
+        };
+        for i in 0..6 {
+            for c in [(i / 2) as f32, (i % 2) as f32, 0.0] {
+                put(&mut b, c.to_le_bytes().to_vec());
+            }
+        }
+        let n = indices.len() as i64;
+        for (value, ty) in std::iter::once((n, count)).chain(indices.iter().map(|&i| (i, item))) {
+            let bytes = match ty {
+                "int" => (value as i32).to_le_bytes().to_vec(),
+                "short" => (value as i16).to_le_bytes().to_vec(),
+                "uchar" => vec![value as u8],
+                _ => (value as f32).to_le_bytes().to_vec(),
+            };
+            put(&mut b, bytes);
+        }
+        b
+    }
+
+    #[test]
+    fn binary_tristrips_in_both_byte_orders_and_list_types() {
+        let indices = [0, 1, 2, 3, 4, -1, 3, 4, 5, 5, -1, 0, 1];
+        let expected = vec![[0, 1, 2], [2, 1, 3], [2, 3, 4], [3, 4, 5], [5, 4, 5]];
+        for big in [false, true] {
+            for (count, item) in [("int", "int"), ("uchar", "int"), ("uchar", "short")] {
+                let what = format!("{big} {count} {item}");
+                let p = parse(&binary_strips(&indices, big, count, item), "s.ply").unwrap();
+                assert_eq!(p.vertices.len(), 6, "{what}");
+                assert_eq!(p.vertices[3], DVec3::new(1.0, 1.0, 0.0), "{what}");
+                assert_eq!(p.triangles, expected, "{what}");
+            }
+        }
+        let p = parse(&binary_strips(&indices, false, "int", "float"), "s.ply").unwrap();
+        assert_eq!(p.triangles, expected);
+    }
+
+    #[test]
+    fn face_and_tristrips_in_the_files_element_order() {
+        let text = ascii_strips(
+            &format!("element face 1\nproperty list uchar int vertex_indices\n{STRIPS}"),
+            "4 0 2 3 1\n0 5 2 3 4 5 -1\n0 3 4 5 0\n",
+        );
+        let p = parse(text.as_bytes(), "s.ply").unwrap();
+        assert_eq!(
+            p.triangles,
+            vec![[0, 2, 3], [0, 3, 1], [2, 3, 4], [4, 3, 5], [4, 5, 0]]
+        );
+        // Binary: the faces read ahead (issue 15), the strips after them.
+        let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 6\n\
+            property float x\nproperty float y\nproperty float z\n\
+            element face 2\nproperty list uchar uint vertex_indices\n\
+            element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+            .to_vec();
+        b.extend([0u8; 6 * 12]);
+        for t in [[0u32, 2, 3], [0, 3, 1]] {
+            b.push(3);
+            t.iter().for_each(|i| b.extend(i.to_le_bytes()));
+        }
+        for i in [4i32, 2, 3, 4, 5] {
+            b.extend(i.to_le_bytes());
+        }
+        let p = parse(&b, "s.ply").unwrap();
+        assert_eq!(
+            p.triangles,
+            vec![[0, 2, 3], [0, 3, 1], [2, 3, 4], [4, 3, 5]]
+        );
+    }
+
+    #[test]
+    fn tristrips_errors_are_typed_and_name_the_record() {
+        // Out of range, and below the -1 that ends a strip.
+        for (bad, index) in [("9", 9), ("-2", -2)] {
+            let text = ascii_strips(STRIPS, &format!("0 4 0 1 2 3\n0 4 3 4 {bad} 5\n"));
+            let e = parse(text.as_bytes(), "s.ply").unwrap_err();
+            assert_eq!(
+                e,
+                MeshError::IndexOutOfRange {
+                    file: "s.ply".into(),
+                    face: 1,
+                    line: Some(18),
+                    index,
+                    vertex_count: 6,
+                }
+            );
+            assert!(e.to_string().starts_with("s.ply:18: face 1"), "{e}");
+        }
+        for big in [false, true] {
+            for index in [6, -2, i64::from(i32::MIN)] {
+                let b = binary_strips(&[0, 1, 2, -1, 2, index, 4], big, "int", "int");
+                let e = parse(&b, "s.ply").unwrap_err().to_string();
+                assert!(
+                    e.starts_with("s.ply: face 0 refers to vertex index")
+                        && e.contains(&format!("index {index},")),
+                    "{big}: {e}"
+                );
+            }
+            let b = binary_strips(&[0, 1, 2, -1, 2, 3, 4], big, "int", "int");
+            let e = parse(&b[..b.len() - 2], "s.ply").unwrap_err().to_string();
+            assert!(
+                e.contains("'tristrips' element 0") && e.contains("truncated"),
+                "{e}"
+            );
+        }
+        let text = ascii_strips(STRIPS, "0 4 0 1 2 3\n0 4 3 4 5\n");
+        let e = parse(text.as_bytes(), "s.ply").unwrap_err().to_string();
+        assert!(e.contains("truncated"), "{e}");
+        let text = ascii_strips("element tristrips 1\nproperty list int int idx\n", "1 0\n");
+        let e = parse(text.as_bytes(), "s.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.ply:7:") && e.contains("'tristrips' has no list property"),
+            "{e}"
+        );
     }
 }
