@@ -611,7 +611,10 @@ pub fn prepare_scan_owned_with(
                     let found = map.is_none().then(|| holes(&unwelded.imported().mesh));
                     (map, found)
                 },
-                || Indexed::build(&unwelded.imported().mesh, SpatialIndex::Auto),
+                || {
+                    let mesh = &unwelded.imported().mesh;
+                    Indexed::build_imported(mesh, unwelded.used_bounds(), SpatialIndex::Auto)
+                },
             );
             let indexed = indexed?;
             let imported = unwelded.finish(map);

@@ -275,6 +275,7 @@ fn finish_import(
             Unwelded {
                 imported,
                 weld: false,
+                bounds: None,
             }
         });
     }
@@ -283,7 +284,7 @@ fn finish_import(
     // 24 vertices), which would turn every seam into fake holes for the
     // fiducial detector, so they are welded after this ([`Unwelded`]).
     let weld = matches!(format, MeshFormat::Obj | MeshFormat::Ply);
-    let (mesh, mut warnings) = finish(parsed, file, units.to_mm(), up_axis)?;
+    let (mesh, mut warnings, bounds) = finish(parsed, file, units.to_mm(), up_axis)?;
     let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
     warnings.extend(units_doubt.map(|d| d.message(file)));
     if options.up_axis.is_none() {
@@ -301,6 +302,7 @@ fn finish_import(
             external_files,
         },
         weld,
+        bounds: Some(bounds),
     })
 }
 
@@ -317,6 +319,9 @@ pub struct Unwelded {
     /// Whether the format is welded here (OBJ and PLY; the other parsers
     /// weld as they read).
     weld: bool,
+    /// The bounds of the vertices the triangles use, found while reading
+    /// (`None` for a cloud's mesh); the weld keeps them.
+    bounds: Option<Bounds>,
 }
 
 /// Which vertex each vertex merges into ([`Unwelded::weld_map`]).
@@ -327,6 +332,13 @@ impl Unwelded {
     /// The scan as read, not welded.
     pub fn imported(&self) -> &ImportedMesh {
         &self.imported
+    }
+
+    /// The bounds of the vertices the triangles use, in the printer frame
+    /// (what the surface's check finds: the importer has checked the
+    /// indices and the coordinates, and read every corner), when known.
+    pub fn used_bounds(&self) -> Option<Bounds> {
+        self.bounds
     }
 
     /// The weld's map, found without changing the mesh: `None` when no two
@@ -631,6 +643,9 @@ fn check_triangle_count(n: usize, file: &str) -> Result<(), MeshError> {
     Ok(())
 }
 
+/// The lowest and highest corner of a box.
+type Bounds = (DVec3, DVec3);
+
 /// The shared steps after parsing. Parsers already report bad values with
 /// their line or element; these checks are the backstop that guarantees the
 /// invariants downstream stages rely on (finite, in range, some area).
@@ -641,24 +656,29 @@ fn check_triangle_count(n: usize, file: &str) -> Result<(), MeshError> {
 /// tall, was left out, and the nozzle was driven through it with a
 /// clearance of 0.603 mm reported). The queries that need area (the
 /// projection, the facet contact) find none in them; the swept clearance
-/// tries their corners and edges.
+/// tries their corners and edges. Also returns the bounds of the vertices
+/// the triangles use.
 fn finish(
     parsed: Parsed,
     file: &str,
     scale: f64,
     up_axis: UpAxis,
-) -> Result<(TriMesh, Vec<String>), MeshError> {
+) -> Result<(TriMesh, Vec<String>, Bounds), MeshError> {
     let Parsed {
         mut vertices,
         triangles,
         mut warnings,
     } = parsed;
     check_finite(&vertices, file)?;
+    to_printer_frame(&mut vertices, scale, up_axis);
     let n = vertices.len();
     // A triangle two of whose corners the weld would merge has those
     // corners at one position, so it has zero area here already: counted
-    // the same welded or not.
+    // the same welded or not. The same pass reads every corner, so it
+    // finds the bounds of the vertices in use too (the surface's check
+    // would read them all again, issue 15).
     let mut degenerate = 0usize;
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for (face, &tri) in triangles.iter().enumerate() {
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(MeshError::IndexOutOfRange {
@@ -670,6 +690,8 @@ fn finish(
             });
         }
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
+        lo = lo.min(a).min(b).min(c);
+        hi = hi.max(a).max(b).max(c);
         if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || zero_area(a, b, c) {
             degenerate += 1;
         }
@@ -685,13 +707,13 @@ fn finish(
         return Err(MeshError::Empty { file: file.into() });
     }
     check_triangle_count(triangles.len(), file)?;
-    to_printer_frame(&mut vertices, scale, up_axis);
     Ok((
         TriMesh {
             vertices,
             triangles,
         },
         warnings,
+        (lo, hi),
     ))
 }
 
@@ -1026,7 +1048,7 @@ mod tests {
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
             warnings: vec![],
         };
-        let (mesh, warnings) = finish(parsed(), "t", 1.0, UpAxis::Z).unwrap();
+        let (mesh, warnings, _) = finish(parsed(), "t", 1.0, UpAxis::Z).unwrap();
         assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]]);
         assert_eq!(warnings.len(), 1);
         assert!(
@@ -1181,7 +1203,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             warnings: vec![],
         };
-        let (mesh, _) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
+        let (mesh, ..) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
         assert_eq!(mesh.vertices[2], DVec3::new(0.0, 0.0, 2.0));
     }
 

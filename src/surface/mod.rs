@@ -46,6 +46,25 @@ impl Indexed {
         Ok(Indexed::with_bounds(mesh, bbox, kind))
     }
 
+    /// [`Self::build`] for an imported mesh whose used vertices' bounds
+    /// the importer found (`mesh::Unwelded::used_bounds`; the importer
+    /// checks what [`Surface::check`] checks but the triangle count, which
+    /// is checked here): the check's pass is not made again.
+    pub(crate) fn build_imported(
+        mesh: &TriMesh,
+        bounds: Option<(DVec3, DVec3)>,
+        kind: SpatialIndex,
+    ) -> Result<Indexed> {
+        match bounds {
+            Some(bbox)
+                if !mesh.triangles.is_empty() && mesh.triangles.len() <= MAX_TOPOLOGY_TRIANGLES =>
+            {
+                Ok(Indexed::with_bounds(mesh, bbox, kind))
+            }
+            _ => Indexed::build(mesh, kind),
+        }
+    }
+
     /// The index of a checked mesh whose bounds are `bbox`.
     fn with_bounds(mesh: &TriMesh, bbox: (DVec3, DVec3), kind: SpatialIndex) -> Indexed {
         Indexed {
@@ -667,6 +686,40 @@ pub(crate) mod tests {
     #[test]
     fn empty_mesh_is_an_error() {
         assert!(Surface::new(TriMesh::default()).is_err());
+    }
+
+    /// The bounds the importer finds while reading (and the surface's
+    /// check is then not run for) are the check's: in other units, +Y up,
+    /// with a far vertex no triangle uses, and a cloud's mesh has none.
+    #[test]
+    fn the_importers_bounds_are_the_checks() {
+        use crate::mesh::{import_mesh_unwelded, ExternalFiles, ImportOptions, ScanUnits, UpAxis};
+        let obj = "v 0 0 0\nv 1.5 0 0.25\nv 0 1 2\nv 1 1 -3\nv 500 -500 500\nf 1 2 3\nf 2 4 3\n";
+        for (units, up_axis) in [
+            (None, None),
+            (Some(ScanUnits::Cm), Some(UpAxis::Y)),
+            (Some(ScanUnits::In), Some(UpAxis::Z)),
+        ] {
+            let options = ImportOptions {
+                units,
+                up_axis,
+                ..ImportOptions::DEFAULT
+            };
+            let u = import_mesh_unwelded(obj.as_bytes(), "a.obj", &options, &ExternalFiles::new())
+                .unwrap();
+            let checked = Surface::check(&u.imported().mesh).unwrap();
+            assert_eq!(u.used_bounds(), Some(checked), "{units:?} {up_axis:?}");
+            assert!(checked.1.max_element() < 100.0);
+        }
+        let xyz = "0 0 0\n1 0 0\n0 1 0\n1 1 0.5\n";
+        let u = import_mesh_unwelded(
+            xyz.as_bytes(),
+            "c.xyz",
+            &ImportOptions::DEFAULT,
+            &ExternalFiles::new(),
+        )
+        .unwrap();
+        assert_eq!(u.used_bounds(), None);
     }
 
     #[test]
