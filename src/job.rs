@@ -17,7 +17,7 @@ use crate::gcode::format::fixed;
 use crate::gcode::{write_program, GcodeError, GcodeJob, MachineProfile};
 use crate::mesh::{
     CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology,
-    TriMesh, UnitsDoubt,
+    TriMesh, UnitsDoubt, UpAxis,
 };
 use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
@@ -344,6 +344,12 @@ impl InputFile {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeshReport {
+    /// How the scan file was read: its units and up axis (reports written
+    /// before these were kept read as mm, +Z up).
+    #[serde(default = "default_units")]
+    pub units: ScanUnits,
+    #[serde(default = "default_up_axis")]
+    pub up_axis: UpAxis,
     pub triangles: usize,
     /// [[minx, miny, minz], [maxx, maxy, maxz]], printer frame.
     pub bbox_mm: [[f64; 3]; 2],
@@ -351,6 +357,14 @@ pub struct MeshReport {
     /// spacing and the edge-length limit used.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub point_cloud: Option<CloudInfo>,
+}
+
+fn default_units() -> ScanUnits {
+    ScanUnits::Mm
+}
+
+fn default_up_axis() -> UpAxis {
+    UpAxis::Z
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -476,6 +490,8 @@ pub struct PreparedScan {
     pub file: InputFile,
     pub format: MeshFormat,
     pub units: ScanUnits,
+    /// The axis of the file that was read as up.
+    pub up_axis: UpAxis,
     /// What the importer noticed (degenerate triangles skipped, ...).
     pub warnings: Vec<String>,
     /// For a point cloud, how it was meshed.
@@ -675,6 +691,7 @@ impl PreparedScan {
             mesh,
             format,
             units,
+            up_axis,
             warnings,
             cloud,
             units_doubt,
@@ -684,6 +701,7 @@ impl PreparedScan {
             file,
             format,
             units,
+            up_axis,
             warnings,
             cloud,
             units_doubt,
@@ -718,6 +736,8 @@ pub fn report(
         version: env!("CARGO_PKG_VERSION").into(),
         inputs: vec![scan.file.clone(), path_file.clone()],
         mesh: MeshReport {
+            units: scan.units,
+            up_axis: scan.up_axis,
             triangles: scan.triangle_count(),
             bbox_mm: [arr(&lo), arr(&hi)],
             point_cloud: scan.cloud,
@@ -788,6 +808,9 @@ pub fn exact(v: f64) -> String {
 }
 
 /// The provenance header of the G-code (spec section 9).
+/// The header key of how the scan file was read ([`provenance`]).
+const SCAN_READ_KEY: &str = "scan read in";
+
 pub fn provenance(report: &Report) -> Vec<(String, String)> {
     let s = &report.settings;
     let mut h: Vec<(String, String)> = Vec::new();
@@ -801,6 +824,14 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             h.push((
                 format!("{k} external file"),
                 format!("{} ({} bytes, sha256 {})", e.name, e.bytes, e.sha256),
+            ));
+        }
+        // How the scan was read: `check` reads it back (the same file read
+        // in other units is another part, QA).
+        if *k == "scan" {
+            h.push((
+                SCAN_READ_KEY.into(),
+                format!("{}, {} up", report.mesh.units, report.mesh.up_axis),
             ));
         }
     }
@@ -1488,6 +1519,29 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
                     &h[..h.len().min(12)],
                     scan.file.name,
                     &scan.file.sha256[..scan.file.sha256.len().min(12)]
+                ));
+            }
+        } else if let Some(v) = line
+            .strip_prefix(SCAN_READ_KEY)
+            .and_then(|v| v.strip_prefix(": "))
+        {
+            let ours = format!("{}, {} up", scan.units, scan.up_axis);
+            let (units, up) = v.split_once(", ").unwrap_or((v, ""));
+            let up = up.trim_end_matches(" up");
+            if v != ours {
+                let flags: Vec<String> = [
+                    (units != scan.units.to_string()).then(|| format!("--scan-units {units}")),
+                    (up != scan.up_axis.to_string()).then(|| {
+                        format!("--up-axis {}", up.trim_start_matches('+').to_lowercase())
+                    }),
+                ]
+                .into_iter()
+                .flatten()
+                .collect();
+                notes.push(format!(
+                    "the program was planned with the scan read in {v}, this check reads it in \
+                     {ours}: read it as it was then ({})",
+                    flags.join(" ")
                 ));
             }
         } else if let Some(v) = line.strip_prefix("registration: ") {

@@ -260,7 +260,8 @@ pub enum RegistrationError {
          scanner did not see; fiducials that lie in a plane (three always do), with the printer \
          points listed the other way round, fit a half turn as well as the right order \
          (residuals near 0): list the printer points in the same order as the scan's fiducials, or check the scan's \
-         up axis (--up-axis); no G-code written"
+         up axis (--up-axis; a depth camera's frame, z the distance from the camera, is -z); \
+         no G-code written"
     )]
     UpsideDown { tilt_deg: f64, rms_mm: f64 },
 }

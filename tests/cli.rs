@@ -2355,3 +2355,120 @@ fn check_names_moves_that_leave_the_build_volume() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(!stderr(&o).contains("build volume"), "{}", stderr(&o));
 }
+
+/// The stepped block's files in `dir`, its mesh turned by `turn` and scaled
+/// by `per_mm` (file units per mm) as OBJ, with its drawing: (scan, svg,
+/// the --place value).
+fn block_files(
+    dir: &Path,
+    name: &str,
+    per_mm: f64,
+    turn: fn(glam::DVec3) -> glam::DVec3,
+) -> (PathBuf, PathBuf, String) {
+    let part = pcpp::demo::parts::DemoPart::SteppedBlock;
+    let mut mesh = part.mesh();
+    for v in &mut mesh.vertices {
+        *v = turn(*v) * per_mm;
+    }
+    let scan = dir.join(name);
+    std::fs::write(&scan, pcpp::demo::workloads::to_obj(&mesh)).unwrap();
+    let svg = dir.join("block.svg");
+    std::fs::write(&svg, part.svg()).unwrap();
+    let p = part.placement();
+    let place = format!(
+        "{},{},{},{}",
+        p.offset_mm.x, p.offset_mm.y, p.rotation_deg, p.scale
+    );
+    (scan, svg, place)
+}
+
+/// Found by QA: a program planned with the scan read in metres, checked
+/// with the scan read in its default mm, failed with "none of the moves
+/// passes over the scan ... place or register the scan", sending the user
+/// to the registration; the header did not say how the scan was read and
+/// `check` did not print the scan's units warning.
+#[test]
+fn check_names_the_units_the_program_was_planned_with() {
+    let dir = temp_dir("check-units");
+    let (scan, svg, place) = block_files(&dir, "block-m.obj", 1e-3, |v| v);
+    let gcode = dir.join("block.gcode");
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--scan-units", "m", "--place", &place, "-o", s(&gcode)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    assert!(
+        text.contains("\n; scan read in: m, +Z up\n"),
+        "{}",
+        &text[..600]
+    );
+    let o = pcpp(&["check", "--scan", s(&scan), "--gcode", s(&gcode)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(
+            "the program was planned with the scan read in m, +Z up, this check reads it in mm, \
+             +Z up: read it as it was then (--scan-units m)"
+        ),
+        "{err}"
+    );
+    assert!(err.contains("read in mm: check its units"), "{err}");
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&scan),
+        "--gcode",
+        s(&gcode),
+        "--scan-units",
+        "m",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Found by QA: a depth camera's scan (z the distance from the camera, so
+/// the part's top has the smallest z) could only be read as +Z or +Y up:
+/// its dome was planned as a crater. `--up-axis -z` reads it upright: the
+/// same program as the part saved +Z up, but for the header's lines on the
+/// scan; read as +Z up, it gets a note naming -z.
+#[test]
+fn up_axis_minus_z_reads_a_depth_cameras_scan_upright() {
+    let dir = temp_dir("up-minus-z");
+    let (upright, svg, place) = block_files(&dir, "block.obj", 1.0, |v| v);
+    let (camera, ..) = block_files(&dir, "block-camera.obj", 1.0, |v| {
+        glam::DVec3::new(v.x, -v.y, -v.z)
+    });
+    let plan = |scan: &Path, flags: &[&str], out: &str| {
+        let gcode = dir.join(out);
+        let mut args = vec!["--place", place.as_str(), "-o", s(&gcode)];
+        args.extend(flags);
+        let o = plan_on(scan, &svg, &args);
+        (o, gcode)
+    };
+    let (o, a) = plan(&upright, &[], "a.gcode");
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let (o, b) = plan(&camera, &["--up-axis", "-z"], "b.gcode");
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let body = |p: &Path| -> Vec<String> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with("; scan "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(body(&a), body(&b));
+    assert!(std::fs::read_to_string(&b)
+        .unwrap()
+        .contains("\n; scan read in: mm, -Z up\n"));
+    // Read +Z up, the note.
+    let o = pcpp(&["fiducials", "--scan", s(&camera)]);
+    assert!(
+        stderr(&o).contains("it was likely saved with -Z up; if it is shown upside down, read it -Z up (--up-axis -z)"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -592,6 +592,8 @@ fn to_printer_frame(vertices: &mut [DVec3], scale: f64, up_axis: UpAxis) {
             UpAxis::Z => p,
             // +90 deg about X takes the file's +Y to the printer's +Z.
             UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+            // Half a turn about X takes the file's -Z to the printer's +Z.
+            UpAxis::NegZ => DVec3::new(p.x, -p.y, -p.z),
         };
     }
 }

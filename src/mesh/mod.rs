@@ -188,6 +188,12 @@ pub enum UpAxis {
     Z,
     /// +Y up (glTF's convention): turned +90 deg about X, (x, y, z) -> (x, -z, y).
     Y,
+    /// -Z up: a depth camera's or a scanner's own frame, z the distance
+    /// from the camera looking down, so the part's top has the smallest z
+    /// (RealSense, Kinect, many structured-light scanners). Turned half a
+    /// turn about X, (x, y, z) -> (x, -y, -z).
+    #[serde(rename = "-z")]
+    NegZ,
 }
 
 impl FromStr for UpAxis {
@@ -196,8 +202,19 @@ impl FromStr for UpAxis {
         match s.trim().to_ascii_lowercase().as_str() {
             "z" | "+z" => Ok(UpAxis::Z),
             "y" | "+y" => Ok(UpAxis::Y),
-            other => Err(format!("unknown up axis '{other}' (expected z or y)")),
+            "-z" => Ok(UpAxis::NegZ),
+            other => Err(format!("unknown up axis '{other}' (expected z, y or -z)")),
         }
+    }
+}
+
+impl fmt::Display for UpAxis {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            UpAxis::Z => "+Z",
+            UpAxis::Y => "+Y",
+            UpAxis::NegZ => "-Z",
+        })
     }
 }
 

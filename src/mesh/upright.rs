@@ -10,8 +10,10 @@
 //! scanned standing on: the side whose outermost points spread widest
 //! (the bunny's base, the cow's four hooves; a film's lowest points, spread
 //! over its whole footprint). When, as read, that is clearly the -Y side
-//! (+Y when read +Y up: then +Z was up), the scan gets a note naming the
-//! up axis to try. It is only a note: the reading stays the one asked for.
+//! (+Y when read +Y up: then +Z was up), or its top, +Z (a depth camera's
+//! frame, z the distance from the camera: -Z was up), the scan gets a note
+//! naming the up axis to try. It is only a note: the reading stays the one
+//! asked for.
 
 use glam::{DVec2, DVec3};
 
@@ -41,28 +43,33 @@ pub(crate) fn note(vertices: &[DVec3], up: UpAxis, file: &str) -> Option<String>
     let stride = vertices.len().div_ceil(SAMPLES).max(1);
     let sample: Vec<DVec3> = vertices.iter().step_by(stride).copied().collect();
     let spread = side_spreads(&sample)?;
-    // [-X, +X, -Y, +Y, -Z, +Z]: read +Z up, a +Y-up scan rests on -Y; read
-    // +Y up, a +Z-up one rests on +Y (its -Z turned to +Y).
-    let (side, name, other, flag) = match up {
-        UpAxis::Z => (2, "-Y", "+Y", "y"),
-        UpAxis::Y => (3, "+Y", "+Z", "z"),
-    };
-    let rest = spread[side];
+    // [-X, +X, -Y, +Y, -Z, +Z], the side it rests on: the widest, by the
+    // margin.
+    let side = (0..6).max_by(|&a, &b| spread[a].total_cmp(&spread[b]))?;
     let next = (0..6)
         .filter(|&i| i != side)
         .map(|i| spread[i])
         .fold(0.0, f64::max);
-    if rest < LEAST || rest < MARGIN * next {
+    if spread[side] < LEAST || spread[side] < MARGIN * next {
         return None;
     }
+    // Read +Z up, a +Y-up scan rests on -Y and a depth camera's (-Z up) on
+    // +Z; read +Y up, a +Z-up one rests on +Y (its -Z turned to +Y).
+    let (name, other, flag, shown) = match (up, side) {
+        (UpAxis::Z, 2) => ("-Y", "+Y", "y", "lying on its side"),
+        (UpAxis::Z, 5) => ("+Z", "-Z", "-z", "upside down"),
+        (UpAxis::Y, 3) => ("+Y", "+Z", "z", "lying on its side"),
+        _ => return None,
+    };
     let read = match up {
         UpAxis::Z => "+Z up",
         UpAxis::Y => "+Y up (glTF's convention)",
+        UpAxis::NegZ => "-Z up",
     };
     Some(format!(
         "{file}: read {read}, it rests on its {name} side (its outermost points spread far \
          wider there than on any other side): it was likely saved with {other} up; if it is \
-         shown lying on its side, read it {other} up (--up-axis {flag})"
+         shown {shown}, read it {other} up (--up-axis {flag})"
     ))
 }
 
@@ -180,6 +187,15 @@ mod tests {
             super::note(&stand(|p| p).vertices, UpAxis::Z, "cow.stl"),
             None
         );
+    }
+
+    #[test]
+    fn a_depth_cameras_scan_read_z_up_gets_the_minus_z_note() {
+        // z the distance from a camera above: (x, y, z) -> (x, -y, -z).
+        let camera = stand(|p| DVec3::new(p.x, -p.y, 400.0 - p.z));
+        let note = note(&camera.vertices, UpAxis::Z, "depth.ply").expect("a note");
+        assert!(note.contains("rests on its +Z side"), "{note}");
+        assert!(note.ends_with("read it -Z up (--up-axis -z)"), "{note}");
     }
 
     #[test]

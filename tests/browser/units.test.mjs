@@ -291,14 +291,14 @@ test('switching the units away and back brings back the typed placement', async 
 // on its side with nothing said (QA: the Stanford bunny, a cow). An animal
 // on four legs, saved +Y up: the page names the up axis to try, and the
 // note goes once it is read +Y up.
-function animalYUp() {
+function animalYUp(save = ([x, y, z]) => [x, z, -y]) {
   // Standing on -Z: a rounded body over four thin legs 40 x 20 mm apart.
   const pts = [[20, 10, 10], [20, 10, 25], [2, 10, 17.5], [38, 10, 17.5], [20, 2, 17.5], [20, 18, 17.5]];
   for (const [x, y] of [[0, 0], [39, 0], [0, 19], [39, 19]]) {
     for (const [dx, dy] of [[0, 0], [1, 0], [0, 1], [1, 1]]) pts.push([x + dx, y + dy, 0]);
   }
   // Saved +Y up: the file's (x, y, z) is the standing animal's (x, z, -y).
-  const lines = pts.map(([x, y, z]) => `v ${x} ${z} ${-y}`);
+  const lines = pts.map((p) => `v ${save(p).join(' ')}`);
   // The body's faces and each leg's two triangles down to the body's bottom.
   lines.push('f 1 3 5', 'f 1 5 4', 'f 1 4 6', 'f 1 6 3', 'f 2 5 3', 'f 2 4 5', 'f 2 6 4', 'f 2 3 6');
   for (let k = 0; k < 4; k++) {
@@ -323,6 +323,31 @@ test('a scan saved +Y up gets a note naming the up axis, gone once read +Y up', 
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.bbox_mm[1][2] > 20, null, { timeout: 120_000 });
   await waitIdle(page);
   assert.deepEqual(await notes(), []);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A depth camera's scan (z the distance from the camera) is read upside
+// down as +Z up: the page names -Z, which reads it upright.
+test('a depth camera scan gets a note naming -Z, gone once read -Z up', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const camera = animalYUp(([x, y, z]) => [x, -y, 400 - z]);
+  await page.setInputFiles('#scan-input', { name: 'camera.obj', mimeType: 'text/plain', buffer: Buffer.from(camera) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'camera.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const notes = () => page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent).filter((t) => /rests on its/.test(t)));
+  const got = await notes();
+  assert.equal(got.length, 1, JSON.stringify(got));
+  assert.match(got[0], /rests on its \+Z side .* if it is shown upside down, read it -Z up \(Up axis: -Z\)$/);
+  await page.selectOption('#scan-up', '-z');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.bbox_mm[1][2] < 0, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.deepEqual(await notes(), []);
+  // Read -Z up, the legs stand on the bed side: the body's top is highest.
+  const b = await page.evaluate(() => window.pcpp.state.info.bbox_mm);
+  assert.ok(Math.abs(b[1][2] - b[0][2] - 25) < 1e-9, JSON.stringify(b));
   assert.deepEqual(problems, []);
   await context.close();
 });

@@ -1,5 +1,6 @@
 ; pcpp 0.1.0
 ; scan file: demo-test-part.ply (6216475 bytes, sha256 dbe6d31e6e7355c626569e0fda9478dc16efd20a5bd223653c02c720dee787d9)
+; scan read in: mm, +Z up
 ; path file: demo-test-part-lines.svg (659 bytes, sha256 59d5ff20ad48e19174edc3fc622ec0b592f1ab01fd86bf289a383636e8344544)
 ; nozzle: d 0.603 mm, do 0.908 mm
 ; process: tol 0.1 mm, speed 5 mm/s, dwell 0 s

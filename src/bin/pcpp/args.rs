@@ -357,7 +357,12 @@ pub struct ScanArgs {
     pub scan_units: Option<ScanUnits>,
 
     /// The scan's up axis [default: the format's: z; glTF y]
-    #[arg(long, value_name = "A", value_parser = Named::<UpAxis>::new(axis_values))]
+    #[arg(
+        long,
+        value_name = "A",
+        value_parser = Named::<UpAxis>::new(axis_values),
+        allow_hyphen_values = true
+    )]
     pub up_axis: Option<UpAxis>,
 
     /// Point clouds: the longest edge (in XY) of a triangle of the meshed
@@ -530,7 +535,11 @@ fn unit_values() -> Vec<PossibleValue> {
 }
 
 fn axis_values() -> Vec<PossibleValue> {
-    ["z", "y"].map(PossibleValue::new).into()
+    vec![
+        PossibleValue::new("z"),
+        PossibleValue::new("y").help("glTF's convention, Blender's OBJ and STL"),
+        PossibleValue::new("-z").help("a depth camera's frame: z the distance from the camera"),
+    ]
 }
 
 fn registration_values() -> Vec<PossibleValue> {

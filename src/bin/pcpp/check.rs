@@ -33,14 +33,23 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
-    let mut check = job::check_gcode(
+    let checked = job::check_gcode(
         &prepared,
         &text,
         &name,
         &settings.plan.nozzle,
         settings.plan.process.tolerance_mm,
-    )
-    .map_err(|e| Failure::Input(in_file(gcode_path, &name, &e.to_string())))?;
+    );
+    let mut check = match checked {
+        Ok(check) => check,
+        Err(e) => {
+            // What the import noticed may be why (the scan read in other
+            // units than the program was planned with: QA).
+            progress.finish();
+            progress.warn(&prepared.warnings);
+            return Err(Failure::Input(in_file(gcode_path, &name, &e.to_string())));
+        }
+    };
     check.notes.splice(0..0, encoding);
     check.notes.extend(check.outside_volume(&profile));
     if let Some(r) = &a.report {
