@@ -116,6 +116,7 @@ pub(super) fn parse(
         triangles: Vec::new(),
         warnings: Vec::new(),
         skipped_primitives: 0,
+        points: Vec::new(),
     };
     match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(root) => {
@@ -151,11 +152,25 @@ pub(super) fn parse(
             }
         }
     }
+    // A glTF of points alone (photogrammetry and lidar tools export point
+    // clouds as POINTS primitives) is a point cloud, as a PLY or OBJ of
+    // vertices alone is: its points are read and the importer meshes them
+    // (QA: it was refused as "the mesh has no triangles"). Beside
+    // triangles, points describe no surface and are skipped.
+    let as_cloud = scene.triangles.is_empty() && !scene.points.is_empty();
+    if as_cloud {
+        for (index, world, at) in std::mem::take(&mut scene.points) {
+            if let Some(accessor) = gltf.accessors().nth(index) {
+                scene.positions(&accessor, &world, &at)?;
+            }
+        }
+    }
     let mut warnings = scene.warnings;
-    if scene.skipped_primitives > 0 {
+    let skipped = scene.skipped_primitives + scene.points.len();
+    if skipped > 0 {
         warnings.push(format!(
-            "{file}: skipped {} primitive(s) of points or lines (only triangles describe a surface)",
-            scene.skipped_primitives
+            "{file}: skipped {skipped} primitive(s) of points or lines (only triangles describe a \
+             surface)"
         ));
     }
     let parsed = Parsed {
@@ -625,6 +640,10 @@ struct SceneReader<'f, 'b> {
     triangles: Vec<[u32; 3]>,
     warnings: Vec<String>,
     skipped_primitives: usize,
+    /// The POINTS primitives met (their POSITION accessor, where they are
+    /// drawn, and how to name them): read as a point cloud when the scene
+    /// has no triangles.
+    points: Vec<(usize, DMat4, String)>,
 }
 
 impl SceneReader<'_, '_> {
@@ -713,6 +732,13 @@ impl SceneReader<'_, '_> {
         for primitive in mesh.primitives() {
             let at = format!("mesh {} primitive {}", mesh.index(), primitive.index());
             let mode = primitive.mode();
+            let draco = self.draco.contains_key(&(mesh.index(), primitive.index()));
+            if mode == Mode::Points && !draco {
+                if let Some(accessor) = primitive.get(&Semantic::Positions) {
+                    self.points.push((accessor.index(), *world, at));
+                    continue;
+                }
+            }
             if !matches!(
                 mode,
                 Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
@@ -1014,6 +1040,72 @@ mod tests {
         let p = parse(triangle_gltf("", &triangle_uri()).as_bytes(), "t.gltf").unwrap();
         assert_eq!(p.vertices.len(), 3);
         assert_eq!(p.triangles, vec![[0, 1, 2]]);
+    }
+
+    /// A glTF of `n` x `n` points on a dome (metres, +Y up), as a POINTS
+    /// primitive, and, with `triangle`, a triangle primitive beside it.
+    fn points_gltf(n: usize, triangle: bool) -> String {
+        let mut f = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (x, z) = (i as f32 * 0.002, j as f32 * 0.002);
+                let y = 0.005 - 0.3 * ((x - 0.02).powi(2) + (z - 0.02).powi(2));
+                f.extend([x, y, z]);
+            }
+        }
+        let bytes: Vec<u8> = f.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            STANDARD.encode(&bytes)
+        );
+        let prims = if triangle {
+            r#"{"attributes":{"POSITION":0},"mode":0},{"attributes":{"POSITION":0},"indices":1}"#
+        } else {
+            r#"{"attributes":{"POSITION":0},"mode":0}"#
+        };
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{prims}]}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3"}},
+                {{"bufferView":1,"componentType":5121,"count":3,"type":"SCALAR"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":{len}}},{{"buffer":1,"byteLength":3}}],
+            "buffers":[{{"byteLength":{len},"uri":"{uri}"}},
+                {{"byteLength":3,"uri":"data:application/octet-stream;base64,AAEC"}}]}}"#,
+            count = n * n,
+            len = bytes.len()
+        )
+    }
+
+    /// Found by QA: a glTF of points alone was refused as "the mesh has no
+    /// triangles"; it is a point cloud, meshed as a PLY of vertices is.
+    /// Beside triangles, points are skipped with a warning.
+    #[test]
+    fn a_gltf_of_points_alone_is_a_point_cloud() {
+        let json = points_gltf(21, false);
+        let p = parse(json.as_bytes(), "cloud.gltf").unwrap();
+        assert_eq!((p.vertices.len(), p.triangles.len()), (441, 0));
+        let m = crate::mesh::import_mesh(
+            json.as_bytes(),
+            "cloud.gltf",
+            &crate::mesh::ImportOptions::DEFAULT,
+        )
+        .unwrap();
+        let cloud = m.cloud.expect("read as a point cloud");
+        assert_eq!(cloud.points, 441);
+        assert!(m.mesh.triangle_count() > 700, "{}", m.mesh.triangle_count());
+        // Metres, +Y up: 40 mm across, the dome's top up.
+        let (lo, hi) = m.mesh.bbox().unwrap();
+        assert!(((hi - lo).x - 40.0).abs() < 1e-3, "{lo} {hi}");
+        assert!(hi.z > 4.9 && hi.z < 5.1, "{hi}");
+        let both = parse(points_gltf(5, true).as_bytes(), "both.gltf").unwrap();
+        assert_eq!(both.triangles.len(), 1);
+        assert!(
+            both.warnings
+                .iter()
+                .any(|w| w.contains("skipped 1 primitive(s) of points or lines")),
+            "{:?}",
+            both.warnings
+        );
     }
 
     #[test]

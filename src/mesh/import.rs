@@ -262,10 +262,11 @@ fn finish_import(
     let units = options.units.unwrap_or(format.default_units());
     let up_axis = options.up_axis.unwrap_or(format.default_up_axis());
     // A PLY or OBJ with vertices and no faces is a point cloud too
-    // (Meshlab and CloudCompare write clouds as OBJ `v` lines).
+    // (Meshlab and CloudCompare write clouds as OBJ `v` lines), and so is
+    // a glTF of POINTS primitives alone.
     let cloud = match format {
         MeshFormat::Xyz | MeshFormat::Pcd => true,
-        MeshFormat::Ply | MeshFormat::Obj => {
+        MeshFormat::Ply | MeshFormat::Obj | MeshFormat::Gltf | MeshFormat::Glb => {
             parsed.triangles.is_empty() && !parsed.vertices.is_empty()
         }
         _ => false,
