@@ -816,10 +816,41 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             *p *= prepared.px_scale;
         }
     }
+    notes.extend(off_page(&out, &tree, prepared.has_page, prepared.px_scale));
     Ok(SvgImport {
         subpaths: out,
         notes,
     })
+}
+
+/// A note on the shapes that lie partly or wholly off the page (found by
+/// QA: scraps kept beside an Inkscape page were printed with nothing said):
+/// a viewer shows only the page, and what lies beyond it is printed as
+/// drawn. The page is the root's size (its viewBox or width and height; a
+/// document with neither has none), in mm with y up: x 0..w, y -h..0.
+fn off_page(out: &[Subpath2], tree: &usvg::Tree, has_page: bool, px_scale: f64) -> Option<String> {
+    if !has_page {
+        return None;
+    }
+    let size = tree.size();
+    let w = f64::from(size.width()) * MM_PER_PX * px_scale;
+    let h = f64::from(size.height()) * MM_PER_PX * px_scale;
+    // usvg keeps the size in f32, and a stroke along the page's edge is on it.
+    let slack = 1e-5 * (w + h) + 1e-6;
+    let off = |p: &DVec2| p.x < -slack || p.x > w + slack || p.y > slack || p.y < -h - slack;
+    let mut shapes: Vec<&str> = out
+        .iter()
+        .filter(|s| s.points.iter().any(off))
+        .map(|s| s.source.as_str())
+        .collect();
+    shapes.dedup();
+    let first = shapes.first()?;
+    Some(format!(
+        "{} shape(s) lie partly or wholly off the page ({w:.1} x {h:.1} mm), where a viewer \
+         does not show them (the first: '{first}'): they are printed as drawn; move them onto the \
+         page, or delete them if they are scraps",
+        shapes.len()
+    ))
 }
 
 // ---------------------------------------------------------------------------
@@ -887,6 +918,9 @@ struct Prepared {
     /// The root's size, from [`RootSize`].
     empty_viewbox: Option<String>,
     has_viewbox: bool,
+    /// The root has a page: a viewBox, or a width and height that are
+    /// lengths (not percentages).
+    has_page: bool,
     percent_size: Vec<String>,
     /// [`RootSize::px_scale`].
     px_scale: f64,
@@ -1976,6 +2010,12 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         root_probe,
         empty_viewbox: root_size.empty_viewbox,
         has_viewbox: root_size.has_viewbox,
+        has_page: root_size.has_viewbox
+            || ["width", "height"].iter().all(|name| {
+                root.attribute(*name)
+                    .and_then(root_length)
+                    .is_some_and(|l| l.unit != svgtypes::LengthUnit::Percent)
+            }),
         percent_size: root_size.percent,
         px_scale: root_size.px_scale,
     })
