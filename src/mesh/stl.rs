@@ -59,8 +59,22 @@ fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             ),
         )
     })?;
-    let needed = binary_size(n);
     let mut warnings = Vec::new();
+    // A writer that streams facets and never goes back to fill in the
+    // count leaves 0 there (QA: a file of 1800 facets was "the mesh has no
+    // triangles"): whole facets after it are read, with a note.
+    let body = bytes.len().saturating_sub(PREAMBLE);
+    let n = if n == 0 && body >= FACET && body.is_multiple_of(FACET) {
+        let found = u32::try_from(body / FACET).unwrap_or(u32::MAX);
+        warnings.push(format!(
+            "{file}: the binary STL header declares 0 triangles, but {found} whole facets \
+             ({body} bytes) follow it (a writer that never filled in the count): read them"
+        ));
+        found
+    } else {
+        n
+    };
+    let needed = binary_size(n);
     if (bytes.len() as u64) < needed {
         return Err(MeshError::invalid(
             file,
@@ -299,6 +313,34 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("expected 'loop', found 'lop'"), "{e}");
+    }
+
+    /// Two facets after a header whose count was left at 0 (found by QA: a
+    /// streaming writer's file was "the mesh has no triangles"); a body
+    /// that is not whole facets is not guessed at.
+    #[test]
+    fn a_binary_count_left_at_zero_reads_the_whole_facets_after_it() {
+        let mut b = vec![0u8; 84];
+        for tri in [
+            [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        ] {
+            b.extend([0u8; 12]);
+            for c in tri {
+                b.extend(c.iter().flat_map(|v| v.to_le_bytes()));
+            }
+            b.extend([0u8; 2]);
+        }
+        let p = parse(&b, "s.stl").unwrap();
+        assert_eq!(p.triangles.len(), 2);
+        assert_eq!(p.vertices.len(), 4);
+        assert!(
+            p.warnings[0].contains("declares 0 triangles, but 2 whole facets (100 bytes) follow"),
+            "{:?}",
+            p.warnings
+        );
+        b.push(0);
+        assert!(parse(&b, "s.stl").unwrap().triangles.is_empty());
     }
 
     #[test]
