@@ -174,11 +174,32 @@ pub fn import_mesh_unwelded(
              to the file; download the file itself (on GitHub, its \"raw\" or download link)",
         ));
     }
+    if is_svg(bytes) {
+        // The drawing given as the scan (QA: an SVG named .ply was "line 1:
+        // not a PLY file").
+        return Err(MeshError::invalid(
+            file,
+            "the file is an SVG drawing, not a scan: open it as the drawing (the command \
+             line's --path), and the scan (a mesh or point cloud) as the scan",
+        ));
+    }
     let format =
         detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
     let (parsed, external_files) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
     finish_import(parsed, format, file, options, external_files)
+}
+
+/// Whether the bytes are an SVG document: `<svg` first, or an XML
+/// declaration, comments or a doctype and then an `svg` element within
+/// the first 4 KiB.
+fn is_svg(bytes: &[u8]) -> bool {
+    let head = skip_bom_and_space(bytes);
+    let head = &head[..head.len().min(4096)];
+    if head.starts_with(b"<svg") {
+        return true;
+    }
+    head.starts_with(b"<?xml") && head.windows(5).any(|w| w == b"<svg " || w == b"<svg\n")
 }
 
 /// Whether the bytes are an HTML page: `<!DOCTYPE html` or `<html` first,
@@ -1013,6 +1034,26 @@ mod tests {
     fn extension_wins_over_content() {
         assert_eq!(detect_format(b"solid x", "a.OBJ"), Some(MeshFormat::Obj));
         assert_eq!(detect_format(b"", "scan.glb"), Some(MeshFormat::Glb));
+    }
+
+    #[test]
+    fn an_svg_given_as_the_scan_is_named() {
+        for (name, text) in [
+            (
+                "spiral.ply",
+                "<?xml version=\"1.0\"?>\n<!-- x -->\n<svg xmlns=\"http://www.w3.org/2000/svg\"/>",
+            ),
+            (
+                "spiral.obj",
+                "\u{feff}  <svg xmlns=\"http://www.w3.org/2000/svg\"></svg>",
+            ),
+            ("spiral", "<svg\nwidth=\"1mm\"/>"),
+        ] {
+            let e = import_mesh(text.as_bytes(), name, &ImportOptions::DEFAULT)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("is an SVG drawing, not a scan"), "{name}: {e}");
+        }
     }
 
     #[test]
