@@ -663,6 +663,34 @@ fn usage_errors_exit_2_and_name_the_flag() {
         ),
         (&["demo", "--dialect", "fanuc"], "--dialect"),
         (&["demo", "extra"], "extra"),
+        // A value out of range names its own flag, not its group's (QA:
+        // "--tol/--speed/--dwell: invalid parameter tolerance (mm) = 0").
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--tol", "0",
+            ],
+            "error: --tol: invalid parameter tolerance (mm) = 0",
+        ),
+        (
+            &[
+                "plan", "--scan", scan, "--path", svg, "-o", "x.gcode", "--dwell", "700",
+            ],
+            "error: --dwell: invalid parameter dwell (s) = 700",
+        ),
+        (
+            &[
+                "plan",
+                "--scan",
+                scan,
+                "--path",
+                svg,
+                "-o",
+                "x.gcode",
+                "--nozzle-od",
+                "0.5",
+            ],
+            "error: --nozzle-od: invalid parameter nozzle outer diameter (mm) = 0.5",
+        ),
     ];
     for (args, needle) in cases {
         let o = pcpp(args);

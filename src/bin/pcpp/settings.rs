@@ -72,10 +72,32 @@ fn registration(
     r.validate().map_err(|e| {
         usage(
             command,
-            format!("--place-scan/--fiducials/--dot-diameter: {e}"),
+            format!(
+                "{}: {e}",
+                flag_of(&e, "--place-scan/--fiducials/--dot-diameter")
+            ),
         )
     })?;
     Ok(r)
+}
+
+/// The flag that sets the parameter an error names (QA: "--tol/--speed/
+/// --dwell: invalid parameter tolerance (mm) = 0" named three), else
+/// `group`.
+fn flag_of<'a>(e: &pcpp::Error, group: &'a str) -> &'a str {
+    match e {
+        pcpp::Error::Parameter { name, .. } => match *name {
+            "nozzle inner diameter (mm)" => "--nozzle-id",
+            "nozzle outer diameter (mm)" => "--nozzle-od",
+            "tolerance (mm)" => "--tol",
+            "speed (mm/s)" => "--speed",
+            "dwell (s)" => "--dwell",
+            "fiducial dot diameter (mm)" => "--dot-diameter",
+            "scan placement" => "--place-scan",
+            _ => group,
+        },
+        _ => group,
+    }
 }
 
 /// The settings of `check` and the machine profile: scan, registration and
@@ -97,9 +119,12 @@ pub fn check_settings(
     p.process.tolerance_mm = nozzle.tol;
     // Out-of-range values are usage errors too: checked before reading
     // files (a profile file only after them).
-    p.nozzle
-        .validate()
-        .map_err(|e| usage(command, format!("--nozzle-id/--nozzle-od: {e}")))?;
+    p.nozzle.validate().map_err(|e| {
+        usage(
+            command,
+            format!("{}: {e}", flag_of(&e, "--nozzle-id/--nozzle-od")),
+        )
+    })?;
     p.process
         .validate()
         .map_err(|e| usage(command, format!("--tol: {e}")))?;
@@ -120,8 +145,12 @@ pub fn job_settings(
         speed_mm_s: a.process.speed,
         dwell_s: a.process.dwell,
     };
-    p.validate()
-        .map_err(|e| usage(command, format!("--tol/--speed/--dwell: {e}")))?;
+    p.validate().map_err(|e| {
+        usage(
+            command,
+            format!("{}: {e}", flag_of(&e, "--tol/--speed/--dwell")),
+        )
+    })?;
     let (mut s, profile) = check_settings(command, &a.scan, &a.nozzle, &a.registration, machine)?;
     s.plan.process = p;
     s.plan.planner = planner;
