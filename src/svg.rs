@@ -338,12 +338,17 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             let size = tree.size();
             format!(
                 "the page was taken as {:.1} x {:.1} mm, that percentage of the viewBox's size \
-                 read as CSS px (96 per inch)",
-                f64::from(size.width()) * MM_PER_PX,
-                f64::from(size.height()) * MM_PER_PX,
+                 read as {}",
+                f64::from(size.width()) * MM_PER_PX * prepared.px_scale,
+                f64::from(size.height()) * MM_PER_PX * prepared.px_scale,
+                px_words(prepared.px_scale),
             )
         } else {
-            format!("user units were taken as CSS px (1 unit = {MM_PER_PX:.4} mm)")
+            format!(
+                "user units were taken as {} (1 unit = {:.4} mm)",
+                px_words(prepared.px_scale),
+                MM_PER_PX * prepared.px_scale
+            )
         };
         let one = match prepared.percent_size.len() {
             1 => "is a percentage",
@@ -502,7 +507,9 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             continue;
         }
         if let Some(stroke) = path.stroke() {
-            let width_mm = f64::from(stroke.width().get()) * stretch;
+            // In the mm the drawing is printed in (an old Inkscape's px
+            // are scaled after this loop).
+            let width_mm = f64::from(stroke.width().get()) * stretch * prepared.px_scale;
             if width_mm > widest.as_ref().map_or(WIDE_STROKE_MM, |w| w.0) {
                 widest = Some((width_mm, label.clone()));
             }
@@ -821,6 +828,16 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         subpaths: out,
         notes,
     })
+}
+
+/// What px were read as: CSS's 96 per inch, or an old Inkscape's 90
+/// ([`RootSize::px_scale`]).
+fn px_words(px_scale: f64) -> &'static str {
+    if px_scale == 1.0 {
+        "CSS px (96 per inch)"
+    } else {
+        "px at 90 per inch (the Inkscape that wrote it)"
+    }
 }
 
 /// A note on the shapes that lie partly or wholly off the page (found by

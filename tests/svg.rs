@@ -1769,6 +1769,13 @@ fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_is_named() {
     );
     let note = note_with(&notes, "Inkscape 0.48.4");
     assert!(note.contains("90 px per inch"), "{note}");
+    // A note's size in mm is the size printed: a stroke 9 px wide is 2.54 mm
+    // at 90 px per inch (2.38 mm read at 96 was said before).
+    let wide = ink("0.48.4 r9939", a4_px)
+        .replace(r#"stroke="black""#, r#"stroke="black" stroke-width="9""#);
+    let (_, notes) = notes_of(&wide);
+    let note = note_with(&notes, "the widest");
+    assert!(note.contains("is drawn 2.54 mm wide"), "{note}");
     for (version, size) in [
         ("1.3 (0e150ed6c4, 2023-07-21)", a4_px),
         (
