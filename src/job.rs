@@ -1105,13 +1105,6 @@ pub fn write_outputs(
     if let (Some(depth_mm), false) = (below_bed_mm(scan), accept_risk) {
         return Err(Error::BelowBed { depth_mm });
     }
-    if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
-        return Err(Error::FarAbove {
-            height_mm,
-            at: at.to_array(),
-            limit_mm: pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm,
-        });
-    }
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     // Spec 6(f): every move is checked but those that start where nothing
@@ -1232,6 +1225,16 @@ pub fn write_outputs(
             e => Error::Gcode(e),
         }
     })?;
+    // After the writing: a scan outside the build volume is said first
+    // (QA: the page showed "place it on the bed" and "the nozzle would
+    // dispense far above the surface" at once for a scan off the bed).
+    if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
+        return Err(Error::FarAbove {
+            height_mm,
+            at: at.to_array(),
+            limit_mm: pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm,
+        });
+    }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
     if checked.touching_moves > 0 && !accept_risk {
@@ -1957,6 +1960,58 @@ mod tests {
         let json = serde_json::to_string(&a.report).unwrap();
         let back: Report = serde_json::from_str(&json).unwrap();
         assert_eq!(back.inputs, a.report.inputs);
+    }
+
+    /// Found by QA: a scan off the bed with a drawing over a tall post was
+    /// refused for the filament dispensed far above the surface while the
+    /// page also said to place the scan on the bed. The scan outside the
+    /// build volume is said first; on the bed, the post is refused.
+    #[test]
+    fn a_scan_outside_the_volume_is_said_before_the_height_over_a_post() {
+        let axis: Vec<f64> = (0..=80).map(f64::from).collect();
+        let post = |x: f64, y: f64| {
+            if (35.0..=45.0).contains(&x) && (35.0..=45.0).contains(&y) {
+                25.0
+            } else {
+                2.0
+            }
+        };
+        let line = r#"<svg xmlns="http://www.w3.org/2000/svg" width="60mm" height="10mm" viewBox="0 0 60 10"><path d="M 0 5 H 60" stroke="black" fill="none"/></svg>"#;
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let run = |dx: f64| {
+            let mut mesh = crate::mesh::TriMesh::height_field(&axis, &axis, post);
+            for v in &mut mesh.vertices {
+                v.x += dx;
+            }
+            let glb = crate::demo::to_glb(&mesh);
+            let scan = prepare_scan(
+                &glb,
+                "post.glb",
+                &ImportOptions::DEFAULT,
+                &RegistrationSettings::default(),
+            )
+            .unwrap();
+            let settings = PlanSettings {
+                placement: crate::svg::Placement {
+                    offset_mm: glam::DVec2::new(10.0 + dx, 45.0),
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            run_on(
+                &scan,
+                line.as_bytes(),
+                "line.svg",
+                &settings,
+                &profile,
+                false,
+            )
+            .err()
+            .expect("refused")
+        };
+        assert!(matches!(run(0.0), Error::FarAbove { .. }), "{}", run(0.0));
+        let off = run(500.0);
+        assert!(matches!(off, Error::OutsideVolume { .. }), "{off}");
     }
 
     /// A profile whose start block moves the head (homing, then a move
