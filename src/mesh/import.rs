@@ -447,6 +447,7 @@ fn import_cloud(
     } = parsed;
     check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
+    check_finite(&vertices, file)?;
     let upright_note = options
         .up_axis
         .is_none()
@@ -695,6 +696,10 @@ fn finish(
     } = parsed;
     check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, scale, up_axis);
+    // A coordinate finite in the file's units may overflow in mm (1e306 m):
+    // the surface relies on finite vertices, and takes these bounds
+    // without checking them again (review: such a vertex was planned on).
+    check_finite(&vertices, file)?;
     let n = vertices.len();
     // A triangle two of whose corners the weld would merge has those
     // corners at one position, so it has zero area here already: counted

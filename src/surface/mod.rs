@@ -56,8 +56,12 @@ impl Indexed {
         kind: SpatialIndex,
     ) -> Result<Indexed> {
         match bounds {
+            // (Finite bounds only: a non-finite one is the check's to name.)
             Some(bbox)
-                if !mesh.triangles.is_empty() && mesh.triangles.len() <= MAX_TOPOLOGY_TRIANGLES =>
+                if !mesh.triangles.is_empty()
+                    && mesh.triangles.len() <= MAX_TOPOLOGY_TRIANGLES
+                    && bbox.0.is_finite()
+                    && bbox.1.is_finite() =>
             {
                 Ok(Indexed::with_bounds(mesh, bbox, kind))
             }
@@ -711,6 +715,16 @@ pub(crate) mod tests {
             assert_eq!(u.used_bounds(), Some(checked), "{units:?} {up_axis:?}");
             assert!(checked.1.max_element() < 100.0);
         }
+        // A coordinate finite in metres, infinite in mm, is refused.
+        let far = "v 0 0 0\nv 1 0 0\nv 0 1 -1e306\nf 1 2 3\n";
+        let m = ImportOptions {
+            units: Some(ScanUnits::M),
+            ..ImportOptions::DEFAULT
+        };
+        let e = import_mesh_unwelded(far.as_bytes(), "far.obj", &m, &ExternalFiles::new())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("vertex 2 has a non-finite coordinate"), "{e}");
         let xyz = "0 0 0\n1 0 0\n0 1 0\n1 1 0.5\n";
         let u = import_mesh_unwelded(
             xyz.as_bytes(),
