@@ -428,7 +428,7 @@ export function acceptScan(info) {
     settings.scanUp = '';
     saveSettings();
     writeForm();
-    const chosen = [units && `units ${units}`, up && `up axis +${up.toUpperCase()}`].filter(Boolean).join(' and ');
+    const chosen = [units && `units ${units}`, up && `up axis ${up.startsWith('-') ? '' : '+'}${up.toUpperCase()}`].filter(Boolean).join(' and ');
     $('scan-note').textContent = `Read in the file's own units and up axis: ${chosen} were chosen for ${from} `
       + '(Units and Up axis above set them for this file).';
   }

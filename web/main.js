@@ -21,7 +21,8 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  bannerOffers, cancelCentre, centreRequest, initPlacement, onCarried, onCentred, planOutcome, requestCentre, showFitNote,
+  bannerOffers, cancelCentre, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
+  requestCentre, showFitNote,
   showScanPlacement, toolPathOutside, unitsBannerShown,
 } from './placement.js';
 import {
@@ -364,6 +365,7 @@ function onWorkerMessage(e) {
       if (state.pendingScan && state.pendingScan.key === m.key) {
         acceptScan(m.info);
       }
+      if (busy && busy.job && busy.job.scan && !busy.job.scan.units) noteDefaultUnits(m.key, m.info.units);
       dropPlan(busy);
       state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);

@@ -63,7 +63,7 @@ const PAGE_WORDS = [
   [/\(--place centre,ROT,SCALE; the page's scale\) is kept as given/g, '(typed in Scale) is planned as typed'],
   [/\(--place centre, or the page's drawing placement, puts the drawing on the scan's footprint\)/g,
     "('Centre on scan' puts the drawing on the scan's footprint)"],
-  [/\(--up-axis y or z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
+  [/\(--up-axis y, z or -z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
   [/\(--up-axis\)/g, '(Up axis)'],
   [/\(--up-axis (-?)([yz])\)/g, (_, sign, a) => `(Up axis: ${sign || '+'}${a.toUpperCase()})`],
   [/\(--up-axis; a depth camera's frame, z the distance from the camera, is -z\)/g,

@@ -107,6 +107,9 @@ export function moveScan(change) {
     // Shown by the plan request.
   }
   if (!before || !after || JSON.stringify(before) === JSON.stringify(after)) return;
+  // The placements kept for the scan's other readings were where the scan
+  // lay before: not brought back after it moved.
+  readings.clear();
   const info = state.info;
   const drawing = drawingPlacement();
   if (state.centre || state.pendingScan || !info || !drawing) {
@@ -161,12 +164,15 @@ function readingKey() {
 // Before the scan's units or up axis change: where the drawing lies in
 // this reading (not while a centring is on its way: that one is stale).
 export function leaveReading() {
-  const scan = state.pendingScan || state.scan;
-  if (!settings.scanUnits && scan && !state.pendingScan && state.info) {
-    defaultUnits.set(scan.key, state.info.units);
-  }
   if (state.centre) readings.delete(readingKey());
   else readings.set(readingKey(), { placement: { ...settings.placement }, fit: settings.fit });
+}
+
+// The units a scan was read in when none were asked (its file's
+// default): told by the worker's answer to that request (review: taken
+// from the scan on screen, it could be another reading's).
+export function noteDefaultUnits(key, units) {
+  defaultUnits.set(key, units);
 }
 
 // After they changed: the placement this reading had, or the drawing

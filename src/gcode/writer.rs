@@ -206,14 +206,46 @@ pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
         Ok(read) => read,
         Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
     };
+    // A firmware macro (Klipper's PRINT_START, BED_MESH_CALIBRATE) the
+    // reader skips may home and move the head as well (review).
+    let macro_line = text.lines().position(is_macro).map(|k| k + 1);
     let first = read
         .moves
         .iter()
         .map(|m| m.line)
         .chain(read.unknown_moves.iter().map(|u| u.line))
+        .chain(macro_line)
         .min()?;
     let i = from.get(first - 1).copied().unwrap_or_default();
-    Some(format!("start[{i}] `{}`", profile.start[i].trim()))
+    let what = if Some(first) == macro_line {
+        " (a firmware macro, which may home or move the head)"
+    } else {
+        ""
+    };
+    Some(format!("start[{i}] `{}`{what}", profile.start[i].trim()))
+}
+
+/// Whether a line calls a firmware macro: its first word a name (letters,
+/// digits and underscores, two or more, starting with a letter) that is
+/// not a G-code word (a letter and a number: `G28`, `M107`, `T1`).
+fn is_macro(line: &str) -> bool {
+    let word = line
+        .split([';', '(', ' ', '\t'])
+        .next()
+        .unwrap_or_default()
+        .trim();
+    let mut chars = word.chars();
+    let Some(first) = chars.next() else {
+        return false;
+    };
+    let rest = chars.as_str();
+    // A G-code word, or several run together (`G1X10`): a number follows
+    // the letter.
+    let code_word = rest.starts_with(|c: char| c.is_ascii_digit() || c == '.' || c == '-');
+    first.is_ascii_alphabetic()
+        && word.len() >= 2
+        && word.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !code_word
 }
 
 /// The moves of the `end` block's text (filled), the head at `at` when it
@@ -754,6 +786,12 @@ M84
             (vec!["G21", "G29 ; level"], Some("start[1] `G29 ; level`")),
             (vec!["G21\nG0 X10", "M107"], Some("start[0] `G21\nG0 X10`")),
             (vec!["G21", "M107", "G4 P100"], None),
+            (
+                vec!["G21", "PRINT_START BED=60", "G28"],
+                Some("start[1] `PRINT_START BED=60` (a firmware macro, which may home or move the head)"),
+            ),
+            (vec!["G21", "M107 ; fan off", "T0", "M104 S0"], None),
+            (vec!["G21", "G1Z5"], Some("start[1] `G1Z5`")),
             (vec![], None),
         ] {
             p.start = start.iter().map(|l| l.to_string()).collect();

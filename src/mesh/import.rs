@@ -310,7 +310,12 @@ fn finish_import(
     let units_doubt = UnitsDoubt::of(&mesh, units, options.units.is_some());
     warnings.extend(units_doubt.map(|d| d.message(file)));
     if options.up_axis.is_none() {
-        warnings.extend(upright::note(&mesh.vertices, up_axis, file));
+        warnings.extend(upright::note(
+            &mesh.vertices,
+            &mesh.triangles,
+            up_axis,
+            file,
+        ));
     }
     Ok(Unwelded {
         imported: ImportedMesh {
@@ -451,7 +456,7 @@ fn import_cloud(
     let upright_note = options
         .up_axis
         .is_none()
-        .then(|| upright::note(&vertices, up_axis, file))
+        .then(|| upright::note(&vertices, &[], up_axis, file))
         .flatten();
     let (mesh, info) = cloud::triangulate(vertices, options.max_edge_mm, file)?;
     check_triangle_count(mesh.triangle_count(), file)?;

@@ -39,7 +39,12 @@ const LEAST: f64 = 0.02;
 /// A note when the scan's `vertices` (a mesh's or a cloud's), read with
 /// `up` (the format's default, not the user's choice), rest clearly on a
 /// side that says the other axis was up.
-pub(crate) fn note(vertices: &[DVec3], up: UpAxis, file: &str) -> Option<String> {
+pub(crate) fn note(
+    vertices: &[DVec3],
+    triangles: &[[u32; 3]],
+    up: UpAxis,
+    file: &str,
+) -> Option<String> {
     let stride = vertices.len().div_ceil(SAMPLES).max(1);
     let sample: Vec<DVec3> = vertices.iter().step_by(stride).copied().collect();
     let spread = side_spreads(&sample)?;
@@ -57,7 +62,10 @@ pub(crate) fn note(vertices: &[DVec3], up: UpAxis, file: &str) -> Option<String>
     // +Z; read +Y up, a +Z-up one rests on +Y (its -Z turned to +Y).
     let (name, other, flag, shown) = match (up, side) {
         (UpAxis::Z, 2) => ("-Y", "+Y", "y", "lying on its side"),
-        (UpAxis::Z, 5) => ("+Z", "-Z", "-z", "upside down"),
+        // Only a mesh whose surface faces down as read: a depth camera sees
+        // the faces turned to it, at -Z. A scan seen from above with a flat
+        // top over a tilted base spreads widest at its top too (review).
+        (UpAxis::Z, 5) if faces_down(vertices, triangles) => ("+Z", "-Z", "-z", "upside down"),
         (UpAxis::Y, 3) => ("+Y", "+Z", "z", "lying on its side"),
         _ => return None,
     };
@@ -71,6 +79,22 @@ pub(crate) fn note(vertices: &[DVec3], up: UpAxis, file: &str) -> Option<String>
          wider there than on any other side): it was likely saved with {other} up; if it is \
          shown {shown}, read it {other} up (--up-axis {flag})"
     ))
+}
+
+/// Whether most of the surface's area faces -Z (triangles wound
+/// counter-clockwise seen from outside): their area-weighted normals sum
+/// to at least half their area, pointing down.
+fn faces_down(vertices: &[DVec3], triangles: &[[u32; 3]]) -> bool {
+    let (mut sum, mut area) = (DVec3::ZERO, 0.0);
+    for t in triangles {
+        let [Some(&a), Some(&b), Some(&c)] = t.map(|i| vertices.get(i as usize)) else {
+            continue;
+        };
+        let n = (b - a).cross(c - a);
+        sum += n;
+        area += n.length();
+    }
+    area > 0.0 && sum.z < -0.5 * area
 }
 
 /// For each side of the box of `points` (-X, +X, -Y, +Y, -Z, +Z): the area
@@ -176,7 +200,7 @@ mod tests {
     fn a_scan_standing_on_minus_y_read_z_up_gets_the_y_note() {
         // Saved +Y up: the file's (x, y, z) is the standing part's (x, z, -y).
         let yup = stand(|p| DVec3::new(p.x, p.z, -p.y));
-        let note = note(&yup.vertices, UpAxis::Z, "cow.stl").expect("a note");
+        let note = note(&yup.vertices, &yup.triangles, UpAxis::Z, "cow.stl").expect("a note");
         assert!(
             note.starts_with("cow.stl: read +Z up, it rests on its -Y side"),
             "{note}"
@@ -184,18 +208,47 @@ mod tests {
         assert!(note.ends_with("read it +Y up (--up-axis y)"), "{note}");
         // Standing on -Z as read: nothing to say.
         assert_eq!(
-            super::note(&stand(|p| p).vertices, UpAxis::Z, "cow.stl"),
+            super::note(&stand(|p| p).vertices, &[], UpAxis::Z, "cow.stl"),
             None
         );
     }
 
+    /// A dome on a table, seen from above (its faces up), `turn`ed.
+    fn dome(turn: impl Fn(DVec3) -> DVec3) -> TriMesh {
+        let axis: Vec<f64> = (0..=40).map(f64::from).collect();
+        let mut m = TriMesh::height_field(&axis, &axis, |x, y| {
+            (12.0 - ((x - 20.0).powi(2) + (y - 20.0).powi(2)) / 12.0).max(0.0)
+        });
+        m.vertices.iter_mut().for_each(|v| *v = turn(*v));
+        m
+    }
+
     #[test]
     fn a_depth_cameras_scan_read_z_up_gets_the_minus_z_note() {
-        // z the distance from a camera above: (x, y, z) -> (x, -y, -z).
-        let camera = stand(|p| DVec3::new(p.x, -p.y, 400.0 - p.z));
-        let note = note(&camera.vertices, UpAxis::Z, "depth.ply").expect("a note");
-        assert!(note.contains("rests on its +Z side"), "{note}");
-        assert!(note.ends_with("read it -Z up (--up-axis -z)"), "{note}");
+        // z the distance from a camera above: half a turn about X.
+        let camera = dome(|p| DVec3::new(p.x, -p.y, 400.0 - p.z));
+        let n = note(&camera.vertices, &camera.triangles, UpAxis::Z, "depth.ply").expect("a note");
+        assert!(n.contains("rests on its +Z side"), "{n}");
+        assert!(n.ends_with("read it -Z up (--up-axis -z)"), "{n}");
+        // Seen from above, a flat top over a tilted base spreads widest at
+        // its top as well: its faces are up, no note (review). Nor for a
+        // cloud's points, which have no faces.
+        let axis: Vec<f64> = (0..=50).map(f64::from).collect();
+        let mesa = TriMesh::height_field(&axis, &axis, |x, y| {
+            if (10.0..=40.0).contains(&x) && (10.0..=40.0).contains(&y) {
+                10.0
+            } else {
+                0.1 * x
+            }
+        });
+        assert_eq!(
+            note(&mesa.vertices, &mesa.triangles, UpAxis::Z, "m.ply"),
+            None
+        );
+        assert_eq!(note(&camera.vertices, &[], UpAxis::Z, "depth.xyz"), None);
+        // The dome upright: none.
+        let up = dome(|p| p);
+        assert_eq!(note(&up.vertices, &up.triangles, UpAxis::Z, "d.ply"), None);
     }
 
     #[test]
@@ -203,7 +256,7 @@ mod tests {
         // glTF read +Y up turns (x, y, z) to (x, -z, y): a part standing on
         // -Z in the file rests on +Y.
         let turned = stand(|p| DVec3::new(p.x, -p.z, p.y));
-        let note = note(&turned.vertices, UpAxis::Y, "cad.glb").expect("a note");
+        let note = note(&turned.vertices, &turned.triangles, UpAxis::Y, "cad.glb").expect("a note");
         assert!(note.contains("rests on its +Y side"), "{note}");
         assert!(note.ends_with("read it +Z up (--up-axis z)"), "{note}");
     }
@@ -216,7 +269,7 @@ mod tests {
                 .collect(),
             triangles: vec![[0, 1, 2], [4, 5, 6]],
         };
-        assert_eq!(note(&cube.vertices, UpAxis::Z, "c"), None);
+        assert_eq!(note(&cube.vertices, &cube.triangles, UpAxis::Z, "c"), None);
         // A film 0.2 mm thick lying flat: it rests on -Z (and +Z alike).
         let film = TriMesh {
             vertices: (0..400)
@@ -227,12 +280,15 @@ mod tests {
                 .collect(),
             triangles: vec![[0, 1, 20]],
         };
-        assert_eq!(note(&film.vertices, UpAxis::Z, "f"), None);
+        assert_eq!(note(&film.vertices, &film.triangles, UpAxis::Z, "f"), None);
         let sliver = TriMesh {
             vertices: vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)],
             triangles: vec![[0, 1, 2]],
         };
-        assert_eq!(note(&sliver.vertices, UpAxis::Z, "s"), None);
+        assert_eq!(
+            note(&sliver.vertices, &sliver.triangles, UpAxis::Z, "s"),
+            None
+        );
     }
 
     #[test]
