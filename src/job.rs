@@ -2014,14 +2014,9 @@ mod tests {
         assert!(matches!(off, Error::OutsideVolume { .. }), "{off}");
     }
 
-    /// A profile whose start block moves the head (homing, then a move
-    /// down) gets a warning naming its line, in the report and the
-    /// header: those moves run before the program's first rise, from
-    /// wherever the head stands, unchecked (spec 6(f); safety audit,
-    /// finding 4). The built-in profile gets none, and every header says
-    /// that the first rise is not checked.
-    #[test]
-    fn a_start_block_that_moves_the_head_is_named() {
+    /// The demo's stepped block as a GLB, prepared unregistered, with its
+    /// placement and drawing.
+    fn stepped_block() -> (PreparedScan, PlanSettings, String) {
         let part = crate::demo::parts::DemoPart::SteppedBlock;
         let glb = crate::demo::to_glb(&part.mesh());
         let scan = prepare_scan(
@@ -2035,7 +2030,18 @@ mod tests {
             placement: part.placement(),
             ..Default::default()
         };
-        let svg = part.svg();
+        (scan, settings, part.svg())
+    }
+
+    /// A profile whose start block moves the head (homing, then a move
+    /// down) gets a warning naming its line, in the report and the
+    /// header: those moves run before the program's first rise, from
+    /// wherever the head stands, unchecked (spec 6(f); safety audit,
+    /// finding 4). The built-in profile gets none, and every header says
+    /// that the first rise is not checked.
+    #[test]
+    fn a_start_block_that_moves_the_head_is_named() {
+        let (scan, settings, svg) = stepped_block();
         let marlin = MachineProfile::builtin("marlin").unwrap();
         let mut homing = marlin.clone();
         homing.start = ["G21", "G90", "G28", "G1 Z5 F{travel_f}"]
@@ -2068,21 +2074,8 @@ mod tests {
     /// G-code, and without a negative zero.
     #[test]
     fn the_header_rounds_placement_and_writes_no_negative_zero() {
-        let part = crate::demo::parts::DemoPart::SteppedBlock;
-        let glb = crate::demo::to_glb(&part.mesh());
-        let scan = prepare_scan(
-            &glb,
-            "block.glb",
-            &ImportOptions::DEFAULT,
-            &RegistrationSettings::default(),
-        )
-        .unwrap();
-        let settings = PlanSettings {
-            placement: part.placement(),
-            ..Default::default()
-        };
+        let (scan, settings, svg) = stepped_block();
         let profile = MachineProfile::builtin("marlin").unwrap();
-        let svg = part.svg();
         let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
             .unwrap()
             .report;
