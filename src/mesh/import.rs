@@ -450,8 +450,8 @@ fn import_cloud(
         mut warnings,
         ..
     } = parsed;
-    check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
+    // In mm, as a mesh's (`finish`).
     check_finite(&vertices, file)?;
     let upright_note = options
         .up_axis
@@ -699,11 +699,11 @@ fn finish(
         triangles,
         mut warnings,
     } = parsed;
-    check_finite(&vertices, file)?;
     to_printer_frame(&mut vertices, scale, up_axis);
-    // A coordinate finite in the file's units may overflow in mm (1e306 m):
-    // the surface relies on finite vertices, and takes these bounds
-    // without checking them again (review: such a vertex was planned on).
+    // Checked in mm: a coordinate finite in the file's units may overflow
+    // (1e306 m), and the surface relies on finite vertices and takes these
+    // bounds without checking them again (review: such a vertex was
+    // planned on).
     check_finite(&vertices, file)?;
     let n = vertices.len();
     // A triangle two of whose corners the weld would merge has those
