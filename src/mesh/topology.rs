@@ -37,7 +37,7 @@ pub struct Topology {
 /// Whether a triangle's indices are in range for `n` vertices and distinct:
 /// the fiducials count only such triangles' edges.
 pub(crate) fn valid_triangle(t: &[u32; 3], n: usize) -> bool {
-    in_range(t, n) && t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+    in_range(t, n) && distinct(t)
 }
 
 /// Whether a triangle's indices are all below `n`: only such triangles own
