@@ -811,6 +811,11 @@ pub fn exact(v: f64) -> String {
 /// The header key of how the scan file was read ([`provenance`]).
 const SCAN_READ_KEY: &str = "scan read in";
 
+/// How a scan was read, as the header writes it: `m, +Z up`.
+fn scan_reading(units: ScanUnits, up_axis: UpAxis) -> String {
+    format!("{units}, {up_axis} up")
+}
+
 pub fn provenance(report: &Report) -> Vec<(String, String)> {
     let s = &report.settings;
     let mut h: Vec<(String, String)> = Vec::new();
@@ -831,7 +836,7 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         if *k == "scan" {
             h.push((
                 SCAN_READ_KEY.into(),
-                format!("{}, {} up", report.mesh.units, report.mesh.up_axis),
+                scan_reading(report.mesh.units, report.mesh.up_axis),
             ));
         }
     }
@@ -1528,7 +1533,7 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
             .strip_prefix(SCAN_READ_KEY)
             .and_then(|v| v.strip_prefix(": "))
         {
-            let ours = format!("{}, {} up", scan.units, scan.up_axis);
+            let ours = scan_reading(scan.units, scan.up_axis);
             let (units, up) = v.split_once(", ").unwrap_or((v, ""));
             let up = up.trim_end_matches(" up");
             if v != ours {
@@ -1983,14 +1988,7 @@ mod tests {
             for v in &mut mesh.vertices {
                 v.x += dx;
             }
-            let glb = crate::demo::to_glb(&mesh);
-            let scan = prepare_scan(
-                &glb,
-                "post.glb",
-                &ImportOptions::DEFAULT,
-                &RegistrationSettings::default(),
-            )
-            .unwrap();
+            let scan = prepared_glb(&mesh, "post.glb");
             let settings = PlanSettings {
                 placement: crate::svg::Placement {
                     offset_mm: glam::DVec2::new(10.0 + dx, 45.0),
@@ -2014,18 +2012,23 @@ mod tests {
         assert!(matches!(off, Error::OutsideVolume { .. }), "{off}");
     }
 
+    /// `mesh` as a GLB named `name`, prepared unregistered.
+    fn prepared_glb(mesh: &crate::mesh::TriMesh, name: &str) -> PreparedScan {
+        let glb = crate::demo::to_glb(mesh);
+        prepare_scan(
+            &glb,
+            name,
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap()
+    }
+
     /// The demo's stepped block as a GLB, prepared unregistered, with its
     /// placement and drawing.
     fn stepped_block() -> (PreparedScan, PlanSettings, String) {
         let part = crate::demo::parts::DemoPart::SteppedBlock;
-        let glb = crate::demo::to_glb(&part.mesh());
-        let scan = prepare_scan(
-            &glb,
-            "block.glb",
-            &ImportOptions::DEFAULT,
-            &RegistrationSettings::default(),
-        )
-        .unwrap();
+        let scan = prepared_glb(&part.mesh(), "block.glb");
         let settings = PlanSettings {
             placement: part.placement(),
             ..Default::default()
