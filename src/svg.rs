@@ -265,21 +265,15 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 .into(),
         ));
     }
-    if bytes.starts_with(&[0xFE, 0xFF]) || bytes.starts_with(&[0xFF, 0xFE]) {
-        return Err(parse_err(
-            "the file is UTF-16 text; save it as UTF-8 (every SVG editor can)".into(),
-        ));
-    }
-    let text = std::str::from_utf8(bytes).map_err(|e| {
+    let text = decode_text(bytes).map_err(|e| {
         // A binary scan chosen as the drawing, named as one.
         let kind = match scan_kind(bytes) {
             Some(k) => format!("; it looks like a binary {k}"),
             None => String::new(),
         };
-        parse_err(format!(
-            "not UTF-8 text ({e}); SVG is an XML text file{kind}"
-        ))
+        parse_err(format!("{e}{kind}"))
     })?;
+    let text: &str = &text;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
 
     // A document that uses an editor's prefix without declaring it is read
@@ -1606,6 +1600,118 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
         declared.push(prefix);
     }
     (out, declared)
+}
+
+/// The document's text: UTF-8 (with or without a byte-order mark),
+/// UTF-16 with its byte-order mark (Windows tools write it), or the
+/// single-byte encodings an XML declaration names that older editors
+/// (Illustrator, Inkscape 0.4x, CorelDRAW) save in: ISO-8859-1 (Latin-1,
+/// every byte the code point of its value), windows-1252 (Latin-1 with
+/// printable characters for 0x80-0x9F) and US-ASCII. Anything else is
+/// refused naming what was found: a drawing is never guessed at.
+fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
+    use std::borrow::Cow;
+    let utf16 = |be: bool| -> Result<Cow<'_, str>, String> {
+        let body = &bytes[2..];
+        if body.len() % 2 != 0 {
+            return Err(
+                "UTF-16 text (by its byte-order mark) with an odd number of bytes: \
+                 the file is cut short; save it again (as UTF-8 if you can)"
+                    .into(),
+            );
+        }
+        let units = body.chunks_exact(2).map(|c| {
+            if be {
+                u16::from_be_bytes([c[0], c[1]])
+            } else {
+                u16::from_le_bytes([c[0], c[1]])
+            }
+        });
+        char::decode_utf16(units)
+            .collect::<Result<String, _>>()
+            .map(Cow::Owned)
+            .map_err(|e| {
+                format!(
+                    "UTF-16 text (by its byte-order mark) with an unpaired surrogate \
+                     0x{:04X}: save it again as UTF-8",
+                    e.unpaired_surrogate()
+                )
+            })
+    };
+    if bytes.starts_with(&[0xFE, 0xFF]) {
+        return utf16(true);
+    }
+    if bytes.starts_with(&[0xFF, 0xFE]) {
+        return utf16(false);
+    }
+    let declared = declared_encoding(bytes);
+    match declared.map(str::to_ascii_lowercase).as_deref() {
+        Some("iso-8859-1" | "iso8859-1" | "iso_8859-1" | "latin1" | "latin-1" | "l1")
+        | Some("us-ascii" | "ascii")
+            if std::str::from_utf8(bytes).is_err() =>
+        {
+            Ok(Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()))
+        }
+        Some("windows-1252" | "cp1252" | "x-cp1252") if std::str::from_utf8(bytes).is_err() => {
+            Ok(Cow::Owned(bytes.iter().map(|&b| cp1252(b)).collect()))
+        }
+        lower => match std::str::from_utf8(bytes) {
+            Ok(text) => Ok(Cow::Borrowed(text)),
+            Err(e) => {
+                let byte = bytes[e.valid_up_to()];
+                let line = 1 + bytes[..e.valid_up_to()]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count();
+                let said = match (declared, lower) {
+                    (Some(enc), Some(l)) if l != "utf-8" && l != "utf8" => format!(
+                        "; its XML declaration names the encoding '{enc}', which is not read \
+                         (UTF-8, UTF-16, ISO-8859-1 and windows-1252 are): save it as UTF-8"
+                    ),
+                    _ => "; save it as UTF-8 (every SVG editor can), or name its encoding in \
+                          the XML declaration (<?xml version=\"1.0\" \
+                          encoding=\"ISO-8859-1\"?>)"
+                        .into(),
+                };
+                Err(format!(
+                    "not UTF-8 text (line {line}, byte 0x{byte:02X}); SVG is an XML text \
+                     file{said}"
+                ))
+            }
+        },
+    }
+}
+
+/// The `encoding` of the XML declaration that opens `bytes` (after a
+/// UTF-8 byte-order mark), if there is one.
+fn declared_encoding(bytes: &[u8]) -> Option<&str> {
+    let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
+    let head = bytes.strip_prefix(b"<?xml")?;
+    let end = head.windows(2).take(512).position(|w| w == b"?>")?;
+    let decl = std::str::from_utf8(&head[..end]).ok()?;
+    let at = decl.find("encoding")?;
+    let rest = decl[at + "encoding".len()..]
+        .trim_start()
+        .strip_prefix('=')?;
+    let rest = rest.trim_start();
+    let quote = rest.chars().next().filter(|&c| c == '"' || c == '\'')?;
+    let value = &rest[1..];
+    Some(&value[..value.find(quote)?])
+}
+
+/// A windows-1252 byte as its character (the WHATWG table: 0x80-0x9F are
+/// printable characters, the five it leaves undefined are the C1 controls
+/// of their value, as in ISO-8859-1).
+fn cp1252(b: u8) -> char {
+    const HIGH: [u16; 32] = [
+        0x20AC, 0x81, 0x201A, 0x0192, 0x201E, 0x2026, 0x2020, 0x2021, 0x02C6, 0x2030, 0x0160,
+        0x2039, 0x0152, 0x8D, 0x017D, 0x8F, 0x90, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022, 0x2013,
+        0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0x9D, 0x017E, 0x0178,
+    ];
+    match b {
+        0x80..=0x9F => char::from_u32(u32::from(HIGH[usize::from(b - 0x80)])).unwrap_or('?'),
+        _ => char::from(b),
+    }
 }
 
 /// The scan format `bytes` look like, by the importers' own sniffing

@@ -1632,11 +1632,15 @@ fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_uns
 }
 
 /// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
-/// utf-8 sequence of 1 bytes from index 0)"; now it says what to do, as
-/// the UTF-16 OBJ message does.
+/// utf-8 sequence of 1 bytes from index 0)", then refused with "save it as
+/// UTF-8"; its byte-order mark says how to read it, and it is read.
 #[test]
-fn regression_a_utf16_svg_was_not_told_to_be_saved_as_utf8() {
-    let text = doc(MM, r#"<path d="M 0 0 L 10 0" stroke="black"/>"#);
+fn a_utf16_svg_is_read_by_its_byte_order_mark() {
+    let text = doc(
+        MM,
+        "<title>\u{e9}t\u{e9} \u{1F4E1}</title><path d=\"M 0 0 L 10 0\" stroke=\"black\"/>",
+    );
+    let want = import_svg(text.as_bytes(), "u8.svg").unwrap();
     for bom in [[0xFF, 0xFE], [0xFE, 0xFF]] {
         let mut bytes = bom.to_vec();
         for u in text.encode_utf16() {
@@ -1647,12 +1651,71 @@ fn regression_a_utf16_svg_was_not_told_to_be_saved_as_utf8() {
             };
             bytes.extend_from_slice(&pair);
         }
-        let e = import_svg(&bytes, "u16.svg").unwrap_err().to_string();
+        assert_eq!(import_svg(&bytes, "u16.svg").unwrap(), want);
+        // Cut short by one byte: refused, naming the file.
+        let e = import_svg(&bytes[..bytes.len() - 1], "u16.svg")
+            .unwrap_err()
+            .to_string();
         assert!(
-            e.contains("u16.svg") && e.contains("UTF-16 text; save it as UTF-8"),
+            e.contains("u16.svg") && e.contains("odd number of bytes"),
             "{e}"
         );
     }
+}
+
+/// An SVG saved by an older editor in ISO-8859-1 or windows-1252, as its
+/// XML declaration says (a QA finding: "not UTF-8 text (invalid utf-8
+/// sequence of 1 bytes from index 146)"), is read as declared; a byte
+/// that is not UTF-8 with no such declaration, or another encoding, is
+/// refused naming the line and what to do.
+#[test]
+fn a_latin1_or_cp1252_svg_is_read_as_its_declaration_says() {
+    let body = |enc: &str, title: &[u8]| -> Vec<u8> {
+        let mut b = format!(
+            "<?xml version=\"1.0\" encoding=\"{enc}\"?>\n<svg \
+             xmlns=\"http://www.w3.org/2000/svg\" width=\"50mm\" height=\"50mm\" \
+             viewBox=\"0 0 50 50\">\n<title>"
+        )
+        .into_bytes();
+        b.extend_from_slice(title);
+        b.extend_from_slice(
+            b"</title><path d=\"M 5 5 L 45 5 A 10 10 0 0 1 45 25\" stroke=\"black\" \
+              fill=\"none\"/></svg>\n",
+        );
+        b
+    };
+    let want = import_svg(
+        &body("UTF-8", "\u{e9}t\u{e9} \u{20ac}".as_bytes()),
+        "u8.svg",
+    )
+    .unwrap();
+    assert!(!want.is_empty());
+    for enc in ["ISO-8859-1", "latin1", "windows-1252", "US-ASCII"] {
+        // 0xE9 is e-acute in all but ASCII, 0x80 the euro sign in cp1252.
+        let got = import_svg(&body(enc, b"\xe9t\xe9 \x80"), "old.svg");
+        assert_eq!(got.unwrap(), want, "{enc}");
+    }
+    let e = import_svg(&body("KOI8-R", b"\xe9t\xe9"), "koi.svg")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("koi.svg")
+            && e.contains("line 3")
+            && e.contains("'KOI8-R'")
+            && e.contains("save it as UTF-8"),
+        "{e}"
+    );
+    let mut undeclared = body("UTF-8", b"\xe9t\xe9");
+    undeclared.drain(..undeclared.iter().position(|&b| b == b'\n').unwrap() + 1);
+    let e = import_svg(&undeclared, "plain.svg")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("plain.svg")
+            && e.contains("line 2, byte 0xE9")
+            && e.contains("encoding=\"ISO-8859-1\""),
+        "{e}"
+    );
 }
 
 /// A scan or a program chosen as the drawing read "not well-formed XML:
