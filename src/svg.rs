@@ -1613,7 +1613,7 @@ fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
     use std::borrow::Cow;
     let utf16 = |be: bool| -> Result<Cow<'_, str>, String> {
         let body = &bytes[2..];
-        if body.len() % 2 != 0 {
+        if !body.len().is_multiple_of(2) {
             return Err(
                 "UTF-16 text (by its byte-order mark) with an odd number of bytes: \
                  the file is cut short; save it again (as UTF-8 if you can)"
