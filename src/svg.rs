@@ -323,8 +323,13 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         },
         ..usvg::Options::default()
     };
-    let tree = usvg::Tree::from_str(&prepared.text, &options)
-        .map_err(|e| parse_err(format!("not a usable SVG: {e}")))?;
+    let tree = usvg::Tree::from_str(&prepared.text, &options).map_err(|e| match e {
+        usvg::Error::ElementsLimitReached
+        | usvg::Error::ParsingFailed(roxmltree::Error::NodesLimitReached) => {
+            parse_err(use_expansion(&prepared.text))
+        }
+        e => parse_err(format!("not a usable SVG: {e}")),
+    })?;
     if !prepared.percent_size.is_empty() {
         // usvg takes a percentage of the viewBox's size in px; with no
         // viewBox the page is the drawing's extent and user units are px.
@@ -1727,6 +1732,99 @@ fn scan_kind(bytes: &[u8]) -> Option<&'static str> {
         MeshFormat::Pcd => "PCD point cloud",
         MeshFormat::Xyz => return None,
     })
+}
+
+/// Why usvg gave up on a document whose `<use>`s expand without end or
+/// past its limits (it says only "nodes limit reached"): the chain of ids
+/// of a `<use>` that refers back to itself through others, with the lines,
+/// or else the expansion itself. A `<use>` inside the element it refers to
+/// is left out: usvg skips it, as browsers do.
+fn use_expansion(text: &str) -> String {
+    let opt = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    let too_big = "the drawing expands to more than a million elements or nests deeper than \
+                   1024 levels (<use>s of <use>s that multiply): not read; unlink the clones \
+                   in the editor (Inkscape: Edit > Clone > Unlink Clone) or simplify the file"
+        .to_string();
+    let Ok(doc) = roxmltree::Document::parse_with_options(text, opt) else {
+        return too_big;
+    };
+    fn href<'a>(n: &roxmltree::Node<'a, '_>) -> Option<&'a str> {
+        n.attribute("href")
+            .or(n.attribute((XLINK_NS, "href")))
+            .and_then(|h| h.trim().strip_prefix('#'))
+    }
+    let ids: HashMap<&str, roxmltree::Node> = doc
+        .descendants()
+        .filter_map(|n| Some((n.attribute("id")?, n)))
+        .collect();
+    // For each element with an id, the (target, line) of the <use>s in it.
+    let mut edges: HashMap<&str, Vec<(&str, u32)>> = HashMap::new();
+    for (&id, &e) in &ids {
+        let mut out = Vec::new();
+        for u in e.descendants().filter(|n| n.tag_name().name() == "use") {
+            let Some((target, t)) = href(&u).and_then(|h| Some((h, *ids.get(h)?))) else {
+                continue;
+            };
+            // Inside its own target: skipped, not a cycle.
+            if !u.ancestors().any(|a| a == t) {
+                out.push((target, doc.text_pos_at(u.range().start).row));
+            }
+        }
+        edges.insert(id, out);
+    }
+    // Depth-first, with the path of (id, line of the <use> taken from it).
+    fn walk<'a>(
+        id: &'a str,
+        edges: &HashMap<&'a str, Vec<(&'a str, u32)>>,
+        state: &mut HashMap<&'a str, bool>,
+        path: &mut Vec<(&'a str, u32)>,
+    ) -> Option<Vec<(&'a str, u32)>> {
+        state.insert(id, true);
+        for &(target, line) in edges.get(id).map_or(&[][..], |v| &v[..]) {
+            path.push((id, line));
+            match state.get(target) {
+                Some(true) => {
+                    let from = path.iter().position(|&(i, _)| i == target)?;
+                    let mut cycle = path[from..].to_vec();
+                    cycle.push((target, 0));
+                    return Some(cycle);
+                }
+                Some(false) => {}
+                None => {
+                    if let Some(c) = walk(target, edges, state, path) {
+                        return Some(c);
+                    }
+                }
+            }
+            path.pop();
+        }
+        state.insert(id, false);
+        None
+    }
+    let mut state = HashMap::new();
+    let mut names: Vec<&str> = ids.keys().copied().collect();
+    names.sort_by_key(|id| ids[id].range().start);
+    for id in names {
+        if state.contains_key(id) {
+            continue;
+        }
+        if let Some(cycle) = walk(id, &edges, &mut state, &mut Vec::new()) {
+            let chain = cycle[..cycle.len() - 1]
+                .iter()
+                .zip(&cycle[1..])
+                .map(|(&(from, line), &(to, _))| format!("'{from}' uses '#{to}' (line {line})"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            return format!(
+                "a <use> refers back to itself: {chain}; such a loop has no end and a browser \
+                 draws nothing for it: remove or retarget one of these <use>s"
+            );
+        }
+    }
+    too_big
 }
 
 /// What a file that is not XML at all looks like: a scan or a program

@@ -1912,3 +1912,45 @@ fn shapes_off_the_page_are_named() {
         .iter()
         .any(|n| n.contains("off the page")));
 }
+
+/// `<use>`s that refer to each other in a loop ('a' uses 'b', 'b' uses
+/// 'a') made usvg give up with "SVG data parsing failed cause nodes limit
+/// reached"; the error names the loop's ids and lines. A `<use>` of
+/// `<use>`s that multiply past usvg's million elements says so and what to
+/// do. A `<use>` inside the element it refers to is skipped, as a browser
+/// does, and the rest is read.
+#[test]
+fn use_loops_and_use_bombs_are_named() {
+    let e = import_error(&doc(
+        MM,
+        "\n<g id=\"a\"><path d=\"M 5 5 L 45 5\" stroke=\"black\"/><use href=\"#b\"/></g>\
+         \n<g id=\"b\"><use xlink:href=\"#a\" transform=\"translate(0,5)\"/></g>\n",
+    ));
+    assert!(
+        e.contains("qa.svg")
+            && e.contains("'a' uses '#b' (line 2), 'b' uses '#a' (line 3)")
+            && e.contains("remove or retarget"),
+        "{e}"
+    );
+    let mut body = String::from("<defs><path id=\"l0\" d=\"M 5 5 L 6 5\" stroke=\"black\"/>");
+    for i in 1..12 {
+        body.push_str(&format!("<g id=\"l{i}\">"));
+        for _ in 0..10 {
+            body.push_str(&format!("<use href=\"#l{}\"/>", i - 1));
+        }
+        body.push_str("</g>");
+    }
+    body.push_str("</defs><use href=\"#l11\"/>");
+    let e = import_error(&doc(MM, &body));
+    assert!(
+        e.contains("qa.svg")
+            && e.contains("more than a million elements")
+            && e.contains("Unlink Clone"),
+        "{e}"
+    );
+    let subs = import(&doc(
+        MM,
+        r##"<path d="M 5 5 L 45 5" stroke="black"/><g id="g"><use href="#g"/></g>"##,
+    ));
+    assert_eq!(subs.len(), 1, "{subs:?}");
+}
