@@ -32,9 +32,25 @@ impl Nozzle {
         self
     }
 
-    /// Checks 0 < d < do, both finite and at most 10 mm.
+    /// Checks MIN_NOZZLE_MM <= d < do, both finite, d at most 10 mm and
+    /// do at most 20.
     pub fn validate(&self) -> Result<()> {
         positive("nozzle inner diameter (mm)", self.inner_diameter_mm, 10.0)?;
+        if self.inner_diameter_mm < MIN_NOZZLE_MM {
+            // A diameter typed in metres (0.000603 for the paper's tip)
+            // would be planned at a spacing of a fraction of a micrometre:
+            // millions of samples a line, minutes of planning, and a
+            // program for a nozzle that does not exist.
+            return Err(Error::Parameter {
+                name: "nozzle inner diameter (mm)",
+                value: shown(self.inner_diameter_mm),
+                reason: format!(
+                    "must be at least {MIN_NOZZLE_MM} mm (1 um, the finest glass-capillary \
+                     nozzles): the diameters are in mm (the paper's 20-gauge tip is 0.603; in \
+                     metres it would be 0.000603)"
+                ),
+            });
+        }
         positive("nozzle outer diameter (mm)", self.outer_diameter_mm, 20.0)?;
         if self.outer_diameter_mm <= self.inner_diameter_mm {
             return Err(Error::Parameter {
@@ -49,6 +65,11 @@ impl Nozzle {
         Ok(())
     }
 }
+
+/// The finest nozzle inner diameter accepted (mm): 1 um, the finest
+/// glass-capillary nozzles direct ink writing uses (the sampling spaces
+/// such a path at [`crate::sampling::MIN_SPACING_MM`], no finer).
+pub const MIN_NOZZLE_MM: f64 = 1e-3;
 
 impl Default for Nozzle {
     fn default() -> Self {
@@ -130,6 +151,27 @@ fn positive(name: &'static str, v: f64, max: f64) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A diameter typed in metres (a QA run gave 0.0001, which planned for
+    /// minutes) is refused, saying the value is in mm; 1 um is accepted.
+    #[test]
+    fn a_nozzle_finer_than_a_micrometre_is_refused_as_metres() {
+        let n = |d: f64| {
+            Nozzle::default()
+                .with_inner_diameter_mm(d)
+                .with_outer_diameter_mm(2.0 * d)
+        };
+        n(MIN_NOZZLE_MM).validate().unwrap();
+        for d in [0.000603, 1e-4, 0.5 * MIN_NOZZLE_MM] {
+            let e = n(d).validate().unwrap_err().to_string();
+            assert!(
+                e.contains("nozzle inner diameter (mm)")
+                    && e.contains("at least 0.001 mm")
+                    && e.contains("in metres it would be 0.000603"),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn defaults_are_the_papers_20_gauge_tip() {
