@@ -298,6 +298,27 @@ fn a_larger_edge_limit_closes_the_fiducial_holes() {
         ..ImportOptions::DEFAULT
     };
     let m = import_mesh(text.as_bytes(), "part.xyz", &options).unwrap();
+    assert!(
+        !m.warnings.iter().any(|w| w.contains("--max-edge")),
+        "{:?}",
+        m.warnings
+    );
+    // Given for a mesh, the limit is said not to be used (a QA run found
+    // it dropped silently).
+    let ply = pcpp::demo::demo_scan_bytes();
+    let mesh = import_mesh(&ply, "part.ply", &options).unwrap();
+    let said: Vec<&String> = mesh
+        .warnings
+        .iter()
+        .filter(|w| w.contains("--max-edge"))
+        .collect();
+    assert!(
+        said.len() == 1
+            && said[0].starts_with("part.ply: ")
+            && said[0].contains("2 mm, is not used"),
+        "{:?}",
+        mesh.warnings
+    );
     let info = m.cloud.unwrap();
     assert!(info.max_edge_given && info.max_edge_mm == 2.0);
     let fids = find_fiducials(&m.mesh);

@@ -317,6 +317,13 @@ fn finish_import(
             file,
         ));
     }
+    if let Some(m) = options.max_edge_mm {
+        // Asked for and not used: said, not silently dropped.
+        warnings.push(format!(
+            "{file}: the longest edge for meshing a point cloud (--max-edge), {m} mm, is not \
+             used: the scan is a mesh, whose own triangles are planned on"
+        ));
+    }
     Ok(Unwelded {
         imported: ImportedMesh {
             mesh,
