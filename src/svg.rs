@@ -362,7 +362,6 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut out = Vec::new();
     let mut budget = MAX_POINTS;
     let (mut unpainted, mut first_unpainted) = (0usize, None::<String>);
-    let mut images = 0usize;
     let mut non_finite = 0usize;
     let cos_corner = libm::cos(CORNER_ANGLE_DEG.to_radians());
 
@@ -429,10 +428,8 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 continue;
             }
             usvg::Node::Path(p) => p,
-            usvg::Node::Image(_) => {
-                images += 1;
-                continue;
-            }
+            // Images never reach here (no image is decoded, see the
+            // options): `prepare` counts them.
             _ => continue,
         };
         let id = path.id();
@@ -716,11 +713,6 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         notes.push(format!(
             "{clipped} shape(s) are clipped or masked (clip-path, mask; the first: '{first}'): \
              they are printed whole, not as the viewer shows them; draw only the part to print"
-        ));
-    }
-    if images > 0 {
-        notes.push(format!(
-            "{images} image(s) ignored: only outlines are printed"
         ));
     }
     if let Some(first) = &first_filled {
@@ -2022,6 +2014,8 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     let mut seen: HashSet<&str> = HashSet::new();
     let mut index = 0usize;
     let mut texts = 0usize;
+    let mut flowed = 0usize;
+    let mut images = 0usize;
     let mut markers = 0usize;
     let mut unused = UnusedDefinitions::default();
     let mut unused_seen: HashSet<&str> = HashSet::new();
@@ -2041,6 +2035,16 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         }
         if name == "text" {
             texts += 1;
+            continue;
+        }
+        // Inkscape 0.92's flowed text (SVG 1.2 drafts; browsers show
+        // nothing for it, Inkscape does) and raster images: not outlines.
+        if name == "flowRoot" {
+            flowed += 1;
+            continue;
+        }
+        if name == "image" {
+            images += 1;
             continue;
         }
         if !SHAPES.contains(&name) || in_marker(&node) {
@@ -2199,6 +2203,19 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         notes.push(format!(
             "{texts} text element(s) skipped: text is not converted to paths (no fonts are loaded); \
              convert text to paths in the drawing program"
+        ));
+    }
+    if flowed > 0 {
+        notes.push(format!(
+            "{flowed} flowed text(s) skipped (<flowRoot>, Inkscape 0.92's text in a frame, which \
+             browsers do not show either): text is not converted to paths; convert it to paths \
+             in Inkscape (Path > Object to Path) if it is to be printed"
+        ));
+    }
+    if images > 0 {
+        notes.push(format!(
+            "{images} image(s) ignored (<image>): only outlines are printed; trace a bitmap \
+             into paths first (Inkscape: Path > Trace Bitmap)"
         ));
     }
     if markers > 0 {

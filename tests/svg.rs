@@ -1954,3 +1954,22 @@ fn use_loops_and_use_bombs_are_named() {
     ));
     assert_eq!(subs.len(), 1, "{subs:?}");
 }
+
+/// An `<image>` was meant to get a note, but usvg drops images it does not
+/// decode before they could be counted, and Inkscape 0.92's flowed text
+/// (`<flowRoot>`) vanished without one (a QA finding): each is named,
+/// with what to do, and the outlines beside them are read.
+#[test]
+fn images_and_flowed_text_are_noted() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<path d="M 5 5 L 45 5" stroke="black"/>
+           <flowRoot><flowRegion><rect x="5" y="10" width="30" height="10"/></flowRegion><flowPara>Hi</flowPara></flowRoot>
+           <image x="0" y="20" width="10" height="10" xlink:href="data:image/png;base64,iVBORw0KGgo="/>
+           <image x="0" y="40" width="10" height="10" href="photo.jpg"/>"#,
+    ));
+    assert_eq!(subs.len(), 1, "{subs:?}");
+    assert!(note_with(&notes, "image(s)").starts_with("2 image(s) ignored (<image>)"));
+    let flowed = note_with(&notes, "flowRoot");
+    assert!(flowed.starts_with("1 flowed text(s) skipped") && flowed.contains("Object to Path"));
+}
