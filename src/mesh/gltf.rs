@@ -65,6 +65,16 @@ pub(super) fn parse(
     };
     let (compressed, fallbacks) = meshopt::views(json, uses(meshopt::EXT), file)?;
     let draco = draco_primitives(json, &root, uses(DRACO), file)?;
+    // Also where a file uses it without listing it (which the spec asks
+    // for): a node's copies are never dropped.
+    let instanced = instanced_nodes(
+        json,
+        uses(INSTANCING)
+            || json
+                .windows(INSTANCING.len())
+                .any(|w| w == INSTANCING.as_bytes()),
+        file,
+    )?;
     if let Some(d) = draco.values().next() {
         // glTF lets an accessor have neither bufferView nor sparse values
         // (it then holds zeros), and Draco primitives' accessors are
@@ -89,6 +99,7 @@ pub(super) fn parse(
     root.extensions_required.retain(|e| {
         e != "KHR_mesh_quantization"
             && e != DRACO
+            && e != INSTANCING
             && e != meshopt::EXT
             && !IGNORED_PREFIXES.iter().any(|p| e.starts_with(p))
     });
@@ -141,7 +152,21 @@ pub(super) fn parse(
                 }
                 let world = parent * local_transform(&node);
                 if let Some(mesh) = node.mesh() {
-                    scene.draw(&mesh, &world)?;
+                    match instanced.get(&node.index()) {
+                        Some(inst) => {
+                            for local in scene.instances(&gltf, node.index(), inst)? {
+                                scene.draw(&mesh, &(world * local))?;
+                                if scene.triangles.len() > MAX_TRIANGLES {
+                                    return Err(scene.err(format!(
+                                        "node {}: its instances ({INSTANCING}) make more than \
+                                         {MAX_TRIANGLES} triangles",
+                                        node.index()
+                                    )));
+                                }
+                            }
+                        }
+                        None => scene.draw(&mesh, &world)?,
+                    }
                 }
                 stack.extend(node.children().map(|c| (c, world)));
             }
@@ -337,6 +362,72 @@ fn draco_primitives(
                 },
             );
         }
+    }
+    Ok(out)
+}
+
+/// EXT_mesh_gpu_instancing: a node drawn once per instance, each placed by
+/// the node's transform times its own translation, rotation and scale
+/// (gltf-transform's `instance`, Blender's "GPU Instances"). Optional in
+/// most files that use it, and a reader that skips it reads the mesh once
+/// where the file has many copies, so it is read.
+const INSTANCING: &str = "EXT_mesh_gpu_instancing";
+
+/// The accessors of a node's instances: TRANSLATION, ROTATION, SCALE.
+#[derive(Debug, Clone, Copy, Default)]
+struct Instancing {
+    translation: Option<usize>,
+    rotation: Option<usize>,
+    scale: Option<usize>,
+}
+
+/// The nodes that use [`INSTANCING`], by node index.
+fn instanced_nodes(
+    json: &[u8],
+    used: bool,
+    file: &str,
+) -> Result<std::collections::HashMap<usize, Instancing>, MeshError> {
+    #[derive(serde::Deserialize)]
+    struct Doc {
+        #[serde(default)]
+        nodes: Vec<NodeJson>,
+    }
+    #[derive(serde::Deserialize)]
+    struct NodeJson {
+        #[serde(default)]
+        extensions: Option<serde_json::Map<String, serde_json::Value>>,
+    }
+    let mut out = std::collections::HashMap::new();
+    if !used {
+        return Ok(out);
+    }
+    let doc: Doc = serde_json::from_slice(json)
+        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
+    for (n, node) in doc.nodes.iter().enumerate() {
+        let Some(ext) = node.extensions.as_ref().and_then(|e| e.get(INSTANCING)) else {
+            continue;
+        };
+        let attribute = |name: &str| -> Result<Option<usize>, MeshError> {
+            match ext.get("attributes").and_then(|a| a.get(name)) {
+                None => Ok(None),
+                Some(v) => v.as_u64().map(|i| Some(i as usize)).ok_or_else(|| {
+                    MeshError::invalid(
+                        file,
+                        format!(
+                            "node {n}: its {INSTANCING} attribute {name} is not an accessor index"
+                        ),
+                    )
+                }),
+            }
+        };
+        out.insert(
+            n,
+            Instancing {
+                translation: attribute("TRANSLATION")?,
+                rotation: attribute("ROTATION")?,
+                scale: attribute("SCALE")?,
+            },
+        );
     }
     Ok(out)
 }
@@ -728,6 +819,89 @@ impl SceneReader<'_, '_> {
         })
     }
 
+    /// The transforms of node `n`'s instances ([`INSTANCING`]), in the
+    /// node's frame: translation, rotation and scale per instance, each
+    /// attribute a missing one leaves at its identity; every attribute
+    /// given has one element per instance.
+    fn instances(
+        &self,
+        gltf: &Document,
+        n: usize,
+        inst: &Instancing,
+    ) -> Result<Vec<DMat4>, MeshError> {
+        let read = |index: Option<usize>, name: &str, dims: Dimensions| {
+            let Some(index) = index else {
+                return Ok(None);
+            };
+            let what = format!("node {n}'s instance {name}");
+            let accessor = gltf.accessors().nth(index).ok_or_else(|| {
+                self.err(format!(
+                    "{what} refers to accessor {index}, but there are {}",
+                    gltf.accessors().len()
+                ))
+            })?;
+            if accessor.dimensions() != dims {
+                return Err(self.err(format!(
+                    "{what} accessor {index} is {:?}, not {dims:?}",
+                    accessor.dimensions()
+                )));
+            }
+            let elements = self.elements(&accessor, &what)?;
+            let k = dims.multiplicity();
+            let width = elements.ty.size();
+            let values: Vec<Vec<f64>> = (0..elements.count)
+                .map(|i| {
+                    let e = elements.get(i);
+                    (0..k)
+                        .map(|c| component(e, c * width, elements.ty, elements.normalized))
+                        .collect()
+                })
+                .collect();
+            Ok(Some(values))
+        };
+        let t = read(inst.translation, "TRANSLATION", Dimensions::Vec3)?;
+        let r = read(inst.rotation, "ROTATION", Dimensions::Vec4)?;
+        let s = read(inst.scale, "SCALE", Dimensions::Vec3)?;
+        let counts: Vec<usize> = [&t, &r, &s]
+            .iter()
+            .filter_map(|a| a.as_ref().map(Vec::len))
+            .collect();
+        let Some(&count) = counts.first() else {
+            return Err(self.err(format!(
+                "node {n}: its {INSTANCING} extension gives no TRANSLATION, ROTATION or SCALE"
+            )));
+        };
+        if counts.iter().any(|&c| c != count) {
+            return Err(self.err(format!(
+                "node {n}: its {INSTANCING} attributes have different counts ({counts:?})"
+            )));
+        }
+        let mut out = Vec::with_capacity(count);
+        for i in 0..count {
+            let v3 = |a: &Option<Vec<Vec<f64>>>, default: DVec3| {
+                a.as_ref()
+                    .map_or(default, |a| DVec3::new(a[i][0], a[i][1], a[i][2]))
+            };
+            let translation = v3(&t, DVec3::ZERO);
+            let scale = v3(&s, DVec3::ONE);
+            let q = r.as_ref().map_or(DQuat::IDENTITY, |r| {
+                DQuat::from_xyzw(r[i][0], r[i][1], r[i][2], r[i][3])
+            });
+            // As a node's rotation: exporters round the unit quaternion.
+            let q = if q.length() > 0.0 && q.is_finite() {
+                q.normalize()
+            } else {
+                DQuat::IDENTITY
+            };
+            out.push(DMat4::from_scale_rotation_translation(
+                scale,
+                q,
+                translation,
+            ));
+        }
+        Ok(out)
+    }
+
     fn draw(&mut self, mesh: &Mesh, world: &DMat4) -> Result<(), MeshError> {
         for primitive in mesh.primitives() {
             let at = format!("mesh {} primitive {}", mesh.index(), primitive.index());
@@ -1033,6 +1207,81 @@ mod tests {
             "data:application/octet-stream;base64,{}",
             STANDARD.encode(bytes)
         )
+    }
+
+    /// A triangle drawn by one node with EXT_mesh_gpu_instancing: two
+    /// instances, the first scaled by 2 and moved by (10, 0, 0), the second
+    /// turned 90 degrees about Z and moved by (0, 20, 0). `listed`: the
+    /// extension is in extensionsUsed; `counts`: the three attributes'.
+    fn instanced_gltf(listed: bool, counts: [usize; 3]) -> String {
+        let mut f: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        f.extend([10.0, 0.0, 0.0, 0.0, 20.0, 0.0]);
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        f.extend([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, h, h]);
+        f.extend([2.0, 2.0, 2.0, 1.0, 1.0, 1.0]);
+        let bytes: Vec<u8> = f.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let used = if listed {
+            r#""extensionsUsed":["EXT_mesh_gpu_instancing"],"#
+        } else {
+            ""
+        };
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},{used}"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":
+                {{"TRANSLATION":1,"ROTATION":2,"SCALE":3}}}}}}}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "accessors":[
+              {{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+              {{"bufferView":1,"componentType":5126,"count":{},"type":"VEC3"}},
+              {{"bufferView":2,"componentType":5126,"count":{},"type":"VEC4"}},
+              {{"bufferView":3,"componentType":5126,"count":{},"type":"VEC3"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":24}},
+              {{"buffer":0,"byteOffset":60,"byteLength":32}},{{"buffer":0,"byteOffset":92,"byteLength":24}}],
+            "buffers":[{{"byteLength":116,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+            counts[0],
+            counts[1],
+            counts[2],
+            STANDARD.encode(bytes)
+        )
+    }
+
+    /// A GLB of gltf-transform's `instance` (EXT_mesh_gpu_instancing,
+    /// optional) was read as its mesh once, untransformed: G-code on a part
+    /// that is not there (a QA finding). Each instance is drawn where it
+    /// stands, whether or not the file lists the extension.
+    #[test]
+    fn gpu_instances_are_each_drawn() {
+        for listed in [true, false] {
+            let p = parse(instanced_gltf(listed, [2, 2, 2]).as_bytes(), "i.gltf").unwrap();
+            assert_eq!(p.triangles.len(), 2);
+            let want = [
+                [10.0, 0.0, 0.0],
+                [12.0, 0.0, 0.0],
+                [10.0, 2.0, 0.0],
+                [0.0, 20.0, 0.0],
+                [0.0, 21.0, 0.0],
+                [-1.0, 20.0, 0.0],
+            ];
+            let got: Vec<[f64; 3]> = p
+                .triangles
+                .iter()
+                .flat_map(|t| t.iter().map(|&i| p.vertices[i as usize].to_array()))
+                .collect();
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    g.iter().zip(w).all(|(a, b)| (a - b).abs() < 1e-6),
+                    "{got:?}"
+                );
+            }
+        }
+        let e = parse(instanced_gltf(true, [2, 1, 2]).as_bytes(), "i.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("i.gltf") && e.contains("node 0") && e.contains("different counts"),
+            "{e}"
+        );
     }
 
     #[test]
