@@ -155,7 +155,7 @@ pub(super) fn parse(
                     match instanced.get(&node.index()) {
                         Some(inst) => {
                             for local in scene.instances(&gltf, node.index(), inst)? {
-                                scene.draw(&mesh, &(world * local))?;
+                                scene.draw(&mesh, &(world * local), node.weights())?;
                                 if scene.triangles.len() > MAX_TRIANGLES {
                                     return Err(scene.err(format!(
                                         "node {}: its instances ({INSTANCING}) make more than \
@@ -165,7 +165,7 @@ pub(super) fn parse(
                                 }
                             }
                         }
-                        None => scene.draw(&mesh, &world)?,
+                        None => scene.draw(&mesh, &world, node.weights())?,
                     }
                 }
                 stack.extend(node.children().map(|c| (c, world)));
@@ -173,7 +173,7 @@ pub(super) fn parse(
         }
         None => {
             for mesh in gltf.meshes() {
-                scene.draw(&mesh, &DMat4::IDENTITY)?;
+                scene.draw(&mesh, &DMat4::IDENTITY, None)?;
             }
         }
     }
@@ -902,7 +902,15 @@ impl SceneReader<'_, '_> {
         Ok(out)
     }
 
-    fn draw(&mut self, mesh: &Mesh, world: &DMat4) -> Result<(), MeshError> {
+    /// Draws `mesh` at `world`, in the shape of its morph targets'
+    /// `weights` (the node's, else the mesh's; glTF 3.7.2.2).
+    fn draw(
+        &mut self,
+        mesh: &Mesh,
+        world: &DMat4,
+        weights: Option<&[f32]>,
+    ) -> Result<(), MeshError> {
+        let weights = weights.or(mesh.weights());
         for primitive in mesh.primitives() {
             let at = format!("mesh {} primitive {}", mesh.index(), primitive.index());
             let mode = primitive.mode();
@@ -946,7 +954,31 @@ impl SceneReader<'_, '_> {
                     ));
                     continue;
                 };
-                let corners = self.positions(&accessor, world, &at)?;
+                let corners = match morphed(weights, &primitive) {
+                    // The shape the file shows at rest (glTF 3.7.2.2: the
+                    // base plus each target's offsets times its default
+                    // weight), not the base alone.
+                    Some(targets) => {
+                        let mut points = self.vec3s(&accessor, "POSITION", &at)?;
+                        for (w, target) in targets {
+                            let what = format!("morph target POSITION (weight {w})");
+                            let offsets = self.vec3s(&target, &what, &at)?;
+                            if offsets.len() != points.len() {
+                                return Err(self.err(format!(
+                                    "{at}: {what} accessor {} has {} elements, POSITION {}",
+                                    target.index(),
+                                    offsets.len(),
+                                    points.len()
+                                )));
+                            }
+                            for (p, o) in points.iter_mut().zip(offsets) {
+                                *p += w * o;
+                            }
+                        }
+                        self.place(&points, world, &at)?
+                    }
+                    None => self.positions(&accessor, world, &at)?,
+                };
                 let indices = match primitive.indices() {
                     Some(accessor) => self.indices(&accessor, corners.len(), &at)?,
                     None => (0..corners.len()).collect(),
@@ -999,14 +1031,20 @@ impl SceneReader<'_, '_> {
         world: &DMat4,
         at: &str,
     ) -> Result<Vec<u32>, MeshError> {
-        let e = self.elements(accessor, "POSITION")?;
+        let points = self.vec3s(accessor, "POSITION", at)?;
+        self.place(&points, world, at)
+    }
+
+    /// The values of a VEC3 accessor, in the file's frame.
+    fn vec3s(&self, accessor: &Accessor, what: &str, at: &str) -> Result<Vec<DVec3>, MeshError> {
+        let e = self.elements(accessor, what)?;
         if accessor.dimensions() != Dimensions::Vec3 {
             return Err(self.err(format!(
-                "{at}: POSITION accessor {} is not VEC3",
+                "{at}: {what} accessor {} is not VEC3",
                 accessor.index()
             )));
         }
-        let points: Vec<DVec3> = (0..e.count)
+        Ok((0..e.count)
             .map(|i| {
                 let b = e.get(i);
                 let c = e.ty.size();
@@ -1016,8 +1054,7 @@ impl SceneReader<'_, '_> {
                     component(b, 2 * c, e.ty, e.normalized),
                 )
             })
-            .collect();
-        self.place(&points, world, at)
+            .collect())
     }
 
     /// A Draco-compressed primitive (KHR_draco_mesh_compression): its
@@ -1148,6 +1185,23 @@ impl SceneReader<'_, '_> {
             })
             .collect()
     }
+}
+
+/// The morph targets that move `primitive`'s points at rest: each with a
+/// non-zero default weight and a POSITION offset accessor, with that
+/// weight; `None` when none does (the base shape is the shape).
+fn morphed<'a>(
+    weights: Option<&[f32]>,
+    primitive: &gltf::Primitive<'a>,
+) -> Option<Vec<(f64, Accessor<'a>)>> {
+    let weights = weights?;
+    let targets: Vec<(f64, Accessor<'a>)> = primitive
+        .morph_targets()
+        .zip(weights)
+        .filter(|(_, &w)| w != 0.0)
+        .filter_map(|(t, &w)| Some((f64::from(w), t.positions()?)))
+        .collect();
+    (!targets.is_empty()).then_some(targets)
 }
 
 /// One component at byte `at` of an element, as the value it stands for:
@@ -1282,6 +1336,47 @@ mod tests {
             e.contains("i.gltf") && e.contains("node 0") && e.contains("different counts"),
             "{e}"
         );
+    }
+
+    /// A triangle with one morph target that lifts it by 2 in z, at the
+    /// mesh's default weight `mesh_w` and the node's `node_w`.
+    fn morph_gltf(mesh_w: &str, node_w: &str) -> String {
+        let mut f: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        f.extend([0.0, 0.0, 2.0, 0.0, 0.0, 2.0, 0.0, 0.0, 2.0]);
+        let bytes: Vec<u8> = f.iter().flat_map(|v| v.to_le_bytes()).collect();
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0{node_w}}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"targets":[{{"POSITION":1}}]}}]{mesh_w}}}],
+            "accessors":[
+              {{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+              {{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,2],"max":[0,0,2]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":36}}],
+            "buffers":[{{"byteLength":72,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+            STANDARD.encode(bytes)
+        )
+    }
+
+    /// The default weights of morph targets set the shape a viewer shows
+    /// at rest; a QA run found them ignored (the Khronos morph cube with
+    /// weights [1, 1] was read as its base). The node's weights come
+    /// before the mesh's.
+    #[test]
+    fn morph_targets_take_their_default_weights() {
+        for (mesh_w, node_w, z) in [
+            ("", "", 0.0),
+            (r#","weights":[0]"#, "", 0.0),
+            (r#","weights":[0.5]"#, "", 1.0),
+            (r#","weights":[0.5]"#, r#","weights":[1]"#, 2.0),
+        ] {
+            let p = parse(morph_gltf(mesh_w, node_w).as_bytes(), "m.gltf").unwrap();
+            assert_eq!(p.triangles.len(), 1);
+            assert!(
+                p.vertices.iter().all(|v| (v.z - z).abs() < 1e-9),
+                "{mesh_w} {node_w}: {:?}",
+                p.vertices
+            );
+        }
     }
 
     #[test]
