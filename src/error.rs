@@ -86,11 +86,11 @@ pub enum Error {
     /// much too low, and the clearance checked against the scan does not
     /// hold for the part.
     #[error(
-        "the scan is placed on the bed and then moved {depth_mm:.3} mm down (Move Z; \
-         --place-scan bed,ROT,DX,DY,DZ), so its lowest {depth_mm:.3} mm lie below the bed: if \
-         the part stands on the bed, every move is {depth_mm:.3} mm too low and the nozzle \
-         would hit it; no G-code written. Give a Move Z of 0 or more; if that much of the \
-         scan is not on the printer (a scanned base or table), accept the risk"
+        "the scan is placed on the bed and then moved {depth_mm:.3} mm down (the DZ of \
+         --place-scan bed,DX,DY,DZ), so its lowest {depth_mm:.3} mm lie below the bed: if the \
+         part stands on the bed, every move is {depth_mm:.3} mm too low and the nozzle would \
+         hit it; no G-code written. Give a DZ of 0 or more; if that much of the scan is not \
+         on the printer (a scanned base or table), accept the risk"
     )]
     BelowBed { depth_mm: f64 },
     /// G-code refused for a tool path that dispenses far above the surface

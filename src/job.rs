@@ -1221,8 +1221,8 @@ pub fn write_outputs(
                     fit: format!(
                         "the scan lies inside the build volume, but beside it the tool path \
                          passes {:.3} mm beyond the volume's {} side: move the scan in from \
-                         that side, e.g. place it on the bed (--place-scan bed; in the page, \
-                         'Place on the bed'), or the drawing in from the scan's edge",
+                         that side, e.g. place it on the bed (--place-scan bed), or the drawing \
+                         in from the scan's edge",
                         side.0, side.1
                     ),
                 }

@@ -535,8 +535,7 @@ pub fn check_program(
     "{count} G-code move(s) of planner {planner} would bring the nozzle (outer diameter \
      {outer_diameter_mm} mm) closer to the surface than tol = {tol_mm} mm, checked along each \
      straight move; {first}; no G-code written. Plan with a guarded planner (even, the \
-     default, or pcpp-guarded), or accept the risk (--accept-risk; in the page, the box \
-     'write G-code even where it is refused (at my risk)') to write it anyway",
+     default, or pcpp-guarded), or accept the risk (--accept-risk) to write it anyway",
     count = .summary.touching_moves,
     first = .summary.touching.iter().take(3).map(|t| format!("G-code {t}")).collect::<Vec<_>>().join("; ")
 )]

@@ -225,8 +225,8 @@ pub fn surface_path(
                 "no part of the path lies over the scan's surface: the scan is seen edge-on \
                  from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame), so there is \
                  almost nothing for the nozzle to come down on; if the scan lies on its side in \
-                 the file, choose its up axis (--up-axis y, z or -z, the page's up axis; glTF \
-                 files are +Y up) or register it onto the bed",
+                 the file, choose its up axis (--up-axis y, z or -z; glTF files are +Y up) or \
+                 register it onto the bed",
                 foot.x, foot.y, tall
             )
         } else if !any_line && !dots.is_empty() {
@@ -252,8 +252,8 @@ pub fn surface_path(
             format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
-                 placement offset and the registration (--place centre, or the page's drawing \
-                 placement, puts the drawing on the scan's footprint)",
+                 placement offset and the registration (--place centre puts the drawing on the \
+                 scan's footprint)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
         } else {

@@ -211,15 +211,11 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             hi.z,
             outside.max_element(),
         );
-        placed_message = format!(
-            "{spans}; move it back inside (Move X, Y and Z in the page; --place-scan \
-             bed,ROT,DX,DY,DZ)"
-        );
+        placed_message = format!("{spans}; move it back inside (--place-scan bed,DX,DY,DZ[,ROT])");
         if fits_on_bed {
             format!(
                 "{spans}; if it is still in the scanner's frame, place it on the bed \
-                 (--place-scan bed; in the page, 'Place on the bed') or register it by its \
-                 fiducials"
+                 (--place-scan bed) or register it by its fiducials"
             )
         } else {
             // Placing it cannot help: name the axis it is too large on.
@@ -299,8 +295,8 @@ pub fn centre_drawing(
         placement.scale *= scale;
         note = Some(format!(
             "the drawing ({:.1} x {:.1} mm) is larger than {:.0}% of the scan's footprint \
-             ({:.1} x {:.1} mm): it was scaled by {} to fit; a scale given with the placement \
-             (--place centre,ROT,SCALE; the page's scale) is kept as given",
+             ({:.1} x {:.1} mm): it was scaled by {} to fit; to choose the scale yourself, give \
+             it with the placement (--place centre,ROT,SCALE), which is kept as given",
             size.x,
             size.y,
             FIT_SHARE * 100.0,

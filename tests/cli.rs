@@ -2494,9 +2494,74 @@ fn up_axis_minus_z_reads_a_depth_cameras_scan_upright() {
     // Read +Z up, the note.
     let o = pcpp(&["fiducials", "--scan", s(&camera)]);
     assert!(
-        stderr(&o).contains("it was likely saved with -Z up; if it is shown upside down, read it -Z up (--up-axis -z)"),
+        stderr(&o).contains("it was likely saved with -Z up; if the part is upside down as read, read it -Z up (--up-axis -z)"),
         "{}",
         stderr(&o)
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The CLI's messages named the page's controls ("Move X, Y and Z in the
+/// page", "the page's scale", "in the page, the box ..."), and the
+/// build-volume hint gave `--place-scan bed,ROT,DX,DY,DZ` where the order
+/// is bed,DX,DY,DZ,ROT (a QA run followed it and moved the scan by 90 mm
+/// instead of turning it). They now name the CLI's flags, in their order.
+#[test]
+fn cli_messages_name_flags_not_the_page() {
+    let scan = demo_file("demo-test-part.ply");
+    let svg = demo_file("demo-test-part-lines.svg");
+    let dir = temp_dir("cli_messages_name_flags");
+    let out = dir.join("x.gcode");
+    // Moved out of the build volume.
+    let o = plan_on(
+        &scan,
+        &svg,
+        &[
+            "--place",
+            "centre",
+            "--place-scan",
+            "bed,0,0,900",
+            "-o",
+            s(&out),
+        ],
+    );
+    let e = stderr(&o);
+    assert_eq!(code(&o), 1, "{e}");
+    assert!(e.contains("(--place-scan bed,DX,DY,DZ[,ROT])"), "{e}");
+    // Moved below the bed.
+    let o = plan_on(
+        &scan,
+        &svg,
+        &[
+            "--place",
+            "centre",
+            "--place-scan",
+            "bed,0,0,-1",
+            "-o",
+            s(&out),
+        ],
+    );
+    let e2 = stderr(&o);
+    assert!(
+        e2.contains("(the DZ of --place-scan bed,DX,DY,DZ)")
+            && e2.contains("Give a DZ of 0 or more"),
+        "{e2}"
+    );
+    // A drawing scaled to fit the scan.
+    let big = dir.join("big.svg");
+    std::fs::write(
+        &big,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="500mm" height="20mm" viewBox="0 0 500 20"><path d="M 0 10 L 500 10" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let o = plan_on(&scan, &big, &["--place", "centre", "-o", s(&out)]);
+    let e3 = stderr(&o);
+    assert!(
+        e3.contains("to choose the scale yourself, give it with the placement (--place centre,ROT,SCALE), which is kept as given"),
+        "{e3}"
+    );
+    for text in [&e, &e2, &e3] {
+        assert!(!text.contains("page"), "{text}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -59,11 +59,15 @@ export function profile() {
 // page names the control instead (a flag means nothing in the page). A
 // message the core words otherwise is shown as it is.
 const PAGE_WORDS = [
-  [/ \(--place-scan bed; in the page, ('Place on the bed')\)/g, ' ($1)'],
-  [/\(--place centre,ROT,SCALE; the page's scale\) is kept as given/g, '(typed in Scale) is planned as typed'],
-  [/\(--place centre, or the page's drawing placement, puts the drawing on the scan's footprint\)/g,
+  [/\(--place-scan bed\)/g, "('Place on the bed')"],
+  [/\(--place-scan bed,DX,DY,DZ\[,ROT\]\)/g, '(Move X, Y and Z)'],
+  [/\(the DZ of --place-scan bed,DX,DY,DZ\)/g, '(Move Z)'],
+  [/Give a DZ of 0 or more/g, 'Give a Move Z of 0 or more'],
+  [/give it with the placement \(--place centre,ROT,SCALE\), which is kept as given/g,
+    'type it in Scale, which is planned as typed'],
+  [/\(--place centre puts the drawing on the scan's footprint\)/g,
     "('Centre on scan' puts the drawing on the scan's footprint)"],
-  [/\(--up-axis y, z or -z, the page's up axis; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
+  [/\(--up-axis y, z or -z; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
   [/\(--up-axis\)/g, '(Up axis)'],
   [/\(--up-axis (-?)([yz])\)/g, (_, sign, a) => `(Up axis: ${sign || '+'}${a.toUpperCase()})`],
   [/\(--up-axis; a depth camera's frame, z the distance from the camera, is -z\)/g,
@@ -71,7 +75,7 @@ const PAGE_WORDS = [
   [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
   [/\(--scan-units (\w+) if it really is this (small|large)\)/g, '(Units: $1 if it really is this $2)'],
   [/\(--max-edge\)/g, '(Cloud max edge)'],
-  [/\(--accept-risk; in the page, (the box '[^']*')\)/g, '($1)'],
+  [/\(--accept-risk\)/g, "(the box 'write G-code even where it is refused (at my risk)')"],
   [/keep it next to \S+ \(command line\) or select both files together \(page\)/g, 'select both files together'],
   [/e\.g\. placed on the bed: --place-scan bed\)/g, "e.g. placed on the bed: 'Place on the bed')"],
 ];

@@ -76,8 +76,8 @@ pub(crate) fn note(
     };
     Some(format!(
         "{file}: read {read}, it rests on its {name} side (its outermost points spread far \
-         wider there than on any other side): it was likely saved with {other} up; if it is \
-         shown {shown}, read it {other} up (--up-axis {flag})"
+         wider there than on any other side): it was likely saved with {other} up; if the \
+         part is {shown} as read, read it {other} up (--up-axis {flag})"
     ))
 }
 

@@ -317,7 +317,7 @@ test('a scan saved +Y up gets a note naming the up axis, gone once read +Y up', 
   await waitIdle(page);
   const notes = () => page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent).filter((t) => /rests on its/.test(t)));
   assert.deepEqual(await notes(), ['animal.obj: read +Z up, it rests on its -Y side (its outermost points spread far '
-    + 'wider there than on any other side): it was likely saved with +Y up; if it is shown lying on its side, read it '
+    + 'wider there than on any other side): it was likely saved with +Y up; if the part is lying on its side as read, read it '
     + '+Y up (Up axis: +Y)']);
   await page.selectOption('#scan-up', 'y');
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.bbox_mm[1][2] > 20, null, { timeout: 120_000 });
