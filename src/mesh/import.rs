@@ -53,7 +53,7 @@ fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
     if pcd::looks_like_pcd(text) {
         return Some(MeshFormat::Pcd);
     }
-    if text.starts_with(b"solid") {
+    if stl::starts_solid(text) {
         return Some(MeshFormat::Stl);
     }
     if text.starts_with(b"{") {

@@ -33,13 +33,27 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         .iter()
         .position(|c| !c.is_ascii_whitespace())
         .unwrap_or(bytes.len());
-    if bytes.get(start..).is_some_and(|t| t.starts_with(b"solid")) {
+    if bytes.get(start..).is_some_and(starts_solid) {
         return match parse_ascii(bytes, file) {
             Err(_) if is_binary_size(bytes) || looks_binary(bytes) => parse_binary(bytes, file),
             result => result,
         };
     }
     parse_binary(bytes, file)
+}
+
+/// Whether `text` opens with the keyword `solid`, in any case: some CAD
+/// exporters write ASCII STL's keywords in capitals (`SOLID`, `FACET
+/// NORMAL`), which readers accept (a QA run's file was read as binary and
+/// refused as truncated).
+pub(super) fn starts_solid(text: &[u8]) -> bool {
+    text.get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
+}
+
+/// An ASCII STL keyword, in any case.
+fn is(w: &[u8], keyword: &str) -> bool {
+    w.eq_ignore_ascii_case(keyword.as_bytes())
 }
 
 /// NUL bytes never occur in ascii STL but fill most binary facets; this
@@ -153,7 +167,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     let mut facet = 0usize;
     let expect = |t: &mut Tokens, word: &str| -> Result<(), MeshError> {
         match t.next() {
-            Some(w) if w == word.as_bytes() => Ok(()),
+            Some(w) if is(w, word) => Ok(()),
             Some(w) => Err(MeshError::syntax(
                 file,
                 t.line,
@@ -168,7 +182,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     };
     // Some exporters write several solids into one file: read them all.
     while let Some(word) = t.next() {
-        if word != b"solid" {
+        if !is(word, "solid") {
             return Err(MeshError::syntax(
                 file,
                 t.line,
@@ -181,11 +195,11 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         t.skip_line();
         loop {
             match t.next() {
-                Some(b"endsolid") => {
+                Some(w) if is(w, "endsolid") => {
                     t.skip_line();
                     break;
                 }
-                Some(b"facet") => {}
+                Some(w) if is(w, "facet") => {}
                 Some(w) => {
                     return Err(MeshError::syntax(
                         file,
@@ -213,7 +227,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             polygon.clear();
             loop {
                 match t.next() {
-                    Some(b"vertex") => {
+                    Some(w) if is(w, "vertex") => {
                         let line = t.line;
                         let xyz = [
                             number(&mut t, file)?,
@@ -223,7 +237,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
                         let corner = polygon.len();
                         polygon.push(weld(&mut welder, xyz, file, facet, corner, Some(line))?);
                     }
-                    Some(b"endloop") => break,
+                    Some(w) if is(w, "endloop") => break,
                     Some(w) => {
                         return Err(MeshError::syntax(
                             file,
@@ -294,6 +308,31 @@ mod tests {
         let p = parse(TWO.as_bytes(), "t.stl").unwrap();
         assert_eq!(p.vertices.len(), 4);
         assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    /// ASCII STL with its keywords in capitals (some CAD exporters), or
+    /// just its first word (a QA run's `SOLID` file was read as binary and
+    /// refused as a truncated file of 537538848 triangles), reads as the
+    /// lower-case file does, and is sniffed as STL without its name.
+    #[test]
+    fn ascii_keywords_in_any_case() {
+        let want = parse(TWO.as_bytes(), "t.stl").unwrap();
+        for text in [
+            TWO.to_uppercase(),
+            TWO.replacen("solid", "SOLID", 1),
+            TWO.replace("facet", "Facet"),
+        ] {
+            let p = parse(text.as_bytes(), "t.stl").unwrap();
+            assert_eq!(
+                (&p.vertices, &p.triangles),
+                (&want.vertices, &want.triangles),
+                "{text}"
+            );
+            assert_eq!(
+                crate::mesh::detect_format(text.as_bytes(), ""),
+                Some(crate::mesh::MeshFormat::Stl)
+            );
+        }
     }
 
     #[test]
