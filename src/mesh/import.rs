@@ -37,6 +37,16 @@ fn from_extension(file: &str) -> Option<MeshFormat> {
     }
 }
 
+/// A token of a text scan as an error message shows it: as written, with
+/// control characters and bytes that are not UTF-8 escaped (`\x10`), so
+/// that a stray control byte is not shown as an empty token.
+pub(super) fn shown_token(token: &[u8]) -> String {
+    match std::str::from_utf8(token) {
+        Ok(t) if !t.chars().any(char::is_control) => t.to_string(),
+        _ => token.escape_ascii().to_string(),
+    }
+}
+
 fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
     if bytes.starts_with(b"glTF") {
         return Some(MeshFormat::Glb);

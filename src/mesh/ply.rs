@@ -667,7 +667,7 @@ impl Body<'_> {
                                 "'{}' element {i}: property '{}' is '{}', not a number",
                                 element.name,
                                 prop.name,
-                                String::from_utf8_lossy(token)
+                                super::import::shown_token(token)
                             ),
                         )
                     };
@@ -681,9 +681,29 @@ impl Body<'_> {
                         }
                         (Kind::List { .. }, role) => {
                             let token = t.next().ok_or_else(|| missing(&t))?;
+                            // A list's count: a whole number, 0 or more. A
+                            // line with fewer values than the header says
+                            // (Blender 2.77 put a face list on its
+                            // vertices) reads the next line's first value.
                             let n = ascii_int(token)
                                 .and_then(|n| usize::try_from(n).ok())
-                                .ok_or_else(|| not_number(&t, token))?;
+                                .ok_or_else(|| {
+                                    MeshError::syntax(
+                                        file,
+                                        t.line,
+                                        format!(
+                                            "'{}' element {i}: the count of list property '{}' \
+                                             is '{}', not a whole number of 0 or more; does \
+                                             each '{}' line hold the {} properties the header \
+                                             lists for it?",
+                                            element.name,
+                                            prop.name,
+                                            super::import::shown_token(token),
+                                            element.name,
+                                            element.props.len()
+                                        ),
+                                    )
+                                })?;
                             if matches!(role, Role::FaceIndices | Role::StripIndices) {
                                 polygon.clear();
                                 for _ in 0..n {
@@ -987,6 +1007,25 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("end_header"), "{e}");
+        // A list on the vertices that their lines do not hold (Blender
+        // 2.77): the count read is the next line's x, and the message said
+        // "'7.941797', not a number" (a QA run, assimp's issue623.ply).
+        let bad = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+            property float z\nproperty list uchar uint vertex_indices\nend_header\n\
+            7.5 1 0\n7.5 2 0\n";
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.ply:10:")
+                && e.contains(
+                    "the count of list property 'vertex_indices' is '7.5', not a whole number"
+                )
+                && e.contains("hold the 4 properties"),
+            "{e}"
+        );
+        // A control byte is shown escaped, not as an empty token.
+        let bad = ASCII.replace("1 1 0 255 1 3", "1 \x10 0 255 1 3");
+        let e = parse(bad.as_bytes(), "t.ply").unwrap_err().to_string();
+        assert!(e.contains("is '\\x10', not a number"), "{e}");
     }
 
     #[test]

@@ -290,7 +290,7 @@ fn number(t: &mut Tokens, file: &str) -> Result<f64, MeshError> {
         MeshError::syntax(
             file,
             t.line,
-            format!("'{}' is not a number", String::from_utf8_lossy(token)),
+            format!("'{}' is not a number", super::import::shown_token(token)),
         )
     })
 }
@@ -352,6 +352,18 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("expected 'loop', found 'lop'"), "{e}");
+        // A stray control byte (openscad's unparseable.stl) was "'' is not
+        // a number".
+        let e = parse(
+            TWO.replace("vertex 1 0 0", "vertex 1 \x10 0").as_bytes(),
+            "t.stl",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("t.stl:5:") && e.contains("'\\x10' is not a number"),
+            "{e}"
+        );
     }
 
     /// Two facets after a header whose count was left at 0 (found by QA: a
