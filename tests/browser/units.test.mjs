@@ -361,7 +361,7 @@ test('a depth camera scan gets a note naming -Z, gone once read -Z up', async ()
   const notes = () => page.$$eval('#warnings li', (lis) => lis.map((li) => li.textContent).filter((t) => /rests on its/.test(t)));
   const got = await notes();
   assert.equal(got.length, 1, JSON.stringify(got));
-  assert.match(got[0], /rests on its \+Z side .* if it is shown upside down, read it -Z up \(Up axis: -Z\)$/);
+  assert.match(got[0], /rests on its \+Z side .* if the part is upside down as read, read it -Z up \(Up axis: -Z\)$/);
   await page.selectOption('#scan-up', '-z');
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.bbox_mm[1][2] < 0, null, { timeout: 120_000 });
   await waitIdle(page);
