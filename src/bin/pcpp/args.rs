@@ -116,6 +116,17 @@ pub struct PlanArgs {
     pub report: Option<PathBuf>,
 
     /// The planner
+    ///
+    /// even (the default) keeps the filament's predicted thickness closest
+    /// to d with no contact: it places the tip's centre d/2 ahead of each
+    /// drawn point along the path (do/2 on descents), its back edge over
+    /// the point, as the spec's section 7 measures the filament there; on a
+    /// flat plate its XY runs d/2 ahead of the drawing and swings outside
+    /// sharp corners by as much. pcpp-guarded is the paper's planner with
+    /// its moves kept clear; pcpp, slope and constant are the paper's three
+    /// as it plans them (they may touch the part). pcpp, pcpp-guarded and
+    /// constant put the tip's centre over the drawn point; slope shifts it
+    /// along the path too.
     #[arg(
         long,
         value_name = "P",
