@@ -214,15 +214,21 @@ pub enum SvgError {
     /// The document parsed but draws no stroke or fill that could be printed.
     #[error("{file}: nothing printable: {reason}")]
     NothingPrintable { file: String, reason: String },
-    /// Flattening would need more than [`MAX_POINTS`] points: the drawing is
-    /// enormous in mm; check its width/height units and viewBox.
+    /// Flattening would need more than [`MAX_POINTS`] points over the whole
+    /// file: the drawing is enormous in mm, or has a great many shapes
+    /// (clones); check its width/height units and viewBox, or simplify it.
     #[error(
-        "{file}: {element} needs more than {limit} points at the {tolerance_mm} mm \
-         flattening tolerance; the drawing is too large (check its width/height units and viewBox)"
+        "{file}: the drawing needs more than {limit} points to follow its curves (within \
+         {tolerance_mm} mm), counted over all its shapes; the count passed that at {element}, \
+         shape {nth} of the drawing. A drawing this large in mm or this detailed (many clones \
+         or nodes) is not read, at whatever scale it is placed: check its width/height units \
+         and viewBox, or simplify it (unlink clones, fewer nodes)"
     )]
     TooComplex {
         file: String,
         element: String,
+        /// 1-based: how many shapes were read when the count ran out.
+        nth: usize,
         limit: usize,
         tolerance_mm: f64,
     },
@@ -363,6 +369,8 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut budget = MAX_POINTS;
     let (mut unpainted, mut first_unpainted) = (0usize, None::<String>);
     let mut non_finite = 0usize;
+    // Shapes met so far, for the message when the point budget runs out.
+    let mut shapes_read = 0usize;
     let cos_corner = libm::cos(CORNER_ANGLE_DEG.to_radians());
 
     // The hidden copies: their usvg geometry names the shape of each
@@ -432,6 +440,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             // options): `prepare` counts them.
             _ => continue,
         };
+        shapes_read += 1;
         let id = path.id();
         if id.starts_with(prepared.copy_prefix.as_str()) {
             continue;
@@ -544,6 +553,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                     return Err(SvgError::TooComplex {
                         file: file.to_string(),
                         element: label,
+                        nth: shapes_read,
                         limit: MAX_POINTS,
                         tolerance_mm: FLATTEN_TOLERANCE_MM,
                     })

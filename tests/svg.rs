@@ -851,7 +851,11 @@ fn a_drawing_needing_too_many_points_names_the_limit_and_the_units() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("huge.svg") && e.contains("more than 4000000 points") && e.contains("units"),
+        e.contains("huge.svg")
+            && e.contains("more than 4000000 points")
+            && e.contains("counted over all its shapes")
+            && e.contains("shape 5 of the drawing")
+            && e.contains("units"),
         "{e}"
     );
 }
