@@ -220,17 +220,30 @@ pub fn surface_path(
         let (slo, shi) = surface.bbox();
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
         let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
-        return Err(Error::Plan(if any_sample && edge_on(foot, tall) {
-            format!(
-                "no part of the path lies over the scan's surface: the scan is seen edge-on \
+        return Err(Error::Plan(
+            if any_sample && edge_on(foot, tall) && foot.x < foot.y {
+                // Thin along X: no up axis this program reads turns it face-up
+                // (+Z, +Y and -Z are; a QA run's polygon faced +X, and the
+                // message offered the up axes that cannot help).
+                format!(
+                    "no part of the path lies over the scan's surface: the scan is seen edge-on \
+                 from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame): its surface \
+                 faces sideways, along X, which no up axis turns face-up (--up-axis reads +Z, +Y \
+                 or -Z as up); turn it in a mesh tool (MeshLab, Blender) so that its surface \
+                 faces +Z, or register it onto the bed by its fiducials",
+                    foot.x, foot.y, tall
+                )
+            } else if any_sample && edge_on(foot, tall) {
+                format!(
+                    "no part of the path lies over the scan's surface: the scan is seen edge-on \
                  from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame), so there is \
                  almost nothing for the nozzle to come down on; if the scan lies on its side in \
                  the file, choose its up axis (--up-axis y, z or -z; glTF files are +Y up) or \
                  register it onto the bed",
-                foot.x, foot.y, tall
-            )
-        } else if !any_line && !dots.is_empty() {
-            format!(
+                    foot.x, foot.y, tall
+                )
+            } else if !any_line && !dots.is_empty() {
+                format!(
                 "nothing to print at the nozzle's scale: every path of the drawing ({} of them: \
                  '{}'{}) is a dot or a shape shorter than the samples' spacing of {spacing:.4} mm \
                  as placed; check the drawing's units and the placement's scale",
@@ -238,27 +251,28 @@ pub fn surface_path(
                 dots[0],
                 if dots.len() > 1 { ", ..." } else { "" }
             )
-        } else if any_sample && inside {
-            format!(
-                "no part of the path lies over the scan's surface: the path spans x \
+            } else if any_sample && inside {
+                format!(
+                    "no part of the path lies over the scan's surface: the path spans x \
                  {:.3}..{:.3}, y {:.3}..{:.3} mm, over the scan's extent (x {:.3}..{:.3}, y \
                  {:.3}..{:.3} mm, printer frame) but over its holes or gaps (a bore of the part, \
                  a point cloud's dropouts); move the drawing onto the surface (the placement \
                  offset), and for a point cloud a larger maximum edge (--max-edge) closes wider \
                  gaps",
-                lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
-            )
-        } else if any_sample {
-            format!(
+                    lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
+                )
+            } else if any_sample {
+                format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
                  placement offset and the registration (--place centre puts the drawing on the \
                  scan's footprint)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
-        } else {
-            "the drawing has no path to print".into()
-        }));
+            } else {
+                "the drawing has no path to print".into()
+            },
+        ));
     }
     // Most of a drawing off the scan still printed its fragments with
     // exit 0, the share lost said nowhere (18 warnings, one a piece): said

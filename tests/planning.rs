@@ -826,7 +826,39 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("edge-on") && e.contains("--up-axis") && !e.contains("holes"),
+        e.contains("edge-on") && e.contains("--up-axis y, z or -z") && !e.contains("holes"),
+        "{e}"
+    );
+    // Lying in the YZ plane (facing X), no up axis can help, and the
+    // message says so instead of offering them (a QA finding).
+    let turned = TriMesh {
+        vertices: s
+            .mesh()
+            .vertices
+            .iter()
+            .map(|v| DVec3::new(v.y, v.x, v.z))
+            .collect(),
+        triangles: s.mesh().triangles.clone(),
+    };
+    let s = Surface::new(turned).unwrap();
+    let (lo, hi) = s.bbox();
+    let (placement, _) = pcpp::placement::centre_drawing(
+        &drawn,
+        (lo.truncate(), hi.truncate()),
+        &pcpp::svg::Placement::IDENTITY,
+        true,
+    )
+    .unwrap();
+    let settings = PlanSettings {
+        placement,
+        ..PlanSettings::default()
+    };
+    let e = pipeline::plan(&s, &drawn, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("faces sideways, along X, which no up axis turns face-up")
+            && e.contains("mesh tool"),
         "{e}"
     );
 }

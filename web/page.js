@@ -69,6 +69,7 @@ const PAGE_WORDS = [
     "('Centre on scan' puts the drawing on the scan's footprint)"],
   [/\(--up-axis y, z or -z; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
   [/\(--up-axis\)/g, '(Up axis)'],
+  [/\(--up-axis reads \+Z, \+Y or -Z as up\)/g, '(Up axis offers +Z, +Y and -Z)'],
   [/\(--up-axis (-?)([yz])\)/g, (_, sign, a) => `(Up axis: ${sign || '+'}${a.toUpperCase()})`],
   [/\(--up-axis; a depth camera's frame, z the distance from the camera, is -z\)/g,
     "(Up axis; a depth camera's frame, z the distance from the camera, is -Z)"],
