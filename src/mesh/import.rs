@@ -486,6 +486,20 @@ fn import_cloud(
             info.merged
         ));
     }
+    if let Some(s) = &info.spikes {
+        let [x, y, z] = s.worst_mm;
+        warnings.push(format!(
+            "{file}: {} point(s) stand more than {:.3} mm ({} point spacings) above every \
+             point around them, the highest at ({x:.3}, {y:.3}, {z:.3}) mm (printer frame) \
+             {:.3} mm above its neighbours: stray points (a depth camera's flying pixels)? \
+             The surface is meshed through them and the nozzle rises over them; remove them \
+             from the cloud if they are not part of the part",
+            s.count,
+            cloud::SPIKE_PER_SPACING * info.spacing_mm,
+            cloud::SPIKE_PER_SPACING,
+            s.above_mm
+        ));
+    }
     if info.hidden > 0 {
         warnings.push(format!(
             "{file}: {} of its {} points lie under the surface seen from above (a whole \
