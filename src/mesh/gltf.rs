@@ -64,17 +64,23 @@ pub(super) fn parse(
             .any(|e| e == ext)
     };
     let (compressed, fallbacks) = meshopt::views(json, uses(meshopt::EXT), file)?;
-    let draco = draco_primitives(json, &root, uses(DRACO), file)?;
-    // Also where a file uses it without listing it (which the spec asks
-    // for): a node's copies are never dropped.
-    let instanced = instanced_nodes(
-        json,
-        uses(INSTANCING)
-            || json
-                .windows(INSTANCING.len())
-                .any(|w| w == INSTANCING.as_bytes()),
-        file,
-    )?;
+    // Instancing also where a file uses it without listing it (which the
+    // spec asks for): a node's copies are never dropped.
+    let instancing = uses(INSTANCING)
+        || json
+            .windows(INSTANCING.len())
+            .any(|w| w == INSTANCING.as_bytes());
+    let raw = if uses(DRACO) || instancing {
+        RawExtensions::read(json, file)?
+    } else {
+        RawExtensions::default()
+    };
+    let draco = if uses(DRACO) {
+        draco_primitives(&raw, &root, file)?
+    } else {
+        Default::default()
+    };
+    let instanced = instanced_nodes(&raw, file)?;
     if let Some(d) = draco.values().next() {
         // glTF lets an accessor have neither bufferView nor sparse values
         // (it then holds zeros), and Draco primitives' accessors are
@@ -293,38 +299,46 @@ struct DracoRef {
     position: u32,
 }
 
-/// The Draco-compressed primitives of the file, by (mesh, primitive); none
-/// when it does not use the extension (`used`). The extension object is
-/// read from the JSON text (the `gltf` crate keeps no unknown extensions);
-/// its bufferView is checked against the list.
+/// The extension objects of the file's primitives and nodes, read from the
+/// JSON text (the `gltf` crate keeps no unknown extensions), for the
+/// extensions read here that the crate does not know (Draco, instancing).
+#[derive(Default, serde::Deserialize)]
+struct RawExtensions {
+    #[serde(default)]
+    meshes: Vec<RawMesh>,
+    #[serde(default)]
+    nodes: Vec<RawExtended>,
+}
+
+#[derive(serde::Deserialize)]
+struct RawMesh {
+    #[serde(default)]
+    primitives: Vec<RawExtended>,
+}
+
+/// An object's `extensions`.
+#[derive(serde::Deserialize)]
+struct RawExtended {
+    #[serde(default)]
+    extensions: Option<serde_json::Map<String, serde_json::Value>>,
+}
+
+impl RawExtensions {
+    fn read(json: &[u8], file: &str) -> Result<RawExtensions, MeshError> {
+        serde_json::from_slice(json)
+            .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))
+    }
+}
+
+/// The Draco-compressed primitives of the file, by (mesh, primitive);
+/// each extension object's bufferView is checked against the list.
 fn draco_primitives(
-    json: &[u8],
+    raw: &RawExtensions,
     root: &gltf::json::Root,
-    used: bool,
     file: &str,
 ) -> Result<std::collections::HashMap<(usize, usize), DracoRef>, MeshError> {
-    #[derive(serde::Deserialize)]
-    struct Doc {
-        #[serde(default)]
-        meshes: Vec<MeshJson>,
-    }
-    #[derive(serde::Deserialize)]
-    struct MeshJson {
-        #[serde(default)]
-        primitives: Vec<PrimitiveJson>,
-    }
-    #[derive(serde::Deserialize)]
-    struct PrimitiveJson {
-        #[serde(default)]
-        extensions: Option<serde_json::Map<String, serde_json::Value>>,
-    }
     let mut out = std::collections::HashMap::new();
-    if !used {
-        return Ok(out);
-    }
-    let doc: Doc = serde_json::from_slice(json)
-        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
-    for (m, mesh) in doc.meshes.iter().enumerate() {
+    for (m, mesh) in raw.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let Some(ext) = primitive.extensions.as_ref().and_then(|e| e.get(DRACO)) else {
                 continue;
@@ -383,27 +397,11 @@ struct Instancing {
 
 /// The nodes that use [`INSTANCING`], by node index.
 fn instanced_nodes(
-    json: &[u8],
-    used: bool,
+    raw: &RawExtensions,
     file: &str,
 ) -> Result<std::collections::HashMap<usize, Instancing>, MeshError> {
-    #[derive(serde::Deserialize)]
-    struct Doc {
-        #[serde(default)]
-        nodes: Vec<NodeJson>,
-    }
-    #[derive(serde::Deserialize)]
-    struct NodeJson {
-        #[serde(default)]
-        extensions: Option<serde_json::Map<String, serde_json::Value>>,
-    }
     let mut out = std::collections::HashMap::new();
-    if !used {
-        return Ok(out);
-    }
-    let doc: Doc = serde_json::from_slice(json)
-        .map_err(|e| MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}")))?;
-    for (n, node) in doc.nodes.iter().enumerate() {
+    for (n, node) in raw.nodes.iter().enumerate() {
         let Some(ext) = node.extensions.as_ref().and_then(|e| e.get(INSTANCING)) else {
             continue;
         };
