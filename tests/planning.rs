@@ -807,24 +807,27 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
         ],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
     };
-    let s = Surface::new(mesh).unwrap();
-    let (lo, hi) = s.bbox();
     let drawn = [line(DVec2::new(0.0, 0.0), DVec2::new(20.0, 10.0))];
-    let (placement, _) = pcpp::placement::centre_drawing(
-        &drawn,
-        (lo.truncate(), hi.truncate()),
-        &pcpp::svg::Placement::IDENTITY,
-        true,
-    )
-    .unwrap();
-    assert_eq!(placement.scale, 1.0);
-    let settings = PlanSettings {
-        placement,
-        ..PlanSettings::default()
+    // The drawing centred on the scan and planned: the error.
+    let centred = |s: &Surface| {
+        let (lo, hi) = s.bbox();
+        let (placement, _) = pcpp::placement::centre_drawing(
+            &drawn,
+            (lo.truncate(), hi.truncate()),
+            &pcpp::svg::Placement::IDENTITY,
+            true,
+        )
+        .unwrap();
+        assert_eq!(placement.scale, 1.0);
+        let settings = PlanSettings {
+            placement,
+            ..PlanSettings::default()
+        };
+        pipeline::plan(s, &drawn, &settings)
+            .unwrap_err()
+            .to_string()
     };
-    let e = pipeline::plan(&s, &drawn, &settings)
-        .unwrap_err()
-        .to_string();
+    let e = centred(&Surface::new(mesh.clone()).unwrap());
     assert!(
         e.contains("edge-on") && e.contains("--up-axis y, z or -z") && !e.contains("holes"),
         "{e}"
@@ -832,30 +835,14 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
     // Lying in the YZ plane (facing X), no up axis can help, and the
     // message says so instead of offering them (a QA finding).
     let turned = TriMesh {
-        vertices: s
-            .mesh()
+        vertices: mesh
             .vertices
             .iter()
             .map(|v| DVec3::new(v.y, v.x, v.z))
             .collect(),
-        triangles: s.mesh().triangles.clone(),
+        triangles: mesh.triangles.clone(),
     };
-    let s = Surface::new(turned).unwrap();
-    let (lo, hi) = s.bbox();
-    let (placement, _) = pcpp::placement::centre_drawing(
-        &drawn,
-        (lo.truncate(), hi.truncate()),
-        &pcpp::svg::Placement::IDENTITY,
-        true,
-    )
-    .unwrap();
-    let settings = PlanSettings {
-        placement,
-        ..PlanSettings::default()
-    };
-    let e = pipeline::plan(&s, &drawn, &settings)
-        .unwrap_err()
-        .to_string();
+    let e = centred(&Surface::new(turned).unwrap());
     assert!(
         e.contains("faces sideways, along X, which no up axis turns face-up")
             && e.contains("mesh tool"),
