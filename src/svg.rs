@@ -220,7 +220,7 @@ pub enum SvgError {
     #[error(
         "{file}: the drawing needs more than {limit} points to follow its curves (within \
          {tolerance_mm} mm), counted over all its shapes; the count passed that at {element}, \
-         shape {nth} of the drawing. A drawing this large in mm or this detailed (many clones \
+         shape {nth} as drawn (each <use> copy counts). A drawing this large in mm or this detailed (many clones \
          or nodes) is not read, at whatever scale it is placed: check its width/height units \
          and viewBox, or simplify it (unlink clones, fewer nodes)"
     )]
@@ -1618,14 +1618,12 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
 /// refused naming what was found: a drawing is never guessed at.
 fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
     use std::borrow::Cow;
-    let utf16 = |be: bool| -> Result<Cow<'_, str>, String> {
-        let body = &bytes[2..];
+    let utf16 = |be: bool, bom: bool| -> Result<Cow<'_, str>, String> {
+        let body = &bytes[if bom { 2 } else { 0 }..];
         if !body.len().is_multiple_of(2) {
-            return Err(
-                "UTF-16 text (by its byte-order mark) with an odd number of bytes: \
+            return Err("UTF-16 text with an odd number of bytes: \
                  the file is cut short; save it again (as UTF-8 if you can)"
-                    .into(),
-            );
+                .into());
         }
         let units = body.chunks_exact(2).map(|c| {
             if be {
@@ -1639,17 +1637,25 @@ fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
             .map(Cow::Owned)
             .map_err(|e| {
                 format!(
-                    "UTF-16 text (by its byte-order mark) with an unpaired surrogate \
+                    "UTF-16 text with an unpaired surrogate \
                      0x{:04X}: save it again as UTF-8",
                     e.unpaired_surrogate()
                 )
             })
     };
     if bytes.starts_with(&[0xFE, 0xFF]) {
-        return utf16(true);
+        return utf16(true, true);
     }
     if bytes.starts_with(&[0xFF, 0xFE]) {
-        return utf16(false);
+        return utf16(false, true);
+    }
+    // UTF-16 without a byte-order mark: the document's first character,
+    // '<', with a zero byte after or before it (XML 1.0, appendix F).
+    if bytes.starts_with(b"<\0") {
+        return utf16(false, false);
+    }
+    if bytes.starts_with(b"\0<") {
+        return utf16(true, false);
     }
     let declared = declared_encoding(bytes);
     match declared.map(str::to_ascii_lowercase).as_deref() {
@@ -1671,6 +1677,10 @@ fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
                     .filter(|&&b| b == b'\n')
                     .count();
                 let said = match (declared, lower) {
+                    (Some(enc), Some(l)) if l.starts_with("utf-16") => format!(
+                        "; its XML declaration names '{enc}', but the text is not UTF-16 (it \
+                         starts with one-byte characters): save it as UTF-8"
+                    ),
                     (Some(enc), Some(l)) if l != "utf-8" && l != "utf8" => format!(
                         "; its XML declaration names the encoding '{enc}', which is not read \
                          (UTF-8, UTF-16, ISO-8859-1 and windows-1252 are): save it as UTF-8"
@@ -1693,7 +1703,9 @@ fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
 /// UTF-8 byte-order mark), if there is one.
 fn declared_encoding(bytes: &[u8]) -> Option<&str> {
     let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
-    let head = bytes.strip_prefix(b"<?xml")?;
+    // (Not well-formed XML after white space, but found there too.)
+    let start = bytes.iter().position(|b| !b.is_ascii_whitespace())?;
+    let head = bytes[start..].strip_prefix(b"<?xml")?;
     let end = head.windows(2).take(512).position(|w| w == b"?>")?;
     let decl = std::str::from_utf8(&head[..end]).ok()?;
     let at = decl.find("encoding")?;
@@ -1742,6 +1754,8 @@ fn scan_kind(bytes: &[u8]) -> Option<&'static str> {
 /// or else the expansion itself. A `<use>` inside the element it refers to
 /// is left out: usvg skips it, as browsers do.
 fn use_expansion(text: &str) -> String {
+    // The links of a loop named in the message; a longer loop is cut.
+    const SHOWN_LINKS: usize = 6;
     let opt = roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
@@ -1762,8 +1776,10 @@ fn use_expansion(text: &str) -> String {
         .descendants()
         .filter_map(|n| Some((n.attribute("id")?, n)))
         .collect();
-    // For each element with an id, the (target, line) of the <use>s in it.
-    let mut edges: HashMap<&str, Vec<(&str, u32)>> = HashMap::new();
+    // For each element with an id, the (target, byte offset) of the <use>s
+    // in it (lines are found only for the loop reported: finding each
+    // one's line rescans the text).
+    let mut edges: HashMap<&str, Vec<(&str, usize)>> = HashMap::new();
     for (&id, &e) in &ids {
         let mut out = Vec::new();
         for u in e.descendants().filter(|n| n.tag_name().name() == "use") {
@@ -1772,58 +1788,60 @@ fn use_expansion(text: &str) -> String {
             };
             // Inside its own target: skipped, not a cycle.
             if !u.ancestors().any(|a| a == t) {
-                out.push((target, doc.text_pos_at(u.range().start).row));
+                out.push((target, u.range().start));
             }
         }
         edges.insert(id, out);
     }
-    // Depth-first, with the path of (id, line of the <use> taken from it).
-    fn walk<'a>(
-        id: &'a str,
-        edges: &HashMap<&'a str, Vec<(&'a str, u32)>>,
-        state: &mut HashMap<&'a str, bool>,
-        path: &mut Vec<(&'a str, u32)>,
-    ) -> Option<Vec<(&'a str, u32)>> {
-        state.insert(id, true);
-        for &(target, line) in edges.get(id).map_or(&[][..], |v| &v[..]) {
-            path.push((id, line));
-            match state.get(target) {
-                Some(true) => {
-                    let from = path.iter().position(|&(i, _)| i == target)?;
-                    let mut cycle = path[from..].to_vec();
-                    cycle.push((target, 0));
-                    return Some(cycle);
-                }
-                Some(false) => {}
-                None => {
-                    if let Some(c) = walk(target, edges, state, path) {
-                        return Some(c);
-                    }
-                }
-            }
-            path.pop();
-        }
-        state.insert(id, false);
-        None
-    }
-    let mut state = HashMap::new();
+    // Depth-first with an explicit stack (a chain of thousands of <use>s
+    // would overflow the call stack): each frame is an id and the next of
+    // its edges to follow; `on_path` marks the ids on the stack, `done`
+    // those whose every edge was followed.
     let mut names: Vec<&str> = ids.keys().copied().collect();
     names.sort_by_key(|id| ids[id].range().start);
-    for id in names {
-        if state.contains_key(id) {
+    let mut on_path: HashSet<&str> = HashSet::new();
+    let mut done: HashSet<&str> = HashSet::new();
+    for start in names {
+        if done.contains(start) {
             continue;
         }
-        if let Some(cycle) = walk(id, &edges, &mut state, &mut Vec::new()) {
-            let chain = cycle[..cycle.len() - 1]
-                .iter()
-                .zip(&cycle[1..])
-                .map(|(&(from, line), &(to, _))| format!("'{from}' uses '#{to}' (line {line})"))
-                .collect::<Vec<_>>()
-                .join(", ");
-            return format!(
-                "a <use> refers back to itself: {chain}; such a loop has no end and a browser \
-                 draws nothing for it: remove or retarget one of these <use>s"
-            );
+        let mut stack: Vec<(&str, usize)> = vec![(start, 0)];
+        on_path.insert(start);
+        while let Some(&mut (id, ref mut next)) = stack.last_mut() {
+            let out = edges.get(id).map_or(&[][..], |v| &v[..]);
+            let Some(&(target, _)) = out.get(*next) else {
+                stack.pop();
+                on_path.remove(id);
+                done.insert(id);
+                continue;
+            };
+            *next += 1;
+            if on_path.contains(target) {
+                // The loop: from `target`'s frame to here, each frame's
+                // edge the one it last followed.
+                let from = stack.iter().position(|&(i, _)| i == target).unwrap_or(0);
+                let links = &stack[from..];
+                let mut chain = links
+                    .iter()
+                    .take(SHOWN_LINKS)
+                    .map(|&(i, k)| {
+                        let (to, at) = edges[i][k - 1];
+                        format!("'{i}' uses '#{to}' (line {})", doc.text_pos_at(at).row)
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                if links.len() > SHOWN_LINKS {
+                    chain.push_str(&format!(", ... ({} links in all)", links.len()));
+                }
+                return format!(
+                    "a <use> refers back to itself: {chain}; such a loop has no end and a \
+                     browser draws nothing for it: remove or retarget one of these <use>s"
+                );
+            }
+            if !done.contains(target) {
+                on_path.insert(target);
+                stack.push((target, 0));
+            }
         }
     }
     too_big

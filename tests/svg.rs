@@ -854,7 +854,7 @@ fn a_drawing_needing_too_many_points_names_the_limit_and_the_units() {
         e.contains("huge.svg")
             && e.contains("more than 4000000 points")
             && e.contains("counted over all its shapes")
-            && e.contains("shape 5 of the drawing")
+            && e.contains("shape 5 as drawn")
             && e.contains("units"),
         "{e}"
     );
@@ -1656,6 +1656,8 @@ fn a_utf16_svg_is_read_by_its_byte_order_mark() {
             bytes.extend_from_slice(&pair);
         }
         assert_eq!(import_svg(&bytes, "u16.svg").unwrap(), want);
+        // Without its byte-order mark too (the '<' and a zero byte tell).
+        assert_eq!(import_svg(&bytes[2..], "u16.svg").unwrap(), want);
         // Cut short by one byte: refused, naming the file.
         let e = import_svg(&bytes[..bytes.len() - 1], "u16.svg")
             .unwrap_err()
@@ -1682,23 +1684,38 @@ fn a_latin1_or_cp1252_svg_is_read_as_its_declaration_says() {
         )
         .into_bytes();
         b.extend_from_slice(title);
+        // The same characters name the path: its `source` shows how they
+        // were decoded.
+        b.extend_from_slice(b"</title><path id=\"");
+        b.extend_from_slice(title);
         b.extend_from_slice(
-            b"</title><path d=\"M 5 5 L 45 5 A 10 10 0 0 1 45 25\" stroke=\"black\" \
+            b"\" d=\"M 5 5 L 45 5 A 10 10 0 0 1 45 25\" stroke=\"black\" \
               fill=\"none\"/></svg>\n",
         );
         b
     };
-    let want = import_svg(
-        &body("UTF-8", "\u{e9}t\u{e9} \u{20ac}".as_bytes()),
-        "u8.svg",
-    )
-    .unwrap();
-    assert!(!want.is_empty());
-    for enc in ["ISO-8859-1", "latin1", "windows-1252", "US-ASCII"] {
-        // 0xE9 is e-acute in all but ASCII, 0x80 the euro sign in cp1252.
-        let got = import_svg(&body(enc, b"\xe9t\xe9 \x80"), "old.svg");
-        assert_eq!(got.unwrap(), want, "{enc}");
+    let want = import_svg(&body("UTF-8", "\u{e9}t\u{e9}\u{20ac}".as_bytes()), "u8.svg").unwrap();
+    assert_eq!(want[0].source, "\u{e9}t\u{e9}\u{20ac}");
+    // 0xE9 is e-acute in each, 0x80 the euro sign in cp1252 and the
+    // control character U+0080 in ISO-8859-1 (and US-ASCII, read as it).
+    for (enc, id) in [
+        ("ISO-8859-1", "\u{e9}t\u{e9}\u{80}"),
+        ("latin1", "\u{e9}t\u{e9}\u{80}"),
+        ("windows-1252", "\u{e9}t\u{e9}\u{20ac}"),
+        ("US-ASCII", "\u{e9}t\u{e9}\u{80}"),
+    ] {
+        let got = import_svg(&body(enc, b"\xe9t\xe9\x80"), "old.svg").unwrap();
+        assert_eq!(got[0].points, want[0].points, "{enc}");
+        assert_eq!(got[0].source, id, "{enc}");
     }
+    // Declared UTF-16, written in one-byte characters: said so.
+    let e = import_svg(&body("UTF-16", b"\xe9t\xe9"), "u.svg")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("names 'UTF-16', but the text is not UTF-16"),
+        "{e}"
+    );
     let e = import_svg(&body("KOI8-R", b"\xe9t\xe9"), "koi.svg")
         .unwrap_err()
         .to_string();
@@ -1957,6 +1974,21 @@ fn use_loops_and_use_bombs_are_named() {
         r##"<path d="M 5 5 L 45 5" stroke="black"/><g id="g"><use href="#g"/></g>"##,
     ));
     assert_eq!(subs.len(), 1, "{subs:?}");
+    // A loop through 50,000 <use>s (the search recursed once a link and
+    // overflowed the stack; each link's line was found by rescanning the
+    // text): found, and named by its first links.
+    let n = 50_000;
+    let mut body = String::from("<defs>");
+    for i in 0..n {
+        body.push_str(&format!("<use id=\"u{i}\" href=\"#u{}\"/>\n", (i + 1) % n));
+    }
+    body.push_str("</defs><use href=\"#u0\"/>");
+    let e = import_error(&doc(MM, &body));
+    assert!(
+        e.contains("'u0' uses '#u1' (line 1)") && e.contains("(50000 links in all)"),
+        "{}",
+        &e[..e.len().min(600)]
+    );
 }
 
 /// An `<image>` was meant to get a note, but usvg drops images it does not
