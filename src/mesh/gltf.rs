@@ -190,8 +190,19 @@ pub(super) fn parse(
     // triangles, points describe no surface and are skipped.
     let as_cloud = scene.triangles.is_empty() && !scene.points.is_empty();
     if as_cloud {
+        // Each POINTS primitive drawn, instances too: at most as many
+        // points as a scan's triangles (a node of a million instances of a
+        // large cloud would otherwise be read a million times).
+        let mut points = 0usize;
         for (index, world, at) in std::mem::take(&mut scene.points) {
             if let Some(accessor) = gltf.accessors().nth(index) {
+                points = points.saturating_add(accessor.count());
+                if points > MAX_TRIANGLES {
+                    return Err(scene.err(format!(
+                        "its POINTS primitives, as drawn by its nodes and their instances, \
+                         hold more than {MAX_TRIANGLES} points"
+                    )));
+                }
                 scene.positions(&accessor, &world, &at)?;
             }
         }
@@ -379,6 +390,11 @@ fn draco_primitives(
     }
     Ok(out)
 }
+
+/// How many bytes of zeros a sparse accessor without a bufferView may stand
+/// for, per byte of the file's buffers (a morph target that moves a few
+/// points of a large mesh: the mesh's own positions are in the file).
+const SPARSE_ZEROS_PER_BYTE: u64 = 64;
 
 /// EXT_mesh_gpu_instancing: a node drawn once per instance, each placed by
 /// the node's transform times its own translation, rotation and scale
@@ -781,12 +797,20 @@ impl SceneReader<'_, '_> {
         let ty = accessor.data_type();
         let size = ty.size() * accessor.dimensions().multiplicity();
         let count = accessor.count();
-        let total = count
-            .checked_mul(size)
-            .filter(|&n| n as u64 <= MAX_SCAN_BYTES as u64);
+        // Without a bufferView the base is zeros the file does not hold: a
+        // count past what its bytes could make (a 577-byte file declaring
+        // 80 M elements took 2 GB) is refused before anything is allocated.
+        let held: usize = self.buffers.iter().map(|b| b.len()).sum();
+        let most = if accessor.view().is_some() {
+            MAX_SCAN_BYTES as u64
+        } else {
+            (SPARSE_ZEROS_PER_BYTE * held as u64).clamp(1 << 20, MAX_SCAN_BYTES as u64)
+        };
+        let total = count.checked_mul(size).filter(|&n| n as u64 <= most);
         let Some(total) = total else {
             return Err(self.err(format!(
-                "{what} accessor {index} declares {count} elements, more than a scan may hold"
+                "{what} accessor {index} (sparse) declares {count} elements of {size} bytes, \
+                 more than its file's {held} bytes of buffers can describe"
             )));
         };
         let mut data = vec![0u8; total];
@@ -822,6 +846,7 @@ impl SceneReader<'_, '_> {
         let at = slice(indices.view(), indices.offset(), n.checked_mul(width))?;
         let values = sparse.values();
         let new = slice(values.view(), values.offset(), n.checked_mul(size))?;
+        let mut last = 0usize;
         for k in 0..n {
             let b = &at[k * width..(k + 1) * width];
             let i = match width {
@@ -829,9 +854,19 @@ impl SceneReader<'_, '_> {
                 2 => usize::from(u16::from_le_bytes([b[0], b[1]])),
                 _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
             };
+            // The spec asks for strictly increasing indices: a repeated one
+            // would leave which value holds to the reader.
+            if k > 0 && i <= last {
+                return Err(bad(format!(
+                    "entry {k} replaces element {i}, not one after the entry before it \
+                     ({last}): the indices must increase"
+                )));
+            }
+            last = i;
             let slot = i
                 .checked_mul(size)
-                .and_then(|s| data.get_mut(s..s + size))
+                .and_then(|s| Some(s..s.checked_add(size)?))
+                .and_then(|r| data.get_mut(r))
                 .ok_or_else(|| {
                     bad(format!(
                         "entry {k} replaces element {i}, but there are {count}"
@@ -1350,6 +1385,11 @@ mod tests {
     /// turned 90 degrees about Z and moved by (0, 20, 0). `listed`: the
     /// extension is in extensionsUsed; `counts`: the three attributes'.
     fn instanced_gltf(listed: bool, counts: [usize; 3]) -> String {
+        instanced_gltf_at(listed, counts, "")
+    }
+
+    /// [`instanced_gltf`] with `node` (its transform) on the node.
+    fn instanced_gltf_at(listed: bool, counts: [usize; 3], node: &str) -> String {
         let mut f: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
         f.extend([10.0, 0.0, 0.0, 0.0, 20.0, 0.0]);
         let h = std::f32::consts::FRAC_1_SQRT_2;
@@ -1363,7 +1403,7 @@ mod tests {
         };
         format!(
             r#"{{"asset":{{"version":"2.0"}},{used}"scene":0,"scenes":[{{"nodes":[0]}}],
-            "nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":
+            "nodes":[{{"mesh":0{node},"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":
                 {{"TRANSLATION":1,"ROTATION":2,"SCALE":3}}}}}}}}],
             "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
             "accessors":[
@@ -1410,6 +1450,34 @@ mod tests {
                     "{got:?}"
                 );
             }
+        }
+        // The instances stand in the node's frame: world = node x instance
+        // (the node turned 90 degrees about Z and moved by (0, 100, 0)).
+        let node = r#","translation":[0,100,0],"rotation":[0,0,0.70710678,0.70710678]"#;
+        let p = parse(
+            instanced_gltf_at(true, [2, 2, 2], node).as_bytes(),
+            "i.gltf",
+        )
+        .unwrap();
+        let got: Vec<[f64; 3]> = p
+            .triangles
+            .iter()
+            .flat_map(|t| t.iter().map(|&i| p.vertices[i as usize].to_array()))
+            .collect();
+        let want = [
+            [0.0, 110.0, 0.0],
+            [0.0, 112.0, 0.0],
+            [-2.0, 110.0, 0.0],
+            [-20.0, 100.0, 0.0],
+            [-21.0, 100.0, 0.0],
+            [-20.0, 99.0, 0.0],
+        ];
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                g.iter().zip(w).all(|(a, b)| (a - b).abs() < 1e-5),
+                "{got:?}"
+            );
         }
         let e = parse(instanced_gltf(true, [2, 1, 2]).as_bytes(), "i.gltf")
             .unwrap_err()
@@ -1465,7 +1533,7 @@ mod tests {
     /// triangle's bufferView (else its base is zeros); its sparse part
     /// replaces elements `at` (u16 indices) with (1, 0, 0) and (0, 2, 0).
     fn sparse_gltf(base: bool, at: [u16; 2]) -> String {
-        let mut bytes: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        let mut bytes: Vec<u8> = [0.0f32, 0.0, 5.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
             .iter()
             .flat_map(|f| f.to_le_bytes())
             .collect();
@@ -1481,7 +1549,7 @@ mod tests {
             "nodes":[{{"mesh":0}}],
             "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
             "accessors":[{{{view}"componentType":5126,"count":3,"type":"VEC3",
-                "min":[0,0,0],"max":[1,2,0],
+                "min":[0,0,0],"max":[1,2,5],
                 "sparse":{{"count":2,"indices":{{"bufferView":1,"componentType":5123}},
                   "values":{{"bufferView":2}}}}}}],
             "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":4}},
@@ -1496,6 +1564,8 @@ mod tests {
     /// (a QA finding): they are read, over a bufferView or over zeros.
     #[test]
     fn sparse_accessors_are_read() {
+        // Over zeros, over the view (whose first point is (0, 0, 5)), and
+        // replacing that first point.
         for (base, at, want) in [
             (
                 false,
@@ -1505,28 +1575,34 @@ mod tests {
             (
                 true,
                 [1, 2],
-                [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+                [[0.0, 0.0, 5.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
             ),
             (
                 true,
-                [0, 2],
-                [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+                [0, 1],
+                [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 0.0]],
             ),
         ] {
-            let text = sparse_gltf(base, at);
-            if at == [0, 2] {
-                // Two corners made equal: one vertex, a degenerate triangle.
-                let p = parse(text.as_bytes(), "s.gltf").unwrap();
-                assert_eq!(p.vertices.len(), 2, "{:?}", p.vertices);
-                continue;
-            }
-            let p = parse(text.as_bytes(), "s.gltf").unwrap();
+            let p = parse(sparse_gltf(base, at).as_bytes(), "s.gltf").unwrap();
             let got: Vec<[f64; 3]> = p.triangles[0]
                 .iter()
                 .map(|&i| p.vertices[i as usize].to_array())
                 .collect();
-            assert_eq!(got, want.to_vec(), "base {base}");
+            assert_eq!(got, want.to_vec(), "base {base}, at {at:?}");
         }
+        // Indices that do not increase, and an element past the count.
+        let e = parse(sparse_gltf(true, [2, 1]).as_bytes(), "s.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("entry 1 replaces element 1") && e.contains("must increase"),
+            "{e}"
+        );
+        // Zeros the file does not hold, 80 M of them (a review's 577-byte
+        // file took 2 GB): refused before they are allocated.
+        let bomb = sparse_gltf(false, [1, 2]).replacen(r#""count":3"#, r#""count":80000000"#, 1);
+        let e = parse(bomb.as_bytes(), "s.gltf").unwrap_err().to_string();
+        assert!(e.contains("declares 80000000 elements of 12 bytes"), "{e}");
         let e = parse(sparse_gltf(true, [1, 7]).as_bytes(), "s.gltf")
             .unwrap_err()
             .to_string();
