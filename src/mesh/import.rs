@@ -489,14 +489,18 @@ fn import_cloud(
     if let Some(s) = &info.spikes {
         let [x, y, z] = s.worst_mm;
         warnings.push(format!(
-            "{file}: {} point(s) stand more than {:.3} mm ({} point spacings) above every \
-             point around them, the highest at ({x:.3}, {y:.3}, {z:.3}) mm (printer frame) \
-             {:.3} mm above its neighbours: stray points (a depth camera's flying pixels)? \
-             The surface is meshed through them and the nozzle rises over them; remove them \
-             from the cloud if they are not part of the part",
+            "{file}: {} point(s) stand more than {:.3} mm above every point around them, the \
+             highest at ({x:.3}, {y:.3}, {z:.3}) mm as read (in mm, {}), {:.3} mm above its \
+             neighbours: stray points (a depth camera's flying pixels)? The surface is meshed \
+             through them and the nozzle rises over them; remove them from the cloud if they \
+             are not part of the part",
             s.count,
-            cloud::SPIKE_PER_SPACING * info.spacing_mm,
-            cloud::SPIKE_PER_SPACING,
+            cloud::spike_limit(info.spacing_mm),
+            match up_axis {
+                UpAxis::Z => "+Z up",
+                UpAxis::Y => "+Y up read as +Z",
+                UpAxis::NegZ => "-Z up read as +Z",
+            },
             s.above_mm
         ));
     }
