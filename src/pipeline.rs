@@ -220,8 +220,11 @@ pub fn surface_path(
         let (slo, shi) = surface.bbox();
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
         let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
+        // Thin along X only (a bar or needle thin both ways may lie down
+        // under another up axis: a review's 0.5 x 0.6 x 50 mm one did).
+        let faces_x = foot.x < EDGE_ON_SHARE * foot.y;
         return Err(Error::Plan(
-            if any_sample && edge_on(foot, tall) && foot.x < foot.y {
+            if any_sample && edge_on(foot, tall) && faces_x {
                 // Thin along X: no up axis this program reads turns it face-up
                 // (+Z, +Y and -Z are; a QA run's polygon faced +X, and the
                 // message offered the up axes that cannot help).

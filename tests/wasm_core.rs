@@ -1114,7 +1114,7 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
     let message = fit["message"].as_str().unwrap();
     assert!(
         message.contains("outside the build volume of profile marlin")
-            && message.contains("'Place on the bed'"),
+            && message.contains("(--place-scan bed)"),
         "{message}"
     );
     assert!(pcpp::wasm::volume_fit(&b[..5], "marlin", None).is_err());
