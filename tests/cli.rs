@@ -1482,6 +1482,29 @@ fn a_gltf_without_its_bin_names_the_file_it_looked_for() {
         );
     }
     assert!(!out.exists());
+    // From standard input, the folder looked in is the current one (a QA
+    // run was told to keep the file "next to stdin").
+    {
+        use std::io::Write;
+        use std::process::Stdio;
+        let mut child = Command::new(BIN)
+            .current_dir(&dir)
+            .args(["fiducials", "--scan", "-"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let text = std::fs::read(&gltf).unwrap();
+        child.stdin.take().unwrap().write_all(&text).unwrap();
+        let o = child.wait_with_output().unwrap();
+        let err = stderr(&o);
+        assert!(
+            code(&o) == 1
+                && err.contains("keep it in the current folder (a .gltf read from standard input"),
+            "{err}"
+        );
+    }
     // A buffer on the web is refused before anything is read.
     let remote = std::fs::read_to_string(&gltf)
         .unwrap()

@@ -49,8 +49,9 @@ pub enum MeshError {
     /// folder, the page needs both files selected together.
     #[error(
         "{file}: buffer {buffer} is stored in the external file '{path}', which was not given: \
-         keep it next to {file} (command line) or select both files together (page), or export \
-         the scan as one .glb"
+         keep it {} (command line) or select both files together (page), or export the scan \
+         as one .glb",
+        beside(file)
     )]
     MissingExternalFile {
         file: String,
@@ -138,5 +139,16 @@ mod tests {
             e.to_string(),
             "a.ply: face 2 refers to vertex index 9, but only 4 vertices are defined"
         );
+    }
+}
+
+/// Where the CLI looks for a `.gltf`'s separate files: beside it, or in the
+/// current folder for one read from standard input (a QA run was told to
+/// keep the file "next to standard input").
+fn beside(file: &str) -> String {
+    if matches!(file, "standard input" | "stdin" | "-") {
+        "in the current folder (a .gltf read from standard input finds its files there)".into()
+    } else {
+        format!("next to {file}")
     }
 }
