@@ -112,6 +112,17 @@ impl MeshError {
     }
 }
 
+/// Where the CLI looks for a `.gltf`'s separate files: beside it, or in the
+/// current folder for one read from standard input (a QA run was told to
+/// keep the file "next to standard input").
+fn beside(file: &str) -> String {
+    if matches!(file, "standard input" | "stdin" | "-") {
+        "in the current folder (a .gltf read from standard input finds its files there)".into()
+    } else {
+        format!("next to {file}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,16 +150,5 @@ mod tests {
             e.to_string(),
             "a.ply: face 2 refers to vertex index 9, but only 4 vertices are defined"
         );
-    }
-}
-
-/// Where the CLI looks for a `.gltf`'s separate files: beside it, or in the
-/// current folder for one read from standard input (a QA run was told to
-/// keep the file "next to standard input").
-fn beside(file: &str) -> String {
-    if matches!(file, "standard input" | "stdin" | "-") {
-        "in the current folder (a .gltf read from standard input finds its files there)".into()
-    } else {
-        format!("next to {file}")
     }
 }
