@@ -220,9 +220,9 @@ pub enum SvgError {
     #[error(
         "{file}: the drawing needs more than {limit} points to follow its curves (within \
          {tolerance_mm} mm), counted over all its shapes; the count passed that at {element}, \
-         shape {nth} as drawn (each <use> copy counts). A drawing this large in mm or this detailed (many clones \
-         or nodes) is not read, at whatever scale it is placed: check its width/height units \
-         and viewBox, or simplify it (unlink clones, fewer nodes)"
+         shape {nth} as drawn (each <use> copy counts). A drawing this large in mm or this \
+         detailed (many clones or nodes) is not read, at whatever scale it is placed: check its \
+         width/height units and viewBox, or simplify it (unlink clones, fewer nodes)"
     )]
     TooComplex {
         file: String,
@@ -1657,45 +1657,46 @@ fn decode_text(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, String> {
     if bytes.starts_with(b"\0<") {
         return utf16(true, false);
     }
+    // Text that is UTF-8 is read as UTF-8 whatever the declaration says
+    // (a file saved as UTF-8 by an editor that kept an old declaration).
+    let e = match std::str::from_utf8(bytes) {
+        Ok(text) => return Ok(Cow::Borrowed(text)),
+        Err(e) => e,
+    };
     let declared = declared_encoding(bytes);
     match declared.map(str::to_ascii_lowercase).as_deref() {
         Some("iso-8859-1" | "iso8859-1" | "iso_8859-1" | "latin1" | "latin-1" | "l1")
-        | Some("us-ascii" | "ascii")
-            if std::str::from_utf8(bytes).is_err() =>
-        {
+        | Some("us-ascii" | "ascii") => {
             Ok(Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()))
         }
-        Some("windows-1252" | "cp1252" | "x-cp1252") if std::str::from_utf8(bytes).is_err() => {
+        Some("windows-1252" | "cp1252" | "x-cp1252") => {
             Ok(Cow::Owned(bytes.iter().map(|&b| cp1252(b)).collect()))
         }
-        lower => match std::str::from_utf8(bytes) {
-            Ok(text) => Ok(Cow::Borrowed(text)),
-            Err(e) => {
-                let byte = bytes[e.valid_up_to()];
-                let line = 1 + bytes[..e.valid_up_to()]
-                    .iter()
-                    .filter(|&&b| b == b'\n')
-                    .count();
-                let said = match (declared, lower) {
-                    (Some(enc), Some(l)) if l.starts_with("utf-16") => format!(
-                        "; its XML declaration names '{enc}', but the text is not UTF-16 (it \
-                         starts with one-byte characters): save it as UTF-8"
-                    ),
-                    (Some(enc), Some(l)) if l != "utf-8" && l != "utf8" => format!(
-                        "; its XML declaration names the encoding '{enc}', which is not read \
-                         (UTF-8, UTF-16, ISO-8859-1 and windows-1252 are): save it as UTF-8"
-                    ),
-                    _ => "; save it as UTF-8 (every SVG editor can), or name its encoding in \
-                          the XML declaration (<?xml version=\"1.0\" \
-                          encoding=\"ISO-8859-1\"?>)"
-                        .into(),
-                };
-                Err(format!(
-                    "not UTF-8 text (line {line}, byte 0x{byte:02X}); SVG is an XML text \
-                     file{said}"
-                ))
-            }
-        },
+        lower => {
+            let byte = bytes[e.valid_up_to()];
+            let line = 1 + bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            let said = match (declared, lower) {
+                (Some(enc), Some(l)) if l.starts_with("utf-16") => format!(
+                    "; its XML declaration names '{enc}', but the text is not UTF-16 (it \
+                     starts with one-byte characters): save it as UTF-8"
+                ),
+                (Some(enc), Some(l)) if l != "utf-8" && l != "utf8" => format!(
+                    "; its XML declaration names the encoding '{enc}', which is not read \
+                     (UTF-8, UTF-16, ISO-8859-1 and windows-1252 are): save it as UTF-8"
+                ),
+                _ => "; save it as UTF-8 (every SVG editor can), or name its encoding in \
+                      the XML declaration (<?xml version=\"1.0\" \
+                      encoding=\"ISO-8859-1\"?>)"
+                    .into(),
+            };
+            Err(format!(
+                "not UTF-8 text (line {line}, byte 0x{byte:02X}); SVG is an XML text \
+                 file{said}"
+            ))
+        }
     }
 }
 
