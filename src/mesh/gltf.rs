@@ -724,6 +724,17 @@ struct Elements<'b> {
 }
 
 impl Elements<'_> {
+    /// The first `k` (at most 4) components of element `i`, as the values
+    /// they stand for; the rest 0.
+    fn value(&self, i: usize, k: usize) -> [f64; 4] {
+        let (e, width) = (self.get(i), self.ty.size());
+        let mut out = [0.0; 4];
+        for (c, v) in out.iter_mut().enumerate().take(k) {
+            *v = component(e, c * width, self.ty, self.normalized);
+        }
+        out
+    }
+
     fn get(&self, i: usize) -> &[u8] {
         let start = i.saturating_mul(self.stride);
         self.data
@@ -965,16 +976,11 @@ impl SceneReader<'_, '_> {
             }
             let elements = self.elements(&accessor, &what)?;
             let k = dims.multiplicity();
-            let width = elements.ty.size();
-            let values: Vec<Vec<f64>> = (0..elements.count)
-                .map(|i| {
-                    let e = elements.get(i);
-                    (0..k)
-                        .map(|c| component(e, c * width, elements.ty, elements.normalized))
-                        .collect()
-                })
-                .collect();
-            Ok(Some(values))
+            Ok(Some(
+                (0..elements.count)
+                    .map(|i| elements.value(i, k))
+                    .collect::<Vec<_>>(),
+            ))
         };
         let t = read(inst.translation, "TRANSLATION", Dimensions::Vec3)?;
         let r = read(inst.rotation, "ROTATION", Dimensions::Vec4)?;
@@ -995,7 +1001,7 @@ impl SceneReader<'_, '_> {
         }
         let mut out = Vec::with_capacity(count);
         for i in 0..count {
-            let v3 = |a: &Option<Vec<Vec<f64>>>, default: DVec3| {
+            let v3 = |a: &Option<Vec<[f64; 4]>>, default: DVec3| {
                 a.as_ref()
                     .map_or(default, |a| DVec3::new(a[i][0], a[i][1], a[i][2]))
             };
@@ -1163,13 +1169,8 @@ impl SceneReader<'_, '_> {
         }
         Ok((0..e.count)
             .map(|i| {
-                let b = e.get(i);
-                let c = e.ty.size();
-                DVec3::new(
-                    component(b, 0, e.ty, e.normalized),
-                    component(b, c, e.ty, e.normalized),
-                    component(b, 2 * c, e.ty, e.normalized),
-                )
+                let [x, y, z, _] = e.value(i, 3);
+                DVec3::new(x, y, z)
             })
             .collect())
     }
