@@ -107,6 +107,26 @@ pub enum Error {
         at: [f64; 3],
         limit_mm: f64,
     },
+    /// G-code refused for a drawing most of which lies beside the scan or
+    /// over its holes ([`crate::pipeline::MIN_PRINTED_SHARE`]).
+    #[error(
+        "only {printed_mm:.1} of the drawing's {drawn_mm:.1} mm ({percent:.0} %) lie over the \
+         scan; the rest lies beside it or over its holes and would not be printed; no G-code \
+         written. The drawing as placed spans x {:.3}..{:.3}, y {:.3}..{:.3} mm and the scan x \
+         {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame): check the placement (--place centre \
+         puts the drawing on the scan's footprint), or accept the risk to print only the part \
+         over the scan",
+        .drawing_xy[0], .drawing_xy[2], .drawing_xy[1], .drawing_xy[3],
+        .scan_xy[0], .scan_xy[2], .scan_xy[1], .scan_xy[3]
+    )]
+    MostlyOffScan {
+        printed_mm: f64,
+        drawn_mm: f64,
+        percent: f64,
+        /// lo x, lo y, hi x, hi y (mm, printer frame).
+        drawing_xy: [f64; 4],
+        scan_xy: [f64; 4],
+    },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

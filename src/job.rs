@@ -1157,6 +1157,15 @@ pub fn write_outputs(
             at.x, at.y, at.z
         ));
     }
+    if plan.coverage.mostly_off_scan() {
+        let c = plan.coverage;
+        risks.push(format!(
+            "only {:.1} of the drawing's {:.1} mm ({:.0} %) lie over the scan and are printed",
+            c.printed_mm,
+            c.drawn_mm,
+            c.printed_percent()
+        ));
+    }
     if let Some(depth) = below_bed_mm(scan) {
         risks.push(format!(
             "the scan is placed {depth:.3} mm below the bed (Move Z)"
@@ -1233,6 +1242,17 @@ pub fn write_outputs(
     // After the writing: a scan outside the build volume is said first
     // (QA: the page showed "place it on the bed" and "the nozzle would
     // dispense far above the surface" at once for a scan off the bed).
+    if plan.coverage.mostly_off_scan() && !accept_risk {
+        let (lo, hi) = scan.surface.bbox();
+        let c = plan.coverage;
+        return Err(Error::MostlyOffScan {
+            printed_mm: c.printed_mm,
+            drawn_mm: c.drawn_mm,
+            percent: c.printed_percent(),
+            drawing_xy: c.drawing_xy,
+            scan_xy: [lo.x, lo.y, hi.x, hi.y],
+        });
+    }
     if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
         return Err(Error::FarAbove {
             height_mm,

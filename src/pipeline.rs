@@ -109,6 +109,46 @@ pub struct SurfacePiece {
 pub struct SurfacePath {
     pub pieces: Vec<SurfacePiece>,
     pub warnings: Vec<String>,
+    /// How much of the drawing lies over the scan.
+    #[serde(default)]
+    pub coverage: Coverage,
+}
+
+/// How much of the drawing, as placed and sampled, lies over the scan's
+/// surface and is printed (the rest lies beside the scan or over its
+/// holes).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Coverage {
+    /// The drawing's length in XY, mm.
+    pub drawn_mm: f64,
+    /// The part of it over the scan's surface, mm.
+    pub printed_mm: f64,
+    /// The drawing's XY extent as placed: lo x, lo y, hi x, hi y (mm,
+    /// printer frame).
+    pub drawing_xy: [f64; 4],
+}
+
+/// Below this share of the drawing's length printed, the G-code is refused
+/// unless the risk is accepted (our decision): a drawing mostly beside the
+/// scan is a placement gone wrong far more often than a wish to print a
+/// fragment of it, and a script saw success (exit 0) for 5 % of a ring
+/// printed (QA).
+pub const MIN_PRINTED_SHARE: f64 = 0.5;
+
+impl Coverage {
+    /// Whether less than [`MIN_PRINTED_SHARE`] of the drawing is printed.
+    pub fn mostly_off_scan(&self) -> bool {
+        self.printed_mm < MIN_PRINTED_SHARE * self.drawn_mm
+    }
+
+    /// The printed share, in percent.
+    pub fn printed_percent(&self) -> f64 {
+        if self.drawn_mm > 0.0 {
+            100.0 * self.printed_mm / self.drawn_mm
+        } else {
+            100.0
+        }
+    }
 }
 
 /// Stage 4: placement, sampling at d/2 (spec section 3), projection
@@ -291,7 +331,16 @@ pub fn surface_path(
             ),
         );
     }
-    Ok(SurfacePath { pieces, warnings })
+    let coverage = Coverage {
+        drawn_mm,
+        printed_mm: on_scan_mm,
+        drawing_xy: [lo.x, lo.y, hi.x, hi.y],
+    };
+    Ok(SurfacePath {
+        pieces,
+        warnings,
+        coverage,
+    })
 }
 
 /// Whether a scan `foot` wide (its footprint in printer XY) and `tall` high
@@ -336,6 +385,8 @@ pub struct Plan {
     /// The tool-path point that dispenses highest above the surface right
     /// under the tip, past [`FLOATING_HEIGHT_PER_D`] d: (height, point).
     pub highest_floating: Option<(f64, DVec3)>,
+    /// How much of the drawing lies over the scan and is printed.
+    pub coverage: Coverage,
 }
 
 /// A plan's smallest clearance is found exactly up to tol plus this (mm);
@@ -564,6 +615,7 @@ fn plan_stage(
         uncleared,
         motion,
         highest_floating: (floating > 0).then_some(highest),
+        coverage: sp.coverage,
     }
 }
 

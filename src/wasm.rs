@@ -67,7 +67,8 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 /// (`mesh`, `svg`, `registration`, `gcode` for a G-code file that could not
 /// be read, `touching` for G-code refused by the motion check,
 /// `whole-object` for G-code refused on a point cloud of a whole object,
-/// or `other`):
+/// `units`, `below-bed`, `far-above` and `mostly-off` for the other
+/// refusals that accepting the risk lifts, or `other`):
 /// the page drops a file whose bytes could not be read but keeps one that
 /// only failed to register. A `touching` error also carries `touching`, the
 /// check's summary (`motion::MotionSummary`: the first touching moves with
@@ -94,6 +95,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "below-bed"
     } else if matches!(e, Error::FarAbove { .. }) {
         "far-above"
+    } else if matches!(e, Error::MostlyOffScan { .. }) {
+        "mostly-off"
     } else {
         "other"
     };

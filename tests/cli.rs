@@ -1212,13 +1212,32 @@ fn a_tool_path_beside_a_scan_in_the_beds_corner_says_what_to_move() {
         "{err}"
     );
     assert!(!out.exists());
-    // Placed on the bed (centred on it), it plans.
-    let o = plan_on(
-        &scan,
-        &svg,
-        &["--place", "0,80", "--place-scan", "bed", "-o", s(&out)],
+    // Placed on the bed (centred on it), the tool path is inside the
+    // volume; 6 % of the square lies over the part, refused as a placement
+    // gone wrong (QA F10: a script saw exit 0 for 5 % of a drawing
+    // printed), and planned when the risk is accepted.
+    let place = ["--place", "0,80", "--place-scan", "bed", "-o", s(&out)];
+    let o = plan_on(&scan, &svg, &place);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("edge.svg on ")
+            && err.contains("only 19.8 of the drawing's 320.0 mm (6 %) lie over the scan")
+            && err.contains("no G-code written")
+            && err.contains("the scan x 70.000..150.000, y 70.000..150.000 mm")
+            && err.ends_with("(--accept-risk)\n"),
+        "{err}"
     );
+    assert!(!out.exists());
+    let o = plan_on(&scan, &svg, &[&place[..], &["--accept-risk"]].concat());
     assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let gcode = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        gcode.contains(
+            "only 19.8 of the drawing's 320.0 mm (6 %) lie over the scan and are printed"
+        ),
+        "{gcode}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

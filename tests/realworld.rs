@@ -1003,7 +1003,10 @@ fn plan_over_a_cad_export_writes_finite_gcode() {
         ..PlanSettings::default()
     };
     let profile = MachineProfile::builtin("marlin").expect("marlin profile");
-    let out = run_on(
+    // Seen from above the model is mostly gaps: 12 % of the star lies over
+    // its surface, which is refused unless the risk is accepted (QA F10: a
+    // script saw exit 0 for 5 % of a drawing printed).
+    let e = run_on(
         &prepared,
         star,
         "tabler-star.svg",
@@ -1011,7 +1014,28 @@ fn plan_over_a_cad_export_writes_finite_gcode() {
         &profile,
         false,
     )
+    .err()
+    .expect("most of the star is off the model");
+    assert!(
+        matches!(e, pcpp::Error::MostlyOffScan { percent, .. } if percent < 50.0),
+        "{e}"
+    );
+    let out = run_on(
+        &prepared,
+        star,
+        "tabler-star.svg",
+        &settings,
+        &profile,
+        true,
+    )
     .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        out.gcode
+            .contains("written only because the risk was accepted: only ")
+            && out.gcode.contains("lie over the scan and are printed"),
+        "{}",
+        &out.gcode[..out.gcode.len().min(3000)]
+    );
 
     assert!(out.plan.uncleared.is_empty());
     assert!(!out.plan.pieces.is_empty());

@@ -63,12 +63,14 @@ test('a drag moves the path on the scan and re-plans as it goes; the last placem
 
   // 80 pointer moves, right and up, a little over a second of dragging;
   // halfway the test waits until a plan made during the drag is on screen.
+  // (Not so far that most of the drawing leaves the scan: that is refused,
+  // and the test wants a plan to download.)
   const moves = 80;
   await page.mouse.move(cx, cy);
   await page.mouse.down();
   const t0 = Date.now();
   for (let i = 1; i <= moves; i++) {
-    await page.mouse.move(cx + (110 * i) / moves, cy - (45 * i) / moves + 8 * Math.sin((Math.PI * i) / 20));
+    await page.mouse.move(cx + (40 * i) / moves, cy - (16 * i) / moves + 8 * Math.sin((Math.PI * i) / 20));
     await page.waitForTimeout(12);
     if (i === moves / 2) {
       await page.waitForFunction((n) => window.pcpp.state.stats.plans > n, before.plans, { timeout: 60_000 });

@@ -330,3 +330,36 @@ test('G-code written at the user\'s risk for another refusal than touching names
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A 12 x 12 mm plate as OBJ text (two triangles).
+const SMALL_PLATE = 'v 0 0 1\nv 12 0 1\nv 12 12 1\nv 0 12 1\nf 1 2 3\nf 1 3 4\n';
+
+test('a drawing mostly beside the scan is refused, and written only once the risk is accepted', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A plate (QA F10: a script saw exit 0 for 5 % of a drawing printed).
+  await page.setInputFiles('#scan-input', { name: 'small-plate.obj', mimeType: 'text/plain', buffer: Buffer.from(SMALL_PLATE) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'small-plate.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  // The page fits the drawing to the new scan; moved 10 mm along X, most
+  // of it lies beside the plate.
+  const x = Number(await page.inputValue('#pl-x'));
+  await page.fill('#pl-x', String(x + 10));
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 60_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'Most of the drawing lies beside the scan: no G-code');
+  const text = await page.textContent('#error-panel');
+  assert.match(text, /only \d+\.\d of the drawing's \d+\.\d mm \(\d+ %\) lie over the scan/);
+  // The page's words, not the command line's.
+  assert.match(text, /'Centre on scan' puts the drawing on the scan's footprint/);
+  assert.match(text, /tick "write G-code even where it is refused \(at my risk\)"/);
+  assert.doesNotMatch(text, /--/);
+  await page.check('#accept-risk');
+  await waitSettled(page);
+  assert.equal(await page.isHidden('#error-panel'), true);
+  assert.match(await page.textContent('#risk-warning-text'),
+    /written only because the risk was accepted: only \d+\.\d of the drawing's \d+\.\d mm \(\d+ %\) lie over the scan and are printed/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});

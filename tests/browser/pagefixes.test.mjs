@@ -384,7 +384,7 @@ test('a drawing partly off the scan is said in the status line, not only in the 
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
   assert.match(await page.textContent('#plan-status'), /with even$/);
-  await page.fill('#pl-x', '55');
+  await page.fill('#pl-x', '25');
   await page.waitForFunction(() => /leave the scan/.test(document.getElementById('plan-status').textContent),
     null, { timeout: 120_000 });
   await waitSettled(page);

@@ -181,7 +181,7 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
             Failure::Input(format!("{e} (--accept-risk writes it anyway)"))
         }
         e @ Error::UnitsDoubt { .. } => Failure::Input(e.to_string()),
-        e @ Error::FarAbove { .. } => Failure::Input(format!(
+        e @ (Error::FarAbove { .. } | Error::MostlyOffScan { .. }) => Failure::Input(format!(
             "{} on {}: {e} (--accept-risk)",
             input_shown(&inputs.svg_path),
             input_shown(&inputs.scan_path)
