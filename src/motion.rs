@@ -381,6 +381,12 @@ pub struct MotionSummary {
     pub min_clearance_line: Option<usize>,
     /// Moves whose clearance is below tol.
     pub touching_moves: usize,
+    /// Of those, the moves closest at their start, where the move before
+    /// them ended too close: the contact that move was counted for (a
+    /// retract straight up out of it, say), which they may or may not come
+    /// near again.
+    #[serde(default)]
+    pub touching_from_previous: usize,
     /// The first touching moves (at most [`MAX_LISTED`]), in order.
     pub touching: Vec<Touch>,
 }
@@ -404,6 +410,13 @@ pub struct Touch {
     /// How much higher the tip would have to be there to keep tol: the
     /// depth of the violation.
     pub rise_mm: f64,
+    /// Whether the move is closest at its start, where the move before it
+    /// ended (that move is listed too: it comes at least as close there),
+    /// and that move's G-code line where known.
+    #[serde(default)]
+    pub from_previous: bool,
+    #[serde(default)]
+    pub previous_line: Option<usize>,
 }
 
 fn arr(p: DVec3) -> [f64; 3] {
@@ -418,6 +431,22 @@ impl std::fmt::Display for Touch {
         let [a, b, c] = self.from;
         let [x, y, z] = self.to;
         let [px, py, pz] = self.at;
+        if self.from_previous {
+            // Not a contact of its own making (QA: a retract straight up out
+            // of a collision read as a second collision, to be fixed by
+            // raising a move that moves away from the part).
+            let before = match self.previous_line {
+                Some(line) => format!("the move before it (line {line})"),
+                None => "the move before it".to_string(),
+            };
+            return write!(
+                f,
+                "the move ({a:.3}, {b:.3}, {c:.3}) -> ({x:.3}, {y:.3}, {z:.3}) is closest at its \
+                 start, where {before} ended too close: the nozzle would have to be {:.3} mm \
+                 higher there",
+                self.rise_mm
+            );
+        }
         write!(
             f,
             "the move ({a:.3}, {b:.3}, {c:.3}) -> ({x:.3}, {y:.3}, {z:.3}) comes too close at \
@@ -470,6 +499,14 @@ pub fn check_moves_capped(
             }
             if g.gap_mm < clearance.touch_limit() {
                 s.touching_moves += 1;
+                // Closest at its start, which ends the move before it: that
+                // move comes at least as close there (its end is one of its
+                // positions).
+                let previous = index
+                    .checked_sub(1)
+                    .map(|k| moves[k])
+                    .filter(|&(_, end, _)| g.at == 0.0 && end == a);
+                s.touching_from_previous += usize::from(previous.is_some());
                 if s.touching.len() < MAX_LISTED {
                     s.touching.push(Touch {
                         index,
@@ -479,6 +516,8 @@ pub fn check_moves_capped(
                         at: arr(at),
                         clearance_mm: g.gap_mm,
                         rise_mm: clearance.tol_mm - g.gap_mm,
+                        from_previous: previous.is_some(),
+                        previous_line: previous.and_then(|(.., line)| line),
                     });
                 }
             }
@@ -497,6 +536,7 @@ pub fn check_moves_capped(
             s.min_clearance_line = c.min_clearance_line;
         }
         s.touching_moves += c.touching_moves;
+        s.touching_from_previous += c.touching_from_previous;
         let room = MAX_LISTED - s.touching.len();
         s.touching.extend(c.touching.into_iter().take(room));
     }
@@ -751,6 +791,41 @@ pub(crate) mod tests {
             text.starts_with("line 11: the move (4.000, 5.000, 0.700)"),
             "{text}"
         );
+    }
+
+    /// QA: a retract straight up out of a collision was listed as a second
+    /// collision, asking to raise a move that moves away from the part.
+    #[test]
+    fn a_move_closest_where_the_move_before_ended_is_said_to_be() {
+        let s = step();
+        let c = Clearance::new(&Nozzle::DEFAULT, 0.1);
+        let p = DVec3::new;
+        let moves = vec![
+            // Into the block (its top at z = 2), then straight up out of it.
+            (p(3.0, 5.0, 3.0), p(6.0, 5.0, 1.5), Some(5)),
+            (p(6.0, 5.0, 1.5), p(6.0, 5.0, 5.0), Some(6)),
+            // Up out of the block too, but from elsewhere: its own contact.
+            (p(8.0, 5.0, 1.0), p(8.0, 5.0, 5.0), Some(7)),
+        ];
+        let sum = check_moves(&s, moves, &c);
+        assert_eq!(sum.touching_moves, 3);
+        assert_eq!(sum.touching_from_previous, 1);
+        let flags: Vec<(bool, Option<usize>)> = sum
+            .touching
+            .iter()
+            .map(|t| (t.from_previous, t.previous_line))
+            .collect();
+        assert_eq!(flags, [(false, None), (true, Some(5)), (false, None)]);
+        let text = sum.touching[1].to_string();
+        assert_eq!(
+            text,
+            "line 6: the move (6.000, 5.000, 1.500) -> (6.000, 5.000, 5.000) is closest at its \
+             start, where the move before it (line 5) ended too close: the nozzle would have to \
+             be 0.600 mm higher there"
+        );
+        assert!(sum.touching[2]
+            .to_string()
+            .contains("comes too close at (8.000, 5.000, 1.000)"));
     }
 
     #[test]

@@ -71,7 +71,8 @@ export function onCheck(m) {
         + `give where they start or end, and they come lower than tol above the scan's top); `
         + `${sum.moves === 0 ? 'no move could be checked' : sum.moves === 1 ? 'the 1 checked move does not come closer than tol'
           : `none of the ${sum.moves} checked moves comes closer than tol`}; ${against}`
-      : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol; ${against}`;
+      : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol`
+        + `${sum.touching_from_previous ? `, ${sum.touching_from_previous} of them closest at its start, where the move before it ended too close` : ''}; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];
   const p = (text, id, cls) => details.push(el('p', text, cls, id));
@@ -92,7 +93,11 @@ export function onCheck(m) {
       const tr = body.insertRow();
       cell(tr, t.line ? String(t.line) : '—', 'line');
       cell(tr, `${fmtPoint(t.from)} → ${fmtPoint(t.to)}`);
-      cell(tr, fmtPoint(t.at));
+      // A move closest where the move before it ended too close (a retract
+      // out of that contact): the same contact, said as such.
+      cell(tr, t.from_previous
+        ? `its start, where ${t.previous_line ? `line ${t.previous_line}` : 'the move before it'} ended`
+        : fmtPoint(t.at));
       cell(tr, fmt(t.clearance_mm));
       cell(tr, fmt(t.rise_mm), 'bad');
     }

@@ -107,6 +107,13 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         "{head}; {} move(s) come closer than tol",
         sum.touching_moves
     );
+    if sum.touching_from_previous > 0 {
+        let _ = write!(
+            s,
+            ", {} of them closest at its start, where the move before it ended too close",
+            sum.touching_from_previous
+        );
+    }
     if !check.unchecked_lines.is_empty() {
         let _ = write!(
             s,
