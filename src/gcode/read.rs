@@ -112,6 +112,10 @@ pub enum UnknownMoveKind {
     MachineCoordinates,
     /// Grbl's `$J=` jog.
     Jog,
+    /// A controller command of another language that moves the head
+    /// (Klipper's `FORCE_MOVE`, `BED_MESH_CALIBRATE`, ...), or a start
+    /// macro slicers call (`PRINT_START`), which homes it by convention.
+    Statement,
 }
 
 /// A move the reader could not place; `None` marks an axis whose position
@@ -260,6 +264,23 @@ pub enum GcodeLineProblem {
         keyword: String,
         column: usize,
         instead: &'static str,
+    },
+    #[error(
+        "`G92` at column {column} names no axis: Marlin then changes nothing, RepRap firmware \
+         sets every axis to 0, and Grbl and LinuxCNC refuse it, so where the moves after it go \
+         depends on the firmware; name the axes it sets (G92 X0 Y0 Z0, or G92 E0 for the \
+         extruder alone)"
+    )]
+    BareSetPosition { column: usize },
+    #[error(
+        "the `{keyword}` statement at column {column} {what}: the moves after it would be in a \
+         frame this reader cannot relate to the one the program starts in; write the program \
+         without it, with the offset applied to its coordinates"
+    )]
+    StatementFrame {
+        keyword: String,
+        column: usize,
+        what: &'static str,
     },
     #[error("`{first}` and `{second}` (column {column}) cannot share a line: {why}")]
     Conflict {
@@ -786,7 +807,12 @@ fn classify(code: u32, has_l: bool, has_s: bool) -> G {
         (68, _) => G::Frame {
             what: "rotates the coordinates (G68)",
         },
-        (73, 0) | (81..=89, 0) => G::Unsupported {
+        // QA: skipped with a note, and the check passed programs whose
+        // nozzle ran off the path it checked or plunged into the part.
+        (41 | 42, 0 | 1) => G::Frame {
+            what: "offsets the path by the tool's radius (cutter compensation)",
+        },
+        (73 | 74, 0) | (81..=89, 0) => G::Unsupported {
             what: "canned cycles",
             advice: "the checker follows straight moves only: expand the cycle into G0/G1 moves",
         },
@@ -799,6 +825,9 @@ fn classify(code: u32, has_l: bool, has_s: bool) -> G {
         (92, 1) => G::ClearOffsets,
         (92, 2) => G::SuspendOffsets,
         (92, 3) => G::RestoreOffsets,
+        (92, 9) => G::Frame {
+            what: "sets the current position directly (Marlin's G92.9)",
+        },
         _ => G::Unknown,
     }
 }
@@ -845,6 +874,32 @@ fn g_code(line: &str, w: &Word) -> Result<u32, GcodeLineProblem> {
     // In range 0..100_000 and whole, so the conversion is exact.
     Ok(rounded as u32)
 }
+
+/// Statements (upper case) that move the head where the file does not say:
+/// Klipper's moving, probing and levelling commands (its G-Codes.md), and
+/// the start macros slicers call, which home the printer by convention.
+const MOVING_STATEMENTS: &[&str] = &[
+    "FORCE_MOVE",
+    "MANUAL_STEPPER",
+    "MANUAL_PROBE",
+    "PROBE",
+    "PROBE_ACCURACY",
+    "PROBE_CALIBRATE",
+    "BED_MESH_CALIBRATE",
+    "BED_TILT_CALIBRATE",
+    "DELTA_CALIBRATE",
+    "QUAD_GANTRY_LEVEL",
+    "Z_TILT_ADJUST",
+    "SCREWS_TILT_CALCULATE",
+    "Z_ENDSTOP_CALIBRATE",
+    "Z_OFFSET_APPLY_PROBE",
+    "SET_STEPPER_ENABLE",
+    "TIMELAPSE_TAKE_FRAME",
+    "PRINT_START",
+    "START_PRINT",
+    "PRINT_END",
+    "END_PRINT",
+];
 
 /// Checks an M word; returns its code when it is a whole number.
 fn m_code(line: &str, w: &Word) -> Result<Option<u32>, GcodeLineProblem> {
@@ -896,6 +951,7 @@ enum NoteKind {
     Probing,
     MachineCoordinates,
     Jog,
+    Statement,
 }
 
 impl NoteKind {
@@ -906,6 +962,7 @@ impl NoteKind {
             UnknownMoveKind::Probing => NoteKind::Probing,
             UnknownMoveKind::MachineCoordinates => NoteKind::MachineCoordinates,
             UnknownMoveKind::Jog => NoteKind::Jog,
+            UnknownMoveKind::Statement => NoteKind::Statement,
         }
     }
 }
@@ -1043,6 +1100,10 @@ impl Note {
                  is unknown: the moved axes are unknown until set again"
             ),
             NoteKind::Jog => format!("{lines}: jogs (`$J=`): {unknown_after}"),
+            NoteKind::Statement => format!(
+                "{lines}: controller commands or start macros that move the head ({codes}): \
+                 {unknown_after}"
+            ),
         }
     }
 }
@@ -1188,6 +1249,13 @@ impl<'f> Reader<'f> {
                 .find(|c: char| !(c.is_ascii_alphabetic() || c == '_'))
                 .unwrap_or(text.len())],
         );
+        let frame = |what| {
+            Err(P::StatementFrame {
+                keyword: clip(&keyword),
+                column: col,
+                what,
+            })
+        };
         let statement = |instead| {
             Err(P::ControllerStatement {
                 keyword: clip(&keyword),
@@ -1209,6 +1277,21 @@ impl<'f> Reader<'f> {
             "CW" | "CCW" => statement("G1 segments"),
             "MOVEABS" | "MOVEINC" | "MOVETO" => statement("G0 or G1"),
             "POSOFFSET" => statement("G92"),
+            // Klipper's frame changes (G-Codes.md): refused, as G-code
+            // offsets are (QA: `SET_GCODE_OFFSET Z=-4.95` was skipped with a
+            // note and the program passed).
+            "SET_GCODE_OFFSET" => frame("sets an offset applied to the moves after it (Klipper)"),
+            "RESTORE_GCODE_STATE" => frame(
+                "restores a saved distance mode, origin and offset, and may move back (Klipper)",
+            ),
+            "SET_KINEMATIC_POSITION" => frame("sets the position the printer takes (Klipper)"),
+            // Klipper's commands that move the head where the file does not
+            // say (G-Codes.md), and the start macros slicers call, which
+            // home it by convention.
+            kw if MOVING_STATEMENTS.contains(&kw) => {
+                self.unfollowed(n, UnknownMoveKind::Statement, [None; 3], &clip(&keyword));
+                Ok(())
+            }
             "CALL" | "GOTO" | "GOSUB" | "WHILE" | "FOR" | "REPEAT" | "LOOP" | "IF" => {
                 Err(P::ProgramFlow {
                     word: clip(&keyword),
@@ -1371,9 +1454,12 @@ impl<'f> Reader<'f> {
         }
         let first_axis = axes.iter().flatten().min_by_key(|w| w.start).copied();
         match (consumer, first_axis) {
-            (Some((Consumer::SetPosition, ..)), _) => {
-                self.set_position(n, line, &axes, first_axis.is_some() || other_axes)
+            (Some((Consumer::SetPosition, _, column)), None) if !other_axes => {
+                // QA: read as every axis set to 0 (RepRap firmware), which
+                // hid a move into the part for Marlin, where it does nothing.
+                Err(P::BareSetPosition { column })
             }
+            (Some((Consumer::SetPosition, ..)), _) => self.set_position(n, line, &axes),
             (Some((Consumer::Unfollowed(kind), code, _)), _) => {
                 self.unfollowed(n, kind, [None; 3], &g_name(code));
                 Ok(())
@@ -1514,23 +1600,19 @@ impl<'f> Reader<'f> {
         self.notes.add(NoteKind::of(kind), n).code(code);
     }
 
-    /// `G92`: the named axes (all three, at 0, when the line names no axis
-    /// at all, as RepRap firmware does) take the given program coordinates.
+    /// `G92`: the named axes take the given program coordinates (a `G92`
+    /// that names no axis at all is refused before, [`P::BareSetPosition`]).
     fn set_position(
         &mut self,
         n: usize,
         line: &str,
         axes: &[Option<Word>; 3],
-        any_axis_word: bool,
     ) -> Result<(), GcodeLineProblem> {
         let mut values = [None; 3];
         for (axis, w) in axes.iter().enumerate() {
             if let Some(w) = w {
                 values[axis] = Some(self.coordinate(line, w)?);
             }
-        }
-        if !any_axis_word {
-            values = [Some(0.0); 3];
         }
         for (axis, value) in values.into_iter().enumerate() {
             let Some(value) = value else { continue };
@@ -1760,12 +1842,10 @@ mod tests {
                 DVec3::new(12.0, 12.0, 14.0)
             ]
         );
-        // G92 alone zeroes X, Y and Z; E alone leaves them be.
-        let p = read("G0 X10 Y20 Z30\nG92\nG1 X1\nG92 E0\nG1 Y1\n");
-        assert_eq!(
-            ends(&p),
-            [DVec3::new(11.0, 20.0, 30.0), DVec3::new(11.0, 21.0, 30.0)]
-        );
+        // E alone leaves X, Y and Z be (G92 alone is refused: the
+        // firmware disagree on it).
+        let p = read("G0 X10 Y20 Z30\nG92 E0\nG1 Y1\n");
+        assert_eq!(ends(&p), [DVec3::new(10.0, 1.0, 30.0)]);
         // In inches, G92's values are inches too.
         let p = read("G0 X10 Y0 Z0\nG20 G92 X1\nG21 G1 X25.4\n");
         assert!(close(
@@ -1786,6 +1866,38 @@ mod tests {
             "{:?}",
             p.notes
         );
+    }
+
+    /// QA round 3: Klipper's moving commands and the start macros slicers
+    /// call were skipped with a note, the position kept.
+    #[test]
+    fn moving_statements_make_the_position_unknown() {
+        let p = read("G0 X1 Y1 Z5\nBED_MESH_CALIBRATE\nG1 Z0.2\nPRINT_START BED=60\nG1 X2\n");
+        let kinds: Vec<(usize, UnknownMoveKind)> =
+            p.unknown_moves.iter().map(|u| (u.line, u.kind)).collect();
+        use UnknownMoveKind::*;
+        assert_eq!(
+            kinds,
+            [
+                (1, UnknownStart),
+                (2, Statement),
+                (3, UnknownStart),
+                (4, Statement),
+                (5, UnknownStart)
+            ]
+        );
+        assert!(p.moves.is_empty());
+        assert!(
+            p.notes.iter().any(|n| n.starts_with(
+                "lines 2, 4: controller commands or start macros that move the head \
+                 (BED_MESH_CALIBRATE, PRINT_START): the head goes where"
+            )),
+            "{:?}",
+            p.notes
+        );
+        // Others are still skipped with a note, the position kept.
+        let p = read("G0 X1 Y1 Z5\nSET_FAN_SPEED FAN=a SPEED=1\nG1 X2\n");
+        assert_eq!(p.moves.len(), 1);
     }
 
     #[test]
@@ -1914,6 +2026,15 @@ mod tests {
             ("o100 sub\n", "line 1: `o100` at column 1 is program flow"),
             ("O<probe> call\n", "line 1: `O<probe>` at column 1 is program flow"),
             ("M206 X10\n", "line 1: `M206` at column 1 sets home offsets"),
+            // QA round 3: each passed the check with a note.
+            ("G0 X50 Y50 Z5\nG92\nG1 Z0.05\n", "line 2: `G92` at column 1 names no axis: Marlin then changes nothing, RepRap firmware sets every axis to 0"),
+            ("G41 D1\n", "line 1: `G41` at column 1 offsets the path by the tool's radius (cutter compensation)"),
+            ("G42.1 D2 L1\n", "line 1: `G42.1` at column 1 offsets the path"),
+            ("G98 G74 X60 Y50 Z-3 R2\n", "line 1: canned cycles (`G74` at column 5)"),
+            ("G92.9 Z10\n", "line 1: `G92.9` at column 1 sets the current position directly (Marlin's G92.9)"),
+            ("SET_GCODE_OFFSET Z=-4.95\n", "line 1: the `SET_GCODE_OFFSET` statement at column 1 sets an offset applied to the moves after it (Klipper)"),
+            ("G91\n restore_gcode_state NAME=park MOVE=1\n", "line 2: the `RESTORE_GCODE_STATE` statement at column 2 restores"),
+            ("SET_KINEMATIC_POSITION Z=0\n", "line 1: the `SET_KINEMATIC_POSITION` statement"),
             ("INCREMENTAL\n", "line 1: the `INCREMENTAL` statement at column 1 changes how the nozzle moves"),
             ("  LINEAR X1 Y2\n", "line 1: the `LINEAR` statement at column 3"),
             ("WHILE $DI[0].X == 0\n", "line 1: `WHILE` at column 1 is program flow"),
