@@ -72,7 +72,7 @@ export function onCheck(m) {
         + `${sum.moves === 0 ? 'no move could be checked' : sum.moves === 1 ? 'the 1 checked move does not come closer than tol'
           : `none of the ${sum.moves} checked moves comes closer than tol`}; ${against}`
       : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol`
-        + `${sum.touching_from_previous ? `, ${sum.touching_from_previous} of them closest at its start, where the move before it ended too close` : ''}; ${against}`;
+        + `${sum.touching_from_previous ? `, ${sum.touching_from_previous} of them closest at their start, where the move before each ended too close` : ''}; ${against}`;
   verdict.className = c.clear ? 'verdict good' : 'verdict bad';
   const details = [];
   const p = (text, id, cls) => details.push(el('p', text, cls, id));

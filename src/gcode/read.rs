@@ -31,8 +31,19 @@
 //!   M-code, Grbl and LinuxCNC move there in the modal motion (`X40 Z2 M3`)
 //!   while Marlin does not: the move is checked, and every axis it would
 //!   change is unknown after it.
-//! - `G10` with an `L` word sets offsets (LinuxCNC): refused; without one it
-//!   is RepRap firmware retraction, which moves no X/Y/Z axis.
+//! - `G10` with an `L` word sets offsets (LinuxCNC), and with `P` and an
+//!   axis word a tool's offsets (RepRap firmware): refused; with `P` alone
+//!   it sets a tool's temperatures; without either it is RepRap firmware
+//!   retraction, which moves no X/Y/Z axis.
+//! - Marlin's park codes (`M125`, `M600`, `M601`) park the head and bring
+//!   it back (their X/Y/Z say where, not a move: the position is kept, the
+//!   park not checked); `M48` probes (the position is unknown after it);
+//!   a babystep (`M290 Z`) offsets every move after it: refused.
+//! - A `G92` that names no axis: RepRap firmware sets every axis to 0,
+//!   Marlin changes nothing, Grbl and LinuxCNC refuse it: refused.
+//! - Cutter compensation (`G41`, `G42`) offsets the path the file gives,
+//!   and Marlin's `G92.9` sets the position without the offsets: refused, as
+//!   other frame changes are.
 //! - A number run into a lower-case `e` (`X1e-05`) is refused: that is how
 //!   float formatters (C `%g`, Python, JavaScript) write exponents, which
 //!   G-code does not have, and Marlin would read `X1 E-05`. An upper-case
@@ -72,9 +83,14 @@ const TEXT_M_CODES: &[u32] = &[0, 1, 16, 23, 28, 30, 32, 33, 117, 118, 928];
 /// drives (M574, M584) and motor currents and microsteps (M350, M351, M906,
 /// M907, M913-M915), as Marlin and RepRap firmware document them.
 const AXIS_PARAMETER_M_CODES: &[u32] = &[
-    17, 18, 84, 92, 201, 202, 203, 205, 207, 208, 211, 218, 350, 351, 425, 566, 574, 584, 665, 666,
-    669, 671, 851, 906, 907, 913, 914, 915,
+    17, 18, 84, 92, 201, 202, 203, 205, 207, 208, 211, 218, 350, 351, 420, 422, 425, 566, 569, 574,
+    584, 593, 665, 666, 669, 671, 851, 900, 906, 907, 913, 914, 915,
 ];
+
+/// Marlin's M-codes that park the head and bring it back where it was
+/// (`M125` park, `M600` filament change, `M601` pause): their X and Y say
+/// where it parks and Z how far it lifts, not a move the program makes.
+const PARK_M_CODES: &[u32] = &[125, 600, 601];
 
 /// One straight move, absolute millimetres, in the frame the program starts
 /// in (the printer frame our writer uses; `G92` offsets are undone).
@@ -308,8 +324,11 @@ use GcodeLineProblem as P;
 /// (XOR of the line's bytes before `*`, as Marlin computes it). Lines that
 /// are not G-code words at all (Aerotech `$DO[0].X = 1`, `DWELL 0.5`,
 /// Klipper macros) are skipped with a note, except statements known to move
-/// the nozzle or change modes (`INCREMENTAL`, `LINEAR`, `CALL`, ...), which
-/// are errors, and homing (`HOME`, `$H`), which makes the position unknown.
+/// the nozzle or change modes (`INCREMENTAL`, `LINEAR`, `CALL`, ...) or the
+/// frame (Klipper's `SET_GCODE_OFFSET`, `RESTORE_GCODE_STATE`,
+/// `SET_KINEMATIC_POSITION`), which are errors, and homing, probing and the
+/// start macros slicers call (`HOME`, `$H`, Klipper's `BED_MESH_CALIBRATE`,
+/// `PRINT_START`), which make the position unknown.
 ///
 /// Moves: `G0`/`G1` (modal), `G90`/`G91`, `G20`/`G21` and `G70`/`G71`,
 /// `G92` (`G92` alone sets X, Y and Z to 0, as RepRap does; `G92.1`-`G92.3`
@@ -755,7 +774,9 @@ enum G {
 }
 
 /// `code` is the G number times ten (`G38.2` is 382).
-fn classify(code: u32, has_l: bool, has_s: bool) -> G {
+/// `tool_offsets`: the line has a `P` word and an X, Y or Z word (RepRap
+/// firmware's `G10 P` sets that tool's offsets then).
+fn classify(code: u32, has_l: bool, has_s: bool, tool_offsets: bool) -> G {
     use UnknownMoveKind::{Homing, Probing};
     match (code / 10, code % 10) {
         (0, 0) => G::Motion(Some(Motion::Rapid)),
@@ -775,6 +796,11 @@ fn classify(code: u32, has_l: bool, has_s: bool) -> G {
         },
         (10, 0) if has_l => G::Frame {
             what: "sets work or tool offsets (G10 L)",
+        },
+        // QA round 3: RepRap firmware's tool offsets were read as a
+        // retraction, and their X/Y/Z as a move into the part.
+        (10, 0) if tool_offsets => G::Frame {
+            what: "sets a tool's offsets (RepRap firmware's G10 P)",
         },
         (10 | 11, 0) => G::Retract,
         (12 | 13, _) => G::Unsupported {
@@ -920,10 +946,15 @@ fn m_code(line: &str, w: &Word) -> Result<Option<u32>, GcodeLineProblem> {
         98 => Err(flow("a subprogram or macro call")),
         99 => Err(flow("a subprogram return or program loop")),
         808 => Err(flow("a repeat marker")),
-        206 | 428 => Err(P::UnknownFrame {
+        206 => Err(P::UnknownFrame {
             word,
             column,
             what: "sets home offsets",
+        }),
+        428 => Err(P::UnknownFrame {
+            word,
+            column,
+            what: "sets home offsets (Marlin; elsewhere, as in LinuxCNC, a user's own code)",
         }),
         _ => Ok(Some(code)),
     }
@@ -952,6 +983,7 @@ enum NoteKind {
     MachineCoordinates,
     Jog,
     Statement,
+    Park,
 }
 
 impl NoteKind {
@@ -1100,6 +1132,11 @@ impl Note {
                  is unknown: the moved axes are unknown until set again"
             ),
             NoteKind::Jog => format!("{lines}: jogs (`$J=`): {unknown_after}"),
+            NoteKind::Park => format!(
+                "{lines}: {codes} (park, filament change or pause): the head parks (X and Y say \
+                 where, Z how far it lifts) and comes back where it was; the park moves are not \
+                 checked"
+            ),
             NoteKind::Statement => format!(
                 "{lines}: controller commands or start macros that move the head ({codes}): \
                  {unknown_after}"
@@ -1315,6 +1352,10 @@ impl<'f> Reader<'f> {
     fn execute(&mut self, n: usize, line: &str, words: &[Word]) -> Result<(), GcodeLineProblem> {
         let has = |letter: u8| words.iter().any(|w| w.letter == letter);
         let (has_l, has_s) = (has(b'L'), has(b'S'));
+        let tool_offsets = has(b'P') && (has(b'X') || has(b'Y') || has(b'Z'));
+        // RepRap firmware's `G10 P` without offsets sets a tool's
+        // temperatures: no retraction, no move.
+        let tool_settings = has(b'P') && !tool_offsets;
         if let (Some(w), true) = (words.iter().find(|w| w.letter == b'O'), words.len() > 1) {
             return Err(P::ProgramFlow {
                 word: word_text(line, w),
@@ -1330,6 +1371,7 @@ impl<'f> Reader<'f> {
         let mut consumer: Option<(Consumer, u32, usize)> = None;
         let mut unknown_g: Option<u32> = None;
         let mut m: Option<Option<u32>> = None;
+        let mut m_word: Option<Word> = None;
         let mut feed = None;
         let mut commands = 0;
         for w in words {
@@ -1338,7 +1380,7 @@ impl<'f> Reader<'f> {
                 b'G' => {
                     commands += 1;
                     let code = g_code(line, w)?;
-                    match classify(code, has_l, has_s) {
+                    match classify(code, has_l, has_s, tool_offsets) {
                         G::Motion(mode) => {
                             if let Some((other, other_code)) = motion {
                                 if other != mode {
@@ -1378,6 +1420,7 @@ impl<'f> Reader<'f> {
                                 self.offset = saved;
                             }
                         }
+                        G::Retract if tool_settings && code == 100 => {}
                         G::Retract => self.notes.add(NoteKind::Retract, n).code(&g_name(code)),
                         G::Ignored => {}
                         G::Unknown => {
@@ -1403,6 +1446,7 @@ impl<'f> Reader<'f> {
                     commands += 1;
                     let code = m_code(line, w)?;
                     m.get_or_insert(code);
+                    m_word.get_or_insert(*w);
                 }
                 b'X' | b'Y' | b'Z' => {
                     let axis = usize::from(w.letter - b'X');
@@ -1453,6 +1497,32 @@ impl<'f> Reader<'f> {
             self.motion = mode;
         }
         let first_axis = axes.iter().flatten().min_by_key(|w| w.start).copied();
+        // Marlin's M-codes that move the head their own way (QA round 3:
+        // read as moves to the absolute coordinates their words give).
+        if consumer.is_none() && explicit.is_none() {
+            match m.flatten() {
+                Some(48) => {
+                    self.unfollowed(n, UnknownMoveKind::Probing, [None; 3], "M48");
+                    return Ok(());
+                }
+                Some(290) if first_axis.is_some() => {
+                    let (word, column) = m_word.map_or(("M290".into(), 1), |w| {
+                        (word_text(line, &w), column(line, w.start))
+                    });
+                    return Err(P::UnknownFrame {
+                        word,
+                        column,
+                        what: "babysteps the nozzle (Marlin's M290), an offset the moves after it \
+                               keep",
+                    });
+                }
+                Some(code) if PARK_M_CODES.contains(&code) => {
+                    self.notes.add(NoteKind::Park, n).code(&format!("M{code}"));
+                    return Ok(());
+                }
+                _ => {}
+            }
+        }
         match (consumer, first_axis) {
             (Some((Consumer::SetPosition, _, column)), None) if !other_axes => {
                 // QA: read as every axis set to 0 (RepRap firmware), which
@@ -2031,6 +2101,7 @@ mod tests {
             ("G41 D1\n", "line 1: `G41` at column 1 offsets the path by the tool's radius (cutter compensation)"),
             ("G42.1 D2 L1\n", "line 1: `G42.1` at column 1 offsets the path"),
             ("G98 G74 X60 Y50 Z-3 R2\n", "line 1: canned cycles (`G74` at column 5)"),
+            ("G10 P0 X0 Y0 Z-4.5\n", "line 1: `G10` at column 1 sets a tool's offsets (RepRap firmware's G10 P)"),
             ("G92.9 Z10\n", "line 1: `G92.9` at column 1 sets the current position directly (Marlin's G92.9)"),
             ("SET_GCODE_OFFSET Z=-4.95\n", "line 1: the `SET_GCODE_OFFSET` statement at column 1 sets an offset applied to the moves after it (Klipper)"),
             ("G91\n restore_gcode_state NAME=park MOVE=1\n", "line 2: the `RESTORE_GCODE_STATE` statement at column 2 restores"),
@@ -2136,7 +2207,7 @@ mod tests {
     /// after it; settings codes keep their parameters.
     #[test]
     fn axis_words_beside_a_spindle_or_coolant_m_code_are_a_move() {
-        for m in ["M3 S100", "M8", "M600"] {
+        for m in ["M3 S100", "M8", "M7"] {
             let text = format!("G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 F300\nX40 Y41 Z2 {m}\nG1 X41 Y41 Z10\nG1 X41 Y42\n");
             let p = read(&text);
             assert_eq!(p.moves.len(), 3, "{m}: {:?}", p.moves);
@@ -2163,6 +2234,54 @@ mod tests {
         assert_eq!(p.moves.len(), 2);
         assert_eq!(p.unknown_moves.len(), 1);
         assert_eq!(p.moves[1].from, DVec3::new(40.0, 40.0, 10.0));
+    }
+
+    /// QA round 3: Marlin's park, babystep, fade height and probe test were
+    /// read as moves to the coordinates their words give.
+    #[test]
+    fn marlins_moving_m_codes_are_read_their_own_way() {
+        // Park and return: the position after is the one before.
+        for park in ["M600 X10 Y10 Z0.5", "M125 X10 Y10 Z0.5"] {
+            let p = read(&format!("G90\nG0 X60 Y50 Z5\nG1 Z1\n{park}\nG1 X61\n"));
+            assert_eq!(p.moves.len(), 2, "{park}");
+            assert_eq!(p.moves[1].from, DVec3::new(60.0, 50.0, 1.0), "{park}");
+            assert!(
+                p.notes.iter().any(|n| n.starts_with("line 4: M")
+                    && n.contains("the head parks (X and Y say where, Z how far it lifts)")),
+                "{:?}",
+                p.notes
+            );
+        }
+        // Fade height and other settings: parameters.
+        let p = read("G90\nG0 X60 Y50 Z5\nG1 Z1\nM420 S1 Z10\nG1 X61\n");
+        assert_eq!(p.moves[1].from, DVec3::new(60.0, 50.0, 1.0));
+        assert!(p.unknown_moves.len() == 1);
+        // The probe test probes: the position is unknown after it.
+        let p = read("G90\nG0 X60 Y50 Z5\nM48 P10 X100 Y100\nG1 X61\n");
+        let kinds: Vec<UnknownMoveKind> = p.unknown_moves.iter().map(|u| u.kind).collect();
+        assert_eq!(
+            kinds,
+            [
+                UnknownMoveKind::UnknownStart,
+                UnknownMoveKind::Probing,
+                UnknownMoveKind::UnknownStart
+            ]
+        );
+        // RepRap firmware's tool temperatures: no retraction.
+        let p = read("G10 S200 P0\nG10\n");
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.starts_with("line 2: G10 read as firmware retraction")),
+            "{:?}",
+            p.notes
+        );
+        // A babystep offsets every move after it: refused.
+        let e = error("G90\nG0 X60 Y50 Z5\nM290 Z0.05\n");
+        assert!(
+            e.contains("line 3: `M290` at column 1 babysteps the nozzle (Marlin's M290)"),
+            "{e}"
+        );
     }
 
     #[test]

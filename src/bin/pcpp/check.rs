@@ -110,7 +110,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     if sum.touching_from_previous > 0 {
         let _ = write!(
             s,
-            ", {} of them closest at its start, where the move before it ended too close",
+            ", {} of them closest at their start, where the move before each ended too close",
             sum.touching_from_previous
         );
     }
