@@ -1487,6 +1487,35 @@ pub fn check_gcode(
             line_list(&unchecked_lines)
         ));
     }
+    // Beside the scan nothing is known of the part (QA: a program printing
+    // 80 mm beyond a cropped scan's edge, below its surface's height, was
+    // "clear" with no word): the moves that go there lower than tol above
+    // the scan's top are named.
+    let (slo, shi) = scan.surface.bbox();
+    let beside_scan = |p: DVec3| p.x < slo.x || p.x > shi.x || p.y < slo.y || p.y > shi.y;
+    let beside: Vec<&crate::gcode::GcodeMove> = program
+        .moves
+        .iter()
+        .filter(|m| (beside_scan(m.from) || beside_scan(m.to)) && m.from.z.min(m.to.z) < high)
+        .collect();
+    if let Some(lowest) = beside
+        .iter()
+        .min_by(|a, b| a.from.z.min(a.to.z).total_cmp(&b.from.z.min(b.to.z)))
+    {
+        let lines: Vec<usize> = beside.iter().map(|m| m.line).collect();
+        notes.push(format!(
+            "{} move(s) pass beside the scan lower than tol above its top ({}; the lowest at z \
+             {:.3} mm, line {}, the scan's surface from z {:.3} to {:.3} mm): nothing is known \
+             of the part there, so they are checked only against the part that was scanned; if \
+             the part or what it stands on reaches there, make sure they clear it",
+            beside.len(),
+            line_list(&lines),
+            lowest.from.z.min(lowest.to.z),
+            lowest.line,
+            slo.z,
+            shi.z
+        ));
+    }
     // What the program's header says against this scan, first.
     notes.splice(0..0, frame_notes);
     Ok(GcodeCheck {

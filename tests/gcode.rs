@@ -610,3 +610,43 @@ fn regression_check_passed_a_dive_written_beside_m3() {
         "{notes}"
     );
 }
+
+/// QA round 3: a program printing beyond a cropped scan's edge, below its
+/// surface's height, was "clear" with no word: those moves are named.
+#[test]
+fn regression_moves_beside_the_scan_are_named() {
+    use pcpp::job::check_gcode;
+
+    let scan = demo_scan();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let (lo, hi) = scan.surface.bbox();
+    let x = hi.x + 40.0;
+    let text = format!(
+        "G21\nG90\nG0 X40 Y40 Z{top}\nG0 X{x} Y40 Z{top}\nG1 Z{low}\nG1 X{far} Y40\nG0 Z{top}\n",
+        top = hi.z + 20.0,
+        low = lo.z - 1.0,
+        far = x + 10.0,
+    );
+    let check = check_gcode(&scan, &text, "beside.gcode", &nozzle, 0.1).unwrap();
+    assert!(check.is_clear(), "{:?}", check.summary);
+    let notes = check.notes.join("\n");
+    assert!(
+        notes.contains(&format!(
+            "3 move(s) pass beside the scan lower than tol above its top (lines 5, 6, 7; the \
+             lowest at z {:.3} mm, line 5,",
+            lo.z - 1.0
+        )) && notes.contains("nothing is known of the part there"),
+        "{notes}"
+    );
+    // Over the scan, or high above it: no such note.
+    let over = format!(
+        "G21\nG90\nG0 X40 Y40 Z{top}\nG0 X{x} Y40 Z{top}\n",
+        top = hi.z + 20.0
+    );
+    let check = check_gcode(&scan, &over, "over.gcode", &nozzle, 0.1).unwrap();
+    assert!(
+        !check.notes.join("\n").contains("beside the scan"),
+        "{:?}",
+        check.notes
+    );
+}
