@@ -175,7 +175,12 @@ pub fn surface_path(
     // hundreds of 0.0015 mm pieces gave 300 near-identical warnings).
     let mut dot_warnings: std::collections::HashMap<String, (usize, usize, DVec2, f64)> =
         std::collections::HashMap::new();
+    // Those paths, in the drawing's order.
+    let mut dot_sources: Vec<String> = Vec::new();
     let mut any_line = false;
+    // The longest of them as placed: all a hundredth of the spacing or
+    // less are dots as drawn (zero-length strokes), which no scale prints.
+    let mut longest_dot_mm: f64 = 0.0;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
     // Each subpath's samples as placed, for `close_lines`.
     let mut sampled: Vec<(&str, Vec<DVec2>, bool)> = Vec::with_capacity(drawn.len());
@@ -198,19 +203,23 @@ pub fn surface_path(
             match dot_warnings.get_mut(&sub.source) {
                 Some((_, count, ..)) => *count += 1,
                 None => {
-                    let first = (warnings.len(), 1, dot, placed.length_mm());
+                    // Its place among the warnings: the first such path's
+                    // (the one warning for them all, written below).
+                    let at = dot_warnings
+                        .values()
+                        .map(|w| w.0)
+                        .next()
+                        .unwrap_or_else(|| {
+                            warnings.push(String::new());
+                            warnings.len() - 1
+                        });
+                    let first = (at, 1, dot, placed.length_mm());
                     dot_warnings.insert(sub.source.clone(), first);
-                    warnings.push(format!(
-                        "path '{}' at ({:.3}, {:.3}) is {:.4} mm long as placed, too small to \
-                         print with samples {spacing:.4} mm apart; it is not printed",
-                        sub.source,
-                        dot.x,
-                        dot.y,
-                        placed.length_mm()
-                    ));
+                    dot_sources.push(sub.source.clone());
                 }
             }
             dots.push(sub.source.clone());
+            longest_dot_mm = longest_dot_mm.max(placed.length_mm());
             continue;
         }
         any_line |= samples.len() >= 2;
@@ -234,15 +243,41 @@ pub fn surface_path(
         }
         sampled.push((sub.source.as_str(), samples, placed.closed));
     }
-    for (source, &(at, count, dot, length)) in &dot_warnings {
-        if count > 1 {
-            warnings[at] = format!(
-                "path '{source}': {count} of its pieces are too small to print with samples \
+    // One warning for every part too small to print (QA: an icon's twelve
+    // dots gave twelve, a set of icons 680).
+    if let Some(first) = dot_sources.first() {
+        let (at, count, dot, length) = dot_warnings[first];
+        warnings[at] = match dot_sources.len() {
+            1 if count == 1 => format!(
+                "path '{first}' at ({:.3}, {:.3}) is {length:.4} mm long as placed, too small to \
+                 print with samples {spacing:.4} mm apart; it is not printed",
+                dot.x, dot.y
+            ),
+            1 => format!(
+                "path '{first}': {count} of its pieces are too small to print with samples \
                  {spacing:.4} mm apart (the first at ({:.3}, {:.3}), {length:.4} mm long as \
                  placed); they are not printed",
                 dot.x, dot.y
-            );
-        }
+            ),
+            paths => {
+                let pieces: usize = dot_warnings.values().map(|w| w.1).sum();
+                let named: Vec<String> = dot_sources
+                    .iter()
+                    .take(3)
+                    .map(|s| format!("'{s}'"))
+                    .collect();
+                format!(
+                    "{pieces} part(s) of {paths} paths ({}{}) are too small to print with \
+                     samples {spacing:.4} mm apart: dots (strokes of no length, as pads and \
+                     dots are drawn) or shapes far smaller than the nozzle; the first at \
+                     ({:.3}, {:.3}), {length:.4} mm long as placed; they are not printed",
+                    named.join(", "),
+                    if paths > 3 { ", ..." } else { "" },
+                    dot.x,
+                    dot.y
+                )
+            }
+        };
     }
     // Lines closer together than the filament is wide merge (`spacing`).
     let lines: Vec<Line> = sampled
@@ -286,14 +321,29 @@ pub fn surface_path(
                     foot.x, foot.y, tall
                 )
             } else if !any_line && !dots.is_empty() {
+                // QA: PCB footprints whose pads are strokes of no length
+                // (drawn by their square caps) were told to check their
+                // units, which no scale fixes.
+                let why = if longest_dot_mm == 0.0 {
+                    "a stroke of no length (as pads and dots are drawn, by their round or square \
+                     caps), and this planner prints lines, not dots: draw each pad or dot as an \
+                     outline or a short line"
+                        .to_string()
+                } else {
+                    format!(
+                        "a shape at most {longest_dot_mm:.4} mm long as placed, far shorter than \
+                         the samples' spacing of {spacing:.4} mm: a dot as pads and dots are \
+                         drawn (this planner prints lines, not dots), or a drawing far too small: \
+                         check the drawing's units and the placement's scale"
+                    )
+                };
                 format!(
-                "nothing to print at the nozzle's scale: every path of the drawing ({} of them: \
-                 '{}'{}) is a dot or a shape shorter than the samples' spacing of {spacing:.4} mm \
-                 as placed; check the drawing's units and the placement's scale",
-                dots.len(),
-                dots[0],
-                if dots.len() > 1 { ", ..." } else { "" }
-            )
+                    "nothing to print at the nozzle's scale: every path of the drawing ({} of \
+                     them: '{}'{}) is a dot, {why}",
+                    dots.len(),
+                    dots[0],
+                    if dots.len() > 1 { ", ..." } else { "" }
+                )
             } else if any_sample && inside {
                 format!(
                     "no part of the path lies over the scan's surface: the path spans x \

@@ -1337,18 +1337,28 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A drawing with many parts too small to print (30 zero-length paths
-/// beside a line, as PCB drawings have) gave a warning each, 117 lines on
-/// a real PCB drawing: the CLI prints the first 25 and how many more, and
-/// the report keeps them all. The zero length read "-0.0000 mm".
+/// A drawing with many parts too small to print (30 zero-length paths,
+/// as PCB drawings have) gave a warning each, 117 lines on a real PCB
+/// drawing: they are one warning now (QA round 3: an icon's twelve dots
+/// gave twelve), whose zero length read "-0.0000 mm". Warnings that are
+/// one a path (30 lines whose ends leave the scan) are cut short by the
+/// CLI after 25, and the report keeps them all.
 #[test]
 fn a_flood_of_warnings_is_cut_short_and_the_report_keeps_them_all() {
     let dir = temp_dir("many-warnings");
     let dots: String = (0..30)
         .map(|i| {
             format!(
-                r#"<path id="dot{i}" d="M {x} 10 L {x} 10" stroke="black"/>"#,
-                x = 5 + 2 * i
+                r#"<path id="dot{i}" d="M {x} 2 L {x} 2" stroke="black"/>"#,
+                x = 55 + i
+            )
+        })
+        .collect();
+    let edges: String = (0..30)
+        .map(|i| {
+            format!(
+                r#"<path id="edge{i}" d="M 50 {y} L 100 {y}" stroke="black"/>"#,
+                y = 5 + 2 * i
             )
         })
         .collect();
@@ -1356,7 +1366,7 @@ fn a_flood_of_warnings_is_cut_short_and_the_report_keeps_them_all() {
     std::fs::write(
         &svg,
         format!(
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="70mm" height="20mm" viewBox="0 0 70 20">{dots}<path d="M 5 15 L 65 15" stroke="black"/></svg>"#
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="80mm" viewBox="0 0 100 80">{dots}{edges}</svg>"#
         ),
     )
     .unwrap();
@@ -1365,23 +1375,34 @@ fn a_flood_of_warnings_is_cut_short_and_the_report_keeps_them_all() {
     let o = plan_on(
         &scan,
         &svg,
-        &["--place", "5,20", "-o", s(&out), "--report", s(&report)],
+        &["--place", "0,80", "-o", s(&out), "--report", s(&report)],
     );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let err = stderr(&o);
-    let dots_named = err.lines().filter(|l| l.contains("path 'dot")).count();
-    assert_eq!(dots_named, 25, "{err}");
+    let dots = err
+        .lines()
+        .filter(|l| l.contains("'dot"))
+        .collect::<Vec<_>>();
     assert!(
-        err.contains("... and 5 more warning(s), not shown"),
+        dots.len() == 1
+            && dots[0]
+                .contains("30 part(s) of 30 paths ('dot0', 'dot1', 'dot2', ...) are too small")
+            && dots[0].contains("0.0000 mm long as placed"),
         "{err}"
     );
     assert!(!err.contains("-0.0000"), "{err}");
+    let edges_named = err.lines().filter(|l| l.contains("path 'edge")).count();
+    assert_eq!(edges_named, 23, "{err}");
+    assert!(
+        err.contains("... and 8 more warning(s), not shown"),
+        "{err}"
+    );
     let json: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let kept = json["warnings"]
         .as_array()
         .unwrap()
         .iter()
-        .filter(|w| w.as_str().unwrap().contains("path 'dot"))
+        .filter(|w| w.as_str().unwrap().contains("path 'edge"))
         .count();
     assert_eq!(kept, 30);
     let _ = std::fs::remove_dir_all(&dir);

@@ -471,8 +471,23 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
     let e = pipeline::plan(&flat, &pads, &settings)
         .unwrap_err()
         .to_string();
+    // No scale prints a stroke of no length (QA: Fritzing's pads were told
+    // to check their units).
     assert!(
-        e.contains("nothing to print at the nozzle's scale") && e.contains("'line'"),
+        e.contains(
+            "nothing to print at the nozzle's scale: every path of the drawing (2 of them: \
+             'line', ...) is a dot, a stroke of no length"
+        ) && !e.contains("units"),
+        "{e}"
+    );
+    // A shape only small as placed: a dot, or its units or scale.
+    let tiny = vec![line(DVec2::new(5.0, 5.0), DVec2::new(5.001, 5.0))];
+    let e = pipeline::plan(&flat, &tiny, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("is a dot, a shape at most 0.0010 mm long as placed")
+            && e.contains("check the drawing's units"),
         "{e}"
     );
     // Two plates 20 mm apart; a line between them lies inside the scan's
@@ -963,16 +978,39 @@ fn pieces_too_small_to_print_are_one_warning_a_path() {
         .iter()
         .filter(|w| w.contains("too small to print"))
         .collect();
-    assert_eq!(small.len(), 2, "{small:?}");
+    // One warning for them all (QA: an icon's twelve dots gave twelve).
+    assert_eq!(small.len(), 1, "{small:?}");
     assert!(
-        small[0].starts_with("path 'path #263': 40 of its pieces are too small to print")
-            && small[0].contains("(the first at (5.001, 10.000), 0.0010 mm long as placed)"),
+        small[0].starts_with(
+            "41 part(s) of 2 paths ('path #263', 'pad') are too small to print with samples"
+        ) && small[0].contains("the first at (5.001, 10.000), 0.0010 mm long as placed"),
         "{}",
         small[0]
     );
+    // One path's pieces, and one dot, are said as such.
+    let plan = pipeline::plan(&flat, &drawing[..40], &PlanSettings::default());
+    let e = plan.unwrap_err().to_string();
+    assert!(e.contains("'path #263'"), "{e}");
+    drawing.drain(1..40);
+    let plan = pipeline::plan(&flat, &drawing, &PlanSettings::default()).unwrap();
+    let small: Vec<&String> = plan
+        .warnings
+        .iter()
+        .filter(|w| w.contains("too small to print"))
+        .collect();
+    assert_eq!(small.len(), 1, "{small:?}");
     assert!(
-        small[1].starts_with("path 'pad' at (30.000, 30.000)"),
+        small[0].starts_with("2 part(s) of 2 paths ('path #263', 'pad')"),
         "{}",
-        small[1]
+        small[0]
+    );
+    drawing.remove(1);
+    let plan = pipeline::plan(&flat, &drawing, &PlanSettings::default()).unwrap();
+    assert!(
+        plan.warnings
+            .iter()
+            .any(|w| w.starts_with("path 'path #263' at (5.001, 10.000) is 0.0010 mm long")),
+        "{:?}",
+        plan.warnings
     );
 }
