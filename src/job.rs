@@ -1300,6 +1300,13 @@ pub struct GcodeCheck {
     /// The clearance checked: tol (mm) and the nozzle's outer diameter.
     pub tol_mm: f64,
     pub outer_diameter_mm: f64,
+    /// What the program's header says of the scan it was planned on that
+    /// this check's scan is not: read in other units or with another up
+    /// axis, or in another frame. The moves were checked against a scan
+    /// that is not where the program's part was, so the program is not
+    /// shown clear (QA: a 44 mm cow checked as a 1.7 mm one passed).
+    #[serde(default)]
+    pub planned_otherwise: Vec<String>,
     /// The straight moves followed, in file order (the touching moves'
     /// `index` points into them): for drawing; not in the JSON.
     #[serde(skip)]
@@ -1307,11 +1314,14 @@ pub struct GcodeCheck {
 }
 
 impl GcodeCheck {
-    /// Whether the program is shown to keep tol: no move comes closer, and
-    /// none was left unchecked (a move the file does not place could touch:
-    /// a check that could not look does not pass it).
+    /// Whether the program is shown to keep tol: no move comes closer, none
+    /// was left unchecked (a move the file does not place could touch: a
+    /// check that could not look does not pass it), and the scan is read
+    /// and placed as the program's header says it was planned on.
     pub fn is_clear(&self) -> bool {
-        self.summary.touching_moves == 0 && self.unchecked_lines.is_empty()
+        self.summary.touching_moves == 0
+            && self.unchecked_lines.is_empty()
+            && self.planned_otherwise.is_empty()
     }
 
     /// A note on the moves that leave `profile`'s build volume (the scan
@@ -1387,7 +1397,7 @@ pub fn check_gcode(
              nothing to check; is it the G-code file the printer runs?"
         )));
     }
-    let frame_notes = header_mismatch(text, scan);
+    let (frame_notes, planned_otherwise) = header_mismatch(text, scan);
     let clearance = Clearance::new(nozzle, tol_mm);
     let summary = check_moves(
         &scan.surface,
@@ -1526,6 +1536,7 @@ pub fn check_gcode(
         notes,
         tol_mm,
         outer_diameter_mm: nozzle.outer_diameter_mm,
+        planned_otherwise,
         moves: program.moves,
     })
 }
@@ -1553,8 +1564,12 @@ pub fn line_list(lines: &[usize]) -> String {
 /// say why its moves may miss or hit the part (a program planned on a
 /// scan placed on the bed, checked against the scan placed another way,
 /// showed only collisions). Other tools' programs have no such header.
-fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
+/// The second list holds those of them that say the scan was read or
+/// placed another way (units, up axis, frame): then this check's scan is
+/// not where the program's part was.
+fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
+    let mut otherwise = Vec::new();
     // The leading comment block: `; key: value` (`'` for Aerotech).
     let header = text
         .lines()
@@ -1595,11 +1610,13 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
                 .into_iter()
                 .flatten()
                 .collect();
-                notes.push(format!(
+                let note = format!(
                     "the program was planned with the scan read in {v}, this check reads it in \
                      {ours}: read it as it was then ({})",
                     flags.join(" ")
-                ));
+                );
+                otherwise.push(note.clone());
+                notes.push(note);
             }
         } else if let Some(v) = line.strip_prefix("registration: ") {
             let Some((status, g)) = v.rsplit_once("; G [") else {
@@ -1623,16 +1640,18 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> Vec<String> {
             // Written to 6 decimals: more than their rounding is another
             // frame.
             if off > 1e-5 {
-                notes.push(format!(
+                let note = format!(
                     "the program was planned with the scan in another frame: its header says \
                      \"{status}\", G differing from this check's by up to {off:.3}; place or \
                      register the scan as it was then (this check's scan is {})",
                     scan.registration.status
-                ));
+                );
+                otherwise.push(note.clone());
+                notes.push(note);
             }
         }
     }
-    notes
+    (notes, otherwise)
 }
 
 /// Plans from bytes: the CLI's `plan` and the page's Plan button.

@@ -650,3 +650,39 @@ fn regression_moves_beside_the_scan_are_named() {
         check.notes
     );
 }
+
+/// QA round 2: a program planned on a 44 mm cow (the scan read in inches,
+/// +Y up), checked with the scan read in mm, was "clear" (exit 0) against
+/// a 1.7 mm cow, the header's mismatch said only in a note. A program whose
+/// header says the scan was read or placed another way is not shown clear.
+#[test]
+fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
+    use pcpp::job::check_gcode;
+
+    let scan = demo_scan();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let (_, hi) = scan.surface.bbox();
+    let moves = format!(
+        "G21\nG90\nG0 X40 Y40 Z{z}\nG1 X50 Y40 Z{z}\n",
+        z = hi.z + 5.0
+    );
+    let plain = check_gcode(&scan, &moves, "a.gcode", &nozzle, 0.1).unwrap();
+    assert!(plain.is_clear() && plain.planned_otherwise.is_empty());
+    let text = format!("; scan read in: in, +Y up\n{moves}");
+    let check = check_gcode(&scan, &text, "a.gcode", &nozzle, 0.1).unwrap();
+    assert_eq!(check.summary.touching_moves, 0);
+    assert!(!check.is_clear());
+    assert_eq!(
+        check.planned_otherwise.len(),
+        1,
+        "{:?}",
+        check.planned_otherwise
+    );
+    assert!(
+        check.planned_otherwise[0].starts_with(
+            "the program was planned with the scan read in in, +Y up, this check reads it in mm"
+        ),
+        "{:?}",
+        check.planned_otherwise
+    );
+}

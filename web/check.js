@@ -66,6 +66,9 @@ export function onCheck(m) {
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
   verdict.textContent = c.clear
     ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
+    : sum.touching_moves === 0 && c.unchecked_lines.length === 0
+      ? `not shown clear: no move comes closer than tol to the scan as loaded, but the program was planned `
+        + `on the scan read or placed another way (${(c.planned_otherwise || []).map(pageText).join('; ')}); ${against}`
     : sum.touching_moves === 0
       ? `not shown clear: ${c.unchecked_lines.length} move(s) could not be checked (the file does not `
         + `give where they start or end, and they come lower than tol above the scan's top); `

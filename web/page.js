@@ -73,6 +73,7 @@ const PAGE_WORDS = [
   [/\(--up-axis (-?)([yz])\)/g, (_, sign, a) => `(Up axis: ${sign || '+'}${a.toUpperCase()})`],
   [/\(--up-axis; a depth camera's frame, z the distance from the camera, is -z\)/g,
     "(Up axis; a depth camera's frame, z the distance from the camera, is -Z)"],
+  [/\(--scan-units (\w+) --up-axis (-?)([yz])\)/g, (_, u, sign, a) => `(Units: ${u}; Up axis: ${sign || '+'}${a.toUpperCase()})`],
   [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
   [/\(--scan-units (\w+) if it really is this (small|large)\)/g, '(Units: $1 if it really is this $2)'],
   [/\(--max-edge\)/g, '(Cloud max edge)'],

@@ -205,6 +205,18 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
   const backPx = await viewPixels(page);
   assert.ok(backPx.good > 200, JSON.stringify(backPx));
 
+  // The same program, its header saying the scan was read in inches, +Y
+  // up: checked against the scan as loaded, it is not shown clear (QA: a
+  // 44 mm cow checked as a 1.7 mm one passed), and the page names its
+  // controls, not the command line's flags.
+  const otherwise = own.bytes.toString('utf8').replace(/\n; scan read in: mm, \+Z up\n/, '\n; scan read in: in, +Y up\n');
+  assert.notEqual(otherwise, own.bytes.toString('utf8'));
+  await page.setInputFiles('#gcode-input', gcodeFile('inches.gcode', Buffer.from(otherwise)));
+  await page.waitForFunction(() => /inches\.gcode/.test(document.getElementById('check-verdict').textContent));
+  const said = await page.textContent('#check-verdict');
+  assert.match(said, /^not shown clear: no move comes closer than tol to the scan as loaded, but the program was planned on the scan read or placed another way \(the program was planned with the scan read in in, \+Y up, this check reads it in mm, \+Z up: read it as it was then \(Units: in; Up axis: \+Y\)\); inches\.gcode against/);
+  assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
+
   // Down beside a 2 mm wall of the test part, then up across its corner.
   const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
   await page.setInputFiles('#gcode-input', gcodeFile('cut.gcode', cut));

@@ -259,26 +259,26 @@ test('switching the units away and back brings back the typed placement', async 
     null, { timeout: 120_000 });
   await waitSettled(page);
   const offset = () => page.evaluate(() => [window.pcpp.settings.placement.x, window.pcpp.settings.placement.y].map(Number));
-  await page.fill('#pl-x', '30');
-  await page.fill('#pl-y', '45');
+  await page.fill('#pl-x', '12');
+  await page.fill('#pl-y', '60');
   await waitSettled(page);
-  assert.deepEqual(await offset(), [30, 45]);
+  assert.deepEqual(await offset(), [12, 60]);
   // Read in cm (800 mm across): centred on the scan as now read.
   await page.selectOption('#scan-units', 'cm');
   await waitIdle(page);
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'cm', null, { timeout: 120_000 });
   await waitIdle(page);
   const inCm = await offset();
-  assert.notDeepEqual(inCm, [30, 45]);
+  assert.notDeepEqual(inCm, [12, 60]);
   // Back to mm (the file's default, chosen by name): the typed placement,
   // planned there.
   await page.selectOption('#scan-units', 'mm');
   await waitSettled(page);
-  assert.deepEqual(await offset(), [30, 45]);
-  assert.equal(await page.inputValue('#pl-x'), '30');
-  assert.equal(await page.inputValue('#pl-y'), '45');
+  assert.deepEqual(await offset(), [12, 60]);
+  assert.equal(await page.inputValue('#pl-x'), '12');
+  assert.equal(await page.inputValue('#pl-y'), '60');
   const planned = await page.evaluate(() => window.pcpp.state.lastPlan.summary.settings.placement.offset_mm);
-  assert.deepEqual(planned, [30, 45]);
+  assert.deepEqual(planned, [12, 60]);
   // And cm again: where it was in cm.
   await page.selectOption('#scan-units', 'cm');
   await waitIdle(page);

@@ -86,6 +86,16 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         }
         return Ok(());
     }
+    if sum.touching_moves == 0 && check.unchecked_lines.is_empty() {
+        // Only the header's scan differs (QA: a 44 mm cow checked as a
+        // 1.7 mm one passed with exit 0).
+        return Err(Failure::Input(format!(
+            "{head}; no move comes closer than tol to the scan as this check reads it, but the \
+             program was planned on the scan read or placed another way: {}; so the program is \
+             not shown to keep tol",
+            check.planned_otherwise.join("; ")
+        )));
+    }
     if sum.touching_moves == 0 {
         let lines = &check.unchecked_lines;
         // ("none of those comes closer" of 0 moves read as a pass.)
