@@ -107,6 +107,13 @@ pub enum Error {
         at: [f64; 3],
         limit_mm: f64,
     },
+    /// A refusal that accepting the risk lifts, with the other risks that
+    /// the same acceptance would take (each would be refused on its own).
+    #[error("{first}; accepting the risk would also accept: {}", .others.join("; "))]
+    AlsoRisks {
+        first: Box<Error>,
+        others: Vec<String>,
+    },
     /// G-code refused for a drawing most of which lies beside the scan or
     /// over its holes ([`crate::pipeline::MIN_PRINTED_SHARE`]).
     #[error(

@@ -926,6 +926,19 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
     h
 }
 
+/// What a G-code refusal that accepting the risk lifts is for (see
+/// [`write_outputs`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Risk {
+    Registration,
+    WholeObject,
+    Units,
+    MostlyOff,
+    FarAbove,
+    BelowBed,
+    Uncleared,
+}
+
 /// Warnings whose text the G-code header gives.
 const HEADER_WARNINGS: usize = 10;
 
@@ -1104,12 +1117,6 @@ pub fn write_outputs(
     profile: &MachineProfile,
     accept_risk: bool,
 ) -> Result<(Report, String)> {
-    refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
-    refuse_whole_object_cloud(scan, accept_risk)?;
-    refuse_unit_doubt(scan, accept_risk)?;
-    if let (Some(depth_mm), false) = (below_bed_mm(scan), accept_risk) {
-        return Err(Error::BelowBed { depth_mm });
-    }
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
     // Spec 6(f): every move is checked but those that start where nothing
@@ -1125,59 +1132,109 @@ pub fn write_outputs(
     // What the G-code would have been refused for but for the accepted
     // risk, known before it is written: said in its header (one line, so
     // the header's length does not change) and in the report.
-    let mut risks = Vec::new();
+    let mut risks: Vec<(Risk, String)> = Vec::new();
     match registration_risk(&scan.registration, &settings.nozzle) {
-        Some(RegistrationError::UpsideDown { tilt_deg, .. }) => risks.push(format!(
+        Some(RegistrationError::UpsideDown { tilt_deg, .. }) => risks.push((
+            Risk::Registration,
+            format!(
             "the registration turns the scan upside down (its up axis {tilt_deg:.1} deg from +Z)"
+        ),
         )),
-        Some(RegistrationError::TooFarOff { rms_mm, d_mm, .. }) => risks.push(format!(
-            "the registration leaves the fiducials {rms_mm:.3} mm RMS from the printer points \
+        Some(RegistrationError::TooFarOff { rms_mm, d_mm, .. }) => risks.push((
+            Risk::Registration,
+            format!(
+                "the registration leaves the fiducials {rms_mm:.3} mm RMS from the printer points \
              (more than d = {d_mm} mm)"
+            ),
         )),
         _ => {}
     }
     if let Some(c) = scan.cloud.filter(|c| c.hidden > 0) {
-        risks.push(format!(
+        risks.push((
+            Risk::WholeObject,
+            format!(
             "the scan is a whole object's point cloud ({} of its {} points lie under its top and \
              were left out): between its points the real surface may be higher",
             c.hidden, c.points
+        ),
         ));
     }
     if let Some(d) = scan.units_doubt.filter(|d| !d.given) {
-        risks.push(format!(
-            "the scan is {}{:.3} mm across, read in {} without its units given",
-            if d.too_large { "" } else { "only " },
-            d.size_mm.max_element(),
-            d.units
+        risks.push((
+            Risk::Units,
+            format!(
+                "the scan is {}{:.3} mm across, read in {} without its units given",
+                if d.too_large { "" } else { "only " },
+                d.size_mm.max_element(),
+                d.units
+            ),
         ));
     }
     if let Some((height, at)) = far_above(plan, settings) {
-        risks.push(format!(
-            "the tool path dispenses {height:.3} mm above the surface at ({:.3}, {:.3}, {:.3})",
-            at.x, at.y, at.z
+        risks.push((
+            Risk::FarAbove,
+            format!(
+                "the tool path dispenses {height:.3} mm above the surface at ({:.3}, {:.3}, {:.3})",
+                at.x, at.y, at.z
+            ),
         ));
     }
     if plan.coverage.mostly_off_scan() {
         let c = plan.coverage;
-        risks.push(format!(
-            "only {:.1} of the drawing's {:.1} mm ({:.0} %) lie over the scan and are printed",
-            c.printed_mm,
-            c.drawn_mm,
-            c.printed_percent()
+        risks.push((
+            Risk::MostlyOff,
+            format!(
+                "only {:.1} of the drawing's {:.1} mm ({:.0} %) lie over the scan and are printed",
+                c.printed_mm,
+                c.drawn_mm,
+                c.printed_percent()
+            ),
         ));
     }
     if let Some(depth) = below_bed_mm(scan) {
-        risks.push(format!(
-            "the scan is placed {depth:.3} mm below the bed (Move Z)"
+        risks.push((
+            Risk::BelowBed,
+            format!("the scan is placed {depth:.3} mm below the bed (Move Z)"),
         ));
     }
     if !plan.uncleared.is_empty() {
-        risks.push(format!(
-            "the nozzle still touches the surface at {} planned point(s)",
-            plan.uncleared.len()
+        risks.push((
+            Risk::Uncleared,
+            format!(
+                "the nozzle still touches the surface at {} planned point(s)",
+                plan.uncleared.len()
+            ),
         ));
     }
-    report.motion.accepted_risks = risks;
+    // A refusal says what else accepting its risk would accept (QA: the
+    // page's box was ticked for a whole object's cloud, and the G-code
+    // dispensed 134 mm above the surface, a refusal of its own never
+    // shown).
+    let refused = |e: Error, risk: Option<Risk>| -> Error {
+        let others: Vec<String> = risks
+            .iter()
+            .filter(|(r, _)| Some(*r) != risk)
+            .map(|(_, text)| text.clone())
+            .collect();
+        if others.is_empty() {
+            e
+        } else {
+            Error::AlsoRisks {
+                first: Box::new(e),
+                others,
+            }
+        }
+    };
+    if !accept_risk {
+        refuse_bad_registration(&scan.registration, &settings.nozzle, false)
+            .map_err(|e| refused(e, Some(Risk::Registration)))?;
+        refuse_whole_object_cloud(scan, false).map_err(|e| refused(e, Some(Risk::WholeObject)))?;
+        refuse_unit_doubt(scan, false).map_err(|e| refused(e, Some(Risk::Units)))?;
+        if let Some(depth_mm) = below_bed_mm(scan) {
+            return Err(refused(Error::BelowBed { depth_mm }, Some(Risk::BelowBed)));
+        }
+    }
+    report.motion.accepted_risks = risks.iter().map(|(_, text)| text.clone()).collect();
     let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
     let job = |header| GcodeJob {
         toolpaths: &toolpaths,
@@ -1245,30 +1302,33 @@ pub fn write_outputs(
     if plan.coverage.mostly_off_scan() && !accept_risk {
         let (lo, hi) = scan.surface.bbox();
         let c = plan.coverage;
-        return Err(Error::MostlyOffScan {
+        let e = Error::MostlyOffScan {
             printed_mm: c.printed_mm,
             drawn_mm: c.drawn_mm,
             percent: c.printed_percent(),
             drawing_xy: c.drawing_xy,
             scan_xy: [lo.x, lo.y, hi.x, hi.y],
-        });
+        };
+        return Err(refused(e, Some(Risk::MostlyOff)));
     }
     if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
-        return Err(Error::FarAbove {
+        let e = Error::FarAbove {
             height_mm,
             at: at.to_array(),
             limit_mm: pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm,
-        });
+        };
+        return Err(refused(e, Some(Risk::FarAbove)));
     }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
     if checked.touching_moves > 0 && !accept_risk {
-        return Err(Error::Touching(Box::new(TouchingMoves {
+        let e = Error::Touching(Box::new(TouchingMoves {
             planner: plan.planner.name().into(),
             outer_diameter_mm: settings.nozzle.outer_diameter_mm,
             tol_mm: settings.process.tolerance_mm,
             summary: checked,
-        })));
+        }));
+        return Err(refused(e, None));
     }
     report.motion.risk_accepted =
         checked.touching_moves > 0 || !report.motion.accepted_risks.is_empty();

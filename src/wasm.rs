@@ -75,6 +75,17 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 /// their G-code lines).
 fn core_err(e: crate::Error) -> JsValue {
     use crate::Error;
+    // The other risks accepting this one would accept: the kind and fields
+    // are the refusal's own, the message says them too.
+    if let Error::AlsoRisks { first, others } = e {
+        let message = format!(
+            "{first}; accepting the risk would also accept: {}",
+            others.join("; ")
+        );
+        let err = core_err(*first);
+        let _ = js_sys::Reflect::set(&err, &"message".into(), &message.into());
+        return err;
+    }
     // `matches!` rather than a `match`, so a variant added to the core later
     // falls to "other" instead of breaking this adapter.
     let kind = if matches!(e, Error::Mesh(_)) {

@@ -626,6 +626,44 @@ fn regression_gcode_dispensing_far_above_the_surface_was_written() {
         "{}",
         &out.gcode[..2000]
     );
+    // The line drawn on past the scan as well: the first refusal says the
+    // other risk that accepting it would accept (QA: the page's box was
+    // ticked for one refusal, and the G-code dispensed 134 mm in the air).
+    let long = svg.replace("H15", "H60");
+    let mesh = height_field(&xs, &ys, |x, _| {
+        1.0 + if (x - 10.0).abs() <= 0.15 + 1e-9 {
+            20.0
+        } else {
+            0.0
+        }
+    });
+    let scan = prepared_ply(&mesh, "fin.ply");
+    let e = run_on(
+        &scan,
+        long.as_bytes(),
+        "line.svg",
+        &settings,
+        &profile,
+        false,
+    )
+    .err()
+    .expect("refused");
+    match &e {
+        pcpp::Error::AlsoRisks { first, others } => {
+            assert!(matches!(**first, pcpp::Error::MostlyOffScan { .. }), "{e}");
+            assert_eq!(others.len(), 1, "{others:?}");
+            assert!(
+                others[0].starts_with("the tool path dispenses 20."),
+                "{others:?}"
+            );
+        }
+        _ => panic!("{e}"),
+    }
+    assert!(
+        e.to_string()
+            .contains("; accepting the risk would also accept: the tool path dispenses 20."),
+        "{e}"
+    );
 }
 
 /// Every planner on a level plate 40 mm square at z = 5 (`pcpp compare`)

@@ -148,6 +148,16 @@ fn centre_on_scan(
 /// What the scan's import and registration noticed is said first: it may
 /// be the cause (a scan read in the wrong units leaves nothing to print).
 fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
+    // The other risks the flag would accept, said after the refusal.
+    if let Error::AlsoRisks { first, others } = e {
+        return match plan_failure(inputs, *first, progress) {
+            Failure::Input(m) => Failure::Input(format!(
+                "{m}; --accept-risk would also accept: {}",
+                others.join("; ")
+            )),
+            usage => usage,
+        };
+    }
     // A warning the error repeats is said once, by the error.
     let repeated = |w: &String| matches!(&e, Error::UnitsDoubt { message, .. } if message.starts_with(w.as_str()));
     let warnings: Vec<String> = inputs
