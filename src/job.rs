@@ -1119,6 +1119,18 @@ pub fn write_outputs(
 ) -> Result<(Report, String)> {
     let mut report = report(scan, path_file, plan, settings);
     report.warnings.extend(notes.iter().cloned());
+    // A scan partly outside the build volume whose tool path is inside
+    // (QA: 2 mm of a scan below the bed, taken as it is: the page showed
+    // a banner, the command line said nothing). If the part stands on the
+    // bed, the scan is not in the printer's frame.
+    let fit =
+        crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+    if !fit.inside {
+        report.warnings.push(match scan.registration.status {
+            RegistrationStatus::PlacedOnBed { .. } => fit.placed_message,
+            _ => fit.message,
+        });
+    }
     // Spec 6(f): every move is checked but those that start where nothing
     // says; the header names the first rise, this the profile's own.
     if let Some(line) = crate::gcode::start_block_motion(profile) {

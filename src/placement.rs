@@ -211,14 +211,17 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             hi.z,
             outside.max_element(),
         );
-        placed_message = format!("{spans}; move it back inside (--place-scan bed,DX,DY,DZ[,ROT])");
         if fits_on_bed {
+            placed_message =
+                format!("{spans}; move it back inside (--place-scan bed,DX,DY,DZ[,ROT])");
             format!(
                 "{spans}; if it is still in the scanner's frame, place it on the bed \
                  (--place-scan bed) or register it by its fiducials"
             )
         } else {
-            // Placing it cannot help: name the axis it is too large on.
+            // Placing it cannot help, on the bed or elsewhere (QA: a scan
+            // read in metres, placed on the bed, was told to be moved back
+            // inside): name the axis it is too large on.
             let over = size - room;
             let (axis, k) = [("x", 0), ("y", 1), ("z", 2)]
                 .into_iter()
@@ -470,6 +473,26 @@ mod tests {
                 && !fit.message.contains("place it on the bed"),
             "{}",
             fit.message
+        );
+        // Placed on the bed, the same: moving it cannot help (QA: a scan
+        // read in metres, placed on the bed, was told to move back inside).
+        assert_eq!(fit.placed_message, fit.message);
+        let fit = volume_fit(
+            (DVec3::new(0.0, 0.0, 0.0), DVec3::new(30.0, 30.0, 10.0)),
+            &volume(),
+            "marlin",
+        );
+        assert!(fit.inside);
+        let fit = volume_fit(
+            (DVec3::new(-10.0, 0.0, 0.0), DVec3::new(30.0, 30.0, 10.0)),
+            &volume(),
+            "marlin",
+        );
+        assert!(
+            fit.placed_message
+                .ends_with("move it back inside (--place-scan bed,DX,DY,DZ[,ROT])"),
+            "{}",
+            fit.placed_message
         );
     }
 

@@ -2615,3 +2615,43 @@ fn cli_messages_name_flags_not_the_page() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 2: a scan taken as it is with 2 mm of it below the bed got a
+/// build-volume banner in the page and no word from the command line,
+/// which wrote the same G-code. Both say it now (in the warnings and the
+/// G-code's header): if the part stands on the bed, the scan is not in
+/// the printer's frame.
+#[test]
+fn a_scan_partly_below_the_bed_is_said_to_lie_outside_the_volume() {
+    let dir = temp_dir("below-bed-as-is");
+    // A plate at z = 1 stepping down to z = -2 beyond x = 35.
+    let xs = [0.0, 35.0, 38.0, 40.0];
+    let zs = [1.0, 1.0, -2.0, -2.0];
+    let mut obj = String::new();
+    for (x, z) in xs.iter().zip(zs) {
+        for y in [0.0, 20.0] {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    for k in 0..3 {
+        let (a, b, c, d) = (2 * k + 1, 2 * k + 3, 2 * k + 4, 2 * k + 2);
+        obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+    }
+    let scan = dir.join("step.obj");
+    std::fs::write(&scan, obj).unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20"><path d="M 5 10 L 20 10" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let o = plan_on(&scan, &svg, &["--place", "0,20", "-o", s(&out)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let said = "the scan lies outside the build volume of profile marlin (x 0..220, y 0..220, z \
+                0..250 mm): it spans x 0.0..40.0, y 0.0..20.0, z -2.0..1.0 mm, out by up to 2.0 \
+                mm; if it is still in the scanner's frame, place it on the bed";
+    assert!(stderr(&o).contains(said), "{}", stderr(&o));
+    assert!(std::fs::read_to_string(&out).unwrap().contains(said));
+    let _ = std::fs::remove_dir_all(&dir);
+}
