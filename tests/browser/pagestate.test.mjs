@@ -83,13 +83,16 @@ test('a cancelled scan import is dropped: the scan before it, its name and its G
 
   await page.setInputFiles('#scan-input', cloud);
   // Cancelled as soon as the import shows it runs (the Cancel button).
-  const log = await page.evaluate(() => new Promise((ok) => {
+  const log = await page.evaluate(() => new Promise((ok, fail) => {
     const s = window.pcpp.state;
     const cancel = document.getElementById('cancel-btn');
+    const until = Date.now() + 60_000;
     const poll = () => {
       if (s.busy && s.pendingScan && s.busy.scan === s.pendingScan && !cancel.hidden) {
         cancel.click();
         ok(s.progressLog.slice());
+      } else if (Date.now() > until) {
+        fail(new Error('the import was never seen running'));
       } else setTimeout(poll, 0);
     };
     poll();
@@ -132,17 +135,25 @@ test('a cancelled drawing goes back to the drawing before it, where it was place
   await waitSettled(page);
   const good = await page.evaluate(() => window.pcpp.state.lastPlan.gcode);
   const placement = await page.evaluate(() => ({ ...window.pcpp.settings.placement }));
-  await page.setInputFiles('#svg-input', svgFile('small.svg', SMALL_SVG));
-  await page.evaluate(() => new Promise((ok) => {
+  // The watch is set before the file is given: a small drawing is read and
+  // planned in a few milliseconds, which a watch set after it could miss
+  // (the test then waited for ever on a busy machine); and it gives up
+  // after a minute rather than hang.
+  const cancelled = page.evaluate(() => new Promise((ok, fail) => {
     const s = window.pcpp.state;
+    const until = Date.now() + 60_000;
     const poll = () => {
       if (s.busy && s.pendingSvg && s.busy.svg === s.pendingSvg) {
         document.getElementById('cancel-btn').click();
         ok();
+      } else if (Date.now() > until) {
+        fail(new Error('the drawing was never seen being read or planned'));
       } else setTimeout(poll, 0);
     };
     poll();
   }));
+  await page.setInputFiles('#svg-input', svgFile('small.svg', SMALL_SVG));
+  await cancelled;
   assert.equal(await page.evaluate(() => window.pcpp.state.pendingSvg), null);
   assert.equal(await page.textContent('#svg-name'), 'demo: test-part drawing');
   assert.deepEqual(await page.evaluate(() => ({ ...window.pcpp.settings.placement })), placement);

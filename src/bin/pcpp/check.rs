@@ -69,9 +69,12 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
                 )
             });
     let head = format!(
-        "{}: {} moves checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
+        "{}: {} checked against {} (nozzle outer diameter {} mm, tol {} mm): {clear}",
         input_shown(gcode_path),
-        sum.moves,
+        match sum.moves {
+            1 => "1 move".to_string(),
+            n => format!("{n} moves"),
+        },
         input_shown(&a.scan.scan),
         check.outer_diameter_mm,
         check.tol_mm
