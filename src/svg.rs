@@ -336,6 +336,22 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         }
         e => parse_err(format!("not a usable SVG: {e}")),
     })?;
+    // (One of them given sets the size, the other following the viewBox's
+    // aspect.)
+    if prepared.missing_size.len() == 2 {
+        // QA: icon sets (simple-icons, ionicons) give a viewBox alone; its
+        // size was read as CSS px with nothing said, where width="100%",
+        // read the same, got a note.
+        let size = tree.size();
+        notes.push(format!(
+            "the root <svg> gives no width or height: the drawing was read at its viewBox's \
+             size in {} ({:.1} x {:.1} mm), as browsers show it; give width and height in mm \
+             (e.g. width=\"40mm\") to set its size, or scale it in the placement",
+            px_words(prepared.px_scale),
+            f64::from(size.width()) * MM_PER_PX * prepared.px_scale,
+            f64::from(size.height()) * MM_PER_PX * prepared.px_scale,
+        ));
+    }
     if !prepared.percent_size.is_empty() {
         // usvg takes a percentage of the viewBox's size in px; with no
         // viewBox the page is the drawing's extent and user units are px.
@@ -940,6 +956,9 @@ struct Prepared {
     /// lengths (not percentages).
     has_page: bool,
     percent_size: Vec<String>,
+    /// Which of the root's `width` and `height` are not given, over a
+    /// viewBox: SVG 2 reads them as 100 % (`auto`), as usvg does.
+    missing_size: Vec<&'static str>,
     /// [`RootSize::px_scale`].
     px_scale: f64,
 }
@@ -1168,6 +1187,9 @@ struct RootSize {
     /// `width`/`height` written as percentages (of a window the file does
     /// not have), e.g. `width="100%"`.
     percent: Vec<String>,
+    /// `width`/`height` not given over a valid viewBox (100 %, as SVG 2
+    /// reads them).
+    missing: Vec<&'static str>,
     /// Why the size in mm is not known: a `width`/`height` that is no
     /// length, or one set in CSS.
     unreadable: Vec<String>,
@@ -1231,6 +1253,12 @@ fn root_size(root: roxmltree::Node) -> RootSize {
                 }
             )),
         }
+    }
+    if size.has_viewbox {
+        size.missing = ["width", "height"]
+            .into_iter()
+            .filter(|name| root.attribute(*name).is_none())
+            .collect();
     }
     size.percent = ["width", "height"]
         .into_iter()
@@ -2284,6 +2312,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
                     .is_some_and(|l| l.unit != svgtypes::LengthUnit::Percent)
             }),
         percent_size: root_size.percent,
+        missing_size: root_size.missing,
         px_scale: root_size.px_scale,
     })
 }

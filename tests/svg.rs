@@ -1319,6 +1319,33 @@ fn percentage_width_falls_back_to_px_silently() {
     );
 }
 
+/// A viewBox with no width or height (icon sets: simple-icons, ionicons)
+/// is read at its size in CSS px, as `width="100%"` is, and now said so
+/// too (QA round 3: the percentage got a note, the missing size none).
+/// One of them given sets the size with the viewBox's aspect: no note.
+#[test]
+fn a_viewbox_without_a_size_is_read_in_px_and_said() {
+    let (subs, notes) = notes_of(&doc(
+        r#"viewBox="0 0 40 20""#,
+        r#"<path d="M2,10 H38" stroke="black"/>"#,
+    ));
+    let px = 25.4 / 96.0;
+    assert!((subs[0].length_mm() - 36.0 * px).abs() < 1e-5);
+    let note = note_with(&notes, "no width or height");
+    assert!(
+        note.starts_with(
+            "the root <svg> gives no width or height: the drawing was read at its \
+                          viewBox's size in CSS px (96 per inch) (10.6 x 5.3 mm)"
+        ),
+        "{note}"
+    );
+    let (_, notes) = notes_of(&doc(
+        r#"width="40mm" viewBox="0 0 40 20""#,
+        r#"<path d="M2,10 H38" stroke="black"/>"#,
+    ));
+    assert!(!notes.iter().any(|n| n.contains("gives no")), "{notes:?}");
+}
+
 /// A stroke far wider than a nozzle's trace is printed along its centre
 /// line: the note names the widest and its width in mm.
 #[test]
