@@ -200,7 +200,10 @@ async function openSvg(file) {
   // that drawing's placement: kept in the browser until this one is
   // planned (a drawing that failed is not reopened, so neither is where
   // it was centred), and taken back if this one is cancelled.
-  const prev = state.pendingSvg;
+  // A drawing read but not planned (its plan failed) is gone back to as a
+  // planned one is.
+  if (state.pendingSvg && state.pendingSvg.read) state.svgFile = state.pendingSvg;
+  const prev = state.pendingSvg && !state.pendingSvg.read ? state.pendingSvg : null;
   const was = prev ? prev.pathSource : settings.pathSource;
   const before = prev ? prev.before : { placement: { ...settings.placement }, fit: settings.fit };
   state.pendingSvg = {

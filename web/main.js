@@ -431,7 +431,8 @@ function onWorkerMessage(e) {
 }
 
 // `text` ended as a sentence, before the page's own line after it.
-const ended = (text) => (/[.!?)]$/.test(text.trim()) ? text : `${text.trimEnd()}.`);
+// (A closing parenthesis ends no sentence: "... at (23.0, 50.3, 30.2)".)
+const ended = (text) => (/[.!?]$/.test(text.trim()) ? text : `${text.trimEnd()}.`);
 
 // The refusals that accepting the risk lifts, by the core's error kind,
 // with the error panel's title for each.
@@ -447,6 +448,13 @@ function onPlanError(m, busy) {
   // The worker holds another drawing than the page thinks: the next plan
   // sends it again.
   if (/did not reach the planner/.test(m.message)) state.sentSvgKey = null;
+  // A drawing read whose plan failed (nothing printable, refused) is the
+  // user's drawing all the same: a file opened after it that cannot be
+  // read goes back to it (QA: it went back to the demo drawing).
+  if (state.pendingSvg && busy.svg === state.pendingSvg && m.kind !== 'svg' && m.kind !== 'crash'
+    && m.kind !== 'limit' && m.stage !== 'scan') {
+    state.pendingSvg.read = true;
+  }
   let title = 'Planning failed';
   let message = m.message;
   let file; // the file the title names

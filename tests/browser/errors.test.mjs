@@ -440,3 +440,27 @@ test('a compressed .svgz opened as the drawing is named as such, not taken for a
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 2: a drawing that was read but whose plan failed, then a file
+// that cannot be read: the page went back to the demo drawing, the
+// user's drawing lost. It goes back to the user's drawing.
+test('a broken SVG after a drawing whose plan failed goes back to that drawing', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // Pads only (strokes of no length): read, and nothing to print.
+  const pads = '<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20">'
+    + '<path id="pad1" d="M 5 5 L 5 5" stroke="black" stroke-linecap="square"/>'
+    + '<path id="pad2" d="M 15 5 L 15 5" stroke="black" stroke-linecap="square"/></svg>';
+  await page.setInputFiles('#svg-input', { name: 'pads.svg', mimeType: 'image/svg+xml', buffer: Buffer.from(pads) });
+  await page.waitForFunction(() => /stroke of no length/.test(document.getElementById('error-message').textContent));
+  await waitIdle(page);
+  assert.equal(await page.textContent('#svg-name'), 'pads.svg');
+  await page.setInputFiles('#svg-input', { name: 'broken.svg', mimeType: 'image/svg+xml', buffer: Buffer.from('<svg><path d="M 0 0 L') });
+  await page.waitForFunction(() => /broken\.svg/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Still using the previous SVG, pads\.svg\./);
+  assert.equal(await page.textContent('#svg-name'), 'pads.svg');
+  assert.equal(await page.inputValue('#path-source'), 'file');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
