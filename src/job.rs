@@ -1460,6 +1460,14 @@ pub fn check_gcode(
     crate::params::Process::DEFAULT
         .with_tolerance_mm(tol_mm)
         .validate()?;
+    // QA round 3: a scan given as the program was asked whether it is the
+    // G-code file the printer runs (an OBJ's numbers failed as G-code).
+    if let Some(kind) = scan_text_kind(text) {
+        return Err(Error::Plan(format!(
+            "{file} is {kind}, not a G-code program: give it as the scan (--scan), and the \
+             G-code file the printer runs as the program"
+        )));
+    }
     let program = crate::gcode::read_gcode(text, file)?;
     // A file without a single move (empty, comments only, or not G-code
     // at all) shows nothing about the nozzle: it is not "clear".
@@ -1611,6 +1619,26 @@ pub fn check_gcode(
         planned_otherwise,
         moves: program.moves,
     })
+}
+
+/// What kind of scan `text` is, if it is a scan's text rather than G-code.
+fn scan_text_kind(text: &str) -> Option<&'static str> {
+    let start = text.trim_start();
+    if start.starts_with("ply") {
+        Some("a PLY scan")
+    } else if start
+        .get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case("solid"))
+    {
+        Some("an ASCII STL scan")
+    } else if start.starts_with('{') && start.contains("\"asset\"") {
+        Some("a glTF scan")
+    } else if text.lines().any(|l| l.starts_with("v ")) && text.lines().any(|l| l.starts_with("f "))
+    {
+        Some("an OBJ scan")
+    } else {
+        None
+    }
 }
 
 /// G-code line numbers as a message lists them: "line 6", or "lines 6, 9"

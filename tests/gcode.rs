@@ -578,6 +578,25 @@ fn regression_a_program_without_moves_was_clear() {
             "{text:?}: {e}"
         );
     }
+    // A scan given as the program is named as one (QA round 3).
+    for (text, kind) in [
+        (
+            "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n",
+            "a PLY scan",
+        ),
+        ("solid part\nendsolid part\n", "an ASCII STL scan"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "an OBJ scan"),
+    ] {
+        let e = check_gcode(&scan, text, "scan.txt", &nozzle, 0.1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!(
+                "scan.txt is {kind}, not a G-code program: give it as the scan"
+            )),
+            "{text:?}: {e}"
+        );
+    }
     // One move is checked as before.
     let one = check_gcode(&scan, "G90\nG0 X10 Y10 Z60\n", "one.gcode", &nozzle, 0.1).unwrap();
     assert!(one.is_clear());
