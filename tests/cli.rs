@@ -2655,3 +2655,45 @@ fn a_scan_partly_below_the_bed_is_said_to_lie_outside_the_volume() {
     assert!(std::fs::read_to_string(&out).unwrap().contains(said));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 2: a stray point of a cloud in metres was named by its mm
+/// coordinates "as read", which the file does not hold: it is named by the
+/// file's own numbers, with the mm beside them.
+#[test]
+fn a_stray_point_is_named_by_the_files_own_numbers() {
+    let dir = temp_dir("spike-metres");
+    let mut rows = String::new();
+    for i in 0..41 {
+        for j in 0..41 {
+            let z = if (i, j) == (20, 20) { 0.06 } else { 0.002 };
+            rows += &format!(
+                "{:.4} {:.4} {z:.4}\n",
+                f64::from(i) * 0.001,
+                f64::from(j) * 0.001
+            );
+        }
+    }
+    let scan = dir.join("spike.xyz");
+    std::fs::write(&scan, rows).unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M1 5 L9 5" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--scan-units", "m", "--place", "0,10", "-o", s(&out)],
+    );
+    assert!(
+        stderr(&o).contains(
+            "1 point(s) stand more than 10.000 mm above every point around them, the highest at \
+             (0.02, 0.02, 0.06) in the file (m; 20.000, 20.000, 60.000 in mm)"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -488,19 +488,32 @@ fn import_cloud(
     }
     if let Some(s) = &info.spikes {
         let [x, y, z] = s.worst_mm;
+        // Where it is in the file's own numbers (QA round 2: a cloud in
+        // metres was named in mm "as read").
+        let k = units.to_mm();
+        let at =
+            match up_axis {
+                UpAxis::Z if k == 1.0 => format!("({x:.3}, {y:.3}, {z:.3}) in the file"),
+                UpAxis::Z => format!(
+                    "({}, {}, {}) in the file ({units}; {x:.3}, {y:.3}, {z:.3} in mm)",
+                    trimmed(x / k),
+                    trimmed(y / k),
+                    trimmed(z / k)
+                ),
+                UpAxis::Y | UpAxis::NegZ => format!(
+                "({x:.3}, {y:.3}, {z:.3}) mm, the file's {}coordinates with its {} up turned to \
+                 +Z",
+                if k == 1.0 { String::new() } else { format!("{units} ") },
+                if up_axis == UpAxis::Y { "+Y" } else { "-Z" }
+            ),
+            };
         warnings.push(format!(
             "{file}: {} point(s) stand more than {:.3} mm above every point around them, the \
-             highest at ({x:.3}, {y:.3}, {z:.3}) mm as read (in mm, {}), {:.3} mm above its \
-             neighbours: stray points (a depth camera's flying pixels)? The surface is meshed \
-             through them and the nozzle rises over them; remove them from the cloud if they \
-             are not part of the part",
+             highest at {at}, {:.3} mm above its neighbours: stray points (a depth camera's \
+             flying pixels)? The surface is meshed through them and the nozzle rises over them; \
+             remove them from the cloud if they are not part of the part",
             s.count,
             cloud::spike_limit(info.spacing_mm),
-            match up_axis {
-                UpAxis::Z => "+Z up",
-                UpAxis::Y => "+Y up read as +Z",
-                UpAxis::NegZ => "-Z up read as +Z",
-            },
             s.above_mm
         ));
     }
@@ -1026,6 +1039,18 @@ fn apply_weld(vertices: &mut Vec<DVec3>, triangles: &mut [[u32; 3]], mut map: Ve
     vertices.truncate(kept);
     for t in triangles {
         *t = t.map(|k| map[k as usize]);
+    }
+}
+
+/// `v` with up to 6 decimals, trailing zeros dropped (a file's own
+/// numbers, as a user would search for them).
+fn trimmed(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
     }
 }
 
