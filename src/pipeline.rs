@@ -168,19 +168,20 @@ pub fn surface_path(
     let mut warnings = Vec::new();
     let mut pieces = Vec::new();
     let mut any_sample = false;
-    // The subpaths too small to print, and whether any was large enough.
-    let mut dots: Vec<String> = Vec::new();
-    // Per source, its warning's index and how many of its subpaths were
-    // too small: one warning a path, not one a piece (an Inkscape path of
-    // hundreds of 0.0015 mm pieces gave 300 near-identical warnings).
-    let mut dot_warnings: std::collections::HashMap<String, (usize, usize, DVec2, f64)> =
-        std::collections::HashMap::new();
-    // Those paths, in the drawing's order.
-    let mut dot_sources: Vec<String> = Vec::new();
-    let mut any_line = false;
+    // The paths with subpaths too small to print, in the drawing's order,
+    // with how many each has (`dot_index` finds a path's entry), and the
+    // first one's warning slot, place and length: one warning says them
+    // all, not one a piece (an Inkscape path of hundreds of 0.0015 mm
+    // pieces gave 300 near-identical warnings) nor one a path (an icon's
+    // twelve dots gave twelve).
+    let mut dot_paths: Vec<(String, usize)> = Vec::new();
+    let mut dot_index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    let mut first_dot: Option<(usize, DVec2, f64)> = None;
     // The longest of them as placed: all a hundredth of the spacing or
     // less are dots as drawn (zero-length strokes), which no scale prints.
     let mut longest_dot_mm: f64 = 0.0;
+    // Whether any subpath was large enough to print.
+    let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
     // Each subpath's samples as placed, for `close_lines`.
     let mut sampled: Vec<(&str, Vec<DVec2>, bool)> = Vec::with_capacity(drawn.len());
@@ -200,25 +201,18 @@ pub fn surface_path(
         if let [dot] = samples[..] {
             // A dot, a zero-length segment, or a shape far smaller than
             // the nozzle: its samples d/2 apart are one point.
-            match dot_warnings.get_mut(&sub.source) {
-                Some((_, count, ..)) => *count += 1,
+            match dot_index.get(&sub.source) {
+                Some(&k) => dot_paths[k].1 += 1,
                 None => {
-                    // Its place among the warnings: the first such path's
-                    // (the one warning for them all, written below).
-                    let at = dot_warnings
-                        .values()
-                        .map(|w| w.0)
-                        .next()
-                        .unwrap_or_else(|| {
-                            warnings.push(String::new());
-                            warnings.len() - 1
-                        });
-                    let first = (at, 1, dot, placed.length_mm());
-                    dot_warnings.insert(sub.source.clone(), first);
-                    dot_sources.push(sub.source.clone());
+                    dot_index.insert(sub.source.clone(), dot_paths.len());
+                    dot_paths.push((sub.source.clone(), 1));
                 }
             }
-            dots.push(sub.source.clone());
+            if first_dot.is_none() {
+                // The warning's place: where the first of them was met.
+                warnings.push(String::new());
+                first_dot = Some((warnings.len() - 1, dot, placed.length_mm()));
+            }
             longest_dot_mm = longest_dot_mm.max(placed.length_mm());
             continue;
         }
@@ -243,11 +237,11 @@ pub fn surface_path(
         }
         sampled.push((sub.source.as_str(), samples, placed.closed));
     }
-    // One warning for every part too small to print (QA: an icon's twelve
-    // dots gave twelve, a set of icons 680).
-    if let Some(first) = dot_sources.first() {
-        let (at, count, dot, length) = dot_warnings[first];
-        warnings[at] = match dot_sources.len() {
+    // The one warning for every part too small to print (QA: a set of
+    // icons gave 680).
+    if let Some((at, dot, length)) = first_dot {
+        let (first, count) = (&dot_paths[0].0, dot_paths[0].1);
+        warnings[at] = match dot_paths.len() {
             1 if count == 1 => format!(
                 "path '{first}' at ({:.3}, {:.3}) is {length:.4} mm long as placed, too small to \
                  print with samples {spacing:.4} mm apart; it is not printed",
@@ -260,11 +254,11 @@ pub fn surface_path(
                 dot.x, dot.y
             ),
             paths => {
-                let pieces: usize = dot_warnings.values().map(|w| w.1).sum();
-                let named: Vec<String> = dot_sources
+                let pieces: usize = dot_paths.iter().map(|p| p.1).sum();
+                let named: Vec<String> = dot_paths
                     .iter()
                     .take(3)
-                    .map(|s| format!("'{s}'"))
+                    .map(|(s, _)| format!("'{s}'"))
                     .collect();
                 format!(
                     "{pieces} part(s) of {paths} paths ({}{}) are too small to print with \
@@ -320,7 +314,7 @@ pub fn surface_path(
                  register it onto the bed",
                     foot.x, foot.y, tall
                 )
-            } else if !any_line && !dots.is_empty() {
+            } else if !any_line && !dot_paths.is_empty() {
                 // QA: PCB footprints whose pads are strokes of no length
                 // (drawn by their square caps) were told to check their
                 // units, which no scale fixes.
@@ -340,9 +334,13 @@ pub fn surface_path(
                 format!(
                     "nothing to print at the nozzle's scale: every path of the drawing ({} of \
                      them: '{}'{}) is a dot, {why}",
-                    dots.len(),
-                    dots[0],
-                    if dots.len() > 1 { ", ..." } else { "" }
+                    dot_paths.iter().map(|p| p.1).sum::<usize>(),
+                    dot_paths[0].0,
+                    if dot_paths.len() > 1 || dot_paths[0].1 > 1 {
+                        ", ..."
+                    } else {
+                        ""
+                    }
                 )
             } else if any_sample && inside {
                 format!(
