@@ -77,11 +77,8 @@ fn core_err(e: crate::Error) -> JsValue {
     use crate::Error;
     // The other risks accepting this one would accept: the kind and fields
     // are the refusal's own, the message says them too.
-    if let Error::AlsoRisks { first, others } = e {
-        let message = format!(
-            "{first}; accepting the risk would also accept: {}",
-            others.join("; ")
-        );
+    let message = e.to_string();
+    if let Error::AlsoRisks { first, .. } = e {
         let err = core_err(*first);
         let _ = js_sys::Reflect::set(&err, &"message".into(), &message.into());
         return err;
@@ -111,7 +108,7 @@ fn core_err(e: crate::Error) -> JsValue {
     } else {
         "other"
     };
-    let err = kind_err(kind, &e.to_string());
+    let err = kind_err(kind, &message);
     if let Error::Touching(t) = &e {
         // Without it the message alone still names the first moves.
         if let Ok(summary) = to_js(&t.summary) {

@@ -291,6 +291,9 @@ fn follow_end(
                     super::read::UnknownMoveKind::Homing => "homing or a stored position",
                     super::read::UnknownMoveKind::Probing => "probing",
                     super::read::UnknownMoveKind::MachineCoordinates => "machine coordinates",
+                    super::read::UnknownMoveKind::Statement => {
+                        "a controller command or macro that moves it"
+                    }
                     _ => "a move from or to an unknown position",
                 }
             ),
