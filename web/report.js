@@ -24,7 +24,9 @@ export function showScan(info, positions, indices, seconds) {
   const [lo, hi] = info.bbox_mm;
   $('scan-info').textContent = `${info.format.toUpperCase()}, ${info.triangles.toLocaleString('en')} triangles, `
     + `${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} × ${fmt(hi[2] - lo[2], 1)} mm (${info.units}); `
-    + `${sizeText(info.bytes)} read in ${fmt(seconds, 1)} s; `
+    // (A .gltf's buffers in their own files count: QA saw "993 bytes read"
+    // for a .gltf whose .bin held 674 KB.)
+    + `${sizeText(info.bytes + (info.external_files || []).reduce((sum, f) => sum + f.bytes, 0))} read in ${fmt(seconds, 1)} s; `
     + `planner memory ${(state.memory / (1 << 30)).toFixed(2)} of 4 GiB`
     + (info.cloud_text ? `; ${info.cloud_text}` : '');
   if (state.viewer) {

@@ -169,7 +169,14 @@ async function loadScan(m) {
     const named = err && err.kind === 'mesh' ? missing.filter((f) => String(err.message).includes(`'${f.path}'`)) : [];
     if (named.length) {
       const files = named.map((f) => f.file_name).join(' and ');
-      err.message += `\nSelect ${name} together with ${files} (both at once in the file dialog, or drop both on the page).`;
+      const how = `select ${name} together with ${files} (both at once in the file dialog, or drop both on the page)`;
+      // In place of the core's advice for both the command line and the
+      // page, so it is given once (QA: said twice, the second time after
+      // no full stop).
+      const core = /keep it next to \S+ \(command line\) or select both files together \(page\)/;
+      err.message = core.test(err.message)
+        ? String(err.message).replace(core, how)
+        : `${err.message}\n${how[0].toUpperCase()}${how.slice(1)}.`;
     }
     throw err;
   }
