@@ -452,6 +452,33 @@ fn formats_are_sniffed_without_an_extension() {
     }
 }
 
+/// QA round 2: an OFF mesh got only the list of formats, and MeshLab's
+/// binary point set (.pts, a name text clouds use too) "open the scan's
+/// own file": each is named, with how to convert it.
+#[test]
+fn formats_not_read_are_named_with_how_to_convert_them() {
+    let off = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let e = import_mesh(off, "elephant.off", &RAW)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("elephant.off: not a scan this program reads")
+            && e.contains(
+                "; this is an OFF mesh (Geomview, MeshLab, CGAL): export it as PLY, OBJ or STL"
+            ),
+        "{e}"
+    );
+    let mut pts = b"[Expe/PointSet/Binary/0.1]\nproperty position 12\nnofpoints 1\ndata\n".to_vec();
+    pts.extend([0u8; 12]);
+    let e = import_mesh(&pts, "chameleon.pts", &RAW)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("chameleon.pts: a binary Expe point set (MeshLab's .pts), which this program does not read"),
+        "{e}"
+    );
+}
+
 // ------------------------------------------------------------------ units
 
 #[test]

@@ -4,8 +4,13 @@
 /// A scan that cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
-    #[error("{file}: not a scan this program reads (expected a mesh: OBJ, PLY, STL, glTF, GLB; or a point cloud: XYZ/CSV/TXT, PLY, PCD)")]
-    UnknownFormat { file: String },
+    #[error("{file}: not a scan this program reads (expected a mesh: OBJ, PLY, STL, glTF, GLB; or a point cloud: XYZ/CSV/TXT, PLY, PCD){hint}")]
+    UnknownFormat {
+        file: String,
+        /// How to convert a format known by its extension, after "; ", or
+        /// nothing.
+        hint: String,
+    },
     /// Text formats: a line that cannot be parsed.
     #[error("{file}:{line}: {message}")]
     Syntax {

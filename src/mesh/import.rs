@@ -23,6 +23,31 @@ pub fn detect_format(bytes: &[u8], file: &str) -> Option<MeshFormat> {
     from_extension(file).or_else(|| sniff(bytes))
 }
 
+/// How to turn a scan in a format this program does not read, known by
+/// its extension, into one it reads (QA: CGAL's and MeshLab's .off files
+/// got the list of formats alone).
+fn conversion_hint(file: &str) -> String {
+    let ext = file
+        .rsplit_once('.')
+        .map(|(_, e)| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    let what = match ext.as_str() {
+        "off" => "an OFF mesh (Geomview, MeshLab, CGAL)",
+        "3mf" => "a 3MF model",
+        "fbx" => "an FBX scene",
+        "dae" => "a COLLADA scene",
+        "3ds" => "a 3DS scene",
+        "vtk" | "vtp" => "a VTK file",
+        "e57" | "las" | "laz" => "a laser scanner's point cloud",
+        "step" | "stp" | "iges" | "igs" => "a CAD model (STEP or IGES), not a mesh",
+        _ => return String::new(),
+    };
+    format!(
+        "; this is {what}: export it as PLY, OBJ or STL (MeshLab: File > Export Mesh As; a CAD \
+         program or CloudCompare for the others)"
+    )
+}
+
 fn from_extension(file: &str) -> Option<MeshFormat> {
     let (_, ext) = file.rsplit_once('.')?;
     match ext.to_ascii_lowercase().as_str() {
@@ -193,8 +218,10 @@ pub fn import_mesh_unwelded(
              line's --path), and the scan (a mesh or point cloud) as the scan",
         ));
     }
-    let format =
-        detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat { file: file.into() })?;
+    let format = detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat {
+        file: file.into(),
+        hint: conversion_hint(file),
+    })?;
     let (parsed, external_files) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
     finish_import(parsed, format, file, options, external_files)
@@ -429,6 +456,16 @@ fn binary_in_text(bytes: &[u8], file: &str, format: MeshFormat) -> Option<MeshEr
     }
     let head = &bytes[..bytes.len().min(64 * 1024)];
     let at = head.iter().position(|&b| b == 0)?;
+    // MeshLab's binary point set, which shares the .pts name with text
+    // clouds (QA: told only "open the scan's own file").
+    if bytes.starts_with(b"[Expe/PointSet/Binary") {
+        return Some(MeshError::invalid(
+            file,
+            "a binary Expe point set (MeshLab's .pts), which this program does not read: export \
+             the cloud as PLY or XYZ (MeshLab: File > Export Mesh As)"
+                .to_string(),
+        ));
+    }
     let kind = [
         (&b"\x89PNG"[..], "a PNG image"),
         (&b"\xFF\xD8\xFF"[..], "a JPEG image"),
