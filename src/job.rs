@@ -1606,6 +1606,22 @@ pub fn check_gcode(
             shi.z
         ));
     }
+    // A program that never gives Z (QA round 3: svg2gcode's pen-plotter
+    // programs were told to give the position before their moves).
+    if program.moves.is_empty()
+        && program
+            .unknown_moves
+            .iter()
+            .all(|m| m.from[2].is_none() && m.to[2].is_none())
+    {
+        notes.insert(
+            0,
+            "the file never gives Z: a program for two axes (a pen plotter's or a laser's?), so \
+             no move's height is known and none can be checked against the scan; pcpp checks \
+             programs that move the nozzle in X, Y and Z"
+                .to_string(),
+        );
+    }
     // What the program's header says against this scan, first.
     notes.splice(0..0, frame_notes);
     Ok(GcodeCheck {

@@ -705,3 +705,29 @@ fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
         check.planned_otherwise
     );
 }
+
+/// QA round 3: a pen plotter's program (X and Y only, svg2gcode) was told
+/// to give the position before its moves; it is said to never give Z.
+#[test]
+fn a_program_that_never_gives_z_is_said_to() {
+    use pcpp::job::check_gcode;
+
+    let scan = demo_scan();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let text = "G21\nG90\nG0 X10 Y10\nG1 X20 Y10 F300\nG1 X20 Y20\n";
+    let check = check_gcode(&scan, text, "plot.gcode", &nozzle, 0.1).unwrap();
+    assert!(!check.is_clear());
+    assert!(
+        check.notes[0].starts_with("the file never gives Z: a program for two axes"),
+        "{:?}",
+        check.notes
+    );
+    // One Z anywhere: not said.
+    let text = "G21\nG90\nG0 Z30\nG0 X10 Y10\nG1 X20 Y10 F300\n";
+    let check = check_gcode(&scan, text, "z.gcode", &nozzle, 0.1).unwrap();
+    assert!(
+        !check.notes.iter().any(|n| n.contains("never gives Z")),
+        "{:?}",
+        check.notes
+    );
+}
