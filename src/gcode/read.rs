@@ -331,8 +331,9 @@ use GcodeLineProblem as P;
 /// `PRINT_START`), which make the position unknown.
 ///
 /// Moves: `G0`/`G1` (modal), `G90`/`G91`, `G20`/`G21` and `G70`/`G71`,
-/// `G92` (`G92` alone sets X, Y and Z to 0, as RepRap does; `G92.1`-`G92.3`
-/// as LinuxCNC), `G53` and homing or probing (position unknown after). X, Y
+/// `G92` (one naming no axis is refused: firmware disagree on it;
+/// `G92.1`-`G92.3` as LinuxCNC), `G53` and homing or probing (position
+/// unknown after). X, Y
 /// and Z are followed; A, B, C, U, V, W and E words are ignored with a note.
 pub fn read_gcode(text: &str, file: &str) -> Result<GcodeProgram, GcodeReadError> {
     read_with_limits(text, file, Limits::DEFAULT)
