@@ -343,13 +343,28 @@ pub fn surface_path(
                     }
                 )
             } else if any_sample && inside {
+                // Where the surface is (QA: a ring-shaped cloud's footprint
+                // centre lay 68 mm from its nearest point, and a larger
+                // maximum edge, the one hint, could not help).
+                let middle = 0.5 * (lo + hi);
+                let nearest = nearest_in_xy(surface.mesh(), middle).map_or(String::new(), |p| {
+                    format!(
+                        "; the scan's surface nearest the drawing's middle ({:.3}, {:.3}) is \
+                             at ({:.3}, {:.3}), {:.3} mm from it",
+                        middle.x,
+                        middle.y,
+                        p.x,
+                        p.y,
+                        p.distance(middle)
+                    )
+                });
                 format!(
                     "no part of the path lies over the scan's surface: the path spans x \
                  {:.3}..{:.3}, y {:.3}..{:.3} mm, over the scan's extent (x {:.3}..{:.3}, y \
                  {:.3}..{:.3} mm, printer frame) but over its holes or gaps (a bore of the part, \
-                 a point cloud's dropouts); move the drawing onto the surface (the placement \
-                 offset), and for a point cloud a larger maximum edge (--max-edge) closes wider \
-                 gaps",
+                 a point cloud's dropouts){nearest}; move the drawing onto the surface (the \
+                 placement offset), and for a point cloud a larger maximum edge (--max-edge) \
+                 closes wider gaps",
                     lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
                 )
             } else if any_sample {
@@ -389,6 +404,39 @@ pub fn surface_path(
         warnings,
         coverage,
     })
+}
+
+/// The point of `mesh`'s triangles, seen from above, nearest `to` (in XY;
+/// `None` for a mesh with none). For an error message: every triangle is
+/// tried.
+fn nearest_in_xy(mesh: &crate::mesh::TriMesh, to: DVec2) -> Option<DVec2> {
+    let on_segment = |a: DVec2, b: DVec2| {
+        let ab = b - a;
+        let l = ab.length_squared();
+        let t = if l > 0.0 {
+            ((to - a).dot(ab) / l).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        a + t * ab
+    };
+    let nearer = |p: &DVec2, q: &DVec2| p.distance_squared(to).total_cmp(&q.distance_squared(to));
+    mesh.triangles
+        .iter()
+        .map(|t| t.map(|i| mesh.vertices[i as usize].truncate()))
+        .map(|[a, b, c]| {
+            // Inside (either winding): the point itself.
+            let side = |p: DVec2, q: DVec2| (q - p).perp_dot(to - p);
+            let (s0, s1, s2) = (side(a, b), side(b, c), side(c, a));
+            if (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0) {
+                return to;
+            }
+            [on_segment(a, b), on_segment(b, c), on_segment(c, a)]
+                .into_iter()
+                .min_by(nearer)
+                .unwrap_or(a)
+        })
+        .min_by(nearer)
 }
 
 /// Whether a scan `foot` wide (its footprint in printer XY) and `tall` high

@@ -507,6 +507,16 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         e.contains("over the scan's extent") && e.contains("holes or gaps"),
         "{e}"
     );
+    // Where the surface is (QA: on a ring-shaped cloud the one hint was a
+    // larger maximum edge, which could not help): the plates' edges, 10 mm
+    // from the line's middle.
+    assert!(
+        e.contains(
+            "the scan's surface nearest the drawing's middle (20.000, 20.000) is at (10.000, \
+             20.000), 10.000 mm from it"
+        ),
+        "{e}"
+    );
     // Off the scan altogether: the placement is what to check.
     let off = [line(DVec2::new(50.0, 20.0), DVec2::new(60.0, 20.0))];
     let e = pipeline::plan(&plates, &off, &settings)
