@@ -1456,6 +1456,20 @@ pub fn check_gcode(
     nozzle: &crate::params::Nozzle,
     tol_mm: f64,
 ) -> Result<GcodeCheck> {
+    check_gcode_as(scan, text, file, nozzle, tol_mm, false)
+}
+
+/// [`check_gcode`] of a program for a Grbl controller when `grbl`
+/// ([`crate::gcode::read_gcode_grbl`]: X/Y/Z beside a spindle or coolant
+/// M-code are a move whose end is known).
+pub fn check_gcode_as(
+    scan: &PreparedScan,
+    text: &str,
+    file: &str,
+    nozzle: &crate::params::Nozzle,
+    tol_mm: f64,
+    grbl: bool,
+) -> Result<GcodeCheck> {
     nozzle.validate()?;
     crate::params::Process::DEFAULT
         .with_tolerance_mm(tol_mm)
@@ -1468,7 +1482,11 @@ pub fn check_gcode(
              G-code file the printer runs as the program"
         )));
     }
-    let program = crate::gcode::read_gcode(text, file)?;
+    let program = if grbl {
+        crate::gcode::read_gcode_grbl(text, file)?
+    } else {
+        crate::gcode::read_gcode(text, file)?
+    };
     // A file without a single move (empty, comments only, or not G-code
     // at all) shows nothing about the nozzle: it is not "clear".
     if program.moves.is_empty() && program.unknown_moves.is_empty() {

@@ -2697,3 +2697,51 @@ fn a_stray_point_is_named_by_the_files_own_numbers() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 3: a Grbl laser program (X/Y beside `M3 S..` on every line)
+/// could not be checked with `--dialect grbl`: each such line lost the
+/// position. With the grbl profile it is read as Grbl reads it.
+#[test]
+fn check_reads_a_grbl_program_as_grbl_does() {
+    let dir = temp_dir("check-grbl");
+    let gcode = dir.join("laser.nc");
+    // 2 mm over a plate at z = 1, below the top of a ledge in its corner
+    // (z = 10): a move the file does not place is not clear by height.
+    std::fs::write(
+        &gcode,
+        "G21\nG90\nG0 X10 Y10 Z30\nG1 Z3 F300\nX20 Y10 M3 S100\nX20 Y20 M3 S0\nX10 Y20 M3 S100\nG0 Z40\n",
+    )
+    .unwrap();
+    let scan = dir.join("plate.obj");
+    std::fs::write(
+        &scan,
+        "v 0 0 1\nv 40 0 1\nv 40 40 1\nv 0 40 1\nv 35 35 10\nv 40 35 10\nv 40 40 10\nf 1 2 3\nf 1 3 4\nf 5 6 7\n",
+    )
+    .unwrap();
+    let o = pcpp(&["check", "--scan", s(&scan), "--gcode", s(&gcode)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("could not be checked"),
+        "{}",
+        stderr(&o)
+    );
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&scan),
+        "--gcode",
+        s(&gcode),
+        "--dialect",
+        "grbl",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains("laser.nc: 5 moves checked against")
+            && out.contains("no move comes closer than tol"),
+        "{out}\n{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("as Grbl makes it"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}

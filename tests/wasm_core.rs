@@ -539,6 +539,7 @@ fn a_scan_hashed_beside_its_import_plans_once_its_digest_is_given() {
         "demo.gcode",
         js(&settings.plan.nozzle),
         settings.plan.process.tolerance_mm,
+        None,
     );
     assert!(
         checked.is_err(),
@@ -958,8 +959,9 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
     let session = staged_session(&demo::demo_scan_bytes(), demo::DEMO_SCAN_NAME, &settings);
     let nozzle = js(&settings.plan.nozzle);
     let tol = settings.plan.process.tolerance_mm;
-    let check =
-        |text: &[u8], name: &str| session.check_gcode(text, name, js(&settings.plan.nozzle), tol);
+    let check = |text: &[u8], name: &str| {
+        session.check_gcode(text, name, js(&settings.plan.nozzle), tol, None)
+    };
     // The demo's own G-code clears the part.
     let ok = check(GOLDEN_MARLIN.as_bytes(), "demo-even.gcode").unwrap_or_else(|e| panic!("{e:?}"));
     assert_eq!(get(&ok, "clear"), JsValue::TRUE);
@@ -983,6 +985,30 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
     assert_eq!(c.summary.touching[0].line, Some(4));
     assert!(c.summary.touching[0].rise_mm > 1.0);
 
+    // The dialect chosen in the page: grbl reads X/Y beside M3 as Grbl
+    // does, a move whose end is known (QA round 3).
+    let laser = b"G21 G90\nG0 X40 Y40 Z30\nG1 Z29 F300\nX41 Y40 M3 S100\nX42 Y40 M3 S0\n";
+    let as_any: job::GcodeCheck =
+        serde_wasm_bindgen::from_value(check(laser, "laser.nc").unwrap()).unwrap();
+    let as_grbl: job::GcodeCheck = serde_wasm_bindgen::from_value(
+        session
+            .check_gcode(
+                laser,
+                "laser.nc",
+                js(&settings.plan.nozzle),
+                tol,
+                Some("grbl".into()),
+            )
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(as_grbl.summary.moves, as_any.summary.moves + 1);
+    assert!(
+        as_grbl.notes.iter().any(|n| n.contains("as Grbl makes it")),
+        "{:?}",
+        as_grbl.notes
+    );
+
     // What the reader cannot follow is an error naming the file and line.
     let err = check(b"G21 G90\nG0 X10 Y10 Z30\nG2 X20 Y10 I5 J0\n", "arc.nc").unwrap_err();
     let (message, kind) = message_and_kind(&err);
@@ -999,14 +1025,20 @@ fn gcode_files_are_checked_against_the_scan_and_bad_ones_name_the_line() {
     let mut thin = settings.plan.nozzle;
     thin.outer_diameter_mm = 0.1;
     let err = session
-        .check_gcode(cut.as_bytes(), "cut.gcode", js(&thin), tol)
+        .check_gcode(cut.as_bytes(), "cut.gcode", js(&thin), tol, None)
         .unwrap_err();
     assert!(message_and_kind(&err).0.contains("outer"), "{err:?}");
     assert!(session
-        .check_gcode(cut.as_bytes(), "cut.gcode", JsValue::from_str("x"), tol)
+        .check_gcode(
+            cut.as_bytes(),
+            "cut.gcode",
+            JsValue::from_str("x"),
+            tol,
+            None
+        )
         .is_err());
     assert!(session
-        .check_gcode(cut.as_bytes(), "cut.gcode", nozzle, -1.0)
+        .check_gcode(cut.as_bytes(), "cut.gcode", nozzle, -1.0, None)
         .is_err());
 }
 

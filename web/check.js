@@ -30,7 +30,8 @@ export function checkGcodeFile(file) {
   $('check-verdict').textContent = `checking ${file.name}…`;
   $('check-verdict').className = 'verdict';
   $('check-details').replaceChildren();
-  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol });
+  // A Grbl program is read as Grbl reads it (the dialect chosen).
+  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol, dialect: s.dialect });
 }
 
 function showCheckError(name, message) {

@@ -338,7 +338,7 @@ async function onProgram(m, type, run) {
 // Checks a G-code File against the session's scan.
 function check(m) {
   return onProgram(m, 'check', (bytes) => {
-    const result = session.checkGcode(bytes, m.name, m.nozzle, m.tol);
+    const result = session.checkGcode(bytes, m.name, m.nozzle, m.tol, m.dialect);
     const transfer = result.moves ? [result.moves.buffer, result.kinds.buffer] : [];
     return [{ scan: session.info().name, result }, transfer];
   });

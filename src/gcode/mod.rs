@@ -50,8 +50,8 @@ pub use profile::{
 };
 pub(crate) use read::numbered_lines;
 pub use read::{
-    read_gcode, GcodeLineProblem, GcodeMove, GcodeProgram, GcodeReadError, UnknownMove,
-    UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,
+    read_gcode, read_gcode_grbl, GcodeLineProblem, GcodeMove, GcodeProgram, GcodeReadError,
+    UnknownMove, UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,
 };
 pub use writer::{
     start_block_motion, write_gcode, write_program, GcodeJob, MoveKind, WrittenMove, WrittenProgram,

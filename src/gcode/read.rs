@@ -336,7 +336,15 @@ use GcodeLineProblem as P;
 /// unknown after). X, Y
 /// and Z are followed; A, B, C, U, V, W and E words are ignored with a note.
 pub fn read_gcode(text: &str, file: &str) -> Result<GcodeProgram, GcodeReadError> {
-    read_with_limits(text, file, Limits::DEFAULT)
+    read_with_limits(text, file, Limits::DEFAULT, false)
+}
+
+/// [`read_gcode`] for a Grbl controller (our `grbl` profile): X/Y/Z beside
+/// an M-code that is not a setting's are a move in the modal motion, as
+/// Grbl makes it, and where it ends is known (QA: a laser program that
+/// writes `X5.2 Y0.2 M03 S0` on every line could not be checked).
+pub fn read_gcode_grbl(text: &str, file: &str) -> Result<GcodeProgram, GcodeReadError> {
+    read_with_limits(text, file, Limits::DEFAULT, true)
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -356,6 +364,7 @@ fn read_with_limits(
     text: &str,
     file: &str,
     limits: Limits,
+    grbl: bool,
 ) -> Result<GcodeProgram, GcodeReadError> {
     if text.len() > limits.bytes {
         return Err(GcodeReadError::TooLarge {
@@ -365,6 +374,7 @@ fn read_with_limits(
         });
     }
     let mut reader = Reader::new(file);
+    reader.grbl = grbl;
     let mut lines = 0;
     for (n, line) in numbered_lines(text) {
         if n > limits.lines {
@@ -976,6 +986,7 @@ enum NoteKind {
     UnknownGAxes,
     MAxisParameters,
     MAxisAmbiguous,
+    MAxisMoves,
     G92Unknown,
     Retract,
     UnknownStart,
@@ -1110,6 +1121,10 @@ impl Note {
                  axes it changes are unknown after it until set again (write G1 or G0 on such \
                  a line to make it a move on every controller)"
             ),
+            NoteKind::MAxisMoves => format!(
+                "{lines}: X/Y/Z words on a line with {codes} and no G-code read as a move in the \
+                 modal motion, as Grbl makes it"
+            ),
             NoteKind::G92Unknown => format!(
                 "{lines}: G92 set a position that was unknown: the program's coordinates from \
                  there on are taken as the frame of the check"
@@ -1207,6 +1222,8 @@ struct Reader<'f> {
     notes: Notes,
     /// Reused for every line.
     words: Vec<Word>,
+    /// Read for Grbl ([`read_gcode_grbl`]).
+    grbl: bool,
 }
 
 impl<'f> Reader<'f> {
@@ -1224,6 +1241,7 @@ impl<'f> Reader<'f> {
             unknown: Vec::new(),
             notes: Notes::default(),
             words: Vec::new(),
+            grbl: false,
         }
     }
 
@@ -1564,6 +1582,11 @@ impl<'f> Reader<'f> {
                     let name = code.map_or_else(|| "M".to_string(), |c| format!("M{c}"));
                     let settings = code.is_some_and(|c| AXIS_PARAMETER_M_CODES.contains(&c));
                     match self.motion {
+                        Some(mode) if !settings && self.grbl => {
+                            // Grbl's reading: a move, its end known.
+                            self.move_to(n, line, &axes, mode)?;
+                            self.notes.add(NoteKind::MAxisMoves, n).code(&name);
+                        }
                         Some(mode) if !settings => {
                             // Both readings: the move is checked, and where
                             // it ends is unknown (it may not have been made).
@@ -2237,6 +2260,37 @@ mod tests {
         assert_eq!(p.moves[1].from, DVec3::new(40.0, 40.0, 10.0));
     }
 
+    /// QA round 3: a Grbl laser program (`X5.2 Y0.2 M03 S0` on every line)
+    /// lost X after each line, `--dialect grbl` or not: read for Grbl, the
+    /// line is a move whose end is known.
+    #[test]
+    fn read_for_grbl_axis_words_beside_m3_are_a_move() {
+        let text =
+            "G21\nG90\nG0 X40 Y40 Z20\nG1 Z10 F300\nX40 Y41 Z2 M3 S100\nX41 Y41 M3 S0\nG1 X42\n";
+        let p = read_gcode_grbl(text, "laser.nc").unwrap();
+        let moved: Vec<(usize, DVec3)> = p.moves.iter().map(|m| (m.line, m.to)).collect();
+        assert_eq!(
+            moved,
+            [
+                (4, DVec3::new(40.0, 40.0, 10.0)),
+                (5, DVec3::new(40.0, 41.0, 2.0)),
+                (6, DVec3::new(41.0, 41.0, 2.0)),
+                (7, DVec3::new(42.0, 41.0, 2.0)),
+            ]
+        );
+        assert_eq!(p.unknown_moves.len(), 1, "{:?}", p.unknown_moves);
+        assert!(
+            p.notes.iter().any(
+                |n| n.starts_with("lines 5-6: X/Y/Z words on a line with M3")
+                    && n.contains("as Grbl makes it")
+            ),
+            "{:?}",
+            p.notes
+        );
+        // Read for any controller: both readings, the axes unknown after.
+        assert!(read(text).unknown_moves.len() > 1);
+    }
+
     /// QA round 3: Marlin's park, babystep, fade height and probe test were
     /// read as moves to the coordinates their words give.
     #[test]
@@ -2314,17 +2368,17 @@ mod tests {
             bytes: 100,
             lines: 3,
         };
-        let e = read_with_limits(&"G1 X1\n".repeat(17), "big.gcode", small).map(|_| ());
+        let e = read_with_limits(&"G1 X1\n".repeat(17), "big.gcode", small, false).map(|_| ());
         assert_eq!(
             e.map_err(|e| e.to_string()),
             Err("big.gcode: 102 bytes, more than the 100 bytes this reader accepts: split the program and check each part".into())
         );
-        let e = read_with_limits("\n\n\n\n", "long.gcode", small).map(|_| ());
+        let e = read_with_limits("\n\n\n\n", "long.gcode", small, false).map(|_| ());
         assert!(
             matches!(e, Err(GcodeReadError::TooManyLines { max: 3, .. })),
             "{e:?}"
         );
-        assert!(read_with_limits("\n\n\n", "ok.gcode", small).is_ok());
+        assert!(read_with_limits("\n\n\n", "ok.gcode", small, false).is_ok());
         assert_eq!(Limits::DEFAULT.bytes, 256 << 20);
         assert_eq!(Limits::DEFAULT.lines, 10_000_000);
     }

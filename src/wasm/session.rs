@@ -566,11 +566,15 @@ impl Session {
         name: &str,
         nozzle: JsValue,
         tol_mm: f64,
+        dialect: Option<String>,
     ) -> Result<JsValue, JsValue> {
         let nozzle: Nozzle = from_js("nozzle", nozzle)?;
         let text = gcode_text(bytes, name)?;
         self.digest_known()?;
-        let check = job::check_gcode(&self.scan, text, name, &nozzle, tol_mm).map_err(core_err)?;
+        // The grbl profile's programs read as Grbl reads them.
+        let grbl = dialect.as_deref() == Some("grbl");
+        let check =
+            job::check_gcode_as(&self.scan, text, name, &nozzle, tol_mm, grbl).map_err(core_err)?;
         let out = to_js(&check)?;
         let o: &js_sys::Object = out.unchecked_ref();
         set(o, "clear", &JsValue::from_bool(check.is_clear()));

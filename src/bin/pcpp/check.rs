@@ -33,12 +33,14 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
-    let checked = job::check_gcode(
+    // Read as Grbl reads it for the grbl profile (`--dialect grbl`).
+    let checked = job::check_gcode_as(
         &prepared,
         &text,
         &name,
         &settings.plan.nozzle,
         settings.plan.process.tolerance_mm,
+        profile.name == "grbl",
     );
     let mut check = match checked {
         Ok(check) => check,
