@@ -1655,24 +1655,20 @@ pub fn check_gcode_as(
     })
 }
 
-/// What kind of scan `text` is, if it is a scan's text rather than G-code.
+/// What kind of scan `text` is, by the importers' own sniffing
+/// ([`crate::mesh::detect_format`], the file's name left out: a program
+/// may be named `.txt`), if it is a scan rather than G-code. A text point
+/// cloud is not told from other text.
 fn scan_text_kind(text: &str) -> Option<&'static str> {
-    let start = text.trim_start();
-    if start.starts_with("ply") {
-        Some("a PLY scan")
-    } else if start
-        .get(..5)
-        .is_some_and(|w| w.eq_ignore_ascii_case("solid"))
-    {
-        Some("an ASCII STL scan")
-    } else if start.starts_with('{') && start.contains("\"asset\"") {
-        Some("a glTF scan")
-    } else if text.lines().any(|l| l.starts_with("v ")) && text.lines().any(|l| l.starts_with("f "))
-    {
-        Some("an OBJ scan")
-    } else {
-        None
-    }
+    use crate::mesh::MeshFormat;
+    Some(match crate::mesh::detect_format(text.as_bytes(), "")? {
+        MeshFormat::Obj => "an OBJ scan",
+        MeshFormat::Ply => "a PLY scan",
+        MeshFormat::Stl => "an ASCII STL scan",
+        MeshFormat::Gltf | MeshFormat::Glb => "a glTF scan",
+        MeshFormat::Pcd => "a PCD point cloud",
+        MeshFormat::Xyz => return None,
+    })
 }
 
 /// G-code line numbers as a message lists them: "line 6", or "lines 6, 9"
