@@ -528,14 +528,16 @@ fn import_cloud(
         // Where it is in the file's own numbers (QA round 2: a cloud in
         // metres was named in mm "as read").
         let k = units.to_mm();
+        let own = |v: f64| crate::gcode::format::trimmed(v / k, 6);
         let at =
             match up_axis {
                 UpAxis::Z if k == 1.0 => format!("({x:.3}, {y:.3}, {z:.3}) in the file"),
+                // The file's own numbers, as a user would search for them.
                 UpAxis::Z => format!(
                     "({}, {}, {}) in the file ({units}; {x:.3}, {y:.3}, {z:.3} in mm)",
-                    trimmed(x / k),
-                    trimmed(y / k),
-                    trimmed(z / k)
+                    own(x),
+                    own(y),
+                    own(z)
                 ),
                 UpAxis::Y | UpAxis::NegZ => format!(
                 "({x:.3}, {y:.3}, {z:.3}) mm, the file's {}coordinates with its {} up turned to \
@@ -1076,18 +1078,6 @@ fn apply_weld(vertices: &mut Vec<DVec3>, triangles: &mut [[u32; 3]], mut map: Ve
     vertices.truncate(kept);
     for t in triangles {
         *t = t.map(|k| map[k as usize]);
-    }
-}
-
-/// `v` with up to 6 decimals, trailing zeros dropped (a file's own
-/// numbers, as a user would search for them).
-fn trimmed(v: f64) -> String {
-    let s = format!("{v:.6}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.into()
     }
 }
 
