@@ -54,6 +54,9 @@ export function showPlan(plan) {
     updateDragOffset();
     requestDraw();
   }
+  // Which drawing on which scan the figures and warnings are of: after a
+  // failed plan they stay on screen, and say so.
+  labelPlan(plan, false);
   const st = summary.stats;
   const pl = summary.settings.placement;
   const rows = [
@@ -79,6 +82,21 @@ export function showPlan(plan) {
   if (!state.interacting || view.defects.length < 20000) showErrorPlot();
 }
 
+// The figures of the plan on screen, greyed when they are a previous
+// plan's.
+const PLAN_FIGURES = ['motion-table', 'motion-touches', 'stats-table', 'warnings'];
+
+// Labels the figures and warnings on screen with the drawing and scan of
+// `plan`; when a plan failed and this, the previous one, stays on screen
+// (`previous`), they are greyed and said to be that plan's (QA round 2
+// F6: the demo drawing's warnings stood under the user's drawing that
+// failed, with nothing to say whose they were).
+export function labelPlan(plan, previous) {
+  $('plan-of').textContent = `${previous ? 'the previous plan, not the one that failed: ' : ''}`
+    + `${plan.svgName} on ${plan.scanName}`;
+  for (const id of PLAN_FIGURES) $(id).classList.toggle('stale', previous);
+}
+
 // No plan on screen (the last one was for another scan, or another frame
 // of this one): its tables, warnings and plot emptied, not shown under the
 // new scan's name.
@@ -88,6 +106,8 @@ export function clearPlan() {
   for (const id of ['motion-touches', 'warnings', 'plot-legend']) $(id).replaceChildren();
   $('plot-note').textContent = '';
   $('plan-time').textContent = '';
+  $('plan-of').textContent = '';
+  for (const id of PLAN_FIGURES) $(id).classList.remove('stale');
   const plot = $('plot');
   plot.getContext('2d').clearRect(0, 0, plot.width, plot.height);
 }

@@ -10,11 +10,13 @@ let shownTopic = null;
 
 // `file`: the file the title names; the core's message starting with its
 // name does not say it a second time. `topic`: what the error is about
-// (above).
-export function showError(title, message, file, topic = null) {
+// (above). `notice`: not a failure of the user's (the demo drawing refused
+// on a new scan), shown in the panel's calm colours.
+export function showError(title, message, file, topic = null, notice = false) {
   const m = String(message);
   $('error-title').textContent = title;
   $('error-message').textContent = pageText(file && m.startsWith(`${file}: `) ? m.slice(file.length + 2) : m);
+  $('error-panel').classList.toggle('notice', notice);
   $('error-panel').hidden = false;
   shownTopic = topic;
 }

@@ -1,0 +1,95 @@
+// What the page shows around a failed plan (QA round 2 F6): the figures
+// and warnings of the plan left on screen say whose they are, and the demo
+// drawing, planned on a user's freshly opened scan, is not reported as the
+// user's failure.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { openPage, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
+
+const env = withPageServer();
+
+const svg = (name, body) => ({
+  name,
+  mimeType: 'image/svg+xml',
+  buffer: Buffer.from('<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="20mm" viewBox="0 0 40 20">'
+    + `${body}</svg>\n`),
+});
+
+test('after a failed plan the plan left on screen is labelled and greyed as the previous one', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const demo = await page.evaluate(() => window.pcpp.state.lastPlan.svgName);
+  assert.equal(await page.textContent('#plan-of'), `${demo} on demo-test-part.ply`);
+  assert.equal(await page.evaluate(() => document.getElementById('warnings').classList.contains('stale')), false);
+
+  // A drawing of dots only: read, but nothing to print.
+  await page.setInputFiles('#svg-input', svg('dots.svg',
+    '<path d="M 10 10 L 10 10 M 30 10 L 30 10" stroke="black" stroke-width="1" fill="none"/>'));
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#plan-status'), /showing the previous plan/);
+  assert.equal(await page.textContent('#plan-of'),
+    `the previous plan, not the one that failed: ${demo} on demo-test-part.ply`);
+  for (const id of ['warnings', 'stats-table', 'motion-table']) {
+    assert.equal(await page.evaluate((i) => document.getElementById(i).classList.contains('stale'), id), true, id);
+  }
+  // The error is the user's: the panel's error colours.
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+
+  // A drawing that plans: its own label, nothing greyed.
+  await page.setInputFiles('#svg-input', svg('line.svg', '<path d="M 5 10 L 35 10" stroke="black" fill="none"/>'));
+  await waitSettled(page);
+  assert.match(await page.textContent('#plan-status'), /^planned line\.svg on demo-test-part\.ply/);
+  assert.equal(await page.textContent('#plan-of'), 'line.svg on demo-test-part.ply');
+  assert.equal(await page.evaluate(() => document.getElementById('warnings').classList.contains('stale')), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// Two closed boxes as OBJ text: an 80 x 80 x 2 mm plate and a 20 mm post
+// standing on its middle. The demo drawing across it would dispense far
+// above the plate beside the post.
+function platePostObj() {
+  const lines = [];
+  const faces = [];
+  const box = ([x0, y0, z0], [x1, y1, z1]) => {
+    const base = lines.length;
+    for (const z of [z0, z1]) for (const [x, y] of [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]) lines.push(`v ${x} ${y} ${z}`);
+    const q = (a, b, c, d) => faces.push(`f ${base + a} ${base + b} ${base + c}`, `f ${base + a} ${base + c} ${base + d}`);
+    q(1, 4, 3, 2); q(5, 6, 7, 8);
+    q(1, 2, 6, 5); q(2, 3, 7, 6); q(3, 4, 8, 7); q(4, 1, 5, 8);
+  };
+  box([0, 0, 0], [80, 80, 2]);
+  box([30, 30, 2], [50, 50, 22]);
+  return `${lines.join('\n')}\n${faces.join('\n')}\n`;
+}
+
+test('the demo drawing refused on a freshly opened scan is a notice about the demo drawing, not an error', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#error-panel'), false);
+  assert.equal(await page.textContent('#error-title'), 'plate-post.obj is open; the demo drawing does not print on it');
+  const message = await page.textContent('#error-message');
+  // Why (the refusal as it was), then what to do.
+  assert.match(message, /^The nozzle would dispense far above the surface\.\n/);
+  assert.match(message, /dispense/);
+  assert.match(message, /\nThe demo drawing only shows the page at work: open your drawing \(SVG\) to plan it on this scan\.$/);
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), true);
+  assert.equal(await page.textContent('#plan-status'),
+    'plate-post.obj open: the demo drawing does not print on it; open your drawing (SVG)');
+
+  // The user's own drawing refused on the same scan is the user's error.
+  await page.setInputFiles('#svg-input', svg('across.svg', '<path d="M 0 10 L 40 10" stroke="black" fill="none"/>'));
+  await page.waitForFunction(() => !/demo drawing/.test(document.getElementById('error-title').textContent)
+    || /^planned across\.svg/.test(document.getElementById('plan-status').textContent), null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#error-panel'), false);
+  assert.match(await page.textContent('#error-message'), /dispense/);
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
