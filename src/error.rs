@@ -40,7 +40,7 @@ pub enum Error {
     },
     /// The tool path leaves the machine's build volume and the scan lies
     /// outside it: says where the scan lies and how to place it.
-    #[error("{source}; {fit}")]
+    #[error("{}", outside_volume(source, fit))]
     OutsideVolume {
         source: Box<GcodeError>,
         fit: String,
@@ -137,3 +137,92 @@ pub enum Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// [`Error::OutsideVolume`]'s text: the point out of the volume, then what
+/// `fit` says of the scan and how to place it, in place of the point's own
+/// generic advice (check the registration or the profile). Where `fit`
+/// names the volume (a scan outside it), the point does not name it a
+/// second time (QA round 2: "... lies outside the build volume of profile
+/// marlin (...): check the registration ...; the scan lies outside the
+/// build volume of profile marlin (...)"). `fit` is kept whole: the page
+/// finds its banner's sentence in the message.
+fn outside_volume(source: &GcodeError, fit: &str) -> String {
+    let GcodeError::OutOfVolume {
+        subpath,
+        point,
+        position: p,
+        volume,
+        profile,
+    } = source
+    else {
+        return format!("{source}; {fit}");
+    };
+    let at = format!(
+        "subpath {subpath}, point {point} at ({:.3}, {:.3}, {:.3}) mm",
+        p.x, p.y, p.z
+    );
+    if fit.starts_with(&format!(
+        "the scan lies outside the build volume of profile {profile} "
+    )) {
+        format!("{at} lies outside the build volume, and {fit}")
+    } else {
+        format!("{at} lies outside the build volume of profile {profile} ({volume}); {fit}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gcode::BuildVolume;
+    use glam::DVec3;
+
+    fn out_of_volume() -> GcodeError {
+        GcodeError::OutOfVolume {
+            subpath: 0,
+            point: 3,
+            position: DVec3::new(110.0, 109.5, 254.7),
+            volume: BuildVolume {
+                min_mm: DVec3::ZERO,
+                max_mm: DVec3::new(220.0, 220.0, 250.0),
+            },
+            profile: "marlin".into(),
+        }
+    }
+
+    /// The volume is named once, the point's generic advice left to the
+    /// scan's own, and the fit's sentence kept whole.
+    #[test]
+    fn outside_volume_names_the_volume_once() {
+        let volume = "x 0..220, y 0..220, z 0..250 mm";
+        let fit = format!(
+            "the scan lies outside the build volume of profile marlin ({volume}): it spans x \
+             -388.5..608.5, y 0.0..10.0, z 0.0..314.7 mm, out by up to 388.5 mm; check the \
+             scan's units"
+        );
+        let e = Error::OutsideVolume {
+            source: Box::new(out_of_volume()),
+            fit: fit.clone(),
+        }
+        .to_string();
+        assert_eq!(
+            e,
+            format!("subpath 0, point 3 at (110.000, 109.500, 254.700) mm lies outside the build volume, and {fit}")
+        );
+        assert_eq!(e.matches(volume).count(), 1, "{e}");
+        assert!(!e.contains("check the registration"), "{e}");
+        // A scan inside, the tool path beside it: the point names the volume.
+        let fit = "the scan lies inside the build volume, but beside it the tool path passes";
+        let e = Error::OutsideVolume {
+            source: Box::new(out_of_volume()),
+            fit: fit.into(),
+        }
+        .to_string();
+        assert_eq!(
+            e,
+            format!(
+                "subpath 0, point 3 at (110.000, 109.500, 254.700) mm lies outside the build \
+                 volume of profile marlin ({volume}); {fit}"
+            )
+        );
+    }
+}
