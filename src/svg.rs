@@ -345,11 +345,16 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         let size = tree.size();
         notes.push(format!(
             "the root <svg> gives no width or height: the drawing was read at its viewBox's \
-             size in {} ({:.1} x {:.1} mm), as browsers show it; give width and height in mm \
-             (e.g. width=\"40mm\") to set its size, or scale it in the placement",
+             size in {} ({:.1} x {:.1} mm), as {}; give width and height in mm (e.g. \
+             width=\"40mm\") to set its size, or scale it in the placement",
             px_words(prepared.px_scale),
             f64::from(size.width()) * MM_PER_PX * prepared.px_scale,
             f64::from(size.height()) * MM_PER_PX * prepared.px_scale,
+            if prepared.px_scale == 1.0 {
+                "browsers show it"
+            } else {
+                "the editor that wrote it drew it"
+            },
         ));
     }
     if !prepared.percent_size.is_empty() {
@@ -852,6 +857,8 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
 fn px_words(px_scale: f64) -> &'static str {
     if px_scale == 1.0 {
         "CSS px (96 per inch)"
+    } else if px_scale == 96.0 / 72.0 {
+        "px at 72 per inch (Illustrator's points)"
     } else {
         "px at 90 per inch (the Inkscape that wrote it)"
     }
@@ -1308,11 +1315,16 @@ fn root_size(root: roxmltree::Node) -> RootSize {
             .flat_map(|doc| doc.children())
             .any(|n| n.is_comment() && n.text().is_some_and(|t| t.contains("Adobe Illustrator")))
         {
+            // One rule for every editor whose px are not CSS's (QA F14: an
+            // old Inkscape's file came out at its editor's size and
+            // Illustrator's at a browser's): the size it was drawn at, the
+            // one its author measured.
+            size.px_scale = 96.0 / 72.0;
             size.notes.push(
                 "made by Adobe Illustrator, which writes its points (72 per inch) as px: read at \
-                 96 px per inch as browsers show it, the drawing is 0.75 times its size in \
-                 Illustrator; to print it at that size, scale it by 1.3333 in the placement, or \
-                 export it with width and height in mm"
+                 72 px per inch, so the drawing has the size it had in Illustrator (a browser \
+                 shows it 0.75 times as large; to print it at that size, scale it by 0.75 in the \
+                 placement)"
                     .to_string(),
             );
         }

@@ -1858,9 +1858,10 @@ fn root_sizes_that_are_no_length_are_refused_by_name() {
 /// Inkscape before 0.92 drew at 90 px per inch: its files are read at 90
 /// (a 40 mm line stays 40 mm), said in a note; Inkscape 1.x's are not, nor
 /// a legacy file whose size is in mm through a viewBox. Illustrator's
-/// points-as-px get a note and are read as browsers read them.
+/// points-as-px are read at 72 per inch, by the same rule: the size the
+/// drawing had in its editor (QA F14: it was read at a browser's size).
 #[test]
-fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_is_named() {
+fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_at_72() {
     let ink = |version: &str, size: &str| {
         format!(
             r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" inkscape:version="{version}" {size}><path d="m 70.866142,70.866142 141.732288,0" stroke="black"/></svg>"#
@@ -1912,16 +1913,39 @@ fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_is_named() {
 <!-- Generator: Adobe Illustrator 27.0.0, SVG Export Plug-In . SVG Version: 6.00 Build 0)  -->
 <svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 170.08 113.39"><path d="M0,10 H72" stroke="black"/></svg>"#;
     let (subs, notes) = notes_of(ai);
+    // 72 points: an inch.
     assert!(
-        (subs[0].length_mm() - 72.0 * 25.4 / 96.0).abs() < 1e-5,
+        (subs[0].length_mm() - 25.4).abs() < 1e-5,
         "{}",
         subs[0].length_mm()
     );
     let note = note_with(&notes, "Adobe Illustrator");
     assert!(
-        note.contains("0.75 times") && note.contains("1.3333"),
+        note.contains("read at 72 px per inch") && note.contains("0.75 times as large"),
         "{note}"
     );
+    // Its size, and its stroke, in the same px: 6 pt is 2.117 mm.
+    let note = note_with(&notes, "no width or height");
+    assert!(
+        note.contains(
+            "px at 72 per inch (Illustrator's points) (60.0 x 40.0 mm), as the editor that \
+             wrote it drew it"
+        ),
+        "{note}"
+    );
+    let (_, notes) =
+        notes_of(&ai.replace(r#"stroke="black""#, r#"stroke="black" stroke-width="6""#));
+    let note = note_with(&notes, "the widest");
+    assert!(note.contains("is drawn 2.12 mm wide"), "{note}");
+    // A file of Illustrator's sized in mm is read by its size.
+    let (subs, notes) = notes_of(&ai.replace("viewBox=", r#"width="60mm" height="40mm" viewBox="#));
+    assert!(
+        // (The viewBox meets the page: the smaller of its two scales.)
+        (subs[0].length_mm() - 72.0 * f64::min(60.0 / 170.08, 40.0 / 113.39)).abs() < 1e-5,
+        "{}",
+        subs[0].length_mm()
+    );
+    assert!(notes.iter().all(|n| !n.contains("72 px")), "{notes:?}");
 }
 
 /// Found by QA: scraps beside an Inkscape page (a line from x 30 to 70 on
