@@ -217,6 +217,22 @@ fn demo_writes_every_file_and_the_golden_gcode() {
     }
 }
 
+/// QA round 3 L4: `pcpp demo out` (the folder without -o, as users type
+/// it) was refused as an unexpected argument; with -o as well it is a
+/// conflict, not a silent choice of one.
+#[test]
+fn demo_takes_its_folder_without_o() {
+    let dir = temp_dir("demo-positional");
+    let o = pcpp(&["demo", "-q", s(&dir), "--part", "stepped-block"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(dir.join("demo-stepped-block-even.gcode").exists());
+    let o = pcpp(&["demo", s(&dir), "-o", s(&dir.join("other"))]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot be used with"), "{}", stderr(&o));
+    assert!(!dir.join("other").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn demo_prints_the_table_and_takes_a_dialect() {
     let dir = temp_dir("demo-aerotech");

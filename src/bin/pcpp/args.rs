@@ -286,15 +286,14 @@ the test part are named demo-<part>-....";
 
 #[derive(Debug, Args)]
 pub struct DemoArgs {
-    /// The folder to write to
-    #[arg(
-        short,
-        long,
-        value_name = "DIR",
-        default_value = "pcpp-demo",
-        value_hint = ValueHint::DirPath
-    )]
-    pub out: PathBuf,
+    /// The folder to write to [default: pcpp-demo]
+    #[arg(short, long, value_name = "DIR", value_hint = ValueHint::DirPath)]
+    pub out: Option<PathBuf>,
+
+    /// The folder to write to, given without -o (`pcpp demo out`, as a
+    /// user types it; QA round 3 L4)
+    #[arg(value_name = "DIR", value_hint = ValueHint::DirPath, conflicts_with = "out")]
+    pub dir: Option<PathBuf>,
 
     /// The G-code dialect
     #[arg(long, value_name = "D", default_value = "marlin", value_parser = dialects())]
@@ -308,6 +307,16 @@ pub struct DemoArgs {
         value_parser = Named::<DemoPart>::new(part_values),
     )]
     pub part: DemoPart,
+}
+
+impl DemoArgs {
+    /// The folder to write to: `-o DIR`, or DIR alone, or pcpp-demo.
+    pub fn folder(&self) -> PathBuf {
+        self.out
+            .clone()
+            .or_else(|| self.dir.clone())
+            .unwrap_or_else(|| PathBuf::from("pcpp-demo"))
+    }
 }
 
 // ---------------------------------------------------------------------------

@@ -32,7 +32,7 @@ fn demo_gcode_name(part: DemoPart, k: PlannerKind) -> String {
 }
 
 pub fn cmd_demo(a: &DemoArgs, progress: &Progress) -> CliResult<()> {
-    let out = &a.out;
+    let out = &a.folder();
     let profile = builtin_profile(&a.dialect)?;
     let part = a.part;
     let fail = |what: &str, e: &dyn std::fmt::Display| Failure::Input(format!("demo {what}: {e}"));
