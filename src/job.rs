@@ -1206,7 +1206,9 @@ pub fn write_outputs(
     if let Some(depth) = below_bed_mm(scan) {
         risks.push((
             Risk::BelowBed,
-            format!("the scan is placed {depth:.3} mm below the bed (Move Z)"),
+            // In words of neither the page nor the CLI: the same G-code
+            // comes from both.
+            format!("the scan's placement on the bed moves it {depth:.3} mm below the bed"),
         ));
     }
     if !plan.uncleared.is_empty() {

@@ -451,7 +451,7 @@ fn regression_a_scan_moved_below_the_bed_wrote_gcode_into_the_part() {
     let out = run(-0.5, true).unwrap();
     assert!(
         out.gcode
-            .contains("the scan is placed 0.500 mm below the bed (Move Z)"),
+            .contains("the scan's placement on the bed moves it 0.500 mm below the bed"),
         "{}",
         &out.gcode[..1500]
     );
