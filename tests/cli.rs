@@ -678,7 +678,7 @@ fn usage_errors_exit_2_and_name_the_flag() {
             "--registration",
         ),
         (&["demo", "--dialect", "fanuc"], "--dialect"),
-        (&["demo", "extra"], "extra"),
+        (&["demo", "one", "extra"], "extra"),
         // A value out of range names its own flag, not its group's (QA:
         // "--tol/--speed/--dwell: invalid parameter tolerance (mm) = 0").
         (
