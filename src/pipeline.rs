@@ -25,7 +25,7 @@ use crate::projection::project_subpath;
 use crate::quality::{predict, summarize, PointQuality, QualitySummary};
 use crate::registration::Registration;
 use crate::sampling::try_sample_subpath;
-use crate::spacing::{close_lines, Line};
+use crate::spacing::{blobs, close_lines, Line};
 use crate::spline::{local_geometry, LocalGeometry};
 use crate::stats::{path_stats, PathStats};
 use crate::surface::Surface;
@@ -284,6 +284,9 @@ pub fn surface_path(
         .collect();
     if let Some(close) = close_lines(&lines, nozzle.inner_diameter_mm) {
         warnings.push(close.message(nozzle.inner_diameter_mm));
+    }
+    if let Some(blobs) = blobs(&lines, nozzle.inner_diameter_mm) {
+        warnings.push(blobs.message(nozzle.inner_diameter_mm));
     }
     if pieces.is_empty() {
         let (slo, shi) = surface.bbox();

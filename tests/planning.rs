@@ -963,6 +963,58 @@ fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
     }
 }
 
+/// QA round 4 F4: a drawing scaled down to under a millimetre (a typo for
+/// the scale) folds its lines up within the filament's width, where
+/// `close_lines` passes them over as neighbours along one line: it was
+/// planned with 0 % defects and no word. It is said to print as a blob,
+/// in the report and the G-code header; at its size it is not.
+#[test]
+fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_a_word() {
+    use pcpp::job::run_on;
+    let xs = range(0.0, 30.0, 150);
+    let mesh = height_field(&xs, &xs, |x, y| {
+        1.0 + 0.2 * (0.3 * x).sin() * (0.2 * y).cos()
+    });
+    let scan = prepared_ply(&mesh, "film.ply");
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    let svg = pcpp::demo::antennas::hilbert_loop_svg(4, 20.0).unwrap();
+    for (scale, blob) in [(1.0, false), (0.05, true)] {
+        let mut settings = PlanSettings::default();
+        settings.placement.offset_mm = DVec2::new(5.0, 25.0);
+        settings.placement.scale = scale;
+        let out = run_on(
+            &scan,
+            svg.as_bytes(),
+            "hilbert.svg",
+            &settings,
+            &profile,
+            false,
+        )
+        .unwrap_or_else(|e| panic!("scale {scale}: {e}"));
+        let warning = out
+            .report
+            .warnings
+            .iter()
+            .find(|w| w.contains("print as a blob"));
+        assert_eq!(
+            warning.is_some(),
+            blob,
+            "scale {scale}: {:?}",
+            out.report.warnings
+        );
+        if let Some(w) = warning {
+            assert!(
+                w.starts_with("a piece of the drawing, ")
+                    && w.contains(
+                        "folds up tighter than the filament that prints it (0.603 mm wide"
+                    ),
+                "{w}"
+            );
+            assert!(out.gcode.contains("print as a blob"));
+        }
+    }
+}
+
 /// Most of a drawing beside the scan printed its fragment with nothing
 /// but a warning per part: the share printed is said first, once, and not
 /// for a drawing wholly on the scan.
