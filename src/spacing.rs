@@ -76,9 +76,10 @@ pub const BLOB_OVERLAP: f64 = 1.5;
 /// planned with no word and printed as a blob (QA round 4 F4). Decision
 /// (ours): a piece of length L whose samples fill a W x H box is a blob
 /// when it folds inside the filament's width (W and H under d, L more than
-/// [`BLOB_OVERLAP`] times the larger), or when its filament, L d, is more
-/// than [`BLOB_OVERLAP`] times the area it can lie in, (W + d)(H + d):
-/// lines d or more apart never lay more than that area.
+/// [`BLOB_OVERLAP`] times the larger), or when, no larger than
+/// [`APART_PER_D`] d, its filament, L d, is more than [`BLOB_OVERLAP`]
+/// times the area it can lie in, (W + d)(H + d): lines d or more apart
+/// never lay more than that area.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Blobs {
     /// How many pieces.
@@ -138,7 +139,11 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
         }
         let size = hi - lo;
         let folded = size.max_element() < d && length > BLOB_OVERLAP * size.max_element();
-        let crowded = length * d > BLOB_OVERLAP * (size.x + d) * (size.y + d);
+        // (A larger piece's lines that overlap lie further apart along it
+        // than `close_lines` passes over, and it names them: a raster
+        // filling an area is not a blob.)
+        let crowded = size.max_element() <= APART_PER_D * d
+            && length * d > BLOB_OVERLAP * (size.x + d) * (size.y + d);
         if !(folded || crowded) {
             continue;
         }
@@ -340,6 +345,8 @@ mod tests {
         let circle: Vec<DVec2> = (0..12)
             .map(|k| 0.2 * DVec2::from_angle(k as f64 * std::f64::consts::TAU / 12.0))
             .collect();
+        // A raster d apart, and one filling an area (0.27 mm apart, as W3:
+        // `close_lines` names it).
         let raster: Vec<DVec2> = (0..20)
             .flat_map(|k| {
                 let y = k as f64 * d;
@@ -386,8 +393,17 @@ mod tests {
             "{}",
             b.message(d)
         );
+        let fill: Vec<DVec2> = (0..40)
+            .flat_map(|k| {
+                let y = k as f64 * 0.27;
+                let (a, b) = if k % 2 == 0 { (0.0, 10.0) } else { (10.0, 0.0) };
+                [DVec2::new(a, y), DVec2::new(b, y)]
+            })
+            .collect();
+        let fill = leak(fill);
         for (name, points, closed) in [
             ("raster", raster, false),
+            ("fill", fill, false),
             ("dash", &dash[..], false),
             ("spiral", spiral, false),
         ] {
