@@ -68,7 +68,8 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 /// be read, `touching` for G-code refused by the motion check,
 /// `whole-object` for G-code refused on a point cloud of a whole object,
 /// `units`, `below-bed`, `far-above` and `mostly-off` for the other
-/// refusals that accepting the risk lifts, or `other`):
+/// refusals that accepting the risk lifts, `volume` for a tool path out of
+/// the build volume, or `other`):
 /// the page drops a file whose bytes could not be read but keeps one that
 /// only failed to register. A `touching` error also carries `touching`, the
 /// check's summary (`motion::MotionSummary`: the first touching moves with
@@ -105,6 +106,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "far-above"
     } else if matches!(e, Error::MostlyOffScan { .. }) {
         "mostly-off"
+    } else if matches!(e, Error::OutsideVolume { .. }) {
+        "volume"
     } else {
         "other"
     };

@@ -23,13 +23,13 @@ import { $, hooks, profile, settings, state } from './page.js';
 import {
   bannerOffers, cancelCentre, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
   requestCentre, showFitNote,
-  showScanPlacement, toolPathOutside, unitsBannerShown,
+  showScanPlacement, toolPathOutside, unitsBannerShown, userPlacements,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
 } from './preview.js';
 import {
-  clearPlan, labelPlan, showComparison, showErrorPlot, showPlan, showScan, showScanWarnings,
+  clearComparison, clearPlan, labelComparison, labelPlan, showComparison, showErrorPlot, showPlan, showScan, showScanWarnings,
 } from './report.js';
 import {
   bindForm, currentSvg, jobSettings, loadSettings, saveSettings, writeForm,
@@ -107,9 +107,10 @@ function runPlan() {
   const was = [$('plan-status').textContent, $('plan-status').classList.contains('stale')];
   state.busy = {
     id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now(), was,
-    // A user's scan read by this request, with the demo drawing (see
-    // `onPlanError`).
-    demoOnNewScan: scan === state.pendingScan && !!scan.blob && settings.pathSource === 'demo',
+    // The demo drawing on a user's scan, not placed by the user since the
+    // scan's first plan (see `onPlanError`).
+    demoOnUserScan: !!scan.blob && settings.pathSource === 'demo'
+      && userPlacements() === (scan.placementsAtFirstPlan ??= userPlacements()),
   };
   state.queued = false;
   laterProgress('starting');
@@ -202,7 +203,10 @@ function restorePlan() {
   const plan = state.lastPlan;
   if (!plan || !plan.inputs || state.queued || currentInputs() !== plan.inputs) return false;
   const c = state.lastComparison;
-  if (c && c.gen === plan.gen) c.gen = state.gen;
+  if (c && c.gen === plan.gen) {
+    c.gen = state.gen;
+    labelComparison('current');
+  }
   plan.gen = state.gen;
   offerDownloads(plan);
   labelPlan(plan, false);
@@ -219,7 +223,19 @@ const meshOf = (busy) => JSON.stringify([busy.scan.key, busy.job.scan, busy.job.
 // frame: units, up axis, registration, placement on the bed): a plan on
 // screen planned on another mesh goes, its figures and paths not shown as
 // this scan's; the next plan fills them.
+// The planners' comparison of the request `busy` (message `m`), as kept.
+const comparisonOf = (m, busy, series) => ({
+  rows: m.comparison, series, gen: busy.gen, mesh: meshOf(busy), svgName: busy.svg.name, scanName: busy.scan.name,
+});
+
 function dropPlan(busy) {
+  // A comparison of another mesh goes too (QA round 4 F3: a refused plan's
+  // comparison stayed under the next scan while its units were asked).
+  const c = state.lastComparison;
+  if (c && c.mesh !== meshOf(busy)) {
+    state.lastComparison = null;
+    clearComparison();
+  }
   if (!state.lastPlan || state.lastPlan.mesh === meshOf(busy)) return;
   state.lastPlan = null;
   state.lastComparison = null;
@@ -407,7 +423,7 @@ function onWorkerMessage(e) {
         showScanPlacement();
         if (state.info) showFiducials();
       }
-      if (m.comparison) state.lastComparison = { rows: m.comparison, series: m.series, gen: busy.gen };
+      if (m.comparison) state.lastComparison = comparisonOf(m, busy, m.series);
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
@@ -417,8 +433,10 @@ function onWorkerMessage(e) {
         setStatus(downloadFollows() ? 're-planning for the new value: the download follows'
           : 'settings changed: re-planning…', true);
       }
-      if (m.comparison) showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm);
-      else $('compare-table').classList.add('stale');
+      if (m.comparison) {
+        showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm);
+        labelComparison('current');
+      } else $('compare-table').classList.add('stale');
       // A settled plan (compared, current) is what the preview plays.
       if (m.comparison && busy.gen === state.gen) previewPlanShown();
       break;
@@ -548,8 +566,9 @@ function onPlanError(m, busy) {
   // A plan refused for its motion still compared the planners on the
   // settings that failed: the table shows why.
   if (m.comparison) {
-    state.lastComparison = { rows: m.comparison, series: null, gen: busy.gen };
+    state.lastComparison = { ...comparisonOf(m, busy, null), failed: true };
     showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm);
+    labelComparison('failed');
   }
   // A scan outside the build volume, with the banner on screen offering to
   // place it: the banner says it, with its button; a red panel repeating
@@ -557,18 +576,22 @@ function onPlanError(m, busy) {
   if (m.stage === 'plan') planOutcome(message);
   const unitsOffered = m.kind === 'units' && unitsBannerShown();
   const offered = m.stage === 'plan' && (bannerOffers(message) || unitsOffered);
-  // The demo drawing, planned as the user's scan was read (the page plans
-  // whatever drawing it holds on a new scan), refused for something of the
-  // drawing's (its motion, where it lies, how high it dispenses, a gap):
-  // the refusal is of a drawing the user never chose, so it is said as
-  // that, with what to do next, not as a failure (QA round 2 F6: a red
-  // panel was the first thing seen of one's own scan). Refusals of the
-  // scan itself (its units, a whole object, the registration) stay errors.
-  // A banner offering the fix (the build volume) says it as it is.
-  const demoTried = busy.demoOnNewScan && m.stage === 'plan' && busy.gen === state.gen && !offered
+  // The demo drawing on a user's scan, not yet placed by the user (the
+  // page plans whatever drawing it holds on a new scan, and again as the
+  // scan is placed or re-read),
+  // refused for something of the drawing's (its motion, where it lies, how
+  // high it dispenses, a gap): the refusal is of a drawing the user never
+  // chose, so it is said as that, with what to do next, not as a failure
+  // and not with the box that accepts the risk (QA round 2 F6: a red panel
+  // was the first thing seen of one's own scan; QA round 4 F2, F5). The
+  // scan's own refusals (its units, the build volume, a whole object, the
+  // registration) stay errors (QA round 4 F1), and a banner offering the
+  // fix says it as it is.
+  const demoTried = busy.demoOnUserScan && m.stage === 'plan' && busy.gen === state.gen && !offered
     && ['touching', 'far-above', 'mostly-off', 'other'].includes(m.kind);
   if (demoTried) {
-    message = `${ended(title.replace(/: no G-code$/, ''))}\n${message}\nThe demo drawing only shows the page at work: `
+    const why = m.kind === 'other' ? '' : `${ended(title.replace(/: no G-code$/, ''))}\n`;
+    message = `${why}${ended(m.message)}\nThe demo drawing only shows the page at work: `
       + 'open your drawing (SVG) to plan it on this scan.';
     title = `${busy.scan.name} is open; the demo drawing does not print on it`;
   }
@@ -576,6 +599,12 @@ function onPlanError(m, busy) {
   else showError(title, message, file, topic, demoTried);
   if (busy.gen === state.gen && restorePlan()) return;
   if (state.lastPlan) labelPlan(state.lastPlan, true);
+  // Without a comparison of its own, the one on screen is the previous
+  // plan's; one of an earlier failed plan says nothing of this one.
+  if (!m.comparison && state.lastComparison && state.lastComparison.failed) {
+    state.lastComparison = null;
+    clearComparison();
+  } else if (!m.comparison) labelComparison('previous');
   showScanWarnings();
   // Nothing stale on offer; the previous plan stays on screen, where it was
   // planned.

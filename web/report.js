@@ -83,18 +83,43 @@ export function showPlan(plan) {
 }
 
 // The figures of the plan on screen, greyed when they are a previous
-// plan's.
-const PLAN_FIGURES = ['motion-table', 'motion-touches', 'stats-table', 'warnings'];
+// plan's, and their labels.
+const PLAN_FIGURES = ['motion-table', 'motion-touches', 'stats-table', 'warnings', 'plot'];
+const PLAN_LABELS = ['motion-of', 'plan-of', 'plot-of'];
 
 // Labels the figures and warnings on screen with the drawing and scan of
 // `plan`; when a plan failed and this, the previous one, stays on screen
 // (`previous`), they are greyed and said to be that plan's (QA round 2
 // F6: the demo drawing's warnings stood under the user's drawing that
-// failed, with nothing to say whose they were).
+// failed, with nothing to say whose they were; round 4 F3: each panel
+// says it).
 export function labelPlan(plan, previous) {
-  $('plan-of').textContent = `${previous ? 'the previous plan, not the one that failed: ' : ''}`
-    + `${plan.svgName} on ${plan.scanName}`;
+  const text = `${previous ? 'the previous plan, not the one that failed: ' : ''}${plan.svgName} on ${plan.scanName}`;
+  for (const id of PLAN_LABELS) $(id).textContent = text;
   for (const id of PLAN_FIGURES) $(id).classList.toggle('stale', previous);
+}
+
+// Labels the planners' comparison on screen (`state.lastComparison`, its
+// drawing and scan): of the plan on screen ('current'), of a plan that
+// failed ('failed': it shows why), or of the previous plan, greyed, after
+// one that failed without a comparison ('previous').
+const COMPARISON_OF = {
+  current: '',
+  failed: 'the plan that failed, compared (why it was refused): ',
+  previous: 'the previous plan, not the one that failed: ',
+};
+export function labelComparison(mode) {
+  const c = state.lastComparison;
+  if (!c) return;
+  $('compare-of').textContent = `${COMPARISON_OF[mode]}${c.svgName} on ${c.scanName}`;
+  $('compare-table').classList.toggle('stale', mode === 'previous');
+}
+
+// No comparison on screen (the last one was of another scan).
+export function clearComparison() {
+  $('compare-table').tBodies[0].replaceChildren();
+  $('compare-table').classList.remove('stale');
+  $('compare-of').textContent = '';
 }
 
 // No plan on screen (the last one was for another scan, or another frame
@@ -106,7 +131,8 @@ export function clearPlan() {
   for (const id of ['motion-touches', 'warnings', 'plot-legend']) $(id).replaceChildren();
   $('plot-note').textContent = '';
   $('plan-time').textContent = '';
-  $('plan-of').textContent = '';
+  $('compare-of').textContent = '';
+  for (const id of PLAN_LABELS) $(id).textContent = '';
   for (const id of PLAN_FIGURES) $(id).classList.remove('stale');
   const plot = $('plot');
   plot.getContext('2d').clearRect(0, 0, plot.width, plot.height);

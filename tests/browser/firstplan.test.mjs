@@ -30,9 +30,16 @@ test('after a failed plan the plan left on screen is labelled and greyed as the 
   assert.match(await page.textContent('#plan-status'), /showing the previous plan/);
   assert.equal(await page.textContent('#plan-of'),
     `the previous plan, not the one that failed: ${demo} on demo-test-part.ply`);
-  for (const id of ['warnings', 'stats-table', 'motion-table']) {
+  for (const id of ['warnings', 'stats-table', 'motion-table', 'plot']) {
     assert.equal(await page.evaluate((i) => document.getElementById(i).classList.contains('stale'), id), true, id);
   }
+  // Each panel says whose figures it shows (QA round 4 F3), the comparison
+  // too: the dots were not compared, so it is the previous plan's.
+  for (const id of ['motion-of', 'plot-of', 'compare-of']) {
+    assert.equal(await page.textContent(`#${id}`),
+      `the previous plan, not the one that failed: ${demo} on demo-test-part.ply`, id);
+  }
+  assert.equal(await page.evaluate(() => document.getElementById('compare-table').classList.contains('stale')), true);
   // The error is the user's: the panel's error colours.
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
 
@@ -40,8 +47,12 @@ test('after a failed plan the plan left on screen is labelled and greyed as the 
   await page.setInputFiles('#svg-input', svg('line.svg', '<path d="M 5 10 L 35 10" stroke="black" fill="none"/>'));
   await waitSettled(page);
   assert.match(await page.textContent('#plan-status'), /^planned line\.svg on demo-test-part\.ply/);
-  assert.equal(await page.textContent('#plan-of'), 'line.svg on demo-test-part.ply');
-  assert.equal(await page.evaluate(() => document.getElementById('warnings').classList.contains('stale')), false);
+  for (const id of ['plan-of', 'motion-of', 'plot-of', 'compare-of']) {
+    assert.equal(await page.textContent(`#${id}`), 'line.svg on demo-test-part.ply', id);
+  }
+  for (const id of ['warnings', 'plot', 'compare-table']) {
+    assert.equal(await page.evaluate((i) => document.getElementById(i).classList.contains('stale'), id), false, id);
+  }
   assert.deepEqual(problems, []);
   await context.close();
 });
@@ -81,6 +92,19 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), true);
   assert.equal(await page.textContent('#plan-status'),
     'plate-post.obj open: the demo drawing does not print on it; open your drawing (SVG)');
+  // Not the box that accepts the risk, for a drawing the user never chose
+  // (QA round 4 F5).
+  assert.doesNotMatch(message, /tick "write G-code even/);
+  // The refused plan's comparison shows why, and says so.
+  assert.match(await page.textContent('#compare-of'),
+    /^the plan that failed, compared \(why it was refused\): demo-[\w-]+\.svg on plate-post\.obj$/);
+  // Planned again (the Plan button), the demo drawing is still not the
+  // user's failure (QA round 4 F2).
+  await page.click('#plan-btn');
+  await page.waitForFunction(() => !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'plate-post.obj is open; the demo drawing does not print on it');
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), true);
 
   // The user's own drawing refused on the same scan is the user's error.
   await page.setInputFiles('#svg-input', svg('across.svg', '<path d="M 0 10 L 40 10" stroke="black" fill="none"/>'));
@@ -89,6 +113,27 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
   await waitIdle(page);
   assert.equal(await page.isHidden('#error-panel'), false);
   assert.match(await page.textContent('#error-message'), /dispense/);
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A scan larger than the build volume is the scan's problem, whatever the
+// drawing: a red error naming the volume, not the demo drawing's notice
+// (QA round 4 F1: gltfpack's cow got "open your drawing (SVG)").
+test('a scan larger than the build volume is an error about the scan, not the demo drawing\'s notice', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A 300 x 300 mm plate, 5 mm up, from x = 200: wider than marlin's
+  // 220 mm, and the drawing centred on it lies beyond the volume.
+  const plate = 'v 200 0 5\nv 500 0 5\nv 500 300 5\nv 200 300 5\nf 1 2 3\nf 1 3 4\n';
+  await page.setInputFiles('#scan-input', { name: 'big-plate.obj', mimeType: 'text/plain', buffer: Buffer.from(plate) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'big-plate.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.isHidden('#error-panel'), false);
+  assert.doesNotMatch(await page.textContent('#error-title'), /demo drawing/);
+  assert.match(await page.textContent('#error-message'), /larger than the volume/);
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
   assert.deepEqual(problems, []);
   await context.close();
