@@ -913,26 +913,21 @@ fn regression_an_edge_on_scan_was_diagnosed_as_holes_under_the_drawing() {
     );
 }
 
-/// The page's Hilbert loop of order 7 at 20 mm has lines 0.16 mm apart,
-/// a quarter of the filament's width: it was planned into one merged
-/// band (a short circuit for the antenna) without a word. The plan now
-/// warns, in the report and the G-code header; order 4 (1.33 mm apart) is
-/// planned as before, without it.
-#[test]
-fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
-    use pcpp::job::run_on;
+/// A Hilbert loop of 20 mm as the page draws it, of an order and at a
+/// scale, planned and written on a 30 mm wrinkled film (at 5, 25).
+fn hilbert_on_film() -> impl Fn(u32, f64) -> pcpp::job::JobOutput {
     let xs = range(0.0, 30.0, 150);
-    let ys = range(0.0, 30.0, 150);
-    let mesh = height_field(&xs, &ys, |x, y| {
+    let mesh = height_field(&xs, &xs, |x, y| {
         1.0 + 0.2 * (0.3 * x).sin() * (0.2 * y).cos()
     });
     let scan = prepared_ply(&mesh, "film.ply");
     let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
-    for (order, merged) in [(4, false), (7, true)] {
+    move |order, scale| {
         let svg = pcpp::demo::antennas::hilbert_loop_svg(order, 20.0).unwrap();
         let mut settings = PlanSettings::default();
         settings.placement.offset_mm = DVec2::new(5.0, 25.0);
-        let out = run_on(
+        settings.placement.scale = scale;
+        pcpp::job::run_on(
             &scan,
             svg.as_bytes(),
             "hilbert.svg",
@@ -940,7 +935,20 @@ fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
             &profile,
             false,
         )
-        .unwrap_or_else(|e| panic!("order {order}: {e}"));
+        .unwrap_or_else(|e| panic!("order {order}, scale {scale}: {e}"))
+    }
+}
+
+/// The page's Hilbert loop of order 7 at 20 mm has lines 0.16 mm apart,
+/// a quarter of the filament's width: it was planned into one merged
+/// band (a short circuit for the antenna) without a word. The plan now
+/// warns, in the report and the G-code header; order 4 (1.33 mm apart) is
+/// planned as before, without it.
+#[test]
+fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
+    let plan = hilbert_on_film();
+    for (order, merged) in [(4, false), (7, true)] {
+        let out = plan(order, 1.0);
         let warning = out
             .report
             .warnings
@@ -970,27 +978,9 @@ fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
 /// in the report and the G-code header; at its size it is not.
 #[test]
 fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_a_word() {
-    use pcpp::job::run_on;
-    let xs = range(0.0, 30.0, 150);
-    let mesh = height_field(&xs, &xs, |x, y| {
-        1.0 + 0.2 * (0.3 * x).sin() * (0.2 * y).cos()
-    });
-    let scan = prepared_ply(&mesh, "film.ply");
-    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
-    let svg = pcpp::demo::antennas::hilbert_loop_svg(4, 20.0).unwrap();
+    let plan = hilbert_on_film();
     for (scale, blob) in [(1.0, false), (0.05, true)] {
-        let mut settings = PlanSettings::default();
-        settings.placement.offset_mm = DVec2::new(5.0, 25.0);
-        settings.placement.scale = scale;
-        let out = run_on(
-            &scan,
-            svg.as_bytes(),
-            "hilbert.svg",
-            &settings,
-            &profile,
-            false,
-        )
-        .unwrap_or_else(|e| panic!("scale {scale}: {e}"));
+        let out = plan(4, scale);
         let warning = out
             .report
             .warnings

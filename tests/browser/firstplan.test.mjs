@@ -4,7 +4,9 @@
 // user's failure.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { openPage, waitIdle, waitSettled, withPageServer } from './helpers.mjs';
+import {
+  openPage, platePostObj, waitIdle, waitSettled, withPageServer,
+} from './helpers.mjs';
 
 const env = withPageServer();
 
@@ -56,24 +58,6 @@ test('after a failed plan the plan left on screen is labelled and greyed as the 
   assert.deepEqual(problems, []);
   await context.close();
 });
-
-// Two closed boxes as OBJ text: an 80 x 80 x 2 mm plate and a 20 mm post
-// standing on its middle. The demo drawing across it would dispense far
-// above the plate beside the post.
-function platePostObj() {
-  const lines = [];
-  const faces = [];
-  const box = ([x0, y0, z0], [x1, y1, z1]) => {
-    const base = lines.length;
-    for (const z of [z0, z1]) for (const [x, y] of [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]) lines.push(`v ${x} ${y} ${z}`);
-    const q = (a, b, c, d) => faces.push(`f ${base + a} ${base + b} ${base + c}`, `f ${base + a} ${base + c} ${base + d}`);
-    q(1, 4, 3, 2); q(5, 6, 7, 8);
-    q(1, 2, 6, 5); q(2, 3, 7, 6); q(3, 4, 8, 7); q(4, 1, 5, 8);
-  };
-  box([0, 0, 0], [80, 80, 2]);
-  box([30, 30, 2], [50, 50, 22]);
-  return `${lines.join('\n')}\n${faces.join('\n')}\n`;
-}
 
 test('the demo drawing refused on a freshly opened scan is a notice about the demo drawing, not an error', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
