@@ -21,7 +21,7 @@ import {
 } from './inputs.js';
 import { $, hooks, profile, settings, state } from './page.js';
 import {
-  bannerOffers, cancelCentre, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
+  bannerOffers, cancelCentre, capital, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
   requestCentre, showFitNote,
   showScanPlacement, toolPathOutside, unitsBannerShown, userPlacements,
 } from './placement.js';
@@ -591,7 +591,7 @@ function onPlanError(m, busy) {
     && ['touching', 'far-above', 'mostly-off', 'other'].includes(m.kind);
   if (demoTried) {
     const why = m.kind === 'other' ? '' : `${ended(title.replace(/: no G-code$/, ''))}\n`;
-    message = `${why}${ended(m.message)}\nThe demo drawing only shows the page at work: `
+    message = `${why}${capital(ended(m.message))}\nThe demo drawing only shows the page at work: `
       + 'open your drawing (SVG) to plan it on this scan.';
     title = `${busy.scan.name} is open; the demo drawing does not print on it`;
   }

@@ -385,7 +385,7 @@ export function unitsBannerShown() {
   return !$('units-banner').hidden;
 }
 
-const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
+export const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
 
 // A plan's outcome for the banner: the error message of a refused plan,
 // or null for a plan that succeeded.
