@@ -591,7 +591,11 @@ function onPlanError(m, busy) {
     && ['touching', 'far-above', 'mostly-off', 'other'].includes(m.kind);
   if (demoTried) {
     const why = m.kind === 'other' ? '' : `${ended(title.replace(/: no G-code$/, ''))}\n`;
-    message = `${why}${capital(ended(m.message))}\nThe demo drawing only shows the page at work: `
+    // (Without the core's offer to accept the risk, nor the other risks
+    // that would take: QA round 5 N2.)
+    const reason = m.message.replace(/;? accepting the risk would also accept: [^\n]*/, '')
+      .replace(/,? or accept the risk[^.;\n]*/g, '');
+    message = `${why}${capital(ended(reason))}\nThe demo drawing only shows the page at work: `
       + 'open your drawing (SVG) to plan it on this scan.';
     title = `${busy.scan.name} is open; the demo drawing does not print on it`;
   }

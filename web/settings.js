@@ -382,7 +382,16 @@ export function bindForm() {
       syncGauge();
       syncVisibility();
       showScanPlacement();
-      if (id === 'path-source' && ['spiral', 'hilbert', 'monopole'].includes(settings.pathSource)) {
+      // A drawing chosen from the list starts at its own size, centred on
+      // the scan; so does the demo drawing on a user's scan (QA round 5 N1:
+      // it came back where the other drawing lay, at its scale, mostly off
+      // the scan); on its demo part it keeps the part's own placement.
+      // The demo drawing placed so by the page is not the user's again
+      // until they place it (main.js's `demoOnUserScan`).
+      const scan = state.pendingScan || state.scan;
+      const demoOnUserScan = settings.pathSource === 'demo' && scan && scan.blob;
+      if (id === 'path-source' && demoOnUserScan) delete scan.placementsAtFirstPlan;
+      if (id === 'path-source' && (['spiral', 'hilbert', 'monopole'].includes(settings.pathSource) || demoOnUserScan)) {
         requestCentre(true);
       }
       // Read in other units or turned up another way, the scan is another

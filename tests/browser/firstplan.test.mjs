@@ -78,7 +78,7 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
     'plate-post.obj open: the demo drawing does not print on it; open your drawing (SVG)');
   // Not the box that accepts the risk, for a drawing the user never chose
   // (QA round 4 F5).
-  assert.doesNotMatch(message, /tick "write G-code even/);
+  assert.doesNotMatch(message, /tick "write G-code even|accept the risk/);
   // The refused plan's comparison shows why, and says so.
   assert.match(await page.textContent('#compare-of'),
     /^the plan that failed, compared \(why it was refused\): demo-[\w-]+\.svg on plate-post\.obj$/);
@@ -89,6 +89,32 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
   await waitIdle(page);
   assert.equal(await page.textContent('#error-title'), 'plate-post.obj is open; the demo drawing does not print on it');
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), true);
+
+  // The user's own drawing, scaled up by the user: then the demo drawing
+  // chosen again from the list comes back centred at its own size, not
+  // at the other drawing's place and scale, and its refusal is a notice
+  // again (QA round 5 N1).
+  await page.setInputFiles('#svg-input', svg('line.svg', '<path d="M 5 10 L 35 10" stroke="black" fill="none"/>'));
+  // (Planned, or read and refused.)
+  await page.waitForFunction(() => {
+    const st = window.pcpp.state;
+    return (st.svgFile && st.svgFile.name === 'line.svg') || (st.pendingSvg && st.pendingSvg.read);
+  }, null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.fill('#pl-scale', '3');
+  await page.press('#pl-scale', 'Enter');
+  await page.waitForFunction(() => Number(window.pcpp.settings.placement.scale) === 3, null, { timeout: 60_000 });
+  await waitIdle(page);
+  await page.selectOption('#path-source', 'demo');
+  await page.waitForFunction(() => Number(window.pcpp.settings.placement.scale) !== 3
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  await waitIdle(page);
+  // (The settings, not the field: the one typed in keeps its focus.)
+  const scale = await page.evaluate(() => Number(window.pcpp.settings.placement.scale));
+  assert.ok(scale <= 1, String(scale));
+  if (!(await page.isHidden('#error-panel'))) {
+    assert.equal(await page.textContent('#error-title'), 'plate-post.obj is open; the demo drawing does not print on it');
+  }
 
   // The user's own drawing refused on the same scan is the user's error.
   await page.setInputFiles('#svg-input', svg('across.svg', '<path d="M 0 10 L 40 10" stroke="black" fill="none"/>'));
