@@ -288,6 +288,21 @@ pub fn surface_path(
     if let Some(blobs) = blobs(&lines, nozzle.inner_diameter_mm) {
         warnings.push(blobs.message(nozzle.inner_diameter_mm));
     }
+    // A scan seen edge-on from above that still takes some of the drawing
+    // (on its top edge): planned, but most likely lying on its side in the
+    // file (QA round 5 N4: a plate read with another up axis took the
+    // demo drawing scaled to a hundredth with no word of its up axis).
+    let (slo, shi) = surface.bbox();
+    let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
+    if !pieces.is_empty() && edge_on(foot, tall) {
+        warnings.push(format!(
+            "the scan is seen edge-on from above, {:.3} x {:.3} mm wide and {:.3} mm tall \
+             (printer frame): the drawing lies on its top edge; if the scan lies on its side in \
+             the file, choose its up axis (--up-axis y, z or -z; glTF files are +Y up) or \
+             register it onto the bed",
+            foot.x, foot.y, tall
+        ));
+    }
     if pieces.is_empty() {
         let (slo, shi) = surface.bbox();
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;

@@ -517,6 +517,17 @@ pub fn volume_fit(
     ))?)
 }
 
+/// Whether a scan with bounds `bbox` (`[min x, y, z, max x, y, z]`,
+/// printer frame) is seen edge-on from above ([`pipeline::edge_on`]): a
+/// film or plate lying on its side in the file, whose refusals are the
+/// scan's to mend (its up axis), not the drawing's.
+#[wasm_bindgen(js_name = edgeOn)]
+pub fn edge_on(bbox: &[f64]) -> Result<bool, JsError> {
+    let (lo, hi) = bounds("the scan's bounds", bbox)?;
+    let size = hi - lo;
+    Ok(pipeline::edge_on(size.truncate(), size.z))
+}
+
 /// The bed of the machine profile `dialect` (`{centre_mm, z_mm}`), for a
 /// scan placement `{mode: "on-bed", bed, rotation_deg, offset_mm}`.
 #[wasm_bindgen(js_name = bedOf)]

@@ -1005,6 +1005,66 @@ fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_
     }
 }
 
+/// QA round 5 N4: a plate lying on its side in the file (100 x 1.5 mm seen
+/// from above, 100 mm tall) took a drawing along its top edge with no word
+/// of its up axis. It is planned, and said to be seen edge-on; a plate
+/// lying flat is not.
+#[test]
+fn a_scan_seen_edge_on_from_above_is_said_when_it_is_planned_on() {
+    let boxed = |size: DVec3| {
+        let mut vertices = Vec::new();
+        for z in [0.0, size.z] {
+            for (x, y) in [(0.0, 0.0), (size.x, 0.0), (size.x, size.y), (0.0, size.y)] {
+                vertices.push(DVec3::new(x, y, z));
+            }
+        }
+        let triangles = vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
+        ];
+        TriMesh {
+            vertices,
+            triangles,
+        }
+    };
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="10mm" viewBox="0 0 40 10"><path d="M 0 5 L 40 5" stroke="black"/></svg>"#;
+    for (size, edge_on) in [
+        (DVec3::new(100.0, 1.5, 100.0), true),
+        (DVec3::new(100.0, 100.0, 2.0), false),
+    ] {
+        let scan = prepared_ply(&boxed(size), "plate.ply");
+        let mut settings = PlanSettings::default();
+        // The line along the plate's top, in its middle.
+        settings.placement.offset_mm = DVec2::new(30.0, 0.5 * size.y + 5.0);
+        let out = pcpp::job::run_on(&scan, svg.as_bytes(), "line.svg", &settings, &profile, true)
+            .unwrap_or_else(|e| panic!("{size}: {e}"));
+        let said = out
+            .report
+            .warnings
+            .iter()
+            .find(|w| w.contains("seen edge-on from above"));
+        assert_eq!(said.is_some(), edge_on, "{size}: {:?}", out.report.warnings);
+        if let Some(w) = said {
+            assert!(
+                w.contains("100.000 x 1.500 mm wide and 100.000 mm tall")
+                    && w.contains("choose its up axis"),
+                "{w}"
+            );
+        }
+    }
+}
+
 /// Most of a drawing beside the scan printed its fragment with nothing
 /// but a warning per part: the share printed is said first, once, and not
 /// for a drawing wholly on the scan.

@@ -8,7 +8,7 @@
 // downloads.js, check.js (checking a G-code file), preview.js (the print
 // preview), placement.js, fiducials.js, status.js; page.js holds what they
 // share. Text from files and errors is set with textContent.
-import { pageLimits, version } from '../pkg/pcpp.js';
+import { edgeOn, pageLimits, version } from '../pkg/pcpp.js';
 import { onCheck, syncCheckButton } from './check.js';
 import {
   bindDownloads, downloadFollows, dropPress, hideDownloads, offerDownloads, pressReplans,
@@ -19,7 +19,9 @@ import {
   acceptScan, bindFiles, demoScanEntry, dropCentre, dropPendingScan, dropPendingSvg, endRestoring, isScanName, keep,
   loadDemo, restoreInputs,
 } from './inputs.js';
-import { $, hooks, profile, settings, state } from './page.js';
+import {
+  $, fmt, hooks, profile, settings, state,
+} from './page.js';
 import {
   bannerOffers, cancelCentre, capital, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
   requestCentre, showFitNote,
@@ -587,7 +589,17 @@ function onPlanError(m, busy) {
   // scan's own refusals (its units, the build volume, a whole object, the
   // registration) stay errors (QA round 4 F1), and a banner offering the
   // fix says it as it is.
-  const demoTried = busy.demoOnUserScan && m.stage === 'plan' && busy.gen === state.gen && !offered
+  // A scan seen edge-on from above (a plate lying on its side in the
+  // file) is the scan's to mend, whatever the refusal: said under it, and
+  // never the demo drawing's notice (QA round 5 N4).
+  const info = state.info;
+  const sideways = m.stage === 'plan' && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
+  if (sideways && !/edge-on/.test(message)) {
+    const [lo, hi] = info.bbox_mm;
+    message = `${ended(message)}\nThe scan is seen edge-on from above (${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} mm, `
+      + `${fmt(hi[2] - lo[2], 1)} mm tall): if it lies on its side in the file, choose its up axis (Up axis, Scan panel).`;
+  }
+  const demoTried = busy.demoOnUserScan && m.stage === 'plan' && busy.gen === state.gen && !offered && !sideways
     && ['touching', 'far-above', 'mostly-off', 'other'].includes(m.kind);
   if (demoTried) {
     const why = m.kind === 'other' ? '' : `${ended(title.replace(/: no G-code$/, ''))}\n`;

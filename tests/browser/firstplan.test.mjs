@@ -148,3 +148,34 @@ test('a scan larger than the build volume is an error about the scan, not the de
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// A plate lying on its side in the file (100 x 0.5 mm seen from above,
+// 100 mm tall): whatever the refusal, the scan's up axis is said, and the
+// demo drawing's notice is not shown for it (QA round 5 N4).
+test('a scan seen edge-on from above is told to choose its up axis, not to open a drawing', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const v = [];
+  for (const z of [0, 100]) for (const [x, y] of [[0, 0], [100, 0], [100, 0.5], [0, 0.5]]) v.push(`v ${x} ${y} ${z}`);
+  const f = [[1, 3, 2], [1, 4, 3], [5, 6, 7], [5, 7, 8], [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 4, 8], [3, 8, 7],
+    [4, 1, 5], [4, 5, 8]].map((t) => `f ${t.join(' ')}`);
+  await page.setInputFiles('#scan-input', { name: 'edge-on.obj', mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'edge-on.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  // The demo drawing, fitted to the plate's top edge, plans there: its
+  // warnings say the scan is seen edge-on, and which control turns it.
+  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.match(await page.textContent('#warnings'), /the scan is seen edge-on from above, 100\.000 x 0\.500 mm wide and 100\.000 mm tall .*choose its up axis \(Up axis; glTF files are \+Y up\)/);
+  // Refused (a line across the edge's middle at the user's own scale):
+  // an error with the same advice, not the demo drawing's notice.
+  await page.fill('#pl-scale', '1');
+  await page.press('#pl-scale', 'Enter');
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.doesNotMatch(await page.textContent('#error-title'), /demo drawing/);
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+  assert.match(await page.textContent('#error-message'), /edge-on[^]*up axis/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
