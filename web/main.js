@@ -555,6 +555,9 @@ function onPlanError(m, busy) {
     // Refused unless the risk is accepted: the box that accepts it.
     title = RISKS[m.kind];
     message = ended(message) + '\nTo write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).';
+  } else if (m.kind === 'volume') {
+    // (QA round 5 N3: "Planning failed" for a scan larger than the volume.)
+    title = 'The tool path would leave the printer\'s build volume: no G-code';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';

@@ -101,11 +101,12 @@ export function labelPlan(plan, previous) {
 
 // Labels the planners' comparison on screen (`state.lastComparison`, its
 // drawing and scan): of the plan on screen ('current'), of a plan that
-// failed ('failed': it shows why), or of the previous plan, greyed, after
+// failed ('failed': for a refusal of its motion it shows why), or of the
+// previous plan, greyed, after
 // one that failed without a comparison ('previous').
 const COMPARISON_OF = {
   current: '',
-  failed: 'the plan that failed, compared (why it was refused): ',
+  failed: 'the plan that failed, compared: ',
   previous: 'the previous plan, not the one that failed: ',
 };
 export function labelComparison(mode) {
