@@ -294,19 +294,24 @@ pub fn surface_path(
     // demo drawing scaled to a hundredth with no word of its up axis).
     let (slo, shi) = surface.bbox();
     let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
+    let seen_edge_on = || {
+        format!(
+            "the scan is seen edge-on from above, {:.3} x {:.3} mm wide and {:.3} mm tall \
+             (printer frame)",
+            foot.x, foot.y, tall
+        )
+    };
+    const CHOOSE_UP_AXIS: &str = "if the scan lies on its side in the file, choose its up axis \
+                                  (--up-axis y, z or -z; glTF files are +Y up) or register it \
+                                  onto the bed";
     if !pieces.is_empty() && edge_on(foot, tall) {
         warnings.push(format!(
-            "the scan is seen edge-on from above, {:.3} x {:.3} mm wide and {:.3} mm tall \
-             (printer frame): the drawing lies on its top edge; if the scan lies on its side in \
-             the file, choose its up axis (--up-axis y, z or -z; glTF files are +Y up) or \
-             register it onto the bed",
-            foot.x, foot.y, tall
+            "{}: the drawing lies on its top edge; {CHOOSE_UP_AXIS}",
+            seen_edge_on()
         ));
     }
     if pieces.is_empty() {
-        let (slo, shi) = surface.bbox();
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
-        let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
         // Thin along X only (a bar or needle thin both ways may lie down
         // under another up axis: a review's 0.5 x 0.6 x 50 mm one did).
         let faces_x = foot.x < EDGE_ON_SHARE * foot.y;
@@ -316,21 +321,17 @@ pub fn surface_path(
                 // (+Z, +Y and -Z are; a QA run's polygon faced +X, and the
                 // message offered the up axes that cannot help).
                 format!(
-                    "no part of the path lies over the scan's surface: the scan is seen edge-on \
-                 from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame): its surface \
-                 faces sideways, along X, which no up axis turns face-up (--up-axis reads +Z, +Y \
-                 or -Z as up); turn it in a mesh tool (MeshLab, Blender) so that its surface \
-                 faces +Z, or register it onto the bed by its fiducials",
-                    foot.x, foot.y, tall
+                    "no part of the path lies over the scan's surface: {}: its surface faces \
+                     sideways, along X, which no up axis turns face-up (--up-axis reads +Z, +Y \
+                     or -Z as up); turn it in a mesh tool (MeshLab, Blender) so that its surface \
+                     faces +Z, or register it onto the bed by its fiducials",
+                    seen_edge_on()
                 )
             } else if any_sample && edge_on(foot, tall) {
                 format!(
-                    "no part of the path lies over the scan's surface: the scan is seen edge-on \
-                 from above, {:.3} x {:.3} mm wide and {:.3} mm tall (printer frame), so there is \
-                 almost nothing for the nozzle to come down on; if the scan lies on its side in \
-                 the file, choose its up axis (--up-axis y, z or -z; glTF files are +Y up) or \
-                 register it onto the bed",
-                    foot.x, foot.y, tall
+                    "no part of the path lies over the scan's surface: {}, so there is almost \
+                     nothing for the nozzle to come down on; {CHOOSE_UP_AXIS}",
+                    seen_edge_on()
                 )
             } else if !any_line && !dot_paths.is_empty() {
                 // QA: PCB footprints whose pads are strokes of no length
