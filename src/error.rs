@@ -157,10 +157,7 @@ fn outside_volume(source: &GcodeError, fit: &str) -> String {
     else {
         return format!("{source}; {fit}");
     };
-    let at = format!(
-        "subpath {subpath}, point {point} at ({:.3}, {:.3}, {:.3}) mm",
-        p.x, p.y, p.z
-    );
+    let at = crate::gcode::point_at(*subpath, *point, *p);
     if fit.starts_with(&format!(
         "the scan lies outside the build volume of profile {profile} "
     )) {

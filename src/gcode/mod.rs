@@ -104,10 +104,9 @@ pub enum GcodeError {
     /// A tool-path point lies outside the machine's build volume: move the
     /// part (registration) or fix the profile's `build_volume`.
     #[error(
-        "subpath {subpath}, point {point} at ({x:.3}, {y:.3}, {z:.3}) mm lies outside the build \
-         volume of profile {profile} ({volume}): check the registration or the profile's \
-         build_volume",
-        x = .position.x, y = .position.y, z = .position.z
+        "{} lies outside the build volume of profile {profile} ({volume}): check the \
+         registration or the profile's build_volume",
+        point_at(*.subpath, *.point, *.position)
     )]
     OutOfVolume {
         subpath: usize,
@@ -130,4 +129,13 @@ pub enum GcodeError {
         volume: BuildVolume,
         profile: String,
     },
+}
+
+/// A tool-path point as the errors name it: "subpath S, point P at (x, y,
+/// z) mm".
+pub(crate) fn point_at(subpath: usize, point: usize, p: DVec3) -> String {
+    format!(
+        "subpath {subpath}, point {point} at ({:.3}, {:.3}, {:.3}) mm",
+        p.x, p.y, p.z
+    )
 }
