@@ -221,15 +221,15 @@ function restorePlan() {
 // (as the worker keys its session).
 const meshOf = (busy) => JSON.stringify([busy.scan.key, busy.job.scan, busy.job.registration]);
 
-// A scan read for the request `busy` (another file, or the same in another
-// frame: units, up axis, registration, placement on the bed): a plan on
-// screen planned on another mesh goes, its figures and paths not shown as
-// this scan's; the next plan fills them.
 // The planners' comparison of the request `busy` (message `m`), as kept.
 const comparisonOf = (m, busy, series) => ({
   rows: m.comparison, series, gen: busy.gen, mesh: meshOf(busy), svgName: busy.svg.name, scanName: busy.scan.name,
 });
 
+// A scan read for the request `busy` (another file, or the same in another
+// frame: units, up axis, registration, placement on the bed): a plan on
+// screen planned on another mesh goes, its figures and paths not shown as
+// this scan's; the next plan fills them.
 function dropPlan(busy) {
   // A comparison of another mesh goes too (QA round 4 F3: a refused plan's
   // comparison stayed under the next scan while its units were asked).
@@ -581,20 +581,9 @@ function onPlanError(m, busy) {
   if (m.stage === 'plan') planOutcome(message);
   const unitsOffered = m.kind === 'units' && unitsBannerShown();
   const offered = m.stage === 'plan' && (bannerOffers(message) || unitsOffered);
-  // The demo drawing on a user's scan, not yet placed by the user (the
-  // page plans whatever drawing it holds on a new scan, and again as the
-  // scan is placed or re-read),
-  // refused for something of the drawing's (its motion, where it lies, how
-  // high it dispenses, a gap): the refusal is of a drawing the user never
-  // chose, so it is said as that, with what to do next, not as a failure
-  // and not with the box that accepts the risk (QA round 2 F6: a red panel
-  // was the first thing seen of one's own scan; QA round 4 F2, F5). The
-  // scan's own refusals (its units, the build volume, a whole object, the
-  // registration) stay errors (QA round 4 F1), and a banner offering the
-  // fix says it as it is.
   // A scan seen edge-on from above (a plate lying on its side in the
   // file) is the scan's to mend, whatever the refusal: said under it, and
-  // never the demo drawing's notice (QA round 5 N4).
+  // never the demo drawing's notice below (QA round 5 N4).
   const info = state.info;
   const sideways = m.stage === 'plan' && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
   if (sideways && !/edge-on/.test(message)) {
@@ -602,6 +591,16 @@ function onPlanError(m, busy) {
     message = `${ended(message)}\nThe scan is seen edge-on from above (${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} mm, `
       + `${fmt(hi[2] - lo[2], 1)} mm tall): if it lies on its side in the file, choose its up axis (Up axis, Scan panel).`;
   }
+  // The demo drawing on a user's scan, not yet placed by the user (the
+  // page plans whatever drawing it holds on a new scan, and again as the
+  // scan is placed or re-read), refused for something of the drawing's
+  // (its motion, where it lies, how high it dispenses, a gap): the refusal
+  // is of a drawing the user never chose, so it is said as that, with
+  // what to do next, not as a failure and not with the box that accepts
+  // the risk (QA round 2 F6: a red panel was the first thing seen of one's
+  // own scan; QA round 4 F2, F5). The scan's own refusals (its units, the
+  // build volume, a whole object, the registration) stay errors (QA round
+  // 4 F1), and a banner offering the fix says it as it is.
   const demoTried = busy.demoOnUserScan && m.stage === 'plan' && busy.gen === state.gen && !offered && !sideways
     && ['touching', 'far-above', 'mostly-off', 'other'].includes(m.kind);
   if (demoTried) {
