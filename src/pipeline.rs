@@ -429,16 +429,8 @@ pub fn surface_path(
 /// `None` for a mesh with none). For an error message: every triangle is
 /// tried.
 fn nearest_in_xy(mesh: &crate::mesh::TriMesh, to: DVec2) -> Option<DVec2> {
-    let on_segment = |a: DVec2, b: DVec2| {
-        let ab = b - a;
-        let l = ab.length_squared();
-        let t = if l > 0.0 {
-            ((to - a).dot(ab) / l).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        a + t * ab
-    };
+    let on_segment =
+        |a: DVec2, b: DVec2| a + crate::spacing::nearest_on_segment(to, a, b) * (b - a);
     let nearer = |p: &DVec2, q: &DVec2| p.distance_squared(to).total_cmp(&q.distance_squared(to));
     mesh.triangles
         .iter()

@@ -163,6 +163,19 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
     found
 }
 
+/// The fraction t in [0, 1] of the point a + t (b - a) of segment a-b
+/// nearest `p` (0 for a segment of no length).
+#[inline]
+pub(crate) fn nearest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
 /// How many of the flagged samples look for their nearest other line
 /// among all those near (then every 16th); the others stop at the first.
 const FULL_SCANS: usize = 256;
@@ -280,14 +293,8 @@ pub fn close_lines(lines: &[Line], d: f64) -> Option<CloseLines> {
                         }
                         let pts = lines[k2].points;
                         let (a, b) = (pts[j], pts[j + 1]);
-                        let ab = b - a;
-                        let len2 = ab.length_squared();
-                        let t = if len2 > 0.0 {
-                            ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        let dist = p.distance(a + t * ab);
+                        let t = nearest_on_segment(p, a, b);
+                        let dist = p.distance(a + t * (b - a));
                         if dist >= limit || dist >= near {
                             continue;
                         }
