@@ -82,7 +82,12 @@ pub const BLOB_OVERLAP: f64 = 1.5;
 /// never lay more than that area.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Blobs {
-    /// How many pieces.
+    /// Whether the drawing as a whole is one blob (QA round 5 N5: a
+    /// drawing scaled by 0.002 instead of 0.2 was named by one of its
+    /// pieces); then the place, length and box below are the whole
+    /// drawing's, and `source` its first piece's.
+    pub whole: bool,
+    /// How many pieces: the blobs, or for a whole drawing its pieces.
     pub count: usize,
     /// The first one's subpath, place (its box's middle), length and box.
     pub source: String,
@@ -99,7 +104,20 @@ impl Blobs {
             self.length_mm, self.size_mm.x, self.size_mm.y, self.at.x, self.at.y, self.source
         );
         let filament = format!("({d:.3} mm wide, the nozzle's inner diameter)");
-        if self.count == 1 {
+        if self.whole {
+            let (length, w, h) = (self.length_mm, self.size_mm.x, self.size_mm.y);
+            let (x, y) = (self.at.x, self.at.y);
+            let pieces = match self.count {
+                1 => "one piece".to_string(),
+                n => format!("{n} pieces"),
+            };
+            format!(
+                "the whole drawing, {length:.2} mm of line in {pieces} within a {w:.3} x {h:.3} \
+                 mm box at ({x:.3}, {y:.3}), folds up tighter than the filament that prints it \
+                 {filament} can keep apart: it will print as one blob; check the drawing's scale \
+                 and units"
+            )
+        } else if self.count == 1 {
             format!(
                 "a piece of the drawing, {first}, folds up tighter than the filament that \
                  prints it {filament} can keep apart: it will print as a blob; scale the \
@@ -122,7 +140,19 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
     if !(d > 0.0 && d.is_finite()) {
         return None;
     }
+    // The two tests of [`Blobs`] on a length and a box.
+    let is_blob = |length: f64, size: DVec2| {
+        let folded = size.max_element() < d && length > BLOB_OVERLAP * size.max_element();
+        // (A larger piece's lines that overlap lie further apart along it
+        // than `close_lines` passes over, and it names them: a raster
+        // filling an area is not a blob.)
+        let crowded = size.max_element() <= APART_PER_D * d
+            && length * d > BLOB_OVERLAP * (size.x + d) * (size.y + d);
+        folded || crowded
+    };
     let mut found: Option<Blobs> = None;
+    // The whole drawing: its pieces, length and box.
+    let mut all: Option<(usize, String, f64, DVec2, DVec2)> = None;
     for line in lines {
         let (Some(&first), true) = (line.points.first(), line.points.len() >= 2) else {
             continue;
@@ -137,20 +167,24 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
         if line.closed {
             length += line.points[line.points.len() - 1].distance(first);
         }
+        match &mut all {
+            Some((n, _, l, alo, ahi)) => {
+                *n += 1;
+                *l += length;
+                *alo = alo.min(lo);
+                *ahi = ahi.max(hi);
+            }
+            None => all = Some((1, line.source.to_string(), length, lo, hi)),
+        }
         let size = hi - lo;
-        let folded = size.max_element() < d && length > BLOB_OVERLAP * size.max_element();
-        // (A larger piece's lines that overlap lie further apart along it
-        // than `close_lines` passes over, and it names them: a raster
-        // filling an area is not a blob.)
-        let crowded = size.max_element() <= APART_PER_D * d
-            && length * d > BLOB_OVERLAP * (size.x + d) * (size.y + d);
-        if !(folded || crowded) {
+        if !is_blob(length, size) {
             continue;
         }
         match &mut found {
             Some(b) => b.count += 1,
             None => {
                 found = Some(Blobs {
+                    whole: false,
                     count: 1,
                     source: line.source.to_string(),
                     at: 0.5 * (lo + hi),
@@ -160,7 +194,17 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
             }
         }
     }
-    found
+    match all {
+        Some((count, source, length, lo, hi)) if is_blob(length, hi - lo) => Some(Blobs {
+            whole: true,
+            count,
+            source,
+            at: 0.5 * (lo + hi),
+            length_mm: length,
+            size_mm: hi - lo,
+        }),
+        _ => found,
+    }
 }
 
 /// The fraction t in [0, 1] of the point a + t (b - a) of segment a-b
@@ -376,8 +420,14 @@ mod tests {
         let leak = |v: Vec<DVec2>| -> &'static [DVec2] { Box::leak(v.into_boxed_slice()) };
         let (zigzag, circle, raster, spiral) =
             (leak(zigzag), leak(circle), leak(raster), leak(spiral));
-        let b = blobs(&[line("zigzag", zigzag, false)], d).expect("a blob");
-        assert_eq!((b.count, b.source.as_str()), (1, "zigzag"));
+        // Beside a wide spiral, the drawing as a whole is no blob: its
+        // pieces are named.
+        let b = blobs(
+            &[line("zigzag", zigzag, false), line("spiral", spiral, false)],
+            d,
+        )
+        .expect("a blob");
+        assert_eq!((b.whole, b.count, b.source.as_str()), (false, 1, "zigzag"));
         assert!((b.size_mm - DVec2::new(0.7, 0.8)).length() < 1e-12, "{b:?}");
         let message = b.message(d);
         assert!(
@@ -387,16 +437,35 @@ mod tests {
             ),
             "{message}"
         );
-        let b = blobs(&[line("circle", circle, true)], d).expect("a blob");
-        assert_eq!(b.source, "circle");
         let b = blobs(
-            &[line("circle", circle, true), line("zigzag", zigzag, false)],
+            &[line("circle", circle, true), line("spiral", spiral, false)],
+            d,
+        )
+        .expect("a blob");
+        assert_eq!((b.whole, b.source.as_str()), (false, "circle"));
+        let b = blobs(
+            &[
+                line("circle", circle, true),
+                line("zigzag", zigzag, false),
+                line("spiral", spiral, false),
+            ],
             d,
         )
         .expect("blobs");
-        assert_eq!(b.count, 2);
+        assert_eq!((b.whole, b.count), (false, 2));
         assert!(
             b.message(d).starts_with("2 pieces of the drawing fold up"),
+            "{}",
+            b.message(d)
+        );
+        // Alone, the zig-zag is the whole drawing, and is called that.
+        let b = blobs(&[line("zigzag", zigzag, false)], d).expect("a blob");
+        assert_eq!((b.whole, b.count), (true, 1));
+        assert!(
+            b.message(d).starts_with(
+                "the whole drawing, 21.71 mm of line in one piece within a 0.700 x 0.800 mm box \
+                 at (0.350, 0.400), folds up tighter than the filament"
+            ),
             "{}",
             b.message(d)
         );
@@ -418,6 +487,41 @@ mod tests {
             assert_eq!(blobs(&[line(name, points, closed)], d), None, "{name}");
         }
     }
+    /// QA round 5 N5: a snowflake scaled by 0.002, twelve short strokes
+    /// none of them a blob on its own, is one blob as a whole, and said to
+    /// be, with its whole length and box.
+    #[test]
+    fn a_drawing_smaller_than_the_filament_is_one_blob_as_a_whole() {
+        let d = 0.603;
+        let strokes: Vec<Vec<DVec2>> = (0..12)
+            .map(|k| {
+                let dir = DVec2::from_angle(k as f64 * std::f64::consts::TAU / 12.0);
+                vec![0.02 * dir, 0.15 * dir]
+            })
+            .collect();
+        let pieces: Vec<Line> = strokes
+            .iter()
+            .map(|points| Line {
+                source: "flake",
+                points,
+                closed: false,
+            })
+            .collect();
+        for piece in &pieces {
+            assert_eq!(blobs(std::slice::from_ref(piece), d), None);
+        }
+        let b = blobs(&pieces, d).expect("one blob");
+        assert_eq!((b.whole, b.count), (true, 12));
+        assert!((b.length_mm - 12.0 * 0.13).abs() < 1e-9, "{b:?}");
+        assert!(b.size_mm.max_element() <= 0.3 + 1e-12, "{b:?}");
+        let message = b.message(d);
+        assert!(
+            message.starts_with("the whole drawing, 1.56 mm of line in 12 pieces within a ")
+                && message.contains("it will print as one blob; check the drawing's scale"),
+            "{message}"
+        );
+    }
+
     use super::*;
 
     fn line(points: &[DVec2], closed: bool) -> Line<'_> {

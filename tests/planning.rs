@@ -974,8 +974,9 @@ fn regression_lines_closer_than_the_filament_were_planned_without_a_word() {
 /// QA round 4 F4: a drawing scaled down to under a millimetre (a typo for
 /// the scale) folds its lines up within the filament's width, where
 /// `close_lines` passes them over as neighbours along one line: it was
-/// planned with 0 % defects and no word. It is said to print as a blob,
-/// in the report and the G-code header; at its size it is not.
+/// planned with 0 % defects and no word. It is said to print as one blob
+/// (the whole drawing, QA round 5 N5), in the report and the G-code
+/// header; at its size it is not.
 #[test]
 fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_a_word() {
     let plan = hilbert_on_film();
@@ -985,7 +986,7 @@ fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_
             .report
             .warnings
             .iter()
-            .find(|w| w.contains("print as a blob"));
+            .find(|w| w.contains("print as one blob"));
         assert_eq!(
             warning.is_some(),
             blob,
@@ -994,13 +995,13 @@ fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_
         );
         if let Some(w) = warning {
             assert!(
-                w.starts_with("a piece of the drawing, ")
+                w.starts_with("the whole drawing, ")
                     && w.contains(
                         "folds up tighter than the filament that prints it (0.603 mm wide"
                     ),
                 "{w}"
             );
-            assert!(out.gcode.contains("print as a blob"));
+            assert!(out.gcode.contains("print as one blob"));
         }
     }
 }
