@@ -87,6 +87,23 @@ function requestPlan() {
   runPlan();
 }
 
+// Whether `scan` is the user's and the drawing the demo's, not placed by
+// the user since the scan's first plan: its refusal is then a notice
+// about the demo drawing (`onPlanError`). After a reload the scan is read
+// again, and where the user had placed the demo drawing is the settings'
+// `demoMoved` (QA round 5 N6: it got the notice again).
+function demoOnUserScan(scan) {
+  if (!scan.blob || settings.pathSource !== 'demo') return false;
+  const placed = scan.placementsAtFirstPlan
+    ??= scan.restored && settings.demoMoved ? -1 : userPlacements();
+  const pages = userPlacements() === placed;
+  if (settings.demoMoved === pages) {
+    settings.demoMoved = !pages;
+    saveSettings();
+  }
+  return pages;
+}
+
 function runPlan() {
   const scan = state.pendingScan || state.scan;
   let job;
@@ -111,8 +128,7 @@ function runPlan() {
     id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now(), was,
     // The demo drawing on a user's scan, not placed by the user since the
     // scan's first plan (see `onPlanError`).
-    demoOnUserScan: !!scan.blob && settings.pathSource === 'demo'
-      && userPlacements() === (scan.placementsAtFirstPlan ??= userPlacements()),
+    demoOnUserScan: demoOnUserScan(scan),
   };
   state.queued = false;
   laterProgress('starting');

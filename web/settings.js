@@ -70,6 +70,10 @@ export function demoUiSettings(part = 'test-part') {
     // A user's machine profile {name, file, text}; dialect 'custom' uses it.
     customProfile: null,
     acceptRisk: false,
+    // Whether the demo drawing on the user's scan was last planned where
+    // the user placed it (main.js's `demoOnUserScan`): kept over a reload,
+    // where the scan is read again (QA round 5 N6).
+    demoMoved: false,
   };
 }
 
@@ -390,7 +394,10 @@ export function bindForm() {
       // until they place it (main.js's `demoOnUserScan`).
       const scan = state.pendingScan || state.scan;
       const demoOnUserScan = settings.pathSource === 'demo' && scan && scan.blob;
-      if (id === 'path-source' && demoOnUserScan) delete scan.placementsAtFirstPlan;
+      if (id === 'path-source' && demoOnUserScan) {
+        delete scan.placementsAtFirstPlan;
+        settings.demoMoved = false;
+      }
       if (id === 'path-source' && (['spiral', 'hilbert', 'monopole'].includes(settings.pathSource) || demoOnUserScan)) {
         requestCentre(true);
       }

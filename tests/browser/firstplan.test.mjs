@@ -5,7 +5,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import {
-  openPage, platePostObj, waitIdle, waitSettled, withPageServer,
+  openPage, platePostObj, waitIdle, waitKept, waitSettled, withPageServer,
 } from './helpers.mjs';
 
 const env = withPageServer();
@@ -124,6 +124,49 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
   assert.equal(await page.isHidden('#error-panel'), false);
   assert.match(await page.textContent('#error-message'), /dispense/);
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// After a reload the scan is read again: the demo drawing the user left
+// where the page put it is still the demo's (a notice); once the user has
+// moved it, its refusal is theirs (red), before and after a reload (QA
+// round 5 N6: it turned blue again).
+test('the demo drawing moved by the user on their scan stays theirs after a reload', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+  const reopened = async () => {
+    await page.waitForFunction(() => window.pcpp && window.pcpp.state.info
+      && window.pcpp.state.info.name === 'plate-post.obj', null, { timeout: 120_000 });
+    await waitIdle(page);
+  };
+  const shown = () => page.evaluate(() => [document.getElementById('error-title').textContent,
+    document.getElementById('error-panel').classList.contains('notice')]);
+  const notice = ['plate-post.obj is open; the demo drawing does not print on it', true];
+  await reopened();
+  assert.deepEqual(await shown(), notice);
+  await waitKept(page);
+  await page.reload();
+  await reopened();
+  assert.deepEqual(await shown(), notice);
+
+  const x = await page.evaluate(() => Number(window.pcpp.settings.placement.x));
+  await page.fill('#pl-x', String(x + 1));
+  await page.press('#pl-x', 'Enter');
+  await page.waitForFunction((want) => Number(window.pcpp.settings.placement.x) === want, x + 1, { timeout: 60_000 });
+  // (Its plan, not the one before it, ends in the panel.)
+  await page.waitForFunction(() => !document.getElementById('error-panel').classList.contains('notice')
+    || document.getElementById('error-panel').hidden, null, { timeout: 60_000 });
+  await waitIdle(page);
+  const moved = await shown();
+  assert.equal(moved[1], false, moved[0]);
+  assert.notEqual(moved[0], notice[0]);
+  await waitKept(page);
+  await page.reload();
+  await reopened();
+  assert.equal(await page.evaluate(() => Number(window.pcpp.settings.placement.x)), x + 1);
+  assert.deepEqual(await shown(), moved);
   assert.deepEqual(problems, []);
   await context.close();
 });
