@@ -433,7 +433,7 @@ function onWorkerMessage(e) {
       if (st.planMs.length > 1000) { st.planMs.shift(); st.latencyMs.shift(); }
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
-      planOutcome(null);
+      planOutcome(null, busy.gen);
       // Planned: the worker's scan is registered by the settings now (a
       // failed registration leaves the one before, which these are again).
       if (state.regFailed) {
@@ -594,7 +594,7 @@ function onPlanError(m, busy) {
   // A scan outside the build volume, with the banner on screen offering to
   // place it: the banner says it, with its button; a red panel repeating
   // it would only bury it.
-  if (m.stage === 'plan') planOutcome(message);
+  if (m.stage === 'plan') planOutcome(message, busy.gen);
   const unitsOffered = m.kind === 'units' && unitsBannerShown();
   const offered = m.stage === 'plan' && (bannerOffers(message) || unitsOffered);
   // A scan seen edge-on from above (a plate lying on its side in the

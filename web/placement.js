@@ -36,6 +36,11 @@ let banner = null;
 // plan succeeds or another scan is read.
 let besideOut = null;
 const BESIDE = /the scan lies inside the build volume, but beside it the tool path passes .*$/;
+// The last plan's outcome, {key: its scan's, gen: its settings', written:
+// whether it wrote G-code}: the banner of a scan out of the volume says
+// which (QA round 4 F6: it read the same whether G-code was refused or
+// written, for a scan partly below the bed whose tool path is inside).
+let outcome = null;
 
 const finite = (v) => typeof v === 'number' && Number.isFinite(v);
 
@@ -324,7 +329,12 @@ export function showScanPlacement() {
     && !state.pendingScan && !unitsAsked);
   const sentence = outside ? fit.message : beside ? besideOut.text : null;
   banner = !$('place-banner').hidden ? sentence : null;
-  $('place-banner-text').textContent = sentence ? pageText(capital(sentence)) : '';
+  const known = outside && !!outcome && !!state.scan && outcome.key === state.scan.key && outcome.gen === state.gen;
+  const said = !known ? '' : outcome.written
+    ? ' G-code was written: the tool path itself lies inside the volume (its header carries this warning).'
+    : ' No G-code was written.';
+  const text = sentence ? pageText(capital(sentence)) : '';
+  $('place-banner-text').textContent = !said ? text : `${text}${/[.!?]$/.test(text) ? '' : '.'}${said}`;
   $('scan-place').hidden = !on;
   if (on) {
     $('bed-name').textContent = `profile ${profile().name}`;
@@ -388,11 +398,13 @@ export function unitsBannerShown() {
 export const capital = (t) => t.charAt(0).toUpperCase() + t.slice(1);
 
 // A plan's outcome for the banner: the error message of a refused plan,
-// or null for a plan that succeeded.
-export function planOutcome(message) {
+// or null for a plan that succeeded, and the settings' `gen` it was
+// planned for.
+export function planOutcome(message, gen) {
+  outcome = state.scan ? { key: state.scan.key, gen, written: message === null } : null;
   const m = message === null ? null : String(message).match(BESIDE);
   const next = m && state.scan ? { key: state.scan.key, text: m[0] } : null;
-  if (!next && !besideOut) return;
+  if (!next && !besideOut && $('place-banner').hidden) return;
   besideOut = next;
   showScanPlacement();
 }

@@ -67,6 +67,8 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
   const banner = await page.textContent('#place-banner-text');
   assert.match(banner, /^The scan lies outside the build volume of profile marlin \(x 0\.\.220/);
   assert.match(banner, /'Place on the bed'/);
+  // And that nothing was written (QA round 4 F6).
+  assert.match(banner, /fiducials\. No G-code was written\.$/);
   assert.match(await page.textContent('#reg-status'), /^unregistered, taken as it is/);
   // As it is, no G-code and no download: the banner says why, no red error
   // repeats it.
@@ -96,7 +98,8 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
     } catch (e) {
       err = String(e.stderr);
     }
-    assert.ok(pageText(err).includes(banner.charAt(0).toLowerCase() + banner.slice(1)), `${err}\nvs\n${banner}`);
+    const sentence = banner.replace(/\. No G-code was written\.$/, '');
+    assert.ok(pageText(err).includes(sentence.charAt(0).toLowerCase() + sentence.slice(1)), `${err}\nvs\n${sentence}`);
   } else {
     t.diagnostic(`${CLI} not built: the banner is not compared with the CLI's message`);
   }
@@ -193,6 +196,31 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
   assert.equal(await page.inputValue('#bed-dx'), '5');
   assert.equal(await page.isHidden('#place-banner'), true);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A scan reaching 2 mm below the bed whose tool path lies inside the
+// volume: G-code is written, with the warning, and the banner says so; the
+// same banner on a refused plan says nothing was written (QA round 4 F6:
+// both read the same).
+test('the banner of a scan out of the volume says whether G-code was written', async () => {
+  // A slab 80 x 80 mm, from 2 mm below the bed to 1 mm above it.
+  const v = [];
+  for (const z of [-2, 1]) for (const [x, y] of [[60, 60], [140, 60], [140, 140], [60, 140]]) v.push(`v ${x} ${y} ${z}`);
+  const f = ['f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 2 3 7', 'f 2 7 6',
+    'f 3 4 8', 'f 3 8 7', 'f 4 1 5', 'f 4 5 8'];
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'slab.obj', mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'slab.obj', null, { timeout: 120_000 });
+  await waitSettled(page);
+  assert.equal(await page.isVisible('#place-banner'), true);
+  const banner = await page.textContent('#place-banner-text');
+  assert.match(banner, /^The scan lies outside the build volume of profile marlin /);
+  assert.match(banner, /[a-z]\. G-code was written: the tool path itself lies inside the volume \(its header carries this warning\)\.$/);
+  const gcode = await download(page, 'dl-gcode');
+  assert.match(gcode.bytes.toString('utf8'), /the scan lies outside the build volume/);
   assert.deepEqual(problems, []);
   await context.close();
 });
