@@ -366,7 +366,7 @@ pub fn surface_path(
                 // centre lay 68 mm from its nearest point, and a larger
                 // maximum edge, the one hint, could not help).
                 let middle = 0.5 * (lo + hi);
-                let nearest = nearest_in_xy(surface.mesh(), middle).map_or(String::new(), |p| {
+                let nearest = surface.nearest_in_xy(middle).map_or(String::new(), |p| {
                     format!(
                         "; the scan's surface nearest the drawing's middle ({:.3}, {:.3}) is \
                              at ({:.3}, {:.3}), {:.3} mm from it",
@@ -423,31 +423,6 @@ pub fn surface_path(
         warnings,
         coverage,
     })
-}
-
-/// The point of `mesh`'s triangles, seen from above, nearest `to` (in XY;
-/// `None` for a mesh with none). For an error message: every triangle is
-/// tried.
-fn nearest_in_xy(mesh: &crate::mesh::TriMesh, to: DVec2) -> Option<DVec2> {
-    let on_segment =
-        |a: DVec2, b: DVec2| a + crate::spacing::nearest_on_segment(to, a, b) * (b - a);
-    let nearer = |p: &DVec2, q: &DVec2| p.distance_squared(to).total_cmp(&q.distance_squared(to));
-    mesh.triangles
-        .iter()
-        .map(|t| t.map(|i| mesh.vertices[i as usize].truncate()))
-        .map(|[a, b, c]| {
-            // Inside (either winding): the point itself.
-            let side = |p: DVec2, q: DVec2| (q - p).perp_dot(to - p);
-            let (s0, s1, s2) = (side(a, b), side(b, c), side(c, a));
-            if (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0) {
-                return to;
-            }
-            [on_segment(a, b), on_segment(b, c), on_segment(c, a)]
-                .into_iter()
-                .min_by(nearer)
-                .unwrap_or(a)
-        })
-        .min_by(nearer)
 }
 
 /// Whether a scan `foot` wide (its footprint in printer XY) and `tall` high

@@ -12,13 +12,15 @@
 //!
 //! A new drawing, or a drawing on a new scan, is centred on the scan's
 //! footprint and scaled down (with a note) when it does not fit:
-//! [`centre_drawing`]; when the scan is moved on the bed by hand, the
+//! [`centre_drawing`], or on the surface nearest that middle when it lies
+//! over a gap ([`centre_on_surface`]); when the scan is moved on the bed by hand, the
 //! drawing goes with it: [`carry_drawing`].
 
 use glam::{DMat4, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::gcode::{BuildVolume, MachineProfile};
+use crate::surface::Surface;
 use crate::svg::{Placement, Subpath2};
 
 /// The bed of a machine: the middle of its build volume in XY, at its
@@ -325,6 +327,77 @@ pub fn centre_drawing(
     Some((placement, note))
 }
 
+/// [`centre_drawing`] on a scan's surface: on the middle of its footprint,
+/// or, where that middle lies over no surface (a ring-shaped cloud, a
+/// C-shaped part), on the point of the surface nearest it, with a note
+/// saying so (QA round 2 F9: `--place centre` put the drawing in the gap
+/// of a ring-shaped cloud, 68 mm from its nearest point, and planning
+/// refused it).
+pub fn centre_on_surface(
+    drawn: &[Subpath2],
+    surface: &Surface,
+    current: &Placement,
+    fit: bool,
+) -> Option<(Placement, Option<String>)> {
+    let (lo, hi) = surface.bbox();
+    let (flo, fhi) = (lo.truncate(), hi.truncate());
+    let (placement, note) = centre_drawing(drawn, (flo, fhi), current, fit)?;
+    let middle = 0.5 * (flo + fhi);
+    if surface.highest_hit(middle).is_some() {
+        return Some((placement, note));
+    }
+    let Some(nearest) = surface.nearest_in_xy(middle) else {
+        return Some((placement, note));
+    };
+    // The nearest point is on the gap's edge: the drawing centred there
+    // lies half over the gap. It goes on, away from the middle, by up to
+    // its own size, to where most of it (of up to 256 of its points) lies
+    // over the surface.
+    let points: Vec<DVec2> = drawn
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .collect();
+    let step = (points.len() / 256).max(1);
+    let over = |at: &Placement| {
+        (points.iter().step_by(step))
+            .filter(|p| surface.highest_hit(at.apply(**p)).is_some())
+            .count()
+    };
+    let (dlo, dhi) = (points.iter().map(|p| placement.apply(*p)))
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        });
+    let (size, away) = (
+        (dhi - dlo).max_element(),
+        (nearest - middle).normalize_or_zero(),
+    );
+    let (mut best, mut best_over) = (placement, 0);
+    for k in 0..=4 {
+        let mut at = placement;
+        at.offset_mm += nearest - middle + away * (0.25 * k as f64 * size);
+        let n = over(&at);
+        if k == 0 || n > best_over {
+            (best, best_over) = (at, n);
+        }
+    }
+    let centre = middle + (best.offset_mm - placement.offset_mm);
+    let moved = format!(
+        "the middle of the scan's footprint ({:.3}, {:.3}) lies over a gap in the scan: the \
+         drawing is centred on the surface near it, at ({:.3}, {:.3}), {:.3} mm away; move it \
+         where you want it on the scan",
+        middle.x,
+        middle.y,
+        centre.x,
+        centre.y,
+        centre.distance(middle)
+    );
+    let note = Some(match note {
+        Some(n) => format!("{n}; {moved}"),
+        None => moved,
+    });
+    Some((best, note))
+}
+
 /// A factor below 1 with three significant digits (0.953, 0.000272): a
 /// drawing scaled down ten thousand times was "scaled by 0.000".
 fn three_digits(x: f64) -> String {
@@ -616,6 +689,86 @@ mod tests {
             .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(*p), hi.max(*p))
             })
+    }
+
+    /// QA round 2 F9: a ring-shaped scan's footprint has a gap in its
+    /// middle; `--place centre` put the drawing there and planning refused
+    /// it. It goes onto the ring, most of it over the surface, with a note;
+    /// on a scan whose middle is covered it is `centre_drawing`'s placement.
+    #[test]
+    fn a_drawing_centred_over_a_gap_goes_onto_the_surface_near_it() {
+        use crate::mesh::TriMesh;
+        // A ring from r 20 to r 40 mm about (100, 100), 64 sectors.
+        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+        for k in 0..64u32 {
+            let a = DVec2::from_angle(k as f64 * std::f64::consts::TAU / 64.0);
+            for r in [20.0, 40.0] {
+                vertices.push((DVec2::splat(100.0) + r * a).extend(1.0));
+            }
+            let (i, j) = (2 * k, 2 * ((k + 1) % 64));
+            triangles.extend([[i, i + 1, j + 1], [i, j + 1, j]]);
+        }
+        let ring = Surface::new(TriMesh {
+            vertices,
+            triangles,
+        })
+        .unwrap();
+        // A 10 mm circle.
+        let circle = Subpath2 {
+            points: (0..48)
+                .map(|k| 5.0 * DVec2::from_angle(k as f64 * std::f64::consts::TAU / 48.0))
+                .collect(),
+            corner: vec![false; 48],
+            closed: true,
+            source: "c".into(),
+        };
+        let drawn = std::slice::from_ref(&circle);
+        let (lo, hi) = ring.bbox();
+        let (gap, _) = centre_drawing(
+            drawn,
+            (lo.truncate(), hi.truncate()),
+            &Placement::IDENTITY,
+            true,
+        )
+        .unwrap();
+        let on = |p: &Placement| {
+            (circle.points.iter())
+                .filter(|q| ring.highest_hit(p.apply(**q)).is_some())
+                .count()
+        };
+        assert_eq!(on(&gap), 0);
+        let (p, note) = centre_on_surface(drawn, &ring, &Placement::IDENTITY, true).unwrap();
+        assert_eq!(on(&p), 48, "{p:?}");
+        assert_eq!((p.rotation_deg, p.scale), (0.0, 1.0));
+        let note = note.expect("a note");
+        assert!(
+            note.starts_with(
+                "the middle of the scan's footprint (100.000, 100.000) lies over a gap in the \
+                 scan: the drawing is centred on the surface near it, at ("
+            ),
+            "{note}"
+        );
+        // A disk: its middle is covered, and the drawing stays there.
+        let disk = Surface::new(TriMesh {
+            vertices: vec![
+                DVec3::new(60.0, 60.0, 1.0),
+                DVec3::new(140.0, 60.0, 1.0),
+                DVec3::new(140.0, 140.0, 1.0),
+                DVec3::new(60.0, 140.0, 1.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        })
+        .unwrap();
+        let (lo, hi) = disk.bbox();
+        assert_eq!(
+            centre_on_surface(drawn, &disk, &Placement::IDENTITY, true),
+            centre_drawing(
+                drawn,
+                (lo.truncate(), hi.truncate()),
+                &Placement::IDENTITY,
+                true
+            )
+        );
     }
 
     #[test]

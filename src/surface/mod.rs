@@ -223,6 +223,33 @@ impl Surface {
         self.bbox.1.z
     }
 
+    /// The point of the scan's triangles, seen from above, nearest `to` (in
+    /// XY; `None` for a scan with none). For an error message or a drawing
+    /// placed once: every triangle is tried.
+    pub fn nearest_in_xy(&self, to: DVec2) -> Option<DVec2> {
+        let mesh = &self.mesh;
+        let on_segment =
+            |a: DVec2, b: DVec2| a + crate::spacing::nearest_on_segment(to, a, b) * (b - a);
+        let nearer =
+            |p: &DVec2, q: &DVec2| p.distance_squared(to).total_cmp(&q.distance_squared(to));
+        mesh.triangles
+            .iter()
+            .map(|t| t.map(|i| mesh.vertices[i as usize].truncate()))
+            .map(|[a, b, c]| {
+                // Inside (either winding): the point itself.
+                let side = |p: DVec2, q: DVec2| (q - p).perp_dot(to - p);
+                let (s0, s1, s2) = (side(a, b), side(b, c), side(c, a));
+                if (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0) {
+                    return to;
+                }
+                [on_segment(a, b), on_segment(b, c), on_segment(c, a)]
+                    .into_iter()
+                    .min_by(nearer)
+                    .unwrap_or(a)
+            })
+            .min_by(nearer)
+    }
+
     /// z of the highest intersection of the vertical line through `xy` with
     /// the scan (spec section 4), `None` if the line misses it.
     pub fn highest_hit(&self, xy: DVec2) -> Option<f64> {

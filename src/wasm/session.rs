@@ -395,8 +395,9 @@ impl Session {
     }
 
     /// The drawing of [`Session::set_path`] centred on this scan's footprint
-    /// (printer XY), keeping the rotation and scale of `placement` and
-    /// scaling it down when it does not fit ([`placement::centre_drawing`]):
+    /// (printer XY), or on its surface nearest the footprint's middle when
+    /// that is a gap, keeping the rotation and scale of `placement` and
+    /// scaling it down when it does not fit ([`placement::centre_on_surface`]):
     /// `{placement, note}` (`note` says how it was scaled, or is null), or
     /// null for a drawing without points.
     #[wasm_bindgen(js_name = centreDrawing)]
@@ -411,13 +412,8 @@ impl Session {
             .path
             .as_ref()
             .ok_or_else(|| JsError::new("no drawing to centre: set a path first"))?;
-        let (lo, hi) = self.scan.surface.bbox();
-        let centred = placement::centre_drawing(
-            &path.drawn.subpaths,
-            (lo.truncate(), hi.truncate()),
-            &current,
-            true,
-        );
+        let centred =
+            placement::centre_on_surface(&path.drawn.subpaths, &self.scan.surface, &current, true);
         Ok(match centred {
             Some((placement, note)) => to_js(&Centred { placement, note })?,
             None => JsValue::NULL,

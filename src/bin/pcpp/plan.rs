@@ -114,9 +114,10 @@ pub fn registration_line(r: &Registration, method: RegistrationMethod) -> String
     )
 }
 
-/// With `--place centre`, the drawing centred on the scan's footprint
-/// (scaled down to fit, with a warning, when it is larger, unless a scale
-/// was given: that one is kept).
+/// With `--place centre`, the drawing centred on the scan's footprint, or
+/// on the surface nearest its middle when that is a gap (scaled down to
+/// fit, with a warning, when it is larger, unless a scale was given: that
+/// one is kept).
 fn centre_on_scan(
     a: &JobArgs,
     inputs: &Inputs,
@@ -128,10 +129,9 @@ fn centre_on_scan(
     };
     let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
         .map_err(|e| Failure::Input(in_file(&inputs.svg_path, &inputs.svg_name, &e.to_string())))?;
-    let (lo, hi) = inputs.prepared.surface.bbox();
-    let Some((place, note)) = pcpp::placement::centre_drawing(
+    let Some((place, note)) = pcpp::placement::centre_on_surface(
         &drawn.subpaths,
-        (lo.truncate(), hi.truncate()),
+        &inputs.prepared.surface,
         &plan.placement,
         !place.scale_given,
     ) else {
