@@ -12,9 +12,9 @@
 //!
 //! A new drawing, or a drawing on a new scan, is centred on the scan's
 //! footprint and scaled down (with a note) when it does not fit:
-//! [`centre_drawing`], or on the surface nearest that middle when it lies
-//! over a gap ([`centre_on_surface`]); when the scan is moved on the bed by hand, the
-//! drawing goes with it: [`carry_drawing`].
+//! [`centre_drawing`], or on the surface near that middle when it lies
+//! over a gap ([`centre_on_surface`]); when the scan is moved on the bed
+//! by hand, the drawing goes with it: [`carry_drawing`].
 
 use glam::{DMat4, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -329,8 +329,8 @@ pub fn centre_drawing(
 
 /// [`centre_drawing`] on a scan's surface: on the middle of its footprint,
 /// or, where that middle lies over no surface (a ring-shaped cloud, a
-/// C-shaped part), on the point of the surface nearest it, with a note
-/// saying so (QA round 2 F9: `--place centre` put the drawing in the gap
+/// C-shaped part), on the surface near it (see below), with a note saying
+/// so (QA round 2 F9: `--place centre` put the drawing in the gap
 /// of a ring-shaped cloud, 68 mm from its nearest point, and planning
 /// refused it).
 pub fn centre_on_surface(
