@@ -148,6 +148,59 @@ fn demo_move_through_the_region_1_block_edge_is_caught_and_no_longer_planned() {
     }
 }
 
+/// QA round 6 F0: a plunge straight down beside a block, into it: the
+/// wall's top edge crosses the tip's disk at the bottom of the move, no
+/// corner under it. The core's check took the edge at the move's start
+/// (the top) and called the program clear; the oracle and the core now
+/// both find the move too close, by line.
+#[test]
+fn regression_a_plunge_beside_a_wall_was_checked_at_its_top() {
+    let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    // A floor at z = 0 from x = 0 to 5, a block 2 mm high from x = 5 to
+    // 10 (its wall at x = 5), 10 mm deep: large triangles, their corners
+    // far from the plunge.
+    let vertices = vec![
+        v(0.0, 0.0, 0.0),
+        v(5.0, 0.0, 0.0),
+        v(5.0, 10.0, 0.0),
+        v(0.0, 10.0, 0.0),
+        v(5.0, 0.0, 2.0),
+        v(10.0, 0.0, 2.0),
+        v(10.0, 10.0, 2.0),
+        v(5.0, 10.0, 2.0),
+    ];
+    let triangles = vec![
+        [0, 1, 2],
+        [0, 2, 3],
+        [4, 5, 6],
+        [4, 6, 7],
+        // The wall, facing -X.
+        [1, 7, 2],
+        [1, 4, 7],
+    ];
+    let mesh = TriMesh {
+        vertices,
+        triangles,
+    };
+    // Down at x = 4.7: the wall's top edge 0.3 mm from the axis, inside
+    // the 0.454 mm tip; the tip ends 1 mm below the block's top.
+    let plunge = "G90\nG21\nG0 X4.7 Y5 Z20\nG1 X4.7 Y5 Z5\nG1 X4.7 Y5 Z1\n";
+    let oracle = check_gcode(plunge, &mesh, DO, TOL);
+    assert!(oracle.too_close > 0, "{}", describe(&oracle));
+    let surface = pcpp::surface::Surface::new(mesh.clone()).unwrap();
+    let c = pcpp::motion::Clearance::new(&Nozzle::DEFAULT, TOL);
+    let down = [(v(4.7, 5.0, 5.0), v(4.7, 5.0, 1.0), Some(5))];
+    let sum = pcpp::motion::check_moves(&surface, down, &c);
+    assert_eq!(sum.touching_moves, 1, "{sum:?}");
+    assert_eq!(sum.touching[0].line, Some(5));
+    // 1 mm into the block, and tol more.
+    assert!(
+        (sum.touching[0].rise_mm - 1.0 - TOL).abs() < 1e-6,
+        "{:?}",
+        sum.touching[0]
+    );
+}
+
 /// `slope` on the stepped block cuts the steps: refused, naming a move
 /// with its line and depth; accepted, written with a warning in the header,
 /// and the oracle confirms the touching.

@@ -892,7 +892,8 @@ struct EdgeSweep {
     e: DVec2,
     ee: f64,
     w0: DVec2,
-    /// The chords' quadratics at s = 0 and (for a moving tip) s = 1.
+    /// The chords' quadratics at s = 0 and s = 1 (for a tip that does not
+    /// move in XY, one, at its lowest end).
     ends: [(f64, f64, f64); 2],
     n_ends: usize,
     /// g / |g| and 1 / det M, unless the value is constant on the ellipse
@@ -910,7 +911,12 @@ impl EdgeSweep {
         let w0 = p.truncate() - m.a.truncate();
         let d = m.d;
         let moving = d.length_squared() > 1e-30;
-        let ends = [0.0, 1.0].map(|s| {
+        // A tip that does not move in XY (a plunge, a lift) has one chord
+        // for every s, and its worst s is the lowest end: the end the tip
+        // descends to (QA round 6 F0: taken at s = 0, the top of a
+        // descent, a wall's edge across the disk at its bottom was missed).
+        let still = if m.dz < 0.0 { 1.0 } else { 0.0 };
+        let ends = (if moving { [0.0, 1.0] } else { [still; 2] }).map(|s| {
             let f = w0 - s * d;
             (s, f.dot(e), f.length_squared())
         });
@@ -1079,6 +1085,51 @@ mod tests {
         // s = 0.75, z = 2.6 - 1.5 = 1.1: gap -0.9.
         assert!((g.at - 0.75).abs() < 1e-9, "{g:?}");
         assert!((g.gap_mm + 0.9).abs() < 1e-9, "{g:?}");
+    }
+
+    /// QA round 6 F0: a tip that moves only up or down (a plunge) beside a
+    /// wall whose top edge crosses the disk, no corner under it: the edge
+    /// was taken at the move's start, so a descent into the step was
+    /// called clear by the height it started from.
+    #[test]
+    fn a_vertical_move_is_worst_at_its_lowest_end() {
+        let s = step_block();
+        let r = 0.35;
+        // The wall's top edge (x = 5, z = 2) lies 0.3 mm from the axis;
+        // its corners at y = 5 and 5.5 lie 0.39 mm away, beyond r.
+        let (top, bottom) = (DVec3::new(4.7, 5.25, 5.0), DVec3::new(4.7, 5.25, 1.0));
+        for (a, b, at) in [(top, bottom, 1.0), (bottom, top, 0.0)] {
+            let g = s.sweep_gap(a, b, r, f64::INFINITY).unwrap();
+            assert!((g.gap_mm + 1.0).abs() < 1e-9, "{a} -> {b}: {g:?}");
+            assert_eq!(g.at, at);
+            assert!((g.surface_point.z - 2.0).abs() < 1e-12, "{g:?}");
+            // With tol, the same as the point query at the lowest end.
+            let tol = 0.1;
+            let moved = s.nozzle_gap(a, b, r, tol, f64::INFINITY).unwrap();
+            let point = s.nozzle_gap(bottom, bottom, r, tol, f64::INFINITY).unwrap();
+            assert_eq!(moved.gap_mm, point.gap_mm, "{a} -> {b}");
+        }
+        // On a curved surface, every vertical move agrees with dense
+        // sampling.
+        let surf = Surface::new(grid(60, 6.0, |x, y| {
+            (1.3 * x).sin() * 0.8 + (0.9 * y).cos() * 0.5 + 0.2 * x
+        }))
+        .unwrap();
+        let r = 0.454;
+        for k in 0..200 {
+            let (u, v) = ((k as f64 * 0.618_034) % 1.0, (k as f64 * 0.414_214) % 1.0);
+            let a = DVec3::new(1.0 + 4.0 * u, 1.0 + 4.0 * v, 3.0);
+            let b = DVec3::new(a.x, a.y, -1.5 + 2.0 * v);
+            for (a, b) in [(a, b), (b, a)] {
+                let exact = surf.sweep_gap(a, b, r, f64::INFINITY).unwrap();
+                let dense = sampled(&surf, a, b, r, 50);
+                assert!(
+                    exact.gap_mm <= dense + 1e-9,
+                    "{a} {b}: {exact:?} vs {dense}"
+                );
+                assert!(dense - exact.gap_mm < 1e-9, "{a} {b}: {exact:?} vs {dense}");
+            }
+        }
     }
 
     #[test]
