@@ -1381,6 +1381,14 @@ pub struct GcodeCheck {
     /// shown clear (QA: a 44 mm cow checked as a 1.7 mm one passed).
     #[serde(default)]
     pub planned_otherwise: Vec<String>,
+    /// What the program's header says of the nozzle it was planned for
+    /// when this check's is smaller (a smaller outer diameter or tol): a
+    /// clear check of a smaller nozzle does not show the program's own
+    /// clear, so the program is not shown clear (QA round 6 F1: checked
+    /// with the defaults, a program planned for a 1.6 mm tip kept 0.25 mm
+    /// off, whose moves came within 0.05 mm of the part, was called clear).
+    #[serde(default)]
+    pub planned_nozzle: Option<String>,
     /// The straight moves followed, in file order (the touching moves'
     /// `index` points into them): for drawing; not in the JSON.
     #[serde(skip)]
@@ -1396,6 +1404,7 @@ impl GcodeCheck {
         self.summary.touching_moves == 0
             && self.unchecked_lines.is_empty()
             && self.planned_otherwise.is_empty()
+            && self.planned_nozzle.is_none()
     }
 
     /// A note on the moves that leave `profile`'s build volume (the scan
@@ -1642,8 +1651,9 @@ pub fn check_gcode_as(
                 .to_string(),
         );
     }
-    // What the program's header says against this scan, first.
-    notes.splice(0..0, frame_notes);
+    // What the program's header says against this scan and nozzle, first.
+    let planned_nozzle = smaller_nozzle(text, nozzle.outer_diameter_mm, tol_mm);
+    notes.splice(0..0, frame_notes.into_iter().chain(planned_nozzle.clone()));
     Ok(GcodeCheck {
         file: InputFile::new(file, text.as_bytes()),
         lines: program.lines,
@@ -1653,6 +1663,7 @@ pub fn check_gcode_as(
         tol_mm,
         outer_diameter_mm: nozzle.outer_diameter_mm,
         planned_otherwise,
+        planned_nozzle,
         moves: program.moves,
     })
 }
@@ -1699,16 +1710,65 @@ pub fn line_list(lines: &[usize]) -> String {
 /// The second list holds those of them that say the scan was read or
 /// placed another way (units, up axis, frame): then this check's scan is
 /// not where the program's part was.
+/// The nozzle and tol a pcpp program's header says it was planned for
+/// (`; nozzle: d D mm, do DO mm` and `; process: tol T mm, ...`; `'` for
+/// Aerotech), each where the header gives it: `pcpp check` checks with
+/// them unless told otherwise (QA round 6 F1).
+pub fn planned_nozzle(text: &str) -> (Option<crate::params::Nozzle>, Option<f64>) {
+    let (mut nozzle, mut tol) = (None, None);
+    let number = |v: &str, key: &str| -> Option<f64> {
+        let rest = v.split(key).nth(1)?;
+        let n = rest.trim_start().split(' ').next()?;
+        n.parse::<f64>().ok().filter(|x| x.is_finite() && *x > 0.0)
+    };
+    for line in header_lines(text) {
+        if let Some(v) = line.strip_prefix("nozzle: ") {
+            if let (Some(d), Some(od)) = (number(v, "d "), number(v, "do ")) {
+                nozzle = Some(crate::params::Nozzle {
+                    inner_diameter_mm: d,
+                    outer_diameter_mm: od,
+                });
+            }
+        } else if let Some(v) = line.strip_prefix("process: ") {
+            tol = number(v, "tol ");
+        }
+    }
+    (nozzle, tol)
+}
+
+/// The leading comment block of a G-code program, each line without its
+/// comment mark (`;`, or `'` for Aerotech) and trimmed.
+fn header_lines(text: &str) -> impl Iterator<Item = &str> {
+    text.lines()
+        .map(str::trim)
+        .take_while(|l| l.starts_with(';') || l.starts_with('\''))
+        .map(|l| l[1..].trim())
+}
+
+/// [`GcodeCheck::planned_nozzle`]: the header's nozzle and tol against
+/// this check's `outer_diameter_mm` and `tol_mm`, when either is smaller.
+fn smaller_nozzle(text: &str, outer_diameter_mm: f64, tol_mm: f64) -> Option<String> {
+    let (nozzle, tol) = planned_nozzle(text);
+    let od = nozzle.map(|n| n.outer_diameter_mm);
+    // Written to the header's digits: a hair less is the same nozzle.
+    let larger = |planned: Option<f64>, checked: f64| planned.is_some_and(|p| p > checked + 1e-9);
+    if !(larger(od, outer_diameter_mm) || larger(tol, tol_mm)) {
+        return None;
+    }
+    let (od, tol) = (od.unwrap_or(outer_diameter_mm), tol.unwrap_or(tol_mm));
+    Some(format!(
+        "the program was planned for a nozzle of outer diameter {od} mm kept {tol} mm from the \
+         surface (its header), and this check asks less (outer diameter \
+         {outer_diameter_mm} mm, tol {tol_mm} mm): check it with the program's (--nozzle-od \
+         {od} --tol {tol})"
+    ))
+}
+
 fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut otherwise = Vec::new();
     // The leading comment block: `; key: value` (`'` for Aerotech).
-    let header = text
-        .lines()
-        .map(str::trim)
-        .take_while(|l| l.starts_with(';') || l.starts_with('\''))
-        .map(|l| l[1..].trim());
-    for line in header {
+    for line in header_lines(text) {
         if let Some(v) = line.strip_prefix("scan file: ") {
             let planned = v
                 .split("sha256 ")
@@ -1906,6 +1966,33 @@ pub fn comparison_table(rows: &[ComparisonRow]) -> String {
 
 #[cfg(test)]
 mod tests {
+
+    /// The header's nozzle and tol, in either comment style; none where
+    /// the header does not give them whole.
+    #[test]
+    fn the_nozzle_a_program_was_planned_for_is_read_from_its_header() {
+        let ours = "; pcpp 0.1.0\n; nozzle: d 1.2 mm, do 1.6 mm\n; process: tol 0.25 mm, speed 5 \
+                    mm/s, dwell 0 s\nG21\n; nozzle: d 9 mm, do 10 mm\n";
+        let (n, tol) = planned_nozzle(ours);
+        let n = n.expect("a nozzle");
+        assert_eq!(
+            (n.inner_diameter_mm, n.outer_diameter_mm, tol),
+            (1.2, 1.6, Some(0.25))
+        );
+        let aerotech = ours.replace(';', "'");
+        assert_eq!(planned_nozzle(&aerotech), planned_nozzle(ours));
+        assert_eq!(planned_nozzle("G21\nG1 X0 Y0 Z1\n"), (None, None));
+        assert_eq!(
+            planned_nozzle("; nozzle: d 1.2 mm\n; process: tol -1 mm\n"),
+            (None, None)
+        );
+        // Smaller than the header's: said; equal or larger: nothing.
+        assert!(smaller_nozzle(ours, 0.908, 0.25).is_some());
+        assert!(smaller_nozzle(ours, 1.6, 0.1).is_some());
+        assert!(smaller_nozzle(ours, 1.6, 0.25).is_none());
+        assert!(smaller_nozzle(ours, 2.0, 0.3).is_none());
+    }
+
     use super::*;
     use crate::demo::test_part;
     use glam::DMat4;

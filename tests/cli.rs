@@ -912,6 +912,102 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     }
 }
 
+/// QA round 6 F1: a program planned for a 1.6 mm tip kept 0.25 mm off was
+/// checked with the default nozzle (0.908 mm, tol 0.1) with no word, and
+/// called clear where its own nozzle came within 0.05 mm of the part. The
+/// check now takes the nozzle and tol the header names unless given, and
+/// says so; given smaller ones, it does not call the program clear.
+#[test]
+fn check_takes_the_nozzle_the_programs_header_names() {
+    let dir = temp_dir("check-nozzle");
+    let gcode = dir.join("big.gcode");
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        &[
+            "--place",
+            "0,80,0,1",
+            "--nozzle-id",
+            "1.2",
+            "--nozzle-od",
+            "1.6",
+            "--tol",
+            "0.25",
+            "-o",
+            s(&gcode),
+        ],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    assert!(
+        text.contains("\n; nozzle: d 1.2 mm, do 1.6 mm\n"),
+        "{}",
+        &text[..600]
+    );
+    let o = check_on_demo(&gcode, None);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("(nozzle outer diameter 1.6 mm, tol 0.25 mm): min clearance 0.25"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(
+        stderr(&o).contains(
+            "checked with the nozzle the program's header names: outer diameter 1.6 mm, inner \
+             diameter 1.2 mm, tol 0.25 mm"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    // The default nozzle given by hand: smaller than the program's, so the
+    // program is not shown clear, whatever its moves' clearance.
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let small = [
+        "check",
+        "--scan",
+        s(&scan),
+        "--gcode",
+        s(&gcode),
+        "--nozzle-id",
+        "0.603",
+        "--nozzle-od",
+        "0.908",
+        "--tol",
+        "0.1",
+    ];
+    let o = pcpp(&small);
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stderr(&o).contains(
+            "no move comes closer than tol with this nozzle, but the program was planned for a \
+             nozzle of outer diameter 1.6 mm kept 0.25 mm from the surface (its header), and \
+             this check asks less (outer diameter 0.908 mm, tol 0.1 mm): check it with the \
+             program's (--nozzle-od 1.6 --tol 0.25); so the program is not shown to keep tol"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    // A program with no nozzle in its header (another tool's) is checked
+    // with the defaults, with no word of a header.
+    let bare: String = text
+        .lines()
+        .filter(|l| !l.starts_with("; nozzle:") && !l.starts_with("; process:"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let other = dir.join("other.gcode");
+    std::fs::write(&other, bare).unwrap();
+    let o = check_on_demo(&other, None);
+    assert!(
+        stdout(&o).contains("(nozzle outer diameter 0.908 mm, tol 0.1 mm)")
+            || stderr(&o).contains("(nozzle outer diameter 0.908 mm, tol 0.1 mm)"),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    assert!(!stderr(&o).contains("header names"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A registration whose fiducials miss their printer points by 6.4 mm RMS
 /// (made-up printer points on a real scan) wrote G-code with exit 0 and a
 /// warning; past the nozzle's inner diameter it is refused, naming the

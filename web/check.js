@@ -67,6 +67,10 @@ export function onCheck(m) {
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
   verdict.textContent = c.clear
     ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
+    // Planned for a larger nozzle or tol than this check's (QA round 6 F1).
+    : sum.touching_moves === 0 && c.unchecked_lines.length === 0 && !(c.planned_otherwise || []).length
+      && c.planned_nozzle
+      ? `not shown clear: no move comes closer than tol with this nozzle, but ${pageText(c.planned_nozzle)}; ${against}`
     : sum.touching_moves === 0 && c.unchecked_lines.length === 0
       ? `not shown clear: no move comes closer than tol to the scan as loaded, but the program was planned `
         + `on the scan read or placed another way (${(c.planned_otherwise || []).map(pageText).join('; ')}); ${against}`

@@ -77,6 +77,8 @@ const PAGE_WORDS = [
   [/\(--scan-units (\w+)\)/g, '(Units: $1)'],
   [/\(--scan-units (\w+) if it really is this (small|large)\)/g, '(Units: $1 if it really is this $2)'],
   [/\(--max-edge\)/g, '(Cloud max edge)'],
+  [/check it with the program's \(--nozzle-od ([\d.]+) --tol ([\d.]+)\)/g,
+    "check it with the program's (Nozzle and process: outer diameter $1 mm, tol $2 mm)"],
   [/give it as the scan \(--scan\), and the G-code file the printer runs as the program/g,
     'open it as the scan, and check the G-code file the printer runs'],
   [/\(--accept-risk\)/g, "(the box 'write G-code even where it is refused (at my risk)')"],

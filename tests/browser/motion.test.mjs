@@ -222,6 +222,21 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
   assert.match(said, /^not shown clear: no move comes closer than tol to the scan as loaded, but the program was planned on the scan read or placed another way \(the program was planned with the scan read in in, \+Y up, this check reads it in mm, \+Z up: read it as it was then \(Units: in; Up axis: \+Y\)\); inches\.gcode against/);
   assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
 
+  // The same program, its header saying it was planned for a larger
+  // nozzle kept further off: the page's nozzle is smaller, so a clear
+  // check does not show it clear, and the page names its controls (QA
+  // round 6 F1).
+  const larger = own.bytes.toString('utf8').replace(/\n; nozzle: d [\d.]+ mm, do [\d.]+ mm\n/, '\n; nozzle: d 1.2 mm, do 1.6 mm\n')
+    .replace(/\n; process: tol [\d.]+ mm/, '\n; process: tol 0.25 mm');
+  assert.notEqual(larger, own.bytes.toString('utf8'));
+  await page.setInputFiles('#gcode-input', gcodeFile('larger.gcode', Buffer.from(larger)));
+  await page.waitForFunction(() => {
+    const v = document.getElementById('check-verdict').textContent;
+    return /larger\.gcode/.test(v) && !/^checking /.test(v);
+  });
+  assert.match(await page.textContent('#check-verdict'), /^not shown clear: no move comes closer than tol with this nozzle, but the program was planned for a nozzle of outer diameter 1\.6 mm kept 0\.25 mm from the surface \(its header\), and this check asks less \(outer diameter 0\.908 mm, tol 0\.1 mm\): check it with the program's \(Nozzle and process: outer diameter 1\.6 mm, tol 0\.25 mm\); larger\.gcode against/);
+  assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
+
   // Down beside a 2 mm wall of the test part, then up across its corner.
   const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
   await page.setInputFiles('#gcode-input', gcodeFile('cut.gcode', cut));

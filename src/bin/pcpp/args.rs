@@ -198,13 +198,55 @@ pub struct CheckArgs {
     pub scan: ScanArgs,
 
     #[command(flatten)]
-    pub nozzle: NozzleArgs,
+    pub nozzle: CheckNozzleArgs,
 
     #[command(flatten)]
     pub registration: RegistrationArgs,
 
     #[command(flatten)]
     pub machine: MachineArgs,
+}
+
+/// The nozzle `check` checks with: each value given, else the one a pcpp
+/// program's header gives, else the default (QA round 6 F1: a program
+/// planned for another nozzle was checked with the defaults, with no
+/// word).
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Nozzle and process")]
+pub struct CheckNozzleArgs {
+    /// Nozzle inner diameter d [default: the program header's, else 0.603]
+    #[arg(long, value_name = "MM", value_parser = number, allow_hyphen_values = true)]
+    pub nozzle_id: Option<f64>,
+
+    /// Nozzle outer diameter do [default: the program header's, else 0.908]
+    #[arg(long, value_name = "MM", value_parser = number, allow_hyphen_values = true)]
+    pub nozzle_od: Option<f64>,
+
+    /// The distance the nozzle must keep from the surface, tol [default: the
+    /// program header's, else 0.1]
+    #[arg(long, value_name = "MM", value_parser = number, allow_hyphen_values = true)]
+    pub tol: Option<f64>,
+}
+
+impl CheckNozzleArgs {
+    /// The values given, the others from `planned` (the program header's
+    /// nozzle and tol, where it gives them) or the defaults. The two
+    /// diameters go together: one given, the other is not the header's.
+    pub fn or(&self, planned: (Option<Nozzle>, Option<f64>)) -> NozzleArgs {
+        let (nozzle, tol) = planned;
+        let nozzle = nozzle.filter(|_| self.nozzle_id.is_none() && self.nozzle_od.is_none());
+        NozzleArgs {
+            nozzle_id: self.nozzle_id.unwrap_or(
+                nozzle.map_or(Nozzle::DEFAULT.inner_diameter_mm, |n| n.inner_diameter_mm),
+            ),
+            nozzle_od: self.nozzle_od.unwrap_or(
+                nozzle.map_or(Nozzle::DEFAULT.outer_diameter_mm, |n| n.outer_diameter_mm),
+            ),
+            tol: self
+                .tol
+                .unwrap_or(tol.unwrap_or(Process::DEFAULT.tolerance_mm)),
+        }
+    }
 }
 
 const FIDUCIALS_ABOUT: &str = "\

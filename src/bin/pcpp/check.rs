@@ -26,10 +26,36 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     ];
     let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
     let outputs = Outputs::check("check", report, read.into_iter().flatten())?;
-    let (settings, profile) =
-        check_settings("check", &a.scan, &a.nozzle, &a.registration, &a.machine)?;
+    // The values given are checked before the files are read; those not
+    // given are the program header's (a pcpp program's own nozzle and
+    // tol), said when they are not the defaults.
+    let given = a.nozzle.or((None, None));
+    let (mut settings, profile) =
+        check_settings("check", &a.scan, &given, &a.registration, &a.machine)?;
     let gcode_path = &a.gcode;
     let (text, encoding) = read_gcode_text(gcode_path)?;
+    // (The core checks the header's values as it checks the ones given.)
+    let nozzle = a.nozzle.or(job::planned_nozzle(&text));
+    settings.plan.nozzle.inner_diameter_mm = nozzle.nozzle_id;
+    settings.plan.nozzle.outer_diameter_mm = nozzle.nozzle_od;
+    settings.plan.process.tolerance_mm = nozzle.tol;
+    let from_header: Vec<String> = [
+        (nozzle.nozzle_od != given.nozzle_od)
+            .then(|| format!("outer diameter {} mm", nozzle.nozzle_od)),
+        (nozzle.nozzle_id != given.nozzle_id)
+            .then(|| format!("inner diameter {} mm", nozzle.nozzle_id)),
+        (nozzle.tol != given.tol).then(|| format!("tol {} mm", nozzle.tol)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let header_nozzle = (!from_header.is_empty()).then(|| {
+        format!(
+            "checked with the nozzle the program's header names: {} (--nozzle-od, --nozzle-id \
+             and --tol check with another)",
+            from_header.join(", ")
+        )
+    });
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
@@ -52,7 +78,9 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             return Err(Failure::Input(in_file(gcode_path, &name, &e.to_string())));
         }
     };
-    check.notes.splice(0..0, encoding);
+    check
+        .notes
+        .splice(0..0, encoding.into_iter().chain(header_nozzle));
     check.notes.extend(check.outside_volume(&profile));
     if let Some(r) = &a.report {
         write_one(r, to_json(&check)?.as_bytes())?;
@@ -90,6 +118,17 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             println!("{line}");
         }
         return Ok(());
+    }
+    if sum.touching_moves == 0
+        && check.unchecked_lines.is_empty()
+        && check.planned_otherwise.is_empty()
+    {
+        if let Some(planned) = &check.planned_nozzle {
+            return Err(Failure::Input(format!(
+                "{head}; no move comes closer than tol with this nozzle, but {planned}; so the \
+                 program is not shown to keep tol"
+            )));
+        }
     }
     if sum.touching_moves == 0 && check.unchecked_lines.is_empty() {
         // Only the header's scan differs (QA: a 44 mm cow checked as a
