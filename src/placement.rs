@@ -329,10 +329,20 @@ pub fn centre_drawing(
 
 /// [`centre_drawing`] on a scan's surface: on the middle of its footprint,
 /// or, where that middle lies over no surface (a ring-shaped cloud, a
-/// C-shaped part), on the surface near it (see below), with a note saying
-/// so (QA round 2 F9: `--place centre` put the drawing in the gap
-/// of a ring-shaped cloud, 68 mm from its nearest point, and planning
-/// refused it).
+/// C-shaped part) and the drawing centred there lies partly over the gap,
+/// where more of its line lies over the surface, with a note saying so
+/// (QA round 2 F9: `--place centre` put the drawing in the gap of a
+/// ring-shaped cloud, 68 mm from its nearest point, and planning refused
+/// it).
+///
+/// The places tried: a 9 x 9 grid over the footprint, and the surface
+/// nearest the middle and on from it, away from the middle, by up to the
+/// drawing's size (a narrow band). Each is scored by how many of
+/// [`COVER_SAMPLES`] points spread evenly along the drawing's lines lie
+/// over the surface; the best wins, the one nearest the middle among
+/// equals, and the middle itself unless another covers more (QA round 7
+/// F1: scored by the drawing's corners and never kept centred, a 50 mm
+/// square was put off a ring it fitted on).
 pub fn centre_on_surface(
     drawn: &[Subpath2],
     surface: &Surface,
@@ -346,56 +356,93 @@ pub fn centre_on_surface(
     if surface.highest_hit(middle).is_some() {
         return Some((placement, note));
     }
-    let Some(nearest) = surface.nearest_in_xy(middle) else {
-        return Some((placement, note));
-    };
-    // The nearest point is on the gap's edge: the drawing centred there
-    // lies half over the gap. It goes on, away from the middle, by up to
-    // its own size, to where most of it (of up to 256 of its points) lies
-    // over the surface.
-    let points: Vec<DVec2> = drawn
-        .iter()
-        .flat_map(|s| s.points.iter().copied())
-        .collect();
-    let step = (points.len() / 256).max(1);
-    let over = |at: &Placement| {
-        (points.iter().step_by(step))
+    let samples = along_lines(drawn, COVER_SAMPLES);
+    let over = |shift: DVec2| {
+        let mut at = placement;
+        at.offset_mm += shift;
+        (samples.iter())
             .filter(|p| surface.highest_hit(at.apply(**p)).is_some())
             .count()
     };
-    let (dlo, dhi) = (points.iter().map(|p| placement.apply(*p)))
+    let (dlo, dhi) = (samples.iter().map(|p| placement.apply(*p)))
         .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(p), hi.max(p))
         });
-    let (size, away) = (
-        (dhi - dlo).max_element(),
-        (nearest - middle).normalize_or_zero(),
-    );
-    let (mut best, mut best_over) = (placement, 0);
-    for k in 0..=4 {
-        let mut at = placement;
-        at.offset_mm += nearest - middle + away * (0.25 * k as f64 * size);
-        let n = over(&at);
-        if k == 0 || n > best_over {
-            (best, best_over) = (at, n);
+    let size = (dhi - dlo).max_element();
+    let mut shifts: Vec<DVec2> = (0..9)
+        .flat_map(|i| (0..9).map(move |j| DVec2::new(i as f64, j as f64) / 8.0))
+        .map(|f| flo + f * (fhi - flo) - middle)
+        .collect();
+    if let Some(nearest) = surface.nearest_in_xy(middle) {
+        let away = (nearest - middle).normalize_or_zero();
+        shifts.extend((0..=4).map(|k| nearest - middle + away * (0.25 * k as f64 * size)));
+    }
+    let centred = over(DVec2::ZERO);
+    let (mut best, mut best_over) = (DVec2::ZERO, centred);
+    for shift in shifts {
+        let n = over(shift);
+        if n > best_over || (n == best_over && n > centred && shift.length() < best.length()) {
+            (best, best_over) = (shift, n);
         }
     }
-    let centre = middle + (best.offset_mm - placement.offset_mm);
+    if best == DVec2::ZERO {
+        return Some((placement, note));
+    }
+    let centre = middle + best;
+    let share = |n: usize| 100.0 * n as f64 / samples.len().max(1) as f64;
     let moved = format!(
         "the middle of the scan's footprint ({:.3}, {:.3}) lies over a gap in the scan: the \
-         drawing is centred on the surface near it, at ({:.3}, {:.3}), {:.3} mm away; move it \
-         where you want it on the scan",
+         drawing is centred at ({:.3}, {:.3}) instead, {:.3} mm away, where {:.0}% of its line \
+         lies over the scan ({:.0}% centred on the middle); move it where you want it on the \
+         scan",
         middle.x,
         middle.y,
         centre.x,
         centre.y,
-        centre.distance(middle)
+        best.length(),
+        share(best_over),
+        share(centred)
     );
+    let mut placed = placement;
+    placed.offset_mm += best;
     let note = Some(match note {
         Some(n) => format!("{n}; {moved}"),
         None => moved,
     });
-    Some((best, note))
+    Some((placed, note))
+}
+
+/// How many points along the drawing's lines [`centre_on_surface`] scores
+/// a place by.
+pub const COVER_SAMPLES: usize = 256;
+
+/// About `n` points spread evenly along the lines of `drawn` (drawing
+/// coordinates): every subpath's start, then one each `length / n` of
+/// line.
+fn along_lines(drawn: &[Subpath2], n: usize) -> Vec<DVec2> {
+    let length: f64 = (drawn.iter())
+        .flat_map(|s| s.points.windows(2))
+        .map(|w| w[0].distance(w[1]))
+        .sum();
+    let step = length / n.max(1) as f64;
+    let mut out = Vec::with_capacity(n + drawn.len());
+    for s in drawn {
+        let Some(&first) = s.points.first() else {
+            continue;
+        };
+        out.push(first);
+        // How far along the next point lies from the last one taken.
+        let mut next = step;
+        for w in s.points.windows(2) {
+            let l = w[0].distance(w[1]);
+            while step > 0.0 && next <= l {
+                out.push(w[0].lerp(w[1], next / l));
+                next += step;
+            }
+            next -= l;
+        }
+    }
+    out
 }
 
 /// A factor below 1 with three significant digits (0.953, 0.000272): a
@@ -744,9 +791,76 @@ mod tests {
         assert!(
             note.starts_with(
                 "the middle of the scan's footprint (100.000, 100.000) lies over a gap in the \
-                 scan: the drawing is centred on the surface near it, at ("
-            ),
+                 scan: the drawing is centred at ("
+            ) && note
+                .contains("where 100% of its line lies over the scan (0% centred on the middle)"),
             "{note}"
+        );
+        // QA round 7 F1: a 50 mm square on a ring 50 to 80 mm across
+        // lies mostly on it centred (its corners on the band): it stays
+        // there, or goes where more of its line is on the band; it was
+        // put off the ring.
+        let square = Subpath2 {
+            points: [
+                (-25.0, -25.0),
+                (25.0, -25.0),
+                (25.0, 25.0),
+                (-25.0, 25.0),
+                (-25.0, -25.0),
+            ]
+            .map(|(x, y)| DVec2::new(x, y))
+            .to_vec(),
+            corner: vec![true; 5],
+            closed: true,
+            source: "square".into(),
+        };
+        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+        for k in 0..256u32 {
+            let a = DVec2::from_angle(k as f64 * std::f64::consts::TAU / 256.0);
+            for r in [25.0, 40.0] {
+                vertices.push((DVec2::splat(100.0) + r * a).extend(1.0));
+            }
+            let (i, j) = (2 * k, 2 * ((k + 1) % 256));
+            triangles.extend([[i, i + 1, j + 1], [i, j + 1, j]]);
+        }
+        let wide = Surface::new(TriMesh {
+            vertices,
+            triangles,
+        })
+        .unwrap();
+        let samples = along_lines(std::slice::from_ref(&square), 400);
+        let covered = |p: &Placement| {
+            (samples.iter())
+                .filter(|q| wide.highest_hit(p.apply(**q)).is_some())
+                .count() as f64
+                / samples.len() as f64
+        };
+        let fitted = |placement: Placement| Placement {
+            scale: 1.0,
+            ..placement
+        };
+        let (lo, hi) = wide.bbox();
+        let (centred, _) = centre_drawing(
+            std::slice::from_ref(&square),
+            (lo.truncate(), hi.truncate()),
+            &Placement::IDENTITY,
+            false,
+        )
+        .unwrap();
+        let (p, _) = centre_on_surface(
+            std::slice::from_ref(&square),
+            &wide,
+            &Placement::IDENTITY,
+            false,
+        )
+        .unwrap();
+        let (centred, p) = (fitted(centred), fitted(p));
+        assert!(covered(&centred) > 0.5, "{}", covered(&centred));
+        assert!(
+            covered(&p) >= covered(&centred),
+            "{p:?}: {} < {}",
+            covered(&p),
+            covered(&centred)
         );
         // A disk: its middle is covered, and the drawing stays there.
         let disk = Surface::new(TriMesh {
