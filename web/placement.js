@@ -385,7 +385,21 @@ function showUnitsBanner(info) {
     });
     btns.append(b);
   };
-  d.offers.forEach((o, i) => offer(o.units, `Read in ${UNIT_NAMES[o.units]} (${sizeText(o.size_mm, 1)} mm)`, i === 0));
+  // A reading larger than the printer's build volume comes last and is
+  // not the highlighted one, and says so (QA round 7 F3: metres, 1.8 m
+  // across, came first for a 1.8 mm file whose inches fit, and gave a red
+  // error when chosen).
+  const { dialect, file } = profile();
+  const fits = (o) => {
+    try {
+      return volumeFit([0, 0, 0, ...o.size_mm], dialect, file).fits_on_bed;
+    } catch {
+      return true; // a bad profile: its own error is shown when planning
+    }
+  };
+  const offers = d.offers.map((o) => ({ ...o, fits: fits(o) })).sort((a, b) => Number(b.fits) - Number(a.fits));
+  offers.forEach((o, i) => offer(o.units, `Read in ${UNIT_NAMES[o.units]} (${sizeText(o.size_mm, 1)} mm${
+    o.fits ? '' : ', larger than the printer'})`, i === 0 && o.fits));
   offer(d.units, `It is in ${UNIT_NAMES[d.units]}`, false);
 }
 
