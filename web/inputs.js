@@ -200,10 +200,9 @@ async function openSvg(file) {
   // that drawing's placement: kept in the browser until this one is
   // planned (a drawing that failed is not reopened, so neither is where
   // it was centred), and taken back if this one is cancelled.
-  // A drawing read but not planned (its plan failed) is gone back to as a
-  // planned one is.
-  if (state.pendingSvg && state.pendingSvg.read) state.svgFile = state.pendingSvg;
-  const prev = state.pendingSvg && !state.pendingSvg.read ? state.pendingSvg : null;
+  // (A drawing read whose plan failed is kept as a planned one is:
+  // main.js's onPlanError.)
+  const prev = state.pendingSvg;
   const was = prev ? prev.pathSource : settings.pathSource;
   const before = prev ? prev.before : { placement: { ...settings.placement }, fit: settings.fit };
   state.pendingSvg = {

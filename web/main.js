@@ -490,11 +490,17 @@ function onPlanError(m, busy) {
   // sends it again.
   if (/did not reach the planner/.test(m.message)) state.sentSvgKey = null;
   // A drawing read whose plan failed (nothing printable, refused) is the
-  // user's drawing all the same: a file opened after it that cannot be
-  // read goes back to it (QA: it went back to the demo drawing).
+  // user's drawing all the same: kept as a planned one is, with where it
+  // lies, so a reload reopens it (QA round 7 F7: the demo drawing or an
+  // older one came back, its G-code offered) and a file opened after it
+  // that cannot be read goes back to it (QA: it went back to the demo
+  // drawing). A drawing too long for the page is not kept.
   if (state.pendingSvg && busy.svg === state.pendingSvg && m.kind !== 'svg' && m.kind !== 'crash'
-    && m.kind !== 'limit' && m.stage !== 'scan') {
-    state.pendingSvg.read = true;
+    && m.kind !== 'limit' && m.stage !== 'scan' && settings.pathSource === 'file') {
+    state.svgFile = state.pendingSvg;
+    state.pendingSvg = null;
+    keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
+    saveSettings();
   }
   let title = 'Planning failed';
   let message = m.message;

@@ -98,7 +98,7 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
   // (Planned, or read and refused.)
   await page.waitForFunction(() => {
     const st = window.pcpp.state;
-    return (st.svgFile && st.svgFile.name === 'line.svg') || (st.pendingSvg && st.pendingSvg.read);
+    return st.svgFile && st.svgFile.name === 'line.svg';
   }, null, { timeout: 120_000 });
   await waitIdle(page);
   await page.fill('#pl-scale', '3');
@@ -167,6 +167,38 @@ test('the demo drawing moved by the user on their scan stays theirs after a relo
   await reopened();
   assert.equal(await page.evaluate(() => Number(window.pcpp.settings.placement.x)), x + 1);
   assert.deepEqual(await shown(), moved);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A drawing the user opened whose plan was refused is theirs all the same:
+// a reload reopens it where it lay, refused as before (QA round 7 F7: the
+// demo drawing came back, or an older drawing with its G-code offered).
+test('a drawing refused on the scan is reopened after a reload, where it lay', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.setInputFiles('#svg-input', svg('across.svg', '<path d="M 0 10 L 40 10" stroke="black" fill="none"/>'));
+  await page.waitForFunction(() => window.pcpp.state.svgFile && window.pcpp.state.svgFile.name === 'across.svg'
+    && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });
+  await waitIdle(page);
+  const refused = await page.evaluate(() => [document.getElementById('error-title').textContent,
+    document.getElementById('error-panel').classList.contains('notice'), { ...window.pcpp.settings.placement }]);
+  assert.equal(refused[1], false, refused[0]);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  await waitKept(page);
+  await page.reload();
+  await page.waitForFunction(() => window.pcpp && window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj'
+    && window.pcpp.state.svgFile && window.pcpp.state.svgFile.name === 'across.svg', null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.evaluate(() => window.pcpp.settings.pathSource), 'file');
+  assert.deepEqual(await page.evaluate(() => ({ ...window.pcpp.settings.placement })), refused[2]);
+  assert.deepEqual(await page.evaluate(() => [document.getElementById('error-title').textContent,
+    document.getElementById('error-panel').classList.contains('notice')]), refused.slice(0, 2));
+  assert.equal(await page.isHidden('#dl-gcode'), true);
   assert.deepEqual(problems, []);
   await context.close();
 });
