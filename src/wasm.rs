@@ -651,6 +651,9 @@ struct ScanView<'a> {
     external_files: &'a [crate::job::InputFile],
     format: crate::mesh::MeshFormat,
     units: crate::mesh::ScanUnits,
+    /// The up axis it was read with ("z", "y" or "-z", as the page's Up
+    /// axis list names them).
+    up_axis: crate::mesh::UpAxis,
     triangles: usize,
     /// Printer frame (after the registration or placement on the bed).
     bbox_mm: [[f64; 3]; 2],

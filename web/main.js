@@ -23,7 +23,7 @@ import {
   $, fmt, hooks, profile, settings, state,
 } from './page.js';
 import {
-  bannerOffers, cancelCentre, capital, centreRequest, initPlacement, noteDefaultUnits, onCarried, onCentred, planOutcome,
+  bannerOffers, cancelCentre, capital, centreRequest, initPlacement, noteDefaultUnits, noteDefaultUp, onCarried, onCentred, planOutcome,
   requestCentre, showFitNote,
   showScanPlacement, toolPathOutside, unitsBannerShown, userPlacements,
 } from './placement.js';
@@ -405,6 +405,7 @@ function onWorkerMessage(e) {
         acceptScan(m.info);
       }
       if (busy && busy.job && busy.job.scan && !busy.job.scan.units) noteDefaultUnits(m.key, m.info.units);
+      if (busy && busy.job && busy.job.scan && !busy.job.scan.up_axis) noteDefaultUp(m.key, m.info.up_axis);
       dropPlan(busy);
       state.memory = m.memory;
       showScan(m.info, m.positions, m.indices, m.seconds);

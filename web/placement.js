@@ -153,9 +153,12 @@ export function requestCentre(drawing = false) {
 // switched to cm and back to mm, it was centred anew at (45.2, 154.8)).
 // Kept per scan and drawing: another file is another placement.
 const readings = new Map();
-// The units each scan was read in by default ("file default" and the
-// units it stands for are one reading).
+// The units and up axis each scan was read with by default ("file
+// default" and the units or axis it stands for are one reading: QA round
+// 7 F6, +Z to +Y and back to +Z lost the drawing's place, the file's
+// default being +Z).
 const defaultUnits = new Map();
+const defaultUp = new Map();
 
 function readingKey() {
   const scan = state.pendingScan || state.scan;
@@ -163,7 +166,8 @@ function readingKey() {
   const drawing = settings.pathSource === 'file'
     ? (state.pendingSvg || state.svgFile || {}).key : settings.pathSource;
   const units = settings.scanUnits || defaultUnits.get(key) || '';
-  return JSON.stringify([key, drawing, units, settings.scanUp]);
+  const up = settings.scanUp || defaultUp.get(key) || '';
+  return JSON.stringify([key, drawing, units, up]);
 }
 
 // Before the scan's units or up axis change: where the drawing lies in
@@ -178,6 +182,11 @@ export function leaveReading() {
 // from the scan on screen, it could be another reading's).
 export function noteDefaultUnits(key, units) {
   defaultUnits.set(key, units);
+}
+
+// The same for the up axis.
+export function noteDefaultUp(key, up) {
+  defaultUp.set(key, up);
 }
 
 // After they changed: the placement this reading had, or the drawing

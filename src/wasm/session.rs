@@ -266,6 +266,7 @@ impl Session {
             external_files: &s.file.external_files,
             format: s.format,
             units: s.units,
+            up_axis: s.up_axis,
             triangles: s.triangle_count(),
             bbox_mm: [arr(lo), arr(hi)],
             scan_bbox_mm: [arr(slo), arr(shi)],

@@ -308,6 +308,32 @@ test('switching the units away and back brings back the typed placement', async 
   await context.close();
 });
 
+// The same for the up axis (QA round 7 F6: +Z, the file's default, then
+// +Y and back to +Z chosen by name, centred the drawing anew).
+test('switching the up axis away and back brings back the typed placement', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'film-mm.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(false, 0, 1)) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-mm.obj',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  const offset = () => page.evaluate(() => [window.pcpp.settings.placement.x, window.pcpp.settings.placement.y].map(Number));
+  await page.fill('#pl-x', '12');
+  await page.fill('#pl-y', '60');
+  await waitSettled(page);
+  assert.deepEqual(await offset(), [12, 60]);
+  await page.selectOption('#scan-up', 'y');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.up_axis === 'y', null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.notDeepEqual(await offset(), [12, 60]);
+  await page.selectOption('#scan-up', 'z');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.up_axis === 'z', null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.deepEqual(await offset(), [12, 60]);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 // A +Y-up OBJ (Blender's and many scanner apps' default) was shown lying
 // on its side with nothing said (QA: the Stanford bunny, a cow). An animal
 // on four legs, saved +Y up: the page names the up axis to try, and the
