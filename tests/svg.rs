@@ -1696,6 +1696,27 @@ fn a_utf16_svg_is_read_by_its_byte_order_mark() {
     }
 }
 
+/// QA round 7 F12: a PNG picked as the drawing was told to be saved as
+/// UTF-8. Pictures and documents are named as what they are.
+#[test]
+fn a_picture_chosen_as_the_drawing_is_named_as_one() {
+    for (bytes, kind) in [
+        (&b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR"[..], "a PNG image"),
+        (&b"\xff\xd8\xff\xe0\0\x10JFIF"[..], "a JPEG image"),
+        (&b"%PDF-1.7\n%\xe2\xe3"[..], "a PDF document"),
+        (&b"GIF89a\x01\0"[..], "a GIF image"),
+        (&b"RIFF\x10\0\0\0WEBPVP8 "[..], "a WebP image"),
+    ] {
+        let e = import_svg(bytes, "pic.svg").unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("this is {kind}, not an SVG drawing"))
+                && e.contains("pic.svg")
+                && !e.contains("UTF-8"),
+            "{e}"
+        );
+    }
+}
+
 /// An SVG saved by an older editor in ISO-8859-1 or windows-1252, as its
 /// XML declaration says (a QA finding: "not UTF-8 text (invalid utf-8
 /// sequence of 1 bytes from index 146)"), is read as declared; a byte
