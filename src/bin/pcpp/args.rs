@@ -540,8 +540,9 @@ pub struct RegistrationArgs {
     pub dot_diameter: f64,
 
     /// An unregistered scan (still in the scanner's frame): lowest point on
-    /// the bed, footprint centred on it, then moved by DX,DY,DZ mm and turned
-    /// ROT degrees about z; the bed is the --dialect/--profile build volume's
+    /// the bed, the middle of its footprint's box on the bed's middle, turned
+    /// ROT degrees counter-clockwise about z around that middle, then moved by
+    /// DX,DY,DZ mm; the bed is the --dialect/--profile build volume's
     #[arg(
         long,
         value_name = "bed[,DX,DY,DZ[,ROT]]",
