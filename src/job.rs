@@ -1389,6 +1389,13 @@ pub struct GcodeCheck {
     /// off, whose moves came within 0.05 mm of the part, was called clear).
     #[serde(default)]
     pub planned_nozzle: Option<String>,
+    /// The risks a pcpp program's header says were accepted to write it
+    /// (dispensing far above the surface, a registration off its points):
+    /// this check looks at its moves' clearance only, so a clear check says
+    /// them beside its verdict (QA round 7 F13: "clear", and no word of
+    /// the header's WARNING).
+    #[serde(default)]
+    pub written_at_risk: Option<String>,
     /// The straight moves followed, in file order (the touching moves'
     /// `index` points into them): for drawing; not in the JSON.
     #[serde(skip)]
@@ -1664,6 +1671,11 @@ pub fn check_gcode_as(
         outer_diameter_mm: nozzle.outer_diameter_mm,
         planned_otherwise,
         planned_nozzle,
+        written_at_risk: header_lines(text).find_map(|l| {
+            let (_, risks) =
+                l.split_once("WARNING: written only because the risk was accepted: ")?;
+            Some(risks.to_string())
+        }),
         moves: program.moves,
     })
 }

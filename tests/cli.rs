@@ -1008,6 +1008,45 @@ fn check_takes_the_nozzle_the_programs_header_names() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// QA round 7 F13: a program written only because a risk was accepted
+/// (its header's WARNING) was checked "clear" with no word of it. Its
+/// moves may well keep tol; the verdict says the header's risk beside it.
+#[test]
+fn check_repeats_the_risk_a_programs_header_says_was_accepted() {
+    let dir = temp_dir("check-risk");
+    let text = std::fs::read_to_string(demo_file("demo-even.gcode")).unwrap();
+    let risky: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("; safe motion: ") {
+                format!(
+                    "{l}; WARNING: written only because the risk was accepted: the tool path \
+                     dispenses 9.518 mm above the surface\n"
+                )
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    assert_ne!(risky, text);
+    let gcode = dir.join("risky.gcode");
+    std::fs::write(&gcode, risky).unwrap();
+    let o = check_on_demo(&gcode, None);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).ends_with(
+            "no move comes closer than tol; but its header says it was written only because the \
+             risk was accepted: the tool path dispenses 9.518 mm above the surface\n"
+        ),
+        "{}",
+        stdout(&o)
+    );
+    // The program as written: no such words.
+    let o = check_on_demo(&demo_file("demo-even.gcode"), None);
+    assert!(!stdout(&o).contains("risk was accepted"), "{}", stdout(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A registration whose fiducials miss their printer points by 6.4 mm RMS
 /// (made-up printer points on a real scan) wrote G-code with exit 0 and a
 /// warning; past the nozzle's inner diameter it is refused, naming the

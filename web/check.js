@@ -66,7 +66,8 @@ export function onCheck(m) {
   const verdict = $('check-verdict');
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
   verdict.textContent = c.clear
-    ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}`
+    ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}${c.written_at_risk
+      ? `; but its header says it was written only because the risk was accepted: ${c.written_at_risk}` : ''}`
     // Planned for a larger nozzle or tol than this check's (QA round 6 F1).
     : sum.touching_moves === 0 && c.unchecked_lines.length === 0 && !(c.planned_otherwise || []).length
       && c.planned_nozzle
@@ -81,7 +82,7 @@ export function onCheck(m) {
           : `none of the ${sum.moves} checked moves comes closer than tol`}; ${against}`
       : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol`
         + `${sum.touching_from_previous ? `, ${sum.touching_from_previous} of them closest at their start, where the move before each ended too close` : ''}; ${against}`;
-  verdict.className = c.clear ? 'verdict good' : 'verdict bad';
+  verdict.className = c.clear && !c.written_at_risk ? 'verdict good' : 'verdict bad';
   const details = [];
   const p = (text, id, cls) => details.push(el('p', text, cls, id));
   p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined

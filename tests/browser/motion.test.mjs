@@ -237,6 +237,20 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
   assert.match(await page.textContent('#check-verdict'), /^not shown clear: no move comes closer than tol with this nozzle, but the program was planned for a nozzle of outer diameter 1\.6 mm kept 0\.25 mm from the surface \(its header\), and this check asks less \(outer diameter 0\.908 mm, tol 0\.1 mm\): check it with the program's \(Nozzle and process: outer diameter 1\.6 mm, tol 0\.25 mm\); larger\.gcode against/);
   assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
 
+  // Written at a risk its header names: clear of the part, and the risk
+  // said beside the verdict (QA round 7 F13).
+  const risky = own.bytes.toString('utf8').replace(/\n(; safe motion: [^\n]*)\n/,
+    '\n$1; WARNING: written only because the risk was accepted: the tool path dispenses 9.518 mm above the surface\n');
+  assert.notEqual(risky, own.bytes.toString('utf8'));
+  await page.setInputFiles('#gcode-input', gcodeFile('risky.gcode', Buffer.from(risky)));
+  await page.waitForFunction(() => {
+    const v = document.getElementById('check-verdict').textContent;
+    return /risky\.gcode/.test(v) && !/^checking /.test(v);
+  });
+  assert.match(await page.textContent('#check-verdict'),
+    /^clear: none of the \d+ moves comes closer than tol; risky\.gcode against .*; but its header says it was written only because the risk was accepted: the tool path dispenses 9\.518 mm above the surface$/);
+  assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
+
   // Down beside a 2 mm wall of the test part, then up across its corner.
   const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
   await page.setInputFiles('#gcode-input', gcodeFile('cut.gcode', cut));

@@ -110,7 +110,10 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         check.tol_mm
     );
     if check.is_clear() {
-        let line = format!("{head}; no move comes closer than tol");
+        let risk = check.written_at_risk.as_ref().map_or(String::new(), |r| {
+            format!("; but its header says it was written only because the risk was accepted: {r}")
+        });
+        let line = format!("{head}; no move comes closer than tol{risk}");
         // Standard output carries the report written there, alone.
         if a.report.as_deref().is_some_and(is_stdout) {
             eprintln!("{line}");
