@@ -667,16 +667,23 @@ pub(crate) mod tests {
         assert_eq!(safe.unresolved, vec![0]);
     }
 
-    /// Moves across the step's wall at heights that wander in and out of
-    /// reach: thousands, so that the work is cut into many chunks.
+    /// Moves along the step's wall, each point well clear of the surface
+    /// (over the floor, or over the block's top), the side switched every
+    /// 63 or so: the moves that switch cut the wall's top edge, and
+    /// waypoints make them safe (QA round 6 F0: the points wandered within
+    /// reach of the edge themselves, and moves down to them were made
+    /// "safe" only because a plunge's edge contact was taken at its top).
+    /// Thousands, so that the work is cut into many chunks.
     fn wandering_moves(n: usize) -> Vec<DVec3> {
         (0..=n)
             .map(|i| {
                 let t = i as f64;
+                let over = (0.05 * t + 1.0).sin() > 0.0;
+                let (x, z) = if over { (6.2, 2.5) } else { (3.8, 0.5) };
                 DVec3::new(
-                    5.0 + 2.0 * (0.013 * t).sin(),
+                    x + 0.2 * (0.013 * t).sin(),
                     1.0 + 8.0 * i as f64 / n as f64,
-                    2.2 + 0.3 * (0.071 * t).sin() + 0.2 * (0.0031 * t).cos(),
+                    z + 0.2 * (0.071 * t).sin().abs(),
                 )
             })
             .collect()
@@ -721,6 +728,7 @@ pub(crate) mod tests {
             unresolved.extend(one.unresolved.iter().map(|_| j));
         }
         assert!(safe.waypoints > 0);
+        assert!(safe.unresolved.is_empty(), "{:?}", safe.unresolved);
         assert_eq!(safe.points, points);
         assert_eq!(safe.unresolved, unresolved);
     }
