@@ -93,6 +93,16 @@ pub enum Error {
          on the printer (a scanned base or table), accept the risk"
     )]
     BelowBed { depth_mm: f64 },
+    /// G-code refused for a scan placed on the bed that is larger than the
+    /// build volume: the part cannot be on the printer as read (most often
+    /// a scan read in the wrong units: QA round 7 F8, a 1.2 m scan placed
+    /// on a 220 mm bed was planned; not placed, it was refused). The
+    /// message is the volume fit's.
+    #[error(
+        "{0}; no G-code written: a part this large cannot stand on the printer; if it really \
+         does, accept the risk"
+    )]
+    LargerThanVolume(String),
     /// G-code refused for a tool path that dispenses far above the surface
     /// ([`crate::pipeline::REFUSED_HEIGHT_PER_D`]).
     #[error(

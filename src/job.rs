@@ -936,6 +936,7 @@ enum Risk {
     MostlyOff,
     FarAbove,
     BelowBed,
+    TooLarge,
     Uncleared,
 }
 
@@ -1125,10 +1126,18 @@ pub fn write_outputs(
     // bed, the scan is not in the printer's frame.
     let fit =
         crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+    let placed = matches!(
+        scan.registration.status,
+        RegistrationStatus::PlacedOnBed { .. }
+    );
+    // Placed on the bed and still larger than the volume: not a part on
+    // this printer (the tool path may lie inside it all the same).
+    let too_large = (placed && !fit.fits_on_bed).then(|| fit.placed_message.clone());
     if !fit.inside {
-        report.warnings.push(match scan.registration.status {
-            RegistrationStatus::PlacedOnBed { .. } => fit.placed_message,
-            _ => fit.message,
+        report.warnings.push(if placed {
+            fit.placed_message
+        } else {
+            fit.message
         });
     }
     // Spec 6(f): every move is checked but those that start where nothing
@@ -1211,6 +1220,9 @@ pub fn write_outputs(
             format!("the scan's placement on the bed moves it {depth:.3} mm below the bed"),
         ));
     }
+    if let Some(message) = &too_large {
+        risks.push((Risk::TooLarge, message.clone()));
+    }
     if !plan.uncleared.is_empty() {
         risks.push((
             Risk::Uncleared,
@@ -1246,6 +1258,12 @@ pub fn write_outputs(
         refuse_unit_doubt(scan, false).map_err(|e| refused(e, Some(Risk::Units)))?;
         if let Some(depth_mm) = below_bed_mm(scan) {
             return Err(refused(Error::BelowBed { depth_mm }, Some(Risk::BelowBed)));
+        }
+        if let Some(message) = too_large {
+            return Err(refused(
+                Error::LargerThanVolume(message),
+                Some(Risk::TooLarge),
+            ));
         }
     }
     report.motion.accepted_risks = risks.iter().map(|(_, text)| text.clone()).collect();

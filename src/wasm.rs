@@ -102,6 +102,8 @@ fn core_err(e: crate::Error) -> JsValue {
         "units"
     } else if matches!(e, Error::BelowBed { .. }) {
         "below-bed"
+    } else if matches!(e, Error::LargerThanVolume(_)) {
+        "too-large"
     } else if matches!(e, Error::FarAbove { .. }) {
         "far-above"
     } else if matches!(e, Error::MostlyOffScan { .. }) {

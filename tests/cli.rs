@@ -2624,6 +2624,65 @@ fn block_files(
     (scan, svg, place)
 }
 
+/// QA round 7 F8: a scan read in the wrong units (the stepped block read
+/// in cm: some 600 mm across), placed on a 220 mm bed, was planned with a
+/// warning, where not placed it was refused. Placed, it is refused too,
+/// naming the scan and its size, unless the risk is accepted.
+#[test]
+fn a_scan_larger_than_the_printer_placed_on_the_bed_is_refused() {
+    let dir = temp_dir("too-large");
+    let (scan, svg, _) = block_files(&dir, "block.obj", 1.0, |v| v);
+    let gcode = dir.join("out.gcode");
+    let args = |extra: &'static [&'static str]| {
+        let mut a = vec![
+            "--scan-units",
+            "cm",
+            "--place-scan",
+            "bed",
+            "--place",
+            "centre",
+            "-o",
+            s(&gcode),
+        ];
+        a.extend_from_slice(extra);
+        a
+    };
+    let o = plan_on(&scan, &svg, &args(&[]));
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(&format!("{}: the scan lies outside the build volume", s(&scan)))
+            && err.contains("it is larger than the volume (")
+            && err.contains("a part this large cannot stand on the printer; if it really does, accept the risk (--accept-risk)"),
+        "{err}"
+    );
+    assert!(!gcode.exists());
+    let o = plan_on(&scan, &svg, &args(&["--accept-risk"]));
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    assert!(
+        text.lines().any(|l| l.starts_with("; safe motion: ")
+            && l.contains("WARNING: written only because the risk was accepted: ")
+            && l.contains("; the scan lies outside the build volume")
+            && l.contains("it is larger than the volume (")),
+        "{}",
+        &text[..2000.min(text.len())]
+    );
+    // Read in mm it fits, and is planned with no such word.
+    let o = plan_on(
+        &scan,
+        &svg,
+        &["--place-scan", "bed", "--place", "centre", "-o", s(&gcode)],
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        !stderr(&o).contains("larger than the volume"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Found by QA: a program planned with the scan read in metres, checked
 /// with the scan read in its default mm, failed with "none of the moves
 /// passes over the scan ... place or register the scan", sending the user

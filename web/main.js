@@ -482,6 +482,7 @@ const RISKS = {
   'whole-object': 'The scan is a point cloud of a whole object: no G-code',
   'far-above': 'The nozzle would dispense far above the surface: no G-code',
   'below-bed': 'The scan is moved below the bed: no G-code',
+  'too-large': 'The scan is larger than the printer: no G-code',
   'mostly-off': 'Most of the drawing lies beside the scan: no G-code',
 };
 

@@ -225,6 +225,33 @@ test('the banner of a scan out of the volume says whether G-code was written', a
   await context.close();
 });
 
+// A scan placed on the bed, then read in units that make it larger than
+// the printer: refused as the scan's problem, as it is when not placed
+// (QA round 7 F8: planned, with a warning only).
+test('a scan placed on the bed and read larger than the printer is refused', async () => {
+  const v = [];
+  for (const z of [0, 3]) for (const [x, y] of [[-100, 0], [-40, 0], [-40, 60], [-100, 60]]) v.push(`v ${x} ${y} ${z}`);
+  const f = ['f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 2 3 7', 'f 2 7 6',
+    'f 3 4 8', 'f 3 8 7', 'f 4 1 5', 'f 4 5 8'];
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'slab60.obj', mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'slab60.obj', null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.click('#place-bed-btn');
+  await waitIdle(page);
+  await page.selectOption('#scan-units', 'cm');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'cm', null, { timeout: 120_000 });
+  await page.waitForFunction(() => /larger than the printer/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#error-title'), 'The scan is larger than the printer: no G-code');
+  assert.match(await page.textContent('#error-message'), /it is larger than the volume \(x 600\.0 mm, the volume 220\.0 mm\)/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('fiducials: candidates ranked for the dot diameter, chosen by a click, printer points pasted, residuals shown', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitForPlan(page);

@@ -196,7 +196,7 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
             input_shown(&inputs.svg_path),
             input_shown(&inputs.scan_path)
         )),
-        e @ Error::BelowBed { .. } => Failure::Input(format!(
+        e @ (Error::BelowBed { .. } | Error::LargerThanVolume(_)) => Failure::Input(format!(
             "{}: {e} (--accept-risk)",
             input_shown(&inputs.scan_path)
         )),
