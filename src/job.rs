@@ -1730,16 +1730,6 @@ pub fn line_list(lines: &[usize]) -> String {
     s
 }
 
-/// What a pcpp program's own header says it was planned on, against the
-/// scan it is checked with: another scan file (its SHA-256), or the scan
-/// in another frame (the registration or placement G, as the header
-/// writes it to 6 decimals). The check itself stands either way; these
-/// say why its moves may miss or hit the part (a program planned on a
-/// scan placed on the bed, checked against the scan placed another way,
-/// showed only collisions). Other tools' programs have no such header.
-/// The second list holds those of them that say the scan was read or
-/// placed another way (units, up axis, frame): then this check's scan is
-/// not where the program's part was.
 /// The nozzle and tol a pcpp program's header says it was planned for
 /// (`; nozzle: d D mm, do DO mm` and `; process: tol T mm, ...`; `'` for
 /// Aerotech), each where the header gives it: `pcpp check` checks with
@@ -1794,6 +1784,16 @@ fn smaller_nozzle(text: &str, outer_diameter_mm: f64, tol_mm: f64) -> Option<Str
     ))
 }
 
+/// What a pcpp program's own header says it was planned on, against the
+/// scan it is checked with: another scan file (its SHA-256), or the scan
+/// in another frame (the registration or placement G, as the header
+/// writes it to 6 decimals). The check itself stands either way; these
+/// say why its moves may miss or hit the part (a program planned on a
+/// scan placed on the bed, checked against the scan placed another way,
+/// showed only collisions). Other tools' programs have no such header.
+/// The second list holds those of them that say the scan was read or
+/// placed another way (units, up axis, frame): then this check's scan is
+/// not where the program's part was.
 fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut otherwise = Vec::new();
