@@ -738,28 +738,32 @@ mod tests {
             })
     }
 
+    /// A flat ring at z = 1 about (100, 100), from radius `inner` to
+    /// `outer`, in `sectors` quads.
+    fn ring(inner: f64, outer: f64, sectors: u32) -> Surface {
+        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+        for k in 0..sectors {
+            let a = DVec2::from_angle(k as f64 * std::f64::consts::TAU / sectors as f64);
+            for r in [inner, outer] {
+                vertices.push((DVec2::splat(100.0) + r * a).extend(1.0));
+            }
+            let (i, j) = (2 * k, 2 * ((k + 1) % sectors));
+            triangles.extend([[i, i + 1, j + 1], [i, j + 1, j]]);
+        }
+        Surface::new(crate::mesh::TriMesh {
+            vertices,
+            triangles,
+        })
+        .unwrap()
+    }
+
     /// QA round 2 F9: a ring-shaped scan's footprint has a gap in its
     /// middle; `--place centre` put the drawing there and planning refused
     /// it. It goes onto the ring, most of it over the surface, with a note;
     /// on a scan whose middle is covered it is `centre_drawing`'s placement.
     #[test]
     fn a_drawing_centred_over_a_gap_goes_onto_the_surface_near_it() {
-        use crate::mesh::TriMesh;
-        // A ring from r 20 to r 40 mm about (100, 100), 64 sectors.
-        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
-        for k in 0..64u32 {
-            let a = DVec2::from_angle(k as f64 * std::f64::consts::TAU / 64.0);
-            for r in [20.0, 40.0] {
-                vertices.push((DVec2::splat(100.0) + r * a).extend(1.0));
-            }
-            let (i, j) = (2 * k, 2 * ((k + 1) % 64));
-            triangles.extend([[i, i + 1, j + 1], [i, j + 1, j]]);
-        }
-        let ring = Surface::new(TriMesh {
-            vertices,
-            triangles,
-        })
-        .unwrap();
+        let narrow = ring(20.0, 40.0, 64);
         // A 10 mm circle.
         let circle = Subpath2 {
             points: (0..48)
@@ -770,7 +774,7 @@ mod tests {
             source: "c".into(),
         };
         let drawn = std::slice::from_ref(&circle);
-        let (lo, hi) = ring.bbox();
+        let (lo, hi) = narrow.bbox();
         let (gap, _) = centre_drawing(
             drawn,
             (lo.truncate(), hi.truncate()),
@@ -780,11 +784,11 @@ mod tests {
         .unwrap();
         let on = |p: &Placement| {
             (circle.points.iter())
-                .filter(|q| ring.highest_hit(p.apply(**q)).is_some())
+                .filter(|q| narrow.highest_hit(p.apply(**q)).is_some())
                 .count()
         };
         assert_eq!(on(&gap), 0);
-        let (p, note) = centre_on_surface(drawn, &ring, &Placement::IDENTITY, true).unwrap();
+        let (p, note) = centre_on_surface(drawn, &narrow, &Placement::IDENTITY, true).unwrap();
         assert_eq!(on(&p), 48, "{p:?}");
         assert_eq!((p.rotation_deg, p.scale), (0.0, 1.0));
         let note = note.expect("a note");
@@ -814,20 +818,7 @@ mod tests {
             closed: true,
             source: "square".into(),
         };
-        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
-        for k in 0..256u32 {
-            let a = DVec2::from_angle(k as f64 * std::f64::consts::TAU / 256.0);
-            for r in [25.0, 40.0] {
-                vertices.push((DVec2::splat(100.0) + r * a).extend(1.0));
-            }
-            let (i, j) = (2 * k, 2 * ((k + 1) % 256));
-            triangles.extend([[i, i + 1, j + 1], [i, j + 1, j]]);
-        }
-        let wide = Surface::new(TriMesh {
-            vertices,
-            triangles,
-        })
-        .unwrap();
+        let wide = ring(25.0, 40.0, 256);
         let samples = along_lines(std::slice::from_ref(&square), 400);
         let covered = |p: &Placement| {
             (samples.iter())
@@ -863,7 +854,7 @@ mod tests {
             covered(&centred)
         );
         // A disk: its middle is covered, and the drawing stays there.
-        let disk = Surface::new(TriMesh {
+        let disk = Surface::new(crate::mesh::TriMesh {
             vertices: vec![
                 DVec3::new(60.0, 60.0, 1.0),
                 DVec3::new(140.0, 60.0, 1.0),

@@ -17,6 +17,16 @@ const svg = (name, body) => ({
     + `${body}</svg>\n`),
 });
 
+// The plate with a post as a file for the scan input, and opened, read
+// and planned on.
+const platePost = () => ({ name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+async function openPlatePost(page) {
+  await page.setInputFiles('#scan-input', platePost());
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+}
+
 test('after a failed plan the plan left on screen is labelled and greyed as the previous one', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
@@ -62,10 +72,7 @@ test('after a failed plan the plan left on screen is labelled and greyed as the 
 test('the demo drawing refused on a freshly opened scan is a notice about the demo drawing, not an error', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
-  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
-    null, { timeout: 120_000 });
-  await waitIdle(page);
+  await openPlatePost(page);
   assert.equal(await page.isHidden('#error-panel'), false);
   assert.equal(await page.textContent('#error-title'), 'plate-post.obj is open; the demo drawing does not print on it');
   const message = await page.textContent('#error-message');
@@ -135,7 +142,7 @@ test('the demo drawing refused on a freshly opened scan is a notice about the de
 test('the demo drawing moved by the user on their scan stays theirs after a reload', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
+  await page.setInputFiles('#scan-input', platePost());
   const reopened = async () => {
     await page.waitForFunction(() => window.pcpp && window.pcpp.state.info
       && window.pcpp.state.info.name === 'plate-post.obj', null, { timeout: 120_000 });
@@ -177,10 +184,7 @@ test('the demo drawing moved by the user on their scan stays theirs after a relo
 test('a drawing refused on the scan is reopened after a reload, where it lay', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'plate-post.obj', mimeType: 'text/plain', buffer: Buffer.from(platePostObj()) });
-  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate-post.obj',
-    null, { timeout: 120_000 });
-  await waitIdle(page);
+  await openPlatePost(page);
   await page.setInputFiles('#svg-input', svg('across.svg', '<path d="M 0 10 L 40 10" stroke="black" fill="none"/>'));
   await page.waitForFunction(() => window.pcpp.state.svgFile && window.pcpp.state.svgFile.name === 'across.svg'
     && !window.pcpp.state.busy && !window.pcpp.state.queued, null, { timeout: 120_000 });

@@ -200,19 +200,26 @@ test('a scan in its scanner frame and a spiral: one click on "Place on the bed" 
   await context.close();
 });
 
+// A box from `lo` to `hi` (x, y, z, mm) as an OBJ file for the scan input.
+function slabObj(name, lo, hi) {
+  const v = [];
+  for (const z of [lo[2], hi[2]]) {
+    for (const [x, y] of [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]]) v.push(`v ${x} ${y} ${z}`);
+  }
+  const f = ['f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 2 3 7', 'f 2 7 6',
+    'f 3 4 8', 'f 3 8 7', 'f 4 1 5', 'f 4 5 8'];
+  return { name, mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) };
+}
+
 // A scan reaching 2 mm below the bed whose tool path lies inside the
 // volume: G-code is written, with the warning, and the banner says so; the
 // same banner on a refused plan says nothing was written (QA round 4 F6:
 // both read the same).
 test('the banner of a scan out of the volume says whether G-code was written', async () => {
-  // A slab 80 x 80 mm, from 2 mm below the bed to 1 mm above it.
-  const v = [];
-  for (const z of [-2, 1]) for (const [x, y] of [[60, 60], [140, 60], [140, 140], [60, 140]]) v.push(`v ${x} ${y} ${z}`);
-  const f = ['f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 2 3 7', 'f 2 7 6',
-    'f 3 4 8', 'f 3 8 7', 'f 4 1 5', 'f 4 5 8'];
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'slab.obj', mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) });
+  // A slab 80 x 80 mm, from 2 mm below the bed to 1 mm above it.
+  await page.setInputFiles('#scan-input', slabObj('slab.obj', [60, 60, -2], [140, 140, 1]));
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'slab.obj', null, { timeout: 120_000 });
   await waitSettled(page);
   assert.equal(await page.isVisible('#place-banner'), true);
@@ -229,13 +236,9 @@ test('the banner of a scan out of the volume says whether G-code was written', a
 // the printer: refused as the scan's problem, as it is when not placed
 // (QA round 7 F8: planned, with a warning only).
 test('a scan placed on the bed and read larger than the printer is refused', async () => {
-  const v = [];
-  for (const z of [0, 3]) for (const [x, y] of [[-100, 0], [-40, 0], [-40, 60], [-100, 60]]) v.push(`v ${x} ${y} ${z}`);
-  const f = ['f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 2 3 7', 'f 2 7 6',
-    'f 3 4 8', 'f 3 8 7', 'f 4 1 5', 'f 4 5 8'];
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'slab60.obj', mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) });
+  await page.setInputFiles('#scan-input', slabObj('slab60.obj', [-100, 0, 0], [-40, 60, 3]));
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'slab60.obj', null, { timeout: 120_000 });
   await waitIdle(page);
   await page.click('#place-bed-btn');

@@ -272,7 +272,9 @@ test('a scan far too large for its units gets the units banner, offering mm', as
 // the drawing was centred anew at (45.2, 154.8), the typed placement
 // silently lost. A reading of the scan the user comes back to brings
 // back the placement it had; a reading never had is centred on.
-test('switching the units away and back brings back the typed placement', async () => {
+// The page with an 80 mm film in mm open and the drawing typed to (12,
+// 60); `offset()` reads the drawing's offset back.
+async function filmPlacedAt12And60() {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
   await page.setInputFiles('#scan-input', { name: 'film-mm.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(false, 0, 1)) });
@@ -284,6 +286,11 @@ test('switching the units away and back brings back the typed placement', async 
   await page.fill('#pl-y', '60');
   await waitSettled(page);
   assert.deepEqual(await offset(), [12, 60]);
+  return { page, context, problems, offset };
+}
+
+test('switching the units away and back brings back the typed placement', async () => {
+  const { page, context, problems, offset } = await filmPlacedAt12And60();
   // Read in cm (800 mm across): centred on the scan as now read.
   await page.selectOption('#scan-units', 'cm');
   await waitIdle(page);
@@ -311,17 +318,7 @@ test('switching the units away and back brings back the typed placement', async 
 // The same for the up axis (QA round 7 F6: +Z, the file's default, then
 // +Y and back to +Z chosen by name, centred the drawing anew).
 test('switching the up axis away and back brings back the typed placement', async () => {
-  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
-  await waitSettled(page);
-  await page.setInputFiles('#scan-input', { name: 'film-mm.obj', mimeType: 'text/plain', buffer: Buffer.from(filmInMetres(false, 0, 1)) });
-  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-mm.obj',
-    null, { timeout: 120_000 });
-  await waitSettled(page);
-  const offset = () => page.evaluate(() => [window.pcpp.settings.placement.x, window.pcpp.settings.placement.y].map(Number));
-  await page.fill('#pl-x', '12');
-  await page.fill('#pl-y', '60');
-  await waitSettled(page);
-  assert.deepEqual(await offset(), [12, 60]);
+  const { page, context, problems, offset } = await filmPlacedAt12And60();
   await page.selectOption('#scan-up', 'y');
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.up_axis === 'y', null, { timeout: 120_000 });
   await waitIdle(page);
