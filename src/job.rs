@@ -1132,7 +1132,8 @@ pub fn write_outputs(
     );
     // Placed on the bed and still larger than the volume: not a part on
     // this printer (the tool path may lie inside it all the same).
-    let too_large = (placed && !fit.fits_on_bed).then(|| fit.placed_message.clone());
+    // (Not a hair past the volume that `inside` counts as in it.)
+    let too_large = (placed && !fit.inside && !fit.fits_on_bed).then(|| fit.placed_message.clone());
     if !fit.inside {
         report.warnings.push(if placed {
             fit.placed_message
@@ -1677,7 +1678,7 @@ pub fn check_gcode_as(
         );
     }
     // What the program's header says against this scan and nozzle, first.
-    let planned_nozzle = smaller_nozzle(text, nozzle.outer_diameter_mm, tol_mm);
+    let planned_nozzle = smaller_nozzle(planned_nozzle(text), nozzle.outer_diameter_mm, tol_mm);
     notes.splice(0..0, frame_notes.into_iter().chain(planned_nozzle.clone()));
     Ok(GcodeCheck {
         file: InputFile::new(file, text.as_bytes()),
@@ -1765,10 +1766,15 @@ fn header_lines(text: &str) -> impl Iterator<Item = &str> {
         .map(|l| l[1..].trim())
 }
 
-/// [`GcodeCheck::planned_nozzle`]: the header's nozzle and tol against
-/// this check's `outer_diameter_mm` and `tol_mm`, when either is smaller.
-fn smaller_nozzle(text: &str, outer_diameter_mm: f64, tol_mm: f64) -> Option<String> {
-    let (nozzle, tol) = planned_nozzle(text);
+/// [`GcodeCheck::planned_nozzle`]: the header's nozzle and tol
+/// ([`planned_nozzle`]) against this check's `outer_diameter_mm` and
+/// `tol_mm`, when either is smaller.
+fn smaller_nozzle(
+    planned: (Option<crate::params::Nozzle>, Option<f64>),
+    outer_diameter_mm: f64,
+    tol_mm: f64,
+) -> Option<String> {
+    let (nozzle, tol) = planned;
     let od = nozzle.map(|n| n.outer_diameter_mm);
     // Written to the header's digits: a hair less is the same nozzle.
     let larger = |planned: Option<f64>, checked: f64| planned.is_some_and(|p| p > checked + 1e-9);
@@ -2017,10 +2023,10 @@ mod tests {
             (None, None)
         );
         // Smaller than the header's: said; equal or larger: nothing.
-        assert!(smaller_nozzle(ours, 0.908, 0.25).is_some());
-        assert!(smaller_nozzle(ours, 1.6, 0.1).is_some());
-        assert!(smaller_nozzle(ours, 1.6, 0.25).is_none());
-        assert!(smaller_nozzle(ours, 2.0, 0.3).is_none());
+        assert!(smaller_nozzle(planned_nozzle(ours), 0.908, 0.25).is_some());
+        assert!(smaller_nozzle(planned_nozzle(ours), 1.6, 0.1).is_some());
+        assert!(smaller_nozzle(planned_nozzle(ours), 1.6, 0.25).is_none());
+        assert!(smaller_nozzle(planned_nozzle(ours), 2.0, 0.3).is_none());
     }
 
     use super::*;

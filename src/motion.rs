@@ -673,13 +673,20 @@ pub(crate) mod tests {
     /// waypoints make them safe (QA round 6 F0: the points wandered within
     /// reach of the edge themselves, and moves down to them were made
     /// "safe" only because a plunge's edge contact was taken at its top).
-    /// Thousands, so that the work is cut into many chunks.
+    /// Every 700th point lies inside the block: its moves cannot be made
+    /// safe. Thousands, so that the work is cut into many chunks.
     fn wandering_moves(n: usize) -> Vec<DVec3> {
         (0..=n)
             .map(|i| {
                 let t = i as f64;
                 let over = (0.05 * t + 1.0).sin() > 0.0;
-                let (x, z) = if over { (6.2, 2.5) } else { (3.8, 0.5) };
+                let (x, z) = if i % 700 == 350 {
+                    (6.2, 1.0)
+                } else if over {
+                    (6.2, 2.5)
+                } else {
+                    (3.8, 0.5)
+                };
                 DVec3::new(
                     x + 0.2 * (0.013 * t).sin(),
                     1.0 + 8.0 * i as f64 / n as f64,
@@ -728,7 +735,7 @@ pub(crate) mod tests {
             unresolved.extend(one.unresolved.iter().map(|_| j));
         }
         assert!(safe.waypoints > 0);
-        assert!(safe.unresolved.is_empty(), "{:?}", safe.unresolved);
+        assert!(safe.unresolved.len() >= 14, "{:?}", safe.unresolved);
         assert_eq!(safe.points, points);
         assert_eq!(safe.unresolved, unresolved);
     }

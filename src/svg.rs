@@ -258,13 +258,14 @@ pub fn import_svg(bytes: &[u8], file: &str) -> Result<Vec<Subpath2>, SvgError> {
 /// What kind of picture or document `bytes` are, by their first bytes, if
 /// one that is not SVG text.
 fn picture_kind(bytes: &[u8]) -> Option<&'static str> {
-    const KINDS: [(&[u8], &str); 6] = [
+    const KINDS: [(&[u8], &str); 7] = [
         (b"\x89PNG\r\n\x1a\n", "a PNG image"),
         (b"\xff\xd8\xff", "a JPEG image"),
         (b"GIF8", "a GIF image"),
         (b"%PDF-", "a PDF document"),
         (b"BM", "a BMP image"),
         (b"II*\0", "a TIFF image"),
+        (b"MM\0*", "a TIFF image"),
     ];
     KINDS
         .iter()

@@ -959,9 +959,28 @@ fn check_takes_the_nozzle_the_programs_header_names() {
         "{}",
         stderr(&o)
     );
+    // One value given: the others are still the header's.
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let o = pcpp(&[
+        "check",
+        "--scan",
+        s(&scan),
+        "--gcode",
+        s(&gcode),
+        "--nozzle-id",
+        "1.2",
+    ]);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stderr(&o).contains(
+            "checked with the nozzle the program's header names: outer diameter 1.6 mm, tol 0.25 \
+             mm ("
+        ),
+        "{}",
+        stderr(&o)
+    );
     // The default nozzle given by hand: smaller than the program's, so the
     // program is not shown clear, whatever its moves' clearance.
-    let scan = demo_file(demo::DEMO_SCAN_NAME);
     let small = [
         "check",
         "--scan",

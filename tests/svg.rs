@@ -1706,6 +1706,9 @@ fn a_picture_chosen_as_the_drawing_is_named_as_one() {
         (&b"%PDF-1.7\n%\xe2\xe3"[..], "a PDF document"),
         (&b"GIF89a\x01\0"[..], "a GIF image"),
         (&b"RIFF\x10\0\0\0WEBPVP8 "[..], "a WebP image"),
+        (&b"BM\x36\x10\0\0\0\0"[..], "a BMP image"),
+        (&b"II*\0\x08\0\0\0"[..], "a TIFF image"),
+        (&b"MM\0*\0\0\0\x08"[..], "a TIFF image"),
     ] {
         let e = import_svg(bytes, "pic.svg").unwrap_err().to_string();
         assert!(

@@ -198,10 +198,9 @@ async function openSvg(file) {
   }
   // The path source it replaces, taken back if it cannot be read, and
   // that drawing's placement: kept in the browser until this one is
-  // planned (a drawing that failed is not reopened, so neither is where
-  // it was centred), and taken back if this one is cancelled.
-  // (A drawing read whose plan failed is kept as a planned one is:
-  // main.js's onPlanError.)
+  // planned or refused (main.js keeps it then; a drawing that cannot be
+  // read, or is too long for the page, is not reopened, so neither is
+  // where it was centred), and taken back if this one is cancelled.
   const prev = state.pendingSvg;
   const was = prev ? prev.pathSource : settings.pathSource;
   const before = prev ? prev.before : { placement: { ...settings.placement }, fit: settings.fit };

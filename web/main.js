@@ -34,7 +34,7 @@ import {
   clearComparison, clearPlan, labelComparison, labelPlan, showComparison, showErrorPlot, showPlan, showScan, showScanWarnings,
 } from './report.js';
 import {
-  bindForm, currentSvg, jobSettings, loadSettings, saveSettings, writeForm,
+  bindForm, currentSvg, jobSettings, loadSettings, pathSourceBefore, saveSettings, writeForm,
 } from './settings.js';
 import {
   clearError, endProgress, laterProgress, setStatus, showError, showProgress,
@@ -96,12 +96,12 @@ function demoOnUserScan(scan) {
   if (!scan.blob || settings.pathSource !== 'demo') return false;
   const placed = scan.placementsAtFirstPlan
     ??= scan.restored && settings.demoMoved ? -1 : userPlacements();
-  const pages = userPlacements() === placed;
-  if (settings.demoMoved === pages) {
-    settings.demoMoved = !pages;
+  const untouched = userPlacements() === placed;
+  if (settings.demoMoved === untouched) {
+    settings.demoMoved = !untouched;
     saveSettings();
   }
-  return pages;
+  return untouched;
 }
 
 function runPlan() {
@@ -417,14 +417,7 @@ function onWorkerMessage(e) {
       onCarried(m, busy);
       break;
     case 'result': {
-      if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) {
-        state.svgFile = state.pendingSvg;
-        state.pendingSvg = null;
-        keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
-        // Its placement is now the one kept with it (saveSettings kept
-        // the previous drawing's while this one was not yet planned).
-        saveSettings();
-      }
+      if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) adoptPendingSvg();
       state.lastPlan = keptPlan(m, busy);
       const latency = performance.now() - busy.t0;
       const st = state.stats;
@@ -486,6 +479,16 @@ const RISKS = {
   'mostly-off': 'Most of the drawing lies beside the scan: no G-code',
 };
 
+// The drawing read for this plan becomes the user's drawing, kept in the
+// browser with its placement (saveSettings kept the previous drawing's
+// while this one was pending): once planned, or refused (onPlanError).
+function adoptPendingSvg() {
+  state.svgFile = state.pendingSvg;
+  state.pendingSvg = null;
+  keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
+  saveSettings();
+}
+
 function onPlanError(m, busy) {
   dropPress();
   // The worker holds another drawing than the page thinks: the next plan
@@ -499,10 +502,7 @@ function onPlanError(m, busy) {
   // drawing). A drawing too long for the page is not kept.
   if (state.pendingSvg && busy.svg === state.pendingSvg && m.kind !== 'svg' && m.kind !== 'crash'
     && m.kind !== 'limit' && m.stage !== 'scan' && settings.pathSource === 'file') {
-    state.svgFile = state.pendingSvg;
-    state.pendingSvg = null;
-    keep('svg', { name: state.svgFile.name, bytes: state.svgFile.bytes });
-    saveSettings();
+    adoptPendingSvg();
   }
   let title = 'Planning failed';
   let message = m.message;
@@ -561,10 +561,10 @@ function onPlanError(m, busy) {
     title = `Could not read the SVG ${file}`;
     // Back to the path planned before it (an antenna, the demo, or the
     // previous file), where it was.
-    const was = state.pendingSvg.pathSource;
+    const was = pathSourceBefore(state.pendingSvg);
     state.pendingSvg = null;
     cancelCentre();
-    settings.pathSource = was === 'file' && !state.svgFile ? 'demo' : was || 'demo';
+    settings.pathSource = was;
     saveSettings();
     writeForm();
     message += settings.pathSource === 'file'

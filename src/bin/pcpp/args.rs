@@ -229,12 +229,10 @@ pub struct CheckNozzleArgs {
 }
 
 impl CheckNozzleArgs {
-    /// The values given, the others from `planned` (the program header's
-    /// nozzle and tol, where it gives them) or the defaults. The two
-    /// diameters go together: one given, the other is not the header's.
+    /// The values given, each other one from `planned` (the program
+    /// header's nozzle and tol, where it gives them) or the default.
     pub fn or(&self, planned: (Option<Nozzle>, Option<f64>)) -> NozzleArgs {
         let (nozzle, tol) = planned;
-        let nozzle = nozzle.filter(|_| self.nozzle_id.is_none() && self.nozzle_od.is_none());
         NozzleArgs {
             nozzle_id: self.nozzle_id.unwrap_or(
                 nozzle.map_or(Nozzle::DEFAULT.inner_diameter_mm, |n| n.inner_diameter_mm),

@@ -26,19 +26,16 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
     ];
     let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
     let outputs = Outputs::check("check", report, read.into_iter().flatten())?;
-    // The values given are checked before the files are read; those not
-    // given are the program header's (a pcpp program's own nozzle and
-    // tol), said when they are not the defaults.
-    let given = a.nozzle.or((None, None));
-    let (mut settings, profile) =
-        check_settings("check", &a.scan, &given, &a.registration, &a.machine)?;
+    // The nozzle values not given are the program header's (a pcpp
+    // program's own nozzle and tol), said when they are not the defaults:
+    // the program (small beside the scan) is read before the values are
+    // checked, and the scan after.
     let gcode_path = &a.gcode;
     let (text, encoding) = read_gcode_text(gcode_path)?;
-    // (The core checks the header's values as it checks the ones given.)
+    let given = a.nozzle.or((None, None));
     let nozzle = a.nozzle.or(job::planned_nozzle(&text));
-    settings.plan.nozzle.inner_diameter_mm = nozzle.nozzle_id;
-    settings.plan.nozzle.outer_diameter_mm = nozzle.nozzle_od;
-    settings.plan.process.tolerance_mm = nozzle.tol;
+    let (settings, profile) =
+        check_settings("check", &a.scan, &nozzle, &a.registration, &a.machine)?;
     let from_header: Vec<String> = [
         (nozzle.nozzle_od != given.nozzle_od)
             .then(|| format!("outer diameter {} mm", nozzle.nozzle_od)),
