@@ -211,6 +211,41 @@ function slabObj(name, lo, hi) {
   return { name, mimeType: 'text/plain', buffer: Buffer.from(`${v.join('\n')}\n${f.join('\n')}\n`) };
 }
 
+// A ring scanned about the scanner's origin (outside the build volume):
+// the drawing is centred over its band, with a note naming where; placed
+// on the bed, the drawing goes with the scan and the note, whose places
+// are the scanner frame's, goes (QA round 7 F10: it stayed, 70 mm off).
+test('the note of a drawing centred off a gap goes once the scan is placed on the bed', async () => {
+  const lines = [];
+  const n = 64;
+  for (let k = 0; k < n; k++) {
+    const a = (2 * Math.PI * k) / n;
+    for (const r of [20, 40]) lines.push(`v ${(r * Math.cos(a)).toFixed(4)} ${(r * Math.sin(a)).toFixed(4)} 1`);
+  }
+  for (let k = 0; k < n; k++) {
+    const [i, j] = [2 * k + 1, 2 * ((k + 1) % n) + 1];
+    lines.push(`f ${i} ${i + 1} ${j + 1}`, `f ${i} ${j + 1} ${j}`);
+  }
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', { name: 'ring0.obj', mimeType: 'text/plain', buffer: Buffer.from(`${lines.join('\n')}\n`) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'ring0.obj', null, { timeout: 120_000 });
+  await waitIdle(page);
+  // A 10 mm circle: centred on the middle, all of it over the gap.
+  await page.setInputFiles('#svg-input', { name: 'circle.svg', mimeType: 'image/svg+xml',
+    buffer: Buffer.from('<svg xmlns="http://www.w3.org/2000/svg" width="12mm" height="12mm" viewBox="0 0 12 12">'
+      + '<circle cx="6" cy="6" r="5" fill="none" stroke="black"/></svg>\n') });
+  await page.waitForFunction(() => /lies over a gap in the scan/.test(document.getElementById('pl-note').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#pl-note'), /^the middle of the scan's footprint \(0\.000, 0\.000\) lies over a gap in the scan: the drawing is centred at \(/);
+  await page.click('#place-bed-btn');
+  await waitIdle(page);
+  assert.equal(await page.textContent('#pl-note'), '');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 // A scan reaching 2 mm below the bed whose tool path lies inside the
 // volume: G-code is written, with the warning, and the banner says so; the
 // same banner on a refused plan says nothing was written (QA round 4 F6:
