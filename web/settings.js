@@ -111,9 +111,10 @@ export function pathSourceBefore(svg) {
 }
 
 // What the next visit starts from. A drawing not yet planned is not kept
-// (main.js keeps a drawing once planned or refused): nor are its path source and
-// placement, but those of the drawing kept, as it was placed (a drawing
-// too long for the page left its centring and fit on the good one).
+// (main.js keeps a drawing once planned or refused): nor are its path
+// source and placement, but those of the drawing kept, as it was placed
+// (a drawing too long for the page left its centring and fit on the good
+// one).
 function keptSettings() {
   const svg = state.pendingSvg;
   if (settings.pathSource !== 'file' || !svg || !svg.before) return settings;
