@@ -255,28 +255,6 @@ pub fn import_svg(bytes: &[u8], file: &str) -> Result<Vec<Subpath2>, SvgError> {
     import_svg_with_notes(bytes, file).map(|import| import.subpaths)
 }
 
-/// What kind of picture or document `bytes` are, by their first bytes, if
-/// one that is not SVG text.
-fn picture_kind(bytes: &[u8]) -> Option<&'static str> {
-    const KINDS: [(&[u8], &str); 7] = [
-        (b"\x89PNG\r\n\x1a\n", "a PNG image"),
-        (b"\xff\xd8\xff", "a JPEG image"),
-        (b"GIF8", "a GIF image"),
-        (b"%PDF-", "a PDF document"),
-        (b"BM", "a BMP image"),
-        (b"II*\0", "a TIFF image"),
-        (b"MM\0*", "a TIFF image"),
-    ];
-    KINDS
-        .iter()
-        .find(|(magic, _)| bytes.starts_with(magic))
-        .map(|(_, kind)| *kind)
-        .or_else(|| {
-            (bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP")
-                .then_some("a WebP image")
-        })
-}
-
 /// [`import_svg`], also returning notes on what was skipped.
 pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgError> {
     let parse_err = |message: String| SvgError::Parse {
@@ -296,7 +274,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // A picture or a document chosen as the drawing (a wrong pick in a
     // downloads folder): named as what it is (QA round 7 F12: a PNG was
     // told to be saved as UTF-8).
-    if let Some(kind) = picture_kind(bytes) {
+    if let Some(kind) = crate::mesh::other_file_kind(bytes) {
         return Err(parse_err(format!(
             "this is {kind}, not an SVG drawing: a drawing is read from its paths; open the SVG \
              file, or trace the picture to paths first (Inkscape: Path, Trace Bitmap)"

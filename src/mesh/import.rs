@@ -446,6 +446,30 @@ impl Unwelded {
     }
 }
 
+/// What common file that is neither a scan nor a drawing `bytes` are, by
+/// their first bytes: a picture, a document or an archive (a wrong pick in
+/// a downloads folder), named for the error that refuses it.
+pub(crate) fn other_file_kind(bytes: &[u8]) -> Option<&'static str> {
+    const KINDS: [(&[u8], &str); 8] = [
+        (b"\x89PNG", "a PNG image"),
+        (b"\xFF\xD8\xFF", "a JPEG image"),
+        (b"GIF8", "a GIF image"),
+        (b"%PDF", "a PDF document"),
+        (b"BM", "a BMP image"),
+        (b"II*\0", "a TIFF image"),
+        (b"MM\0*", "a TIFF image"),
+        (b"PK\x03\x04", "a ZIP archive"),
+    ];
+    KINDS
+        .iter()
+        .find(|(magic, _)| bytes.starts_with(magic))
+        .map(|(_, kind)| *kind)
+        .or_else(|| {
+            (bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP")
+                .then_some("a WebP image")
+        })
+}
+
 /// A file named as a text format (OBJ, XYZ) that holds binary data: an
 /// image or archive given the wrong name read as lines of nothing, "the
 /// mesh has no triangles". Said as what it is, with the kind of file its
@@ -467,16 +491,14 @@ fn binary_in_text(bytes: &[u8], file: &str, format: MeshFormat) -> Option<MeshEr
         ));
     }
     let kind = [
-        (&b"\x89PNG"[..], "a PNG image"),
-        (&b"\xFF\xD8\xFF"[..], "a JPEG image"),
-        (&b"%PDF"[..], "a PDF document"),
-        (&b"PK\x03\x04"[..], "a ZIP archive"),
         (&b"\x1F\x8B"[..], "gzip-compressed data (unpack it first)"),
         (&b"glTF"[..], "a binary glTF (name it .glb)"),
     ]
     .iter()
     .find(|(magic, _)| bytes.starts_with(magic))
-    .map_or(String::new(), |(_, k)| format!("; it looks like {k}"));
+    .map(|(_, k)| *k)
+    .or_else(|| other_file_kind(bytes))
+    .map_or(String::new(), |k| format!("; it looks like {k}"));
     Some(MeshError::invalid(
         file,
         format!(

@@ -33,6 +33,7 @@ mod xyz;
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use external::{ExternalFiles, ExternalRef};
+pub(crate) use import::other_file_kind;
 pub use import::{
     detect_format, external_files_needed, import_mesh, import_mesh_unwelded, import_mesh_with,
     UnitsDoubt, Unwelded, WeldMap, SMALL_SCAN_MM,
