@@ -183,7 +183,7 @@ pub fn surface_path(
     // Whether any subpath was large enough to print.
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    // Each subpath's samples as placed, for `close_lines`.
+    // Each subpath's samples as placed, for `close_lines` and `blobs`.
     let mut sampled: Vec<(&str, Vec<DVec2>, bool)> = Vec::with_capacity(drawn.len());
     // The drawing's length as sampled, and the part of it over the scan.
     let xy_length =
@@ -304,7 +304,8 @@ pub fn surface_path(
     const CHOOSE_UP_AXIS: &str = "if the scan lies on its side in the file, choose its up axis \
                                   (--up-axis y, z or -z; glTF files are +Y up) or register it \
                                   onto the bed";
-    if !pieces.is_empty() && edge_on(foot, tall) {
+    let is_edge_on = edge_on(foot, tall);
+    if !pieces.is_empty() && is_edge_on {
         warnings.push(format!(
             "{}: the drawing lies on its top edge; {CHOOSE_UP_AXIS}",
             seen_edge_on()
@@ -315,89 +316,87 @@ pub fn surface_path(
         // Thin along X only (a bar or needle thin both ways may lie down
         // under another up axis: a review's 0.5 x 0.6 x 50 mm one did).
         let faces_x = foot.x < EDGE_ON_SHARE * foot.y;
-        return Err(Error::Plan(
-            if any_sample && edge_on(foot, tall) && faces_x {
-                // Thin along X: no up axis this program reads turns it face-up
-                // (+Z, +Y and -Z are; a QA run's polygon faced +X, and the
-                // message offered the up axes that cannot help).
-                format!(
-                    "no part of the path lies over the scan's surface: {}: its surface faces \
+        return Err(Error::Plan(if any_sample && is_edge_on && faces_x {
+            // Thin along X: no up axis this program reads turns it face-up
+            // (+Z, +Y and -Z are; a QA run's polygon faced +X, and the
+            // message offered the up axes that cannot help).
+            format!(
+                "no part of the path lies over the scan's surface: {}: its surface faces \
                      sideways, along X, which no up axis turns face-up (--up-axis reads +Z, +Y \
                      or -Z as up); turn it in a mesh tool (MeshLab, Blender) so that its surface \
                      faces +Z, or register it onto the bed by its fiducials",
-                    seen_edge_on()
-                )
-            } else if any_sample && edge_on(foot, tall) {
-                format!(
-                    "no part of the path lies over the scan's surface: {}, so there is almost \
+                seen_edge_on()
+            )
+        } else if any_sample && is_edge_on {
+            format!(
+                "no part of the path lies over the scan's surface: {}, so there is almost \
                      nothing for the nozzle to come down on; {CHOOSE_UP_AXIS}",
-                    seen_edge_on()
-                )
-            } else if !any_line && !dot_paths.is_empty() {
-                // QA: PCB footprints whose pads are strokes of no length
-                // (drawn by their square caps) were told to check their
-                // units, which no scale fixes.
-                let why = if longest_dot_mm == 0.0 {
-                    "a stroke of no length (as pads and dots are drawn, by their round or square \
+                seen_edge_on()
+            )
+        } else if !any_line && !dot_paths.is_empty() {
+            // QA: PCB footprints whose pads are strokes of no length
+            // (drawn by their square caps) were told to check their
+            // units, which no scale fixes.
+            let why = if longest_dot_mm == 0.0 {
+                "a stroke of no length (as pads and dots are drawn, by their round or square \
                      caps), and this planner prints lines, not dots: draw each pad or dot as an \
                      outline or a short line"
-                        .to_string()
-                } else {
-                    format!(
-                        "a shape at most {longest_dot_mm:.4} mm long as placed, far shorter than \
+                    .to_string()
+            } else {
+                format!(
+                    "a shape at most {longest_dot_mm:.4} mm long as placed, far shorter than \
                          the samples' spacing of {spacing:.4} mm: a dot as pads and dots are \
                          drawn (this planner prints lines, not dots), or a drawing far too small: \
                          check the drawing's units and the placement's scale"
-                    )
-                };
-                format!(
-                    "nothing to print at the nozzle's scale: every path of the drawing ({} of \
-                     them: '{}'{}) is a dot, {why}",
-                    dot_paths.iter().map(|p| p.1).sum::<usize>(),
-                    dot_paths[0].0,
-                    if dot_paths.len() > 1 || dot_paths[0].1 > 1 {
-                        ", ..."
-                    } else {
-                        ""
-                    }
                 )
-            } else if any_sample && inside {
-                // Where the surface is (QA: a ring-shaped cloud's footprint
-                // centre lay 68 mm from its nearest point, and a larger
-                // maximum edge, the one hint, could not help).
-                let middle = 0.5 * (lo + hi);
-                let nearest = surface.nearest_in_xy(middle).map_or(String::new(), |p| {
-                    format!(
-                        "; the scan's surface nearest the drawing's middle ({:.3}, {:.3}) is \
-                             at ({:.3}, {:.3}), {:.3} mm from it",
-                        middle.x,
-                        middle.y,
-                        p.x,
-                        p.y,
-                        p.distance(middle)
-                    )
-                });
+            };
+            format!(
+                "nothing to print at the nozzle's scale: every path of the drawing ({} of \
+                     them: '{}'{}) is a dot, {why}",
+                dot_paths.iter().map(|p| p.1).sum::<usize>(),
+                dot_paths[0].0,
+                if dot_paths.len() > 1 || dot_paths[0].1 > 1 {
+                    ", ..."
+                } else {
+                    ""
+                }
+            )
+        } else if any_sample && inside {
+            // Where the surface is (QA: a ring-shaped cloud's footprint
+            // centre lay 68 mm from its nearest point, and a larger
+            // maximum edge, the one hint, could not help).
+            let middle = 0.5 * (lo + hi);
+            let nearest = surface.nearest_in_xy(middle).map_or(String::new(), |p| {
                 format!(
-                    "no part of the path lies over the scan's surface: the path spans x \
+                    "; the scan's surface nearest the drawing's middle ({:.3}, {:.3}) is \
+                             at ({:.3}, {:.3}), {:.3} mm from it",
+                    middle.x,
+                    middle.y,
+                    p.x,
+                    p.y,
+                    p.distance(middle)
+                )
+            });
+            format!(
+                "no part of the path lies over the scan's surface: the path spans x \
                  {:.3}..{:.3}, y {:.3}..{:.3} mm, over the scan's extent (x {:.3}..{:.3}, y \
                  {:.3}..{:.3} mm, printer frame) but over its holes or gaps (a bore of the part, \
                  a point cloud's dropouts){nearest}; move the drawing onto the surface (the \
                  placement offset), and for a point cloud a larger maximum edge (--max-edge) \
                  closes wider gaps",
-                    lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
-                )
-            } else if any_sample {
-                format!(
+                lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
+            )
+        } else if any_sample {
+            format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
                  placement offset and the registration (--place centre puts the drawing on the \
                  scan's footprint)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
-            } else {
-                "the drawing has no path to print".into()
-            },
-        ));
+        } else {
+            "the drawing has no path to print".into()
+        }));
     }
     // Most of a drawing off the scan still printed its fragments with
     // exit 0, the share lost said nowhere (18 warnings, one a piece): said

@@ -12,7 +12,8 @@
 //! closure, for a closed one): the neighbours along a line, and the two
 //! legs of a corner blunter than about 40 degrees, are not other lines. It
 //! is a warning, not an error: a filled area drawn as a raster overlaps its
-//! lines on purpose.
+//! lines on purpose. What that passes over, a piece (or the whole drawing)
+//! folded up within a few d, is warned of as a blob ([`blobs`]).
 
 use glam::DVec2;
 

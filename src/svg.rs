@@ -861,8 +861,8 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     })
 }
 
-/// What px were read as: CSS's 96 per inch, or an old Inkscape's 90
-/// ([`RootSize::px_scale`]).
+/// What px were read as: CSS's 96 per inch, an old Inkscape's 90 or
+/// Illustrator's 72 ([`RootSize::px_scale`]).
 fn px_words(px_scale: f64) -> &'static str {
     if px_scale == 1.0 {
         "CSS px (96 per inch)"
@@ -1210,8 +1210,8 @@ struct RootSize {
     /// length, or one set in CSS.
     unreadable: Vec<String>,
     /// The factor on the drawing's size in mm for an editor that drew in
-    /// other px than CSS's 96 per inch (Inkscape before 0.92: 90), said in
-    /// `notes`; 1 otherwise.
+    /// other px than CSS's 96 per inch (Inkscape before 0.92: 90; Adobe
+    /// Illustrator: 72), said in `notes`; 1 otherwise.
     px_scale: f64,
     notes: Vec<String>,
 }

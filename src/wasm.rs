@@ -67,8 +67,8 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 /// (`mesh`, `svg`, `registration`, `gcode` for a G-code file that could not
 /// be read, `touching` for G-code refused by the motion check,
 /// `whole-object` for G-code refused on a point cloud of a whole object,
-/// `units`, `below-bed`, `far-above` and `mostly-off` for the other
-/// refusals that accepting the risk lifts, `volume` for a tool path out of
+/// `units`, `below-bed`, `too-large`, `far-above` and `mostly-off` for the
+/// other refusals that accepting the risk lifts, `volume` for a tool path out of
 /// the build volume, or `other`):
 /// the page drops a file whose bytes could not be read but keeps one that
 /// only failed to register. A `touching` error also carries `touching`, the

@@ -127,12 +127,11 @@ export function clearComparison() {
 // of this one): its tables, warnings and plot emptied, not shown under the
 // new scan's name.
 export function clearPlan() {
-  for (const id of ['compare-table', 'motion-table', 'stats-table']) $(id).tBodies[0].replaceChildren();
-  $('compare-table').classList.remove('stale');
+  clearComparison();
+  for (const id of ['motion-table', 'stats-table']) $(id).tBodies[0].replaceChildren();
   for (const id of ['motion-touches', 'warnings', 'plot-legend']) $(id).replaceChildren();
   $('plot-note').textContent = '';
   $('plan-time').textContent = '';
-  $('compare-of').textContent = '';
   for (const id of PLAN_LABELS) $(id).textContent = '';
   for (const id of PLAN_FIGURES) $(id).classList.remove('stale');
   const plot = $('plot');
