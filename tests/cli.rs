@@ -75,6 +75,15 @@ fn plan_on(scan: &Path, svg: &Path, flags: &[&str]) -> Output {
     pcpp(&args)
 }
 
+/// `pcpp plan` of the demo's drawing on the demo's scan with `flags`.
+fn plan_demo(flags: &[&str]) -> Output {
+    plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file(demo::DEMO_PATH_NAME),
+        flags,
+    )
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -263,11 +272,7 @@ fn demo_prints_the_table_and_takes_a_dialect() {
 fn plan_on_the_demo_files_writes_the_golden_gcode() {
     let dir = temp_dir("plan-golden");
     let out = dir.join("out.gcode");
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &["--place", "0,80,0,1", "-o", s(&out)],
-    );
+    let o = plan_demo(&["--place", "0,80,0,1", "-o", s(&out)]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let summary = stdout(&o);
     assert!(summary.contains("points"), "{summary}");
@@ -288,26 +293,22 @@ fn plan_on_the_demo_files_writes_the_golden_gcode() {
 fn plan_report_has_every_field() {
     let dir = temp_dir("plan-report");
     let (out, report) = (dir.join("p.gcode"), dir.join("p.json"));
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &[
-            "--place=0,80",
-            "--output",
-            s(&out),
-            "--report",
-            s(&report),
-            "--planner",
-            "slope",
-            "--accept-risk",
-            "--dialect",
-            "grbl",
-            "--fiducials",
-            "auto",
-            "--printer-points",
-            "4,4,5; 76,4,5; 4,76,5",
-        ],
-    );
+    let o = plan_demo(&[
+        "--place=0,80",
+        "--output",
+        s(&out),
+        "--report",
+        s(&report),
+        "--planner",
+        "slope",
+        "--accept-risk",
+        "--dialect",
+        "grbl",
+        "--fiducials",
+        "auto",
+        "--printer-points",
+        "4,4,5; 76,4,5; 4,76,5",
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stdout(&o).contains("registration"), "{}", stdout(&o));
     let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
@@ -783,11 +784,7 @@ fn a_path_that_misses_the_scan_writes_nothing() {
     let dir = temp_dir("misses");
     let (out, report) = (dir.join("out.gcode"), dir.join("out.json"));
     // Without the placement the SVG lies at y < 0, off the 80 x 80 mm part.
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &["-o", s(&out), "--report", s(&report)],
-    );
+    let o = plan_demo(&["-o", s(&out), "--report", s(&report)]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -798,16 +795,12 @@ fn a_path_that_misses_the_scan_writes_nothing() {
     assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
 
     // An output folder that does not exist: bad input, nothing written.
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &[
-            "--place",
-            "0,80",
-            "-o",
-            s(&dir.join("no-such-dir").join("out.gcode")),
-        ],
-    );
+    let o = plan_demo(&[
+        "--place",
+        "0,80",
+        "-o",
+        s(&dir.join("no-such-dir").join("out.gcode")),
+    ]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(stderr(&o).contains("no-such-dir"), "{}", stderr(&o));
     assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
@@ -817,11 +810,7 @@ fn a_path_that_misses_the_scan_writes_nothing() {
 #[test]
 fn no_progress_chatter_when_stderr_is_not_a_terminal() {
     let dir = temp_dir("quiet");
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &["--place", "0,80", "-o", s(&dir.join("q.gcode"))],
-    );
+    let o = plan_demo(&["--place", "0,80", "-o", s(&dir.join("q.gcode"))]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
@@ -921,22 +910,18 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
 fn check_takes_the_nozzle_the_programs_header_names() {
     let dir = temp_dir("check-nozzle");
     let gcode = dir.join("big.gcode");
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &[
-            "--place",
-            "0,80,0,1",
-            "--nozzle-id",
-            "1.2",
-            "--nozzle-od",
-            "1.6",
-            "--tol",
-            "0.25",
-            "-o",
-            s(&gcode),
-        ],
-    );
+    let o = plan_demo(&[
+        "--place",
+        "0,80,0,1",
+        "--nozzle-id",
+        "1.2",
+        "--nozzle-od",
+        "1.6",
+        "--tol",
+        "0.25",
+        "-o",
+        s(&gcode),
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&gcode).unwrap();
     assert!(
@@ -2270,11 +2255,7 @@ fn regression_outputs_replaced_links_pipes_and_devices_with_files() {
     let plan = |out: &str, more: &[&str]| {
         let mut flags = vec!["--place", "0,80,0,1", "-o", out];
         flags.extend(more);
-        plan_on(
-            &demo_file(demo::DEMO_SCAN_NAME),
-            &demo_file(demo::DEMO_PATH_NAME),
-            &flags,
-        )
+        plan_demo(&flags)
     };
     // A symbolic link: its target takes the G-code, the link stays one.
     std::fs::write(dir.join("target.gcode"), "old").unwrap();
@@ -2406,11 +2387,7 @@ fn regression_a_latin1_byte_in_a_comment_refused_the_whole_program() {
 fn regression_plan_and_check_counted_a_programs_moves_differently() {
     let dir = temp_dir("move-count");
     let out = dir.join("out.gcode");
-    let o = plan_on(
-        &demo_file(demo::DEMO_SCAN_NAME),
-        &demo_file(demo::DEMO_PATH_NAME),
-        &["--place", "0,80", "-o", s(&out)],
-    );
+    let o = plan_demo(&["--place", "0,80", "-o", s(&out)]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let count = |text: &str, before: &str, after: &str| -> usize {
         let end = text
