@@ -316,6 +316,41 @@ pub enum GcodeLineProblem {
 
 use GcodeLineProblem as P;
 
+/// Whether `text` (a statement's text, comments allowed after it) is an
+/// Aerotech digital output set, `$DO[n].AXIS = value` with a number for
+/// the value: it switches an output, and moves nothing.
+fn is_output_set(text: &str) -> bool {
+    let code = text.find([';', '\'']).map_or(text, |k| &text[..k]).trim();
+    let Some(rest) = code.get(..4).filter(|p| p.eq_ignore_ascii_case("$DO[")) else {
+        return false;
+    };
+    let rest = &code[rest.len()..];
+    let Some((index, rest)) = rest.split_once("].") else {
+        return false;
+    };
+    let Some((axis, value)) = rest.split_once('=') else {
+        return false;
+    };
+    !index.is_empty()
+        && index.bytes().all(|b| b.is_ascii_digit())
+        && !axis.trim().is_empty()
+        && axis.trim().bytes().all(|b| b.is_ascii_alphanumeric())
+        && value.trim().parse::<f64>().is_ok_and(f64::is_finite)
+}
+
+/// Whether `text` is an Aerotech dwell, `DWELL <seconds>`: the nozzle
+/// stands still.
+fn is_dwell(text: &str) -> bool {
+    let code = text.find([';', '\'']).map_or(text, |k| &text[..k]).trim();
+    code.get(..5)
+        .is_some_and(|k| k.eq_ignore_ascii_case("DWELL"))
+        && code[5..].starts_with(char::is_whitespace)
+        && code[5..]
+            .trim()
+            .parse::<f64>()
+            .is_ok_and(|s| s.is_finite() && s >= 0.0)
+}
+
 /// Reads a G-code program. `file` only labels errors.
 ///
 /// Comments: `;` and `'` (Aerotech) to the end of the line, `//` likewise,
@@ -1293,6 +1328,13 @@ impl<'f> Reader<'f> {
             self.unfollowed(n, UnknownMoveKind::Jog, [None; 3], "$J=");
             return Ok(());
         }
+        // Statements known not to move the nozzle, which the aerotech
+        // profile writes itself (QA round 6 F6: checking pcpp's own program
+        // warned of its dispenser's switch): a digital output set
+        // (`$DO[0].X = 1`) and a dwell (`DWELL 0.5`).
+        if is_output_set(text) || is_dwell(text) {
+            return Ok(());
+        }
         if text.starts_with("o<") || text.starts_with("O<") {
             return Err(P::ProgramFlow {
                 word: quote_word(line, at),
@@ -1838,16 +1880,10 @@ mod tests {
         );
         assert_eq!(grbl.notes.len(), 1, "{:?}", grbl.notes);
         assert!(grbl.notes[0].starts_with(&unknown_note(grbl)));
-        assert_eq!(aerotech.notes.len(), 2, "{:?}", aerotech.notes);
-        assert!(
-            aerotech.notes[0].starts_with("lines ")
-                && aerotech.notes[0].contains(
-                    "more: not G-code words, skipped (controller statements or macros such as \
-                     `$DO[0].X = 0`)"
-                ),
-            "{:?}",
-            aerotech.notes
-        );
+        // (The dispenser's switch, `$DO[0].X = 1`, is known to move
+        // nothing: QA round 6 F6.)
+        assert_eq!(aerotech.notes.len(), 1, "{:?}", aerotech.notes);
+        assert!(aerotech.notes[0].starts_with(&unknown_note(aerotech)));
     }
 
     /// Each move carries the modal feed, read past comments, checksums and
@@ -2196,15 +2232,50 @@ mod tests {
         );
     }
 
+    /// QA round 6 F6: checking pcpp's own Aerotech program warned that its
+    /// dispenser's switch (`$DO[0].X = 1`) and dwell lines were statements
+    /// the check could not see move. They move nothing, and are read
+    /// silently; a statement only like them is still noted.
+    #[test]
+    fn aerotech_output_sets_and_dwells_are_known_to_move_nothing() {
+        let own = "G71\nG76\nG90\n$DO[0].X = 0\nG0 X0 Y0 Z5\n$DO[0].X = 1 ' on\nDWELL 0.25\n\
+                   G1 X1 F5\n$do[12].Y=0\ndwell 2\n$DO[0].X = 0\nM2\n";
+        let p = read(own);
+        assert_eq!((p.unknown_moves.len(), p.moves.len()), (1, 1));
+        assert!(
+            p.notes.iter().all(|n| !n.contains("not G-code words")),
+            "{:?}",
+            p.notes
+        );
+        for other in [
+            "$DO[0].X = $var",
+            "$DO[0] = 1",
+            "$DOX = 1",
+            "DWELL",
+            "DWELL -1",
+            "DWELLS 1",
+        ] {
+            let p = read(&format!("G90\nG0 X0 Y0 Z0\n{other}\nG1 X1\n"));
+            assert!(
+                p.notes
+                    .iter()
+                    .any(|n| n.starts_with("line 3: not G-code words")),
+                "{other}: {:?}",
+                p.notes
+            );
+        }
+    }
+
     #[test]
     fn statements_of_other_languages_are_skipped_with_one_note() {
         let text = "G90\nG0 X0 Y0 Z0\n$DO[0].X = 1\nDWELL 0.5\nENABLE X Y Z\nG1 X1\nG1 X2\nG1 X3\nG1 X4\nPRIMARY\n";
         let p = read(text);
         assert_eq!(p.moves.len(), 4);
+        // (The output set and the dwell move nothing: not in the note.)
         assert_eq!(
             p.notes[1],
-            "lines 3-5, 10: not G-code words, skipped (controller statements or macros such as \
-             `$DO[0].X = 1`); if one of them moves the nozzle, the check does not see it"
+            "lines 5, 10: not G-code words, skipped (controller statements or macros such as \
+             `ENABLE X Y Z`); if one of them moves the nozzle, the check does not see it"
         );
         // The note stays bounded: the first six ranges, then a count.
         let many: String = (0..1000)
