@@ -1632,16 +1632,32 @@ pub fn check_gcode_as(
             line_list(&unchecked_lines)
         ));
     }
-    // Beside the scan nothing is known of the part (QA: a program printing
-    // 80 mm beyond a cropped scan's edge, below its surface's height, was
-    // "clear" with no word): the moves that go there lower than tol above
-    // the scan's top are named.
+    // Beside the scan, or over a hole in it, nothing is known of the part
+    // (QA: a program printing 80 mm beyond a cropped scan's edge, below its
+    // surface's height, was "clear" with no word; QA round 6 F3: a print
+    // move ending over a scan's dropout inside its box was not named): the
+    // moves that go there lower than tol above the scan's top are named. A
+    // move is looked at where its tip's axis passes, at its ends and every
+    // outer radius between them.
     let (slo, shi) = scan.surface.bbox();
-    let beside_scan = |p: DVec3| p.x < slo.x || p.x > shi.x || p.y < slo.y || p.y > shi.y;
+    let radius = 0.5 * nozzle.outer_diameter_mm;
+    let off_scan = |p: DVec3| {
+        p.x < slo.x
+            || p.x > shi.x
+            || p.y < slo.y
+            || p.y > shi.y
+            || scan.surface.highest_hit(p.truncate()).is_none()
+    };
+    let beside_scan = |m: &crate::gcode::GcodeMove| {
+        let steps = ((m.to - m.from).truncate().length() / radius)
+            .ceil()
+            .max(1.0) as usize;
+        (0..=steps).any(|i| off_scan(m.from.lerp(m.to, i as f64 / steps as f64)))
+    };
     let beside: Vec<&crate::gcode::GcodeMove> = program
         .moves
         .iter()
-        .filter(|m| (beside_scan(m.from) || beside_scan(m.to)) && m.from.z.min(m.to.z) < high)
+        .filter(|m| m.from.z.min(m.to.z) < high && beside_scan(m))
         .collect();
     if let Some(lowest) = beside
         .iter()
@@ -1649,7 +1665,8 @@ pub fn check_gcode_as(
     {
         let lines: Vec<usize> = beside.iter().map(|m| m.line).collect();
         notes.push(format!(
-            "{} move(s) pass beside the scan lower than tol above its top ({}; the lowest at z \
+            "{} move(s) pass beside the scan or over a hole in it lower than tol above its top \
+             ({}; the lowest at z \
              {:.3} mm, line {}, the scan's surface from z {:.3} to {:.3} mm): nothing is known \
              of the part there, so they are checked only against the part that was scanned; if \
              the part or what it stands on reaches there, make sure they clear it",

@@ -560,6 +560,47 @@ fn demo_scan() -> pcpp::job::PreparedScan {
     .unwrap()
 }
 
+/// QA round 6 F3: inside the scan's box, over a hole in it, nothing is
+/// known of the part either, and a print move ending over a scan's
+/// dropout was not named. A plate with a 10 mm hole in its middle: a move
+/// across the hole, and one ending over it, are named; moves over the
+/// plate around it, and one high over the hole, are not.
+#[test]
+fn regression_moves_over_a_hole_in_the_scan_are_named() {
+    use pcpp::job::check_gcode;
+
+    let axis: Vec<f64> = (0..=40).map(f64::from).collect();
+    // (A block at x 32-40 stands 4 mm above the plate, so the moves over
+    // the plate are lower than tol above the scan's top.)
+    let mut plate =
+        pcpp::mesh::TriMesh::height_field(&axis, &axis, |x, _| if x >= 32.0 { 6.0 } else { 2.0 });
+    let vertices = plate.vertices.clone();
+    plate.triangles.retain(|t| {
+        let c = t.iter().map(|&i| vertices[i as usize]).sum::<DVec3>() / 3.0;
+        !((15.0..25.0).contains(&c.x) && (15.0..25.0).contains(&c.y))
+    });
+    let scan = pcpp::job::prepare_scan(
+        &pcpp::demo::to_binary_ply(&plate),
+        "holed.ply",
+        &pcpp::mesh::ImportOptions::DEFAULT,
+        &pcpp::job::RegistrationSettings::default(),
+    )
+    .unwrap();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let program = "G21\nG90\nG0 X5 Y5 Z10\nG1 Z2.5\nG1 X28 Y5\nG1 X28 Y20\nG1 X5 Y20\n\
+                   G1 X5 Y35\nG1 X19 Y35\nG1 X19 Y20\nG0 Z10\nG0 X20 Y20 Z10\n";
+    let check = check_gcode(&scan, program, "holed.gcode", &nozzle, 0.1).unwrap();
+    assert!(check.is_clear(), "{:?}", check.summary);
+    let notes = check.notes.join("\n");
+    assert!(
+        notes.contains(
+            "3 move(s) pass beside the scan or over a hole in it lower than tol above its top \
+             (lines 7, 10, 11; the lowest at z 2.500 mm, line 7,"
+        ),
+        "{notes}"
+    );
+}
+
 /// A file without a move (empty, comments only, a point cloud's numbers)
 /// was checked as "clear: none of the 0 moves comes closer than tol"; it
 /// shows nothing, and now says so.
@@ -651,8 +692,8 @@ fn regression_moves_beside_the_scan_are_named() {
     let notes = check.notes.join("\n");
     assert!(
         notes.contains(&format!(
-            "3 move(s) pass beside the scan lower than tol above its top (lines 5, 6, 7; the \
-             lowest at z {:.3} mm, line 5,",
+            "3 move(s) pass beside the scan or over a hole in it lower than tol above its top \
+             (lines 5, 6, 7; the lowest at z {:.3} mm, line 5,",
             lo.z - 1.0
         )) && notes.contains("nothing is known of the part there"),
         "{notes}"
