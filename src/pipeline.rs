@@ -559,6 +559,7 @@ fn plan_stage(
     let mut uncleared = Vec::new();
     let mut floating = 0usize;
     let mut highest: (f64, DVec3) = (0.0, DVec3::ZERO);
+    let mut off_scan: (usize, Option<DVec3>) = (0, None);
     let clearance = Clearance::new(nozzle, process.tolerance_mm);
     let cap = process.tolerance_mm + CLEARANCE_CAP_ABOVE_TOL_MM;
     let mut motion = PlanMotion {
@@ -601,9 +602,27 @@ fn plan_stage(
         }
         motion.moves += moves.len().saturating_sub(1);
         motion.backward_moves += backward_moves(&piece.ta, &planned.toolpath);
-        for ((t, a), g) in planned.toolpath.iter().zip(&piece.ta).zip(&piece.geometry) {
+        for (j, ((t, a), g)) in planned
+            .toolpath
+            .iter()
+            .zip(&piece.ta)
+            .zip(&piece.geometry)
+            .enumerate()
+        {
             let side = DVec3::new(-g.v.y, g.v.x, 0.0);
             motion.max_sideways_mm = motion.max_sideways_mm.max((*t - *a).dot(side).abs());
+            // The tip runs ahead of its surface point (or behind it on an
+            // ascent, or sideways beside a steep flank): past the end of a
+            // piece, over the gap the path was split at or the scan's edge,
+            // or past a corner, its axis may leave the scan, where nothing
+            // of the part is known (QA round 6 F3: 1.04 mm past the drawn
+            // end over a scan's dropout, descending; `pcpp check` names
+            // such moves too). A tip over the drawn line near its point,
+            // which the projection found over the scan, is not asked.
+            if !near_drawn_line(&piece.ta, j, *t) && surface.highest_hit(t.truncate()).is_none() {
+                off_scan.0 += 1;
+                off_scan.1.get_or_insert(*t);
+            }
         }
         // Where the tip dispenses far above the surface right under it (d
         // over its target is what section 7 asks): planned points the
@@ -673,6 +692,19 @@ fn plan_stage(
             p.z
         ));
     }
+    if let (n, Some(p)) = off_scan {
+        warnings.push(format!(
+            "{}: {n} point(s) of the tool path put the nozzle's axis where the scan has no \
+             surface (ahead of the end of a piece, over a gap in the scan or past its edge, or \
+             stepped sideways beside a steep flank), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is \
+             known there, so the nozzle is kept clear of the scanned surface only; if the part \
+             reaches there unscanned (a scan's dropout), rescan it or move the drawing",
+            planner.name(),
+            p.x,
+            p.y,
+            p.z
+        ));
+    }
     if planner.is_guarded() {
         motion.min_clearance_mm = guarded_min;
     } else if safe_motion {
@@ -698,6 +730,33 @@ fn plan_stage(
         highest_floating: (floating > 0).then_some(highest),
         coverage: sp.coverage,
     }
+}
+
+/// How far (in XY) a tip may lie from the drawn line and still be taken
+/// as over the scan without asking it: the line's samples were found over
+/// it, and a tip this close is at most this far off it.
+const ON_LINE_MM: f64 = 0.02;
+
+/// The segments of the surface path either side of point j that
+/// [`near_drawn_line`] looks at: the tip lies at most about do from its
+/// point, a few samples.
+const LINE_WINDOW: usize = 8;
+
+/// Whether the tip `t` of point j lies within [`ON_LINE_MM`] of the drawn
+/// line (the surface path `ta` seen from above) near its point.
+fn near_drawn_line(ta: &[DVec3], j: usize, t: DVec3) -> bool {
+    let p = t.truncate();
+    let last = ta.len().saturating_sub(1);
+    let near = |k: usize| {
+        let (a, b) = (ta[k].truncate(), ta[k + 1].truncate());
+        let on = a + crate::spacing::nearest_on_segment(p, a, b) * (b - a);
+        on.distance_squared(p) <= ON_LINE_MM * ON_LINE_MM
+    };
+    // The segments nearest the point first: the one ahead, the one behind.
+    (0..LINE_WINDOW)
+        .flat_map(|i| [(j + i < last).then_some(j + i), j.checked_sub(i + 1)])
+        .flatten()
+        .any(near)
 }
 
 /// The whole plan from a registered surface and a drawn path.

@@ -525,6 +525,78 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
     assert!(e.contains("misses the scan entirely"), "{e}");
 }
 
+/// A line drawn across a gap in the scan (two plates, x 0-10 and 30-40,
+/// the left one falling towards the gap at 35 degrees, the right one
+/// rising from it at 54): the path is split at the gap, and `even`'s tip,
+/// which runs ahead of its surface point (its back offset, and the normal
+/// leaning forward on the descent) or behind it (the normal leaning back
+/// on the ascent), passes the piece's end over the gap, where nothing of
+/// the part is known (QA round 6 F3: 1.04 mm past the drawn end over a
+/// scan's dropout, descending, and not a word). The plan says how many
+/// tool-path points put the nozzle's axis off the scan, and the first;
+/// the count is the plates' own (known here without asking the scan).
+#[test]
+fn regression_the_tip_past_a_pieces_end_over_a_gap_was_not_said() {
+    let slope = 0.7;
+    let plate = |from: f64, f: &dyn Fn(f64) -> f64| {
+        height_field(
+            &range(from, from + 10.0, 40),
+            &range(0.0, 40.0, 4),
+            |x, _| f(x),
+        )
+    };
+    let mut m = plate(0.0, &|x| 10.0 - slope * x);
+    let right = plate(30.0, &|x| 3.0 + 2.0 * slope * (x - 30.0));
+    let k = m.vertices.len() as u32;
+    m.vertices.extend(right.vertices);
+    m.triangles
+        .extend(right.triangles.iter().map(|t| t.map(|i| i + k)));
+    let plates = Surface::new(m).unwrap();
+    let over = |p: &DVec3| (0.0..=10.0).contains(&p.x) || (30.0..=40.0).contains(&p.x);
+    let settings = PlanSettings::default();
+    // Across the gap, and a line starting 0.02 mm from its far edge up the
+    // rise.
+    let drawn = [
+        line(DVec2::new(2.0, 20.0), DVec2::new(38.0, 20.0)),
+        line(DVec2::new(30.02, 10.0), DVec2::new(38.0, 10.0)),
+    ];
+    let plan = pipeline::plan(&plates, &drawn, &settings).unwrap();
+    assert_eq!(plan.planner, PlannerKind::Even);
+    assert_eq!(plan.pieces.len(), 3, "{:?}", plan.warnings);
+    let off: Vec<DVec3> = (plan.pieces.iter())
+        .flat_map(|p| p.toolpath.iter().copied().filter(|t| !over(t)))
+        .collect();
+    // Past the left piece's end, and behind the start of the line up the
+    // rise.
+    assert!(off.iter().any(|t| t.x > 10.0 && t.x < 11.0), "{off:?}");
+    assert!(off.iter().any(|t| t.x > 29.0 && t.x < 30.0), "{off:?}");
+    let first = off[0];
+    let said = format!(
+        "even: {} point(s) of the tool path put the nozzle's axis where the scan has no surface \
+         (ahead of the end of a piece, over a gap in the scan or past its edge, or stepped sideways beside a \
+         steep flank), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is known there",
+        off.len(),
+        first.x,
+        first.y,
+        first.z
+    );
+    assert!(
+        plan.warnings.iter().any(|w| w.starts_with(&said)),
+        "{said}\n{:?}",
+        plan.warnings
+    );
+    // Over the scan from end to end: no such word.
+    let on = [line(DVec2::new(2.0, 20.0), DVec2::new(8.0, 20.0))];
+    let plan = pipeline::plan(&plates, &on, &settings).unwrap();
+    assert!(
+        plan.warnings
+            .iter()
+            .all(|w| !w.contains("where the scan has no surface")),
+        "{:?}",
+        plan.warnings
+    );
+}
+
 /// A drawn line across a fin narrower than the nozzle (0.3 mm wide, 5 mm
 /// tall on a flat floor): the guarded planners must lift the tip over it
 /// while dispensing, so the filament there falls from far above the floor.
