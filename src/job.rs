@@ -1641,18 +1641,30 @@ pub fn check_gcode_as(
     // outer radius between them.
     let (slo, shi) = scan.surface.bbox();
     let radius = 0.5 * nozzle.outer_diameter_mm;
-    let off_scan = |p: DVec3| {
-        p.x < slo.x
-            || p.x > shi.x
-            || p.y < slo.y
-            || p.y > shi.y
-            || scan.surface.highest_hit(p.truncate()).is_none()
+    // (The last point asked is kept: a move starts where the one before
+    // it ended.)
+    let mut last: Option<(DVec3, bool)> = None;
+    let mut off_scan = |p: DVec3| match last {
+        Some((q, off)) if q == p => off,
+        _ => {
+            let off = p.x < slo.x
+                || p.x > shi.x
+                || p.y < slo.y
+                || p.y > shi.y
+                || scan.surface.highest_hit(p.truncate()).is_none();
+            last = Some((p, off));
+            off
+        }
     };
-    let beside_scan = |m: &crate::gcode::GcodeMove| {
+    let mut beside_scan = |m: &crate::gcode::GcodeMove| {
         let steps = ((m.to - m.from).truncate().length() / radius)
             .ceil()
             .max(1.0) as usize;
-        (0..=steps).any(|i| off_scan(m.from.lerp(m.to, i as f64 / steps as f64)))
+        // Every sample asked (not stopping at the first off the scan), so
+        // that the one kept is the move's end.
+        (0..=steps)
+            .map(|i| off_scan(m.from.lerp(m.to, i as f64 / steps as f64)))
+            .fold(false, |any, off| any | off)
     };
     let beside: Vec<&crate::gcode::GcodeMove> = program
         .moves
