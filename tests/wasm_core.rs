@@ -923,6 +923,15 @@ fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
     for r in rows.iter().filter(|r| r.planner.is_guarded()) {
         assert_eq!(r.motion.touching_moves, 0, "{:?}", r.planner);
     }
+    // The refused tool path and where it was planned, for the view (QA
+    // round 7 F3): slope's own points, as a plan's view gives them.
+    let view = get(&err, "view");
+    let tool = js_sys::Float32Array::from(get(&view, "tool")).to_vec();
+    assert!(!tool.is_empty() && tool.len() % 3 == 0, "{}", tool.len());
+    let pieces = js_sys::Uint32Array::from(get(&view, "pieces")).to_vec();
+    assert_eq!(pieces.iter().sum::<u32>() as usize * 3, tool.len());
+    let placed: pcpp::svg::Placement = serde_wasm_bindgen::from_value(get(&err, "placement")).unwrap();
+    assert_eq!(placed, plan.placement);
     // Without the comparison, none is attached.
     let err = session
         .plan_live(js(&plan), "marlin", false, None, false, None)

@@ -40,7 +40,7 @@ import {
   clearError, endProgress, laterProgress, setStatus, showError, showProgress,
 } from './status.js';
 import {
-  bindView, drawPlanPaths, onPick, requestDraw, setPicking, updateDragOffset, updateMarkers,
+  bindView, drawPlanPaths, onPick, requestDraw, setPicking, showRefused, updateDragOffset, updateMarkers,
 } from './view.js';
 
 const decoder = new TextDecoder();
@@ -226,6 +226,7 @@ function restorePlan() {
     labelComparison('current');
   }
   plan.gen = state.gen;
+  dropRefused();
   offerDownloads(plan);
   labelPlan(plan, false);
   setStatus(...plannedStatus(plan));
@@ -247,6 +248,7 @@ const comparisonOf = (m, busy, series) => ({
 // screen planned on another mesh goes, its figures and paths not shown as
 // this scan's; the next plan fills them.
 function dropPlan(busy) {
+  if (state.refused && state.refused.mesh !== meshOf(busy)) dropRefused();
   // A comparison of another mesh goes too (QA round 4 F3: a refused plan's
   // comparison stayed under the next scan while its units were asked).
   const c = state.lastComparison;
@@ -260,6 +262,14 @@ function dropPlan(busy) {
   hideDownloads();
   clearPlan();
   previewPlanDropped();
+  if (state.viewShows === 'plan') drawPlanPaths();
+}
+
+// The refused plan's paths go (the next plan's, or the last plan's again,
+// are the view's).
+function dropRefused() {
+  if (!state.refused) return;
+  state.refused = null;
   if (state.viewShows === 'plan') drawPlanPaths();
 }
 
@@ -436,6 +446,7 @@ function onWorkerMessage(e) {
         if (state.info) showFiducials();
       }
       if (m.comparison) state.lastComparison = comparisonOf(m, busy, m.series);
+      state.refused = null;
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
@@ -574,7 +585,8 @@ function onPlanError(m, busy) {
     title = 'The path is too long for the page';
   } else if (m.kind === 'touching') {
     title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
-    message = ended(message) + '\nThe settings, the drawing and the previous plan stay as they were.';
+    message = ended(message) + '\nThe settings and the drawing stay as they were; the view shows the refused tool path, '
+      + 'coloured by its defects, and the figures are the previous plan\'s.';
   } else if (RISKS[m.kind]) {
     // Refused unless the risk is accepted: the box that accepts it.
     title = RISKS[m.kind];
@@ -648,25 +660,40 @@ function onPlanError(m, busy) {
     clearComparison();
   } else if (!m.comparison) labelComparison('previous');
   showScanWarnings();
-  // Nothing stale on offer; the previous plan stays on screen, where it was
-  // planned.
+  // Nothing stale on offer. A plan refused for what it planned (its
+  // motion, where it lies, how high it dispenses, the volume) is shown
+  // where its drawing lay, its points coloured by their defects, so what
+  // the refusal names can be seen and the drawing moved off it (QA round
+  // 7 F3: the view showed the bare scan, or the previous plan elsewhere);
+  // otherwise the previous plan stays on screen, where it was planned.
   hideDownloads();
-  if (state.viewer) {
+  // (Not a refusal of the scan's: its units, size, place or registration,
+  // which the drawing does not change.)
+  const ofScan = ['units', 'below-bed', 'too-large', 'whole-object', 'registration'].includes(m.kind)
+    || (m.kind === 'volume' && !toolPathOutside(m.message));
+  const refusedShown = m.stage === 'plan' && !!m.view && busy.gen === state.gen && !ofScan;
+  if (refusedShown) showRefused(m.view, m.placement, meshOf(busy));
+  else if (state.viewer) {
     state.viewer.setPathOffset(0, 0, 0);
     requestDraw();
   }
-  // The previous plan on screen is said to be that, whichever the failure.
+  // The previous plan on screen is said to be that, whichever the failure,
+  // and a refused tool path too.
+  const showing = refusedShown ? '; the refused tool path is shown where it lies'
+    : state.lastPlan ? '; showing the previous plan' : '';
   if (demoTried) {
     setStatus(`${busy.scan.name} open: the demo drawing does not print on it; open your drawing (SVG)`, false);
   } else if (unitsOffered) {
-    setStatus(`no G-code: choose the scan's units (see above)${state.lastPlan ? '; showing the previous plan' : ''}`, true);
+    setStatus(`no G-code: choose the scan's units (see above)${showing}`, true);
   } else if (offered) {
     setStatus(`no G-code: the ${toolPathOutside(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
-      state.lastPlan ? '; showing the previous plan' : ''}`, true);
+      showing}`, true);
   } else if (notRead) {
     // The scan still used, and its status, stand (it said "plan failed"
     // where nothing had been planned).
     setStatus(...busy.was);
+  } else if (refusedShown) {
+    setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }
 

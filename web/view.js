@@ -128,7 +128,7 @@ function groundPoint([px, py], zPlane) {
 // screen, else the scan's middle (in the top view any height gives the
 // same XY).
 function dragPlaneZ() {
-  const v = state.lastPlan && state.lastPlan.view;
+  const v = shownPaths() && shownPaths().view;
   if (v && v.ta.length >= 3) {
     let z = 0;
     for (let i = 2; i < v.ta.length; i += 3) z += v.ta[i];
@@ -160,7 +160,7 @@ function movePlacementTo(x, y) {
 // at the frame rate while the plan at the new placement is computed.
 export function updateDragOffset() {
   if (!state.viewer) return;
-  const p = state.lastPlan && state.lastPlan.placement;
+  const p = shownPaths() && shownPaths().placement;
   const s = settings.placement;
   let dx = 0;
   let dy = 0;
@@ -291,10 +291,22 @@ export function setViewShows(mode) {
   requestDraw();
 }
 
-// The plan on screen's paths (none before the first plan) in the view.
+// The paths the view shows: a refused plan's where its drawing lay, else
+// the last plan's (none before the first plan).
+const shownPaths = () => state.refused || state.lastPlan;
+
+// A refused plan's paths (`view`, planned at `placement` on the mesh
+// `mesh`), shown where they lay until the next plan: what the refusal
+// names can be seen, and the drawing dragged off it (QA round 7 F3).
+export function showRefused(view, placement, mesh) {
+  state.refused = { view, placement, mesh };
+  drawPlanPaths();
+}
+
+// The paths on screen (see shownPaths) in the view.
 export function drawPlanPaths() {
   if (!state.viewer) return;
-  const v = state.lastPlan && state.lastPlan.view;
+  const v = shownPaths() && shownPaths().view;
   if (v) {
     state.viewer.setPathArrays(v.pieces, v.ta, v.tool, v.defects);
     updateDragOffset();

@@ -53,6 +53,9 @@ function errorOf(err) {
   // compared on the same settings.
   if (err && err.touching) out.touching = err.touching;
   if (err && err.comparison) out.comparison = err.comparison;
+  // A refused plan's paths and placement: the page shows them.
+  if (err && err.view) out.view = err.view;
+  if (err && err.placement) out.placement = err.placement;
   return out;
 }
 

@@ -441,7 +441,9 @@ impl Session {
     /// unless `accept_risk` (an `Error` of kind `touching`, see
     /// [`core_err`]); that error also carries the `comparison` and `series`
     /// when they were asked for, so the page can compare the planners on the
-    /// settings that failed.
+    /// settings that failed. Every refusal of a plan made (touching, far
+    /// above, mostly beside the scan, out of the volume, ...) carries its
+    /// `view` (as a plan's) and the `placement` it was planned at.
     #[wasm_bindgen(js_name = planLive)]
     pub fn plan_live(
         &mut self,
@@ -513,6 +515,14 @@ impl Session {
             Ok(w) => w,
             Err(e) => {
                 let err = core_err(e);
+                // The refused tool path, and where the drawing was placed,
+                // so that the page shows what was refused where it lies
+                // (QA round 7 F3: "move the drawing off that feature" was
+                // to be done blind).
+                let _ = js_sys::Reflect::set(&err, &"view".into(), &plan_arrays(&plan).into());
+                if let Ok(placement) = to_js(&settings.placement) {
+                    let _ = js_sys::Reflect::set(&err, &"placement".into(), &placement);
+                }
                 if compare {
                     let _ = js_sys::Reflect::set(&err, &"comparison".into(), &comparison);
                     let _ = js_sys::Reflect::set(&err, &"series".into(), &series);

@@ -133,7 +133,9 @@ test('a plan whose G-code touches the part names its lines and offers nothing; a
   assert.match(message, /line \d+: the move \([-\d., ]+\) -> \([-\d., ]+\) comes too close at \([-\d., ]+\): the nozzle would have to be \d+\.\d{3} mm higher there/);
   assert.equal(await page.isHidden('#dl-gcode'), true);
   assert.equal(await page.isHidden('#dl-report'), true);
-  assert.equal(await page.textContent('#plan-status'), 'plan failed: showing the previous plan, no download');
+  // The refused tool path is in the view (QA round 7 F3).
+  assert.equal(await page.textContent('#plan-status'), 'no G-code: the refused tool path is shown where the drawing lies (see above)');
+  assert.match(message, /the view shows the refused tool path/);
   // Settings, drawing and previous plan stay.
   const afterSettings = await page.evaluate(() => [...document.querySelectorAll('.side input, .side select, .side textarea')]
     .filter((el) => el.id && el.type !== 'file').map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]));
@@ -374,10 +376,26 @@ test('a drawing mostly beside the scan is refused, and written only once the ris
   // The page fits the drawing to the new scan; moved 10 mm along X, most
   // of it lies beside the plate.
   const x = Number(await page.inputValue('#pl-x'));
+  // What the view is given to draw (its paths' tool points), from here on.
+  const minX = (tool) => { let m = Infinity; for (let i = 0; i < tool.length; i += 3) m = Math.min(m, tool[i]); return m; };
+  const planned = await page.evaluate(`(${minX})(window.pcpp.state.lastPlan.view.tool)`);
+  await page.evaluate(() => {
+    const v = window.pcpp.state.viewer;
+    const set = v.setPathArrays.bind(v);
+    window.drawnTool = null;
+    v.setPathArrays = (pieces, ta, tool, defects) => { window.drawnTool = Array.from(tool); return set(pieces, ta, tool, defects); };
+  });
   await page.fill('#pl-x', String(x + 10));
   await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 60_000 });
   await waitIdle(page);
   assert.equal(await page.textContent('#error-title'), 'Most of the drawing lies beside the scan: no G-code');
+  // The refused tool path is drawn where the drawing now lies, 10 mm on
+  // (QA round 7 F3: the view kept the previous plan where it was), and the
+  // status says so.
+  const drawn = await page.evaluate(`window.drawnTool && (${minX})(window.drawnTool)`);
+  assert.ok(drawn !== null && Math.abs(drawn - (planned + 10)) < 1, `${planned} -> ${drawn}`);
+  assert.equal(await page.evaluate(() => window.pcpp.state.refused.placement.offset_mm[0]), x + 10);
+  assert.match(await page.textContent('#plan-status'), /no G-code: the refused tool path is shown where the drawing lies/);
   const text = await page.textContent('#error-panel');
   assert.match(text, /only \d+\.\d of the drawing's \d+\.\d mm \(\d+ %\) lie over the scan/);
   // The page's words, not the command line's.
@@ -389,6 +407,8 @@ test('a drawing mostly beside the scan is refused, and written only once the ris
   assert.equal(await page.isHidden('#error-panel'), true);
   assert.match(await page.textContent('#risk-warning-text'),
     /written only because the risk was accepted: only \d+\.\d of the drawing's \d+\.\d mm \(\d+ %\) lie over the scan and are printed/);
+  // Planned: the plan's paths are the view's again.
+  assert.equal(await page.evaluate(() => window.pcpp.state.refused), null);
   assert.deepEqual(problems, []);
   await context.close();
 });
