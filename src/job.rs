@@ -1638,7 +1638,8 @@ pub fn check_gcode_as(
     // move ending over a scan's dropout inside its box was not named): the
     // moves that go there lower than tol above the scan's top are named. A
     // move is looked at where its tip's axis passes, at its ends and every
-    // outer radius between them.
+    // outer radius between them (coarser on a move longer than 1024 of
+    // them).
     let (slo, shi) = scan.surface.bbox();
     let radius = 0.5 * nozzle.outer_diameter_mm;
     // (The last point asked is kept: a move starts where the one before
@@ -1657,9 +1658,11 @@ pub fn check_gcode_as(
         }
     };
     let mut beside_scan = |m: &crate::gcode::GcodeMove| {
+        // (At most 1024 samples: a move of a kilometre, which the reader
+        // accepts, is not asked a million times.)
         let steps = ((m.to - m.from).truncate().length() / radius)
             .ceil()
-            .max(1.0) as usize;
+            .clamp(1.0, 1024.0) as usize;
         // Every sample asked (not stopping at the first off the scan), so
         // that the one kept is the move's end.
         (0..=steps)
