@@ -930,7 +930,8 @@ fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
     assert!(!tool.is_empty() && tool.len() % 3 == 0, "{}", tool.len());
     let pieces = js_sys::Uint32Array::from(get(&view, "pieces")).to_vec();
     assert_eq!(pieces.iter().sum::<u32>() as usize * 3, tool.len());
-    let placed: pcpp::svg::Placement = serde_wasm_bindgen::from_value(get(&err, "placement")).unwrap();
+    let placed: pcpp::svg::Placement =
+        serde_wasm_bindgen::from_value(get(&err, "placement")).unwrap();
     assert_eq!(placed, plan.placement);
     // Without the comparison, none is attached.
     let err = session
