@@ -1681,10 +1681,10 @@ pub fn check_gcode_as(
         let lines: Vec<usize> = beside.iter().map(|m| m.line).collect();
         notes.push(format!(
             "{} move(s) pass beside the scan or over a hole in it lower than tol above its top \
-             ({}; the lowest at z \
-             {:.3} mm, line {}, the scan's surface from z {:.3} to {:.3} mm): nothing is known \
-             of the part there, so they are checked only against the part that was scanned; if \
-             the part or what it stands on reaches there, make sure they clear it",
+             ({}; the lowest at z {:.3} mm, line {}, the scan's surface from z {:.3} to {:.3} \
+             mm): nothing is known of the part there, so they are checked only against the part \
+             that was scanned; if the part or what it stands on reaches there, make sure they \
+             clear it",
             beside.len(),
             line_list(&lines),
             lowest.from.z.min(lowest.to.z),

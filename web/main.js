@@ -586,7 +586,7 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'touching') {
     title = `The nozzle would touch the part with ${busy.planner}: no G-code`;
     message = ended(message) + '\nThe settings and the drawing stay as they were; the view shows the refused tool path, '
-      + 'coloured by its defects, and the figures are the previous plan\'s.';
+      + `coloured by its defects${state.lastPlan ? ', and the figures are the previous plan\'s' : ''}.`;
   } else if (RISKS[m.kind]) {
     // Refused unless the risk is accepted: the box that accepts it.
     title = RISKS[m.kind];
