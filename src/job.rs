@@ -1294,6 +1294,15 @@ pub fn write_outputs(
                     },
                 }
             }
+            // The scan inside, the travel height over it above the volume
+            // (QA round 8 F5: "Planning failed", with nothing to do).
+            GcodeError::SafeHeightOutOfVolume { .. } => Error::OutsideVolume {
+                source: Box::new(e),
+                fit: "the scan lies inside the build volume, but the travel height over it does \
+                      not: lower the scan (placed on the bed, its Move Z: --place-scan \
+                      bed,DX,DY,DZ), or use a profile whose build volume is taller"
+                    .into(),
+            },
             // The scan inside, the tool path beside it outside: a drawing
             // up to the edge of a scan that lies against the volume's side
             // (the nozzle passes beside the edge, and waypoints step off).
@@ -1664,9 +1673,14 @@ pub fn check_gcode_as(
             .ceil()
             .clamp(1.0, 1024.0) as usize;
         // Every sample asked (not stopping at the first off the scan), so
-        // that the one kept is the move's end.
+        // that the one kept is the move's end; named where it is off the
+        // scan and low at once (QA round 8 F3: a descent high over a hole,
+        // low only over the scan, was named).
         (0..=steps)
-            .map(|i| off_scan(m.from.lerp(m.to, i as f64 / steps as f64)))
+            .map(|i| {
+                let p = m.from.lerp(m.to, i as f64 / steps as f64);
+                off_scan(p) && p.z < high
+            })
             .fold(false, |any, off| any | off)
     };
     let beside: Vec<&crate::gcode::GcodeMove> = program
@@ -2365,6 +2379,46 @@ mod tests {
         assert!(matches!(run(0.0), Error::FarAbove { .. }), "{}", run(0.0));
         let off = run(500.0);
         assert!(matches!(off, Error::OutsideVolume { .. }), "{off}");
+    }
+
+    /// QA round 8 F5: a scan inside the build volume whose travel height
+    /// (its top plus the clearance) is above it was refused as "Planning
+    /// failed", with nothing to do; it is refused as out of the volume
+    /// (the page's kind `volume`), saying to lower the scan.
+    #[test]
+    fn a_travel_height_above_the_volume_says_to_lower_the_scan() {
+        let axis: Vec<f64> = (0..=20).map(|i| 50.0 + f64::from(i)).collect();
+        let mesh = crate::mesh::TriMesh::height_field(&axis, &axis, |_, _| 248.0);
+        let scan = prepared_glb(&mesh, "high.glb");
+        let line = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M 0 5 H 10" stroke="black" fill="none"/></svg>"#;
+        let settings = PlanSettings {
+            placement: crate::svg::Placement {
+                offset_mm: glam::DVec2::new(55.0, 65.0),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let e = run_on(
+            &scan,
+            line.as_bytes(),
+            "line.svg",
+            &settings,
+            &profile,
+            false,
+        )
+        .err()
+        .expect("refused");
+        assert!(matches!(e, Error::OutsideVolume { .. }), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("safe travel height")
+                && text.contains(
+                    "the scan lies inside the build volume, but the travel height over it does \
+                     not: lower the scan"
+                ),
+            "{text}"
+        );
     }
 
     /// `mesh` as a GLB named `name`, prepared unregistered.

@@ -564,7 +564,8 @@ fn demo_scan() -> pcpp::job::PreparedScan {
 /// known of the part either, and a print move ending over a scan's
 /// dropout was not named. A plate with a 10 mm hole in its middle: a move
 /// across the hole, and one ending over it, are named; moves over the
-/// plate around it, and one high over the hole, are not.
+/// plate around it, one high over the hole, and one descending from high
+/// over the hole to low over the plate (QA round 8 F3), are not.
 #[test]
 fn regression_moves_over_a_hole_in_the_scan_are_named() {
     use pcpp::job::check_gcode;
@@ -588,7 +589,7 @@ fn regression_moves_over_a_hole_in_the_scan_are_named() {
     .unwrap();
     let nozzle = pcpp::Nozzle::DEFAULT;
     let program = "G21\nG90\nG0 X5 Y5 Z10\nG1 Z2.5\nG1 X28 Y5\nG1 X28 Y20\nG1 X5 Y20\n\
-                   G1 X5 Y35\nG1 X19 Y35\nG1 X19 Y20\nG0 Z10\nG0 X20 Y20 Z10\n";
+                   G1 X5 Y35\nG1 X19 Y35\nG1 X19 Y20\nG0 Z10\nG0 X20 Y20 Z10\nG1 X5 Y20 Z2.5\n";
     let check = check_gcode(&scan, program, "holed.gcode", &nozzle, 0.1).unwrap();
     assert!(check.is_clear(), "{:?}", check.summary);
     let notes = check.notes.join("\n");
