@@ -696,10 +696,10 @@ fn plan_stage(
         warnings.push(format!(
             "{}: {n} point(s) of the tool path put the nozzle's axis where the scan has no \
              surface (ahead of the end of a piece, over a gap in the scan or past its edge, or \
-             stepped sideways beside a steep flank), the first at ({:.3}, {:.3}, {:.3}): \
-             nothing of the part is known there, so the nozzle is kept clear of the scanned \
-             surface only; if the part reaches there unscanned (a scan's dropout), rescan it or \
-             move the drawing",
+             stepped sideways beside a steep flank; those over a gap the path bridges are in \
+             that gap's warning), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is \
+             known there, so the nozzle is kept clear of the scanned surface only; if the part \
+             reaches there unscanned (a scan's dropout), rescan it or move the drawing",
             planner.name(),
             p.x,
             p.y,
