@@ -592,8 +592,11 @@ function onPlanError(m, busy) {
     title = RISKS[m.kind];
     message = ended(message) + '\nTo write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).';
   } else if (m.kind === 'volume') {
-    // (QA round 5 N3: "Planning failed" for a scan larger than the volume.)
-    title = 'The tool path would leave the printer\'s build volume: no G-code';
+    // (QA round 5 N3: "Planning failed" for a scan larger than the volume;
+    // QA round 8 F5: the tool path blamed for the scan's place or size.)
+    title = /the scan lies outside the build volume/.test(m.message)
+      ? 'The scan lies outside the printer\'s build volume: no G-code'
+      : 'The tool path would leave the printer\'s build volume: no G-code';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';
@@ -673,9 +676,13 @@ function onPlanError(m, busy) {
     || (m.kind === 'volume' && !toolPathOutside(m.message));
   const refusedShown = m.stage === 'plan' && !!m.view && busy.gen === state.gen && !ofScan;
   if (refusedShown) showRefused(m.view, m.placement, meshOf(busy));
-  else if (state.viewer) {
-    state.viewer.setPathOffset(0, 0, 0);
-    requestDraw();
+  else {
+    // An earlier refusal's paths are not this failure's (QA round 8 F1).
+    dropRefused();
+    if (state.viewer) {
+      state.viewer.setPathOffset(0, 0, 0);
+      requestDraw();
+    }
   }
   // The previous plan on screen is said to be that, whichever the failure,
   // and a refused tool path too.

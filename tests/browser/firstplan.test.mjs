@@ -221,7 +221,8 @@ test('a scan larger than the build volume is an error about the scan, not the de
     null, { timeout: 120_000 });
   await waitIdle(page);
   assert.equal(await page.isHidden('#error-panel'), false);
-  assert.equal(await page.textContent('#error-title'), 'The tool path would leave the printer\'s build volume: no G-code');
+  // (The scan's, not the tool path's: QA round 8 F5.)
+  assert.equal(await page.textContent('#error-title'), 'The scan lies outside the printer\'s build volume: no G-code');
   assert.match(await page.textContent('#error-message'), /larger than the volume/);
   assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
   assert.deepEqual(problems, []);

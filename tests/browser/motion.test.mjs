@@ -183,6 +183,30 @@ test('a plan whose G-code touches the part names its lines and offers nothing; a
   await context.close();
 });
 
+// QA round 8 F1: after a refusal, a failure with no tool path of its own
+// (the drawing moved off the scan) kept the refused path in the view under
+// "showing the previous plan".
+test('a failure with no tool path of its own takes a refused one out of the view', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.selectOption('#demo-part', 'stepped-block');
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
+  await waitSettled(page);
+  await page.selectOption('#planner', 'slope');
+  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
+    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.refused !== null), true);
+  await page.fill('#pl-x', '500');
+  await page.waitForFunction(() => /misses the scan/.test(document.getElementById('error-message').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.refused), null);
+  assert.equal(await page.textContent('#plan-status'), 'plan failed: showing the previous plan, no download');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('a G-code file is checked against the scan: the demo\'s own is clear, a cutting move and an arc are named by line', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
