@@ -316,11 +316,21 @@ pub enum GcodeLineProblem {
 
 use GcodeLineProblem as P;
 
+/// A statement's text before its comment (`;`, `'` or `//`), trimmed.
+fn without_comment(text: &str) -> &str {
+    let end = [text.find(';'), text.find('\''), text.find("//")]
+        .into_iter()
+        .flatten()
+        .min()
+        .unwrap_or(text.len());
+    text[..end].trim()
+}
+
 /// Whether `text` (a statement's text, comments allowed after it) is an
 /// Aerotech digital output set, `$DO[n].AXIS = value` with a number for
 /// the value: it switches an output, and moves nothing.
 fn is_output_set(text: &str) -> bool {
-    let code = text.find([';', '\'']).map_or(text, |k| &text[..k]).trim();
+    let code = without_comment(text);
     let Some(rest) = code.get(..4).filter(|p| p.eq_ignore_ascii_case("$DO[")) else {
         return false;
     };
@@ -341,7 +351,7 @@ fn is_output_set(text: &str) -> bool {
 /// Whether `text` is an Aerotech dwell, `DWELL <seconds>`: the nozzle
 /// stands still.
 fn is_dwell(text: &str) -> bool {
-    let code = text.find([';', '\'']).map_or(text, |k| &text[..k]).trim();
+    let code = without_comment(text);
     code.get(..5)
         .is_some_and(|k| k.eq_ignore_ascii_case("DWELL"))
         && code[5..].starts_with(char::is_whitespace)
@@ -2238,8 +2248,9 @@ mod tests {
     /// silently; a statement only like them is still noted.
     #[test]
     fn aerotech_output_sets_and_dwells_are_known_to_move_nothing() {
+        // (With AeroBasic's `//` comment too: QA round 8 F7.)
         let own = "G71\nG76\nG90\n$DO[0].X = 0\nG0 X0 Y0 Z5\n$DO[0].X = 1 ' on\nDWELL 0.25\n\
-                   G1 X1 F5\n$do[12].Y=0\ndwell 2\n$DO[0].X = 0\nM2\n";
+                   G1 X1 F5\n$do[12].Y=0\ndwell 2 // wait\n$DO[0].X = 0 // off\nM2\n";
         let p = read(own);
         assert_eq!((p.unknown_moves.len(), p.moves.len()), (1, 1));
         assert!(
