@@ -1651,8 +1651,8 @@ pub fn check_gcode_as(
     // them).
     let (slo, shi) = scan.surface.bbox();
     let radius = 0.5 * nozzle.outer_diameter_mm;
-    // (The last point asked is kept: a move starts where the one before
-    // it ended.)
+    // (The last point asked is kept: a move often starts where the one
+    // before it ended.)
     let mut last: Option<(DVec3, bool)> = None;
     let mut off_scan = |p: DVec3| match last {
         Some((q, off)) if q == p => off,
@@ -1672,16 +1672,12 @@ pub fn check_gcode_as(
         let steps = ((m.to - m.from).truncate().length() / radius)
             .ceil()
             .clamp(1.0, 1024.0) as usize;
-        // Every sample asked (not stopping at the first off the scan), so
-        // that the one kept is the move's end; named where it is off the
-        // scan and low at once (QA round 8 F3: a descent high over a hole,
-        // low only over the scan, was named).
-        (0..=steps)
-            .map(|i| {
-                let p = m.from.lerp(m.to, i as f64 / steps as f64);
-                off_scan(p) && p.z < high
-            })
-            .fold(false, |any, off| any | off)
+        // Named where it is off the scan and low at once (QA round 8 F3: a
+        // descent high over a hole, low only over the scan, was named).
+        (0..=steps).any(|i| {
+            let p = m.from.lerp(m.to, i as f64 / steps as f64);
+            p.z < high && off_scan(p)
+        })
     };
     let beside: Vec<&crate::gcode::GcodeMove> = program
         .moves

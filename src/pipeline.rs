@@ -696,8 +696,8 @@ fn plan_stage(
         warnings.push(format!(
             "{}: {n} point(s) of the tool path put the nozzle's axis where the scan has no \
              surface (ahead of the end of a piece, over a gap in the scan or past its edge, or \
-             stepped sideways beside a steep flank; those over a gap the path bridges are in \
-             that gap's warning), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is \
+             stepped sideways beside a steep flank; those on the drawn line over a gap it \
+             bridges are in that gap's warning), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is \
              known there, so the nozzle is kept clear of the scanned surface only; if the part \
              reaches there unscanned (a scan's dropout), rescan it or move the drawing",
             planner.name(),
@@ -735,7 +735,8 @@ fn plan_stage(
 
 /// How far (in XY) a tip may lie from the drawn line and still be taken
 /// as over the scan without asking it: the line's samples were found over
-/// it, and a tip this close is at most this far off it.
+/// it (or over a gap shorter than do that the projection bridged, which
+/// has its own warning), and a tip this close is at most this far off it.
 const ON_LINE_MM: f64 = 0.02;
 
 /// The segments of the surface path either side of point j that

@@ -68,8 +68,9 @@ fn js_err(e: impl std::fmt::Display) -> JsError {
 /// be read, `touching` for G-code refused by the motion check,
 /// `whole-object` for G-code refused on a point cloud of a whole object,
 /// `units`, `below-bed`, `too-large`, `far-above` and `mostly-off` for the
-/// other refusals that accepting the risk lifts, `volume` for a tool path out of
-/// the build volume, or `other`):
+/// other refusals that accepting the risk lifts, `volume` for a tool path
+/// out of the build volume (the scan outside it, its travel height above
+/// it, or the tool path beside it), or `other`):
 /// the page drops a file whose bytes could not be read but keeps one that
 /// only failed to register. A `touching` error also carries `touching`, the
 /// check's summary (`motion::MotionSummary`: the first touching moves with

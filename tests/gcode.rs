@@ -563,7 +563,8 @@ fn demo_scan() -> pcpp::job::PreparedScan {
 /// QA round 6 F3: inside the scan's box, over a hole in it, nothing is
 /// known of the part either, and a print move ending over a scan's
 /// dropout was not named. A plate with a 10 mm hole in its middle: a move
-/// across the hole, and one ending over it, are named; moves over the
+/// across the hole, one ending over it and the rise out of it, are named;
+/// moves over the
 /// plate around it, one high over the hole, and one descending from high
 /// over the hole to low over the plate (QA round 8 F3), are not.
 #[test]

@@ -574,8 +574,8 @@ fn regression_the_tip_past_a_pieces_end_over_a_gap_was_not_said() {
     let said = format!(
         "even: {} point(s) of the tool path put the nozzle's axis where the scan has no \
          surface (ahead of the end of a piece, over a gap in the scan or past its edge, or \
-         stepped sideways beside a steep flank; those over a gap the path bridges are in that \
-         gap's warning), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is known there",
+         stepped sideways beside a steep flank; those on the drawn line over a gap it bridges \
+         are in that gap's warning), the first at ({:.3}, {:.3}, {:.3}): nothing of the part is known there",
         off.len(),
         first.x,
         first.y,

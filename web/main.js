@@ -25,7 +25,7 @@ import {
 import {
   bannerOffers, cancelCentre, capital, centreRequest, initPlacement, noteDefaultUnits, noteDefaultUp, onCarried, onCentred, planOutcome,
   requestCentre, showFitNote,
-  showScanPlacement, toolPathOutside, unitsBannerShown, userPlacements,
+  showScanPlacement, toolPathOutside, unitsBannerShown, userPlacements, volumeCause,
 } from './placement.js';
 import {
   bindPreview, onPreview, previewCheckShown, previewClick, previewPlanDropped, previewPlanShown, syncPreviewButton,
@@ -40,7 +40,7 @@ import {
   clearError, endProgress, laterProgress, setStatus, showError, showProgress,
 } from './status.js';
 import {
-  bindView, drawPlanPaths, onPick, requestDraw, setPicking, showRefused, updateDragOffset, updateMarkers,
+  bindView, drawPlanPaths, dropRefused, onPick, requestDraw, setPicking, showRefused, updateDragOffset, updateMarkers,
 } from './view.js';
 
 const decoder = new TextDecoder();
@@ -265,14 +265,6 @@ function dropPlan(busy) {
   if (state.viewShows === 'plan') drawPlanPaths();
 }
 
-// The refused plan's paths go (the next plan's, or the last plan's again,
-// are the view's).
-function dropRefused() {
-  if (!state.refused) return;
-  state.refused = null;
-  if (state.viewShows === 'plan') drawPlanPaths();
-}
-
 function finish() {
   state.busy = null;
   endProgress();
@@ -446,7 +438,7 @@ function onWorkerMessage(e) {
         if (state.info) showFiducials();
       }
       if (m.comparison) state.lastComparison = comparisonOf(m, busy, m.series);
-      state.refused = null;
+      dropRefused(false);
       showPlan(state.lastPlan);
       if (busy.gen === state.gen) {
         offerDownloads(state.lastPlan);
@@ -594,9 +586,11 @@ function onPlanError(m, busy) {
   } else if (m.kind === 'volume') {
     // (QA round 5 N3: "Planning failed" for a scan larger than the volume;
     // QA round 8 F5: the tool path blamed for the scan's place or size.)
-    title = /the scan lies outside the build volume/.test(m.message)
-      ? 'The scan lies outside the printer\'s build volume: no G-code'
-      : 'The tool path would leave the printer\'s build volume: no G-code';
+    title = {
+      scan: 'The scan lies outside the printer\'s build volume: no G-code',
+      travel: 'The travel height over the scan would leave the printer\'s build volume: no G-code',
+      'tool-path': 'The tool path would leave the printer\'s build volume: no G-code',
+    }[volumeCause(m.message)];
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';
@@ -670,23 +664,30 @@ function onPlanError(m, busy) {
   // 7 F3: the view showed the bare scan, or the previous plan elsewhere);
   // otherwise the previous plan stays on screen, where it was planned.
   hideDownloads();
-  // (Not a refusal of the scan's: its units, size, place or registration,
-  // which the drawing does not change.)
+  // (Not a refusal of the scan's: its units, size, place, travel height
+  // or registration, which the drawing does not change.) Shown whatever
+  // the request's generation, as a plan is: while the drawing is dragged,
+  // most answers are of a placement already left.
   const ofScan = ['units', 'below-bed', 'too-large', 'whole-object', 'registration'].includes(m.kind)
-    || (m.kind === 'volume' && !toolPathOutside(m.message));
-  const refusedShown = m.stage === 'plan' && !!m.view && busy.gen === state.gen && !ofScan;
-  if (refusedShown) showRefused(m.view, m.placement, meshOf(busy));
-  else {
-    // An earlier refusal's paths are not this failure's (QA round 8 F1).
-    dropRefused();
-    if (state.viewer) {
+    || (m.kind === 'volume' && volumeCause(m.message) !== 'tool-path');
+  const refusedShown = m.stage === 'plan' && !!m.view && !ofScan;
+  if (refusedShown) {
+    showRefused(m.view, m.placement, meshOf(busy), busy.gen === state.gen ? currentInputs() : null);
+  } else {
+    // An earlier refusal's paths are not this failure's (QA round 8 F1),
+    // unless nothing they were planned from changed (a file that could not
+    // be read, the one before kept).
+    const r = state.refused;
+    if (r && (!r.inputs || r.inputs !== currentInputs())) dropRefused();
+    if (!state.refused && state.viewer) {
       state.viewer.setPathOffset(0, 0, 0);
       requestDraw();
     }
   }
   // The previous plan on screen is said to be that, whichever the failure,
-  // and a refused tool path too.
-  const showing = refusedShown ? '; the refused tool path is shown where it lies'
+  // and a refused tool path too (this one's, or one kept).
+  const refusedOnScreen = !!state.refused;
+  const showing = refusedOnScreen ? '; the refused tool path is shown where it lies'
     : state.lastPlan ? '; showing the previous plan' : '';
   if (demoTried) {
     setStatus(`${busy.scan.name} open: the demo drawing does not print on it; open your drawing (SVG)`, false);
@@ -699,7 +700,7 @@ function onPlanError(m, busy) {
     // The scan still used, and its status, stand (it said "plan failed"
     // where nothing had been planned).
     setStatus(...busy.was);
-  } else if (refusedShown) {
+  } else if (refusedOnScreen) {
     setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
 }

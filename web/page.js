@@ -118,8 +118,9 @@ export const state = {
   gen: 0,
   planId: 0,
   lastPlan: null,
-  // A refused plan's paths where the drawing lay ({view, placement, mesh}),
-  // shown instead of the last plan's until the next plan (QA round 7 F3).
+  // A refused plan's paths where the drawing lay ({view, placement, mesh,
+  // inputs}), shown instead of the last plan's (QA round 7 F3; see
+  // view.js showRefused, dropRefused).
   refused: null,
   // Workers started so far: a plan's report is asked of the worker that
   // made it (a restarted one holds none).

@@ -440,6 +440,14 @@ export function planOutcome(message, gen) {
 // the build volume (not the scan's own).
 export const toolPathOutside = (message) => BESIDE.test(String(message));
 
+// What a build-volume refusal's `message` is of: 'tool-path' (beside a
+// scan inside the volume), 'travel' (the travel height over a scan inside
+// it: the core says to lower the scan) or 'scan' (its place or size).
+export function volumeCause(message) {
+  if (toolPathOutside(message)) return 'tool-path';
+  return /the travel height over it does not/.test(String(message)) ? 'travel' : 'scan';
+}
+
 // Whether the banner on screen offers the fix for the planning error
 // `message` (the core's sentence on the scan outside the build volume is
 // part of it): the banner says it better, with its button.

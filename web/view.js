@@ -296,11 +296,22 @@ export function setViewShows(mode) {
 const shownPaths = () => state.refused || state.lastPlan;
 
 // A refused plan's paths (`view`, planned at `placement` on the mesh
-// `mesh`), shown where they lay until the next plan: what the refusal
-// names can be seen, and the drawing dragged off it (QA round 7 F3).
-export function showRefused(view, placement, mesh) {
-  state.refused = { view, placement, mesh };
-  drawPlanPaths();
+// `mesh`, from the settings `inputs` when they were the page's), shown
+// where they lay instead of the last plan's: what the refusal names can
+// be seen, and the drawing dragged off it (QA round 7 F3). Drawn now if
+// the view shows the plan (a checked program or the preview stays).
+export function showRefused(view, placement, mesh, inputs) {
+  state.refused = { view, placement, mesh, inputs };
+  if (state.viewShows === 'plan') drawPlanPaths();
+}
+
+// The refused plan's paths go (the next plan's, or the last plan's again,
+// are the view's), redrawn unless `redraw` is false (a plan about to be
+// drawn).
+export function dropRefused(redraw = true) {
+  if (!state.refused) return;
+  state.refused = null;
+  if (redraw && state.viewShows === 'plan') drawPlanPaths();
 }
 
 // The paths on screen (see shownPaths) in the view.

@@ -307,8 +307,7 @@ async function plan(m) {
     const r = session.planLive(m.plan, m.dialect, m.acceptRisk, m.profileFile, m.compare, false);
     const planMs = performance.now() - t0;
     const v = r.view;
-    const transfer = [r.gcode.buffer, v.pieces.buffer, v.ta.buffer, v.tool.buffer,
-      v.defects.buffer, v.slope.buffer, v.kappa.buffer, v.error.buffer];
+    const transfer = [r.gcode.buffer, ...viewBuffers(v)];
     for (const sr of r.series || []) transfer.push(sr.error.buffer, sr.defects.buffer);
     post({
       type: 'result', id, gcode: r.gcode, reportId: r.reportId, summary: r.summary, view: v,
@@ -316,9 +315,14 @@ async function plan(m) {
     }, transfer);
     post({ type: 'done', id });
   } catch (err) {
-    post({ type: 'error', id, stage, ...errorOf(err) });
+    const e = errorOf(err);
+    post({ type: 'error', id, stage, ...e }, e.view ? viewBuffers(e.view) : []);
   }
 }
+
+// The buffers of a plan's view (its typed arrays), transferred.
+const viewBuffers = (v) => [v.pieces.buffer, v.ta.buffer, v.tool.buffer, v.defects.buffer, v.slope.buffer,
+  v.kappa.buffer, v.error.buffer];
 
 // A G-code program (a File, read here like the scan, never on the page's
 // main thread; or bytes the page sent) given to `run` on the session's

@@ -1410,8 +1410,7 @@ impl<'f> Reader<'f> {
             _ => {
                 let note = self.notes.add(NoteKind::NotGcode, n);
                 if note.example.is_empty() {
-                    let shown = text.find([';', '\'']).map_or(text, |k| &text[..k]);
-                    note.example = clip(shown.trim_end());
+                    note.example = clip(without_comment(text));
                 }
                 Ok(())
             }

@@ -197,6 +197,15 @@ test('a failure with no tool path of its own takes a refused one out of the view
     && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
   await waitIdle(page);
   assert.equal(await page.evaluate(() => window.pcpp.state.refused !== null), true);
+  // A drawing that cannot be read changes nothing the refusal was planned
+  // from (the drawing before it is kept): the refused path stays, and the
+  // status says so (a reviewer's finding on QA round 8 F1's fix).
+  await page.setInputFiles('#svg-input', { name: 'bad.svg', mimeType: 'image/svg+xml', buffer: Buffer.from('<svg') });
+  await page.waitForFunction(() => /Could not read the SVG/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.refused !== null), true);
+  assert.equal(await page.textContent('#plan-status'), 'no G-code: the refused tool path is shown where the drawing lies (see above)');
   await page.fill('#pl-x', '500');
   await page.waitForFunction(() => /misses the scan/.test(document.getElementById('error-message').textContent),
     null, { timeout: 120_000 });
