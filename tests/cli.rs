@@ -858,15 +858,21 @@ fn quiet_silences_progress_on_a_terminal() {
 
 // ------------------------------------------------------------------ check
 
+/// `pcpp check` of `gcode` against `scan` with `flags`.
+fn check_on(scan: &Path, gcode: &Path, flags: &[&str]) -> Output {
+    let mut args = vec!["check", "--scan", s(scan), "--gcode", s(gcode)];
+    args.extend(flags);
+    pcpp(&args)
+}
+
 /// `pcpp check` of `gcode` against the demo scan, with a JSON report where
 /// given.
 fn check_on_demo(gcode: &Path, report: Option<&Path>) -> Output {
     let scan = demo_file(demo::DEMO_SCAN_NAME);
-    let mut args = vec!["check", "--scan", s(&scan), "--gcode", s(gcode)];
-    if let Some(r) = report {
-        args.extend(["--report", s(r)]);
+    match report {
+        Some(r) => check_on(&scan, gcode, &["--report", s(r)]),
+        None => check_on(&scan, gcode, &[]),
     }
-    pcpp(&args)
 }
 
 #[test]
@@ -946,15 +952,7 @@ fn check_takes_the_nozzle_the_programs_header_names() {
     );
     // One value given: the others are still the header's.
     let scan = demo_file(demo::DEMO_SCAN_NAME);
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&scan),
-        "--gcode",
-        s(&gcode),
-        "--nozzle-id",
-        "1.2",
-    ]);
+    let o = check_on(&scan, &gcode, &["--nozzle-id", "1.2"]);
     assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
     assert!(
         stderr(&o).contains(
@@ -1627,13 +1625,7 @@ fn a_gltf_with_its_bin_beside_it_plans_like_the_glb() {
     };
     assert_eq!(rest(&a), rest(&b));
     // The other commands that read a scan.
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&gltf),
-        "--gcode",
-        s(&dir.join("separate.gcode")),
-    ]);
+    let o = check_on(&gltf, &dir.join("separate.gcode"), &[]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let o = pcpp(&["fiducials", "--scan", s(&gltf)]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
@@ -2361,15 +2353,11 @@ fn regression_a_latin1_byte_in_a_comment_refused_the_whole_program() {
     );
     let profile = dir.join("machine.json");
     std::fs::write(&profile, b"{\n  \"name\": \"caf\xe9\"\n}\n").unwrap();
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&demo_file(demo::DEMO_SCAN_NAME)),
-        "--gcode",
-        s(&demo_file("demo-even.gcode")),
-        "--profile",
-        s(&profile),
-    ]);
+    let o = check_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &demo_file("demo-even.gcode"),
+        &["--profile", s(&profile)],
+    );
     assert_eq!(code(&o), 1);
     assert!(
         stderr(&o).contains(
@@ -2713,15 +2701,7 @@ fn check_names_the_units_the_program_was_planned_with() {
         "{err}"
     );
     assert!(err.contains("read in mm: check its units"), "{err}");
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&scan),
-        "--gcode",
-        s(&gcode),
-        "--scan-units",
-        "m",
-    ]);
+    let o = check_on(&scan, &gcode, &["--scan-units", "m"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -2932,15 +2912,7 @@ fn check_reads_a_grbl_program_as_grbl_does() {
         "{}",
         stderr(&o)
     );
-    let o = pcpp(&[
-        "check",
-        "--scan",
-        s(&scan),
-        "--gcode",
-        s(&gcode),
-        "--dialect",
-        "grbl",
-    ]);
+    let o = check_on(&scan, &gcode, &["--dialect", "grbl"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let out = stdout(&o);
     assert!(
