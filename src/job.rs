@@ -2347,7 +2347,6 @@ mod tests {
             }
         };
         let line = r#"<svg xmlns="http://www.w3.org/2000/svg" width="60mm" height="10mm" viewBox="0 0 60 10"><path d="M 0 5 H 60" stroke="black" fill="none"/></svg>"#;
-        let profile = MachineProfile::builtin("marlin").unwrap();
         let run = |dx: f64| {
             let mut mesh = crate::mesh::TriMesh::height_field(&axis, &axis, post);
             for v in &mut mesh.vertices {
@@ -2361,16 +2360,7 @@ mod tests {
                 },
                 ..Default::default()
             };
-            run_on(
-                &scan,
-                line.as_bytes(),
-                "line.svg",
-                &settings,
-                &profile,
-                false,
-            )
-            .err()
-            .expect("refused")
+            refused_line(&scan, line, &settings)
         };
         assert!(matches!(run(0.0), Error::FarAbove { .. }), "{}", run(0.0));
         let off = run(500.0);
@@ -2394,17 +2384,7 @@ mod tests {
             },
             ..Default::default()
         };
-        let profile = MachineProfile::builtin("marlin").unwrap();
-        let e = run_on(
-            &scan,
-            line.as_bytes(),
-            "line.svg",
-            &settings,
-            &profile,
-            false,
-        )
-        .err()
-        .expect("refused");
+        let e = refused_line(&scan, line, &settings);
         assert!(matches!(e, Error::OutsideVolume { .. }), "{e}");
         let text = e.to_string();
         assert!(
@@ -2415,6 +2395,15 @@ mod tests {
                 ),
             "{text}"
         );
+    }
+
+    /// The refusal of the drawing `svg` planned on `scan` with `settings`
+    /// for marlin, the risk not accepted.
+    fn refused_line(scan: &PreparedScan, svg: &str, settings: &PlanSettings) -> Error {
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        run_on(scan, svg.as_bytes(), "line.svg", settings, &profile, false)
+            .err()
+            .expect("refused")
     }
 
     /// `mesh` as a GLB named `name`, prepared unregistered.
