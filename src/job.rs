@@ -1424,6 +1424,13 @@ pub struct GcodeCheck {
     /// the header's WARNING).
     #[serde(default)]
     pub written_at_risk: Option<String>,
+    /// Moves that pass beside the scan or over a hole in it lower than tol
+    /// above its top (named in `notes`): clear of the scanned surface, but
+    /// nothing is known of the part there, so a clear check says them
+    /// beside its verdict (QA round 8 F4: a green "clear" over a note of
+    /// moves dispensing into a dropout).
+    #[serde(default)]
+    pub off_scan_moves: usize,
     /// The straight moves followed, in file order (the touching moves'
     /// `index` points into them): for drawing; not in the JSON.
     #[serde(skip)]
@@ -1684,6 +1691,7 @@ pub fn check_gcode_as(
         .iter()
         .filter(|m| m.from.z.min(m.to.z) < high && beside_scan(m))
         .collect();
+    let off_scan_moves = beside.len();
     if let Some(lowest) = beside
         .iter()
         .min_by(|a, b| a.from.z.min(a.to.z).total_cmp(&b.from.z.min(b.to.z)))
@@ -1737,6 +1745,7 @@ pub fn check_gcode_as(
                 l.split_once("WARNING: written only because the risk was accepted: ")?;
             Some(risks.to_string())
         }),
+        off_scan_moves,
         moves: program.moves,
     })
 }

@@ -875,6 +875,41 @@ fn check_on_demo(gcode: &Path, report: Option<&Path>) -> Output {
     }
 }
 
+/// QA round 8 F4: a program clear of the scanned surface but dispensing
+/// beside it was called clear with no word beside the verdict (the note
+/// was among the warnings): the verdict says it, and the exit stays 0.
+#[test]
+fn check_verdict_says_the_moves_beside_the_scan() {
+    let dir = temp_dir("check-beside");
+    let gcode = dir.join("beside.gcode");
+    let (lo, hi) = demo::test_part::test_part().bbox().unwrap();
+    let text = format!(
+        "G21\nG90\nG0 X40 Y40 Z{top}\nG0 X{x} Y40 Z{top}\nG1 Z{low}\nG1 X{far} Y40\nG0 Z{top}\n",
+        top = hi.z + 20.0,
+        x = hi.x + 40.0,
+        low = lo.z - 1.0,
+        far = hi.x + 50.0,
+    );
+    std::fs::write(&gcode, text).unwrap();
+    let o = check_on_demo(&gcode, None);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains(
+            "no move comes closer than tol to the scanned surface, but 3 move(s) pass beside \
+             the scan or over a hole in it, where nothing is known of the part (named above)"
+        ),
+        "{out}"
+    );
+    // Over the scan only: the verdict as before.
+    let o = check_on_demo(&demo_file("demo-even.gcode"), None);
+    let out = stdout(&o);
+    assert!(
+        out.contains("no move comes closer than tol") && !out.contains("beside"),
+        "{out}"
+    );
+}
+
 #[test]
 fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
     for name in ["demo-even.gcode", "demo-pcpp-guarded.gcode"] {

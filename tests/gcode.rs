@@ -601,6 +601,8 @@ fn regression_moves_over_a_hole_in_the_scan_are_named() {
         ),
         "{notes}"
     );
+    // Counted for the verdict (QA round 8 F4).
+    assert_eq!(check.off_scan_moves, 3);
 }
 
 /// A file without a move (empty, comments only, a point cloud's numbers)
@@ -700,6 +702,7 @@ fn regression_moves_beside_the_scan_are_named() {
         )) && notes.contains("nothing is known of the part there"),
         "{notes}"
     );
+    assert_eq!(check.off_scan_moves, 3);
     // Over the scan, or high above it: no such note.
     let over = format!(
         "G21\nG90\nG0 X40 Y40 Z{top}\nG0 X{x} Y40 Z{top}\n",
@@ -711,6 +714,7 @@ fn regression_moves_beside_the_scan_are_named() {
         "{:?}",
         check.notes
     );
+    assert_eq!(check.off_scan_moves, 0);
 }
 
 /// QA round 2: a program planned on a 44 mm cow (the scan read in inches,

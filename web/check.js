@@ -65,7 +65,14 @@ export function onCheck(m) {
   const sum = c.summary;
   const verdict = $('check-verdict');
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
-  verdict.textContent = c.clear
+  // Clear of what was scanned, not of what was not (QA round 8 F4).
+  const off = c.off_scan_moves || 0;
+  verdict.textContent = c.clear && off
+    ? `clear of the scanned surface: none of the ${sum.moves} moves comes closer than tol, but ${off} `
+      + `move(s) pass beside the scan or over a hole in it, where nothing is known of the part (named below); `
+      + `${against}${c.written_at_risk
+      ? `; and its header says it was written only because the risk was accepted: ${c.written_at_risk}` : ''}`
+    : c.clear
     ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}${c.written_at_risk
       ? `; but its header says it was written only because the risk was accepted: ${c.written_at_risk}` : ''}`
     // Planned for a larger nozzle or tol than this check's (QA round 6 F1).
@@ -82,7 +89,7 @@ export function onCheck(m) {
           : `none of the ${sum.moves} checked moves comes closer than tol`}; ${against}`
       : `${sum.touching_moves} of ${sum.moves} moves touch: closer than tol`
         + `${sum.touching_from_previous ? `, ${sum.touching_from_previous} of them closest at their start, where the move before each ended too close` : ''}; ${against}`;
-  verdict.className = c.clear && !c.written_at_risk ? 'verdict good' : 'verdict bad';
+  verdict.className = !c.clear || c.written_at_risk ? 'verdict bad' : off ? 'verdict warn' : 'verdict good';
   const details = [];
   const p = (text, id, cls) => details.push(el('p', text, cls, id));
   p(sum.min_clearance_mm === null || sum.min_clearance_mm === undefined

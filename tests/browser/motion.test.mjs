@@ -286,6 +286,19 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
     /^clear: none of the \d+ moves comes closer than tol; risky\.gcode against .*; but its header says it was written only because the risk was accepted: the tool path dispenses 9\.518 mm above the surface$/);
   assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
 
+  // Down beside the scan and along there: clear of what was scanned, but
+  // not a green "clear" (QA round 8 F4); the moves named below it.
+  const beside = 'G21 G90\nG0 X15.4 Y16 Z30\nG0 X150 Y16 Z30\nG1 Z1 F300\nG1 X160 Y16\nG0 Z30\n';
+  await page.setInputFiles('#gcode-input', gcodeFile('beside.gcode', beside));
+  await page.waitForFunction(() => {
+    const v = document.getElementById('check-verdict').textContent;
+    return /beside\.gcode/.test(v) && !/^checking /.test(v);
+  });
+  assert.match(await page.textContent('#check-verdict'),
+    /^clear of the scanned surface: none of the 4 moves comes closer than tol, but 3 move\(s\) pass beside the scan or over a hole in it, where nothing is known of the part \(named below\); beside\.gcode against demo-test-part\.ply/);
+  assert.deepEqual(await page.$eval('#check-verdict', (e) => [...e.classList]), ['verdict', 'warn']);
+  assert.match(await page.textContent('#check-notes'), /3 move\(s\) pass beside the scan or over a hole in it lower than tol above its top \(lines 4, 5, 6;/);
+
   // Down beside a 2 mm wall of the test part, then up across its corner.
   const cut = 'G21 G90\nG0 X15.4 Y16 Z30\nG1 X15.4 Y16 Z5.603 F300\nG1 X16.230 Y16 Z7.603\nG0 Z30\n';
   await page.setInputFiles('#gcode-input', gcodeFile('cut.gcode', cut));

@@ -110,7 +110,15 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         let risk = check.written_at_risk.as_ref().map_or(String::new(), |r| {
             format!("; but its header says it was written only because the risk was accepted: {r}")
         });
-        let line = format!("{head}; no move comes closer than tol{risk}");
+        // Clear of what was scanned, not of what was not (QA round 8 F4).
+        let off = match check.off_scan_moves {
+            0 => String::new(),
+            n => format!(
+                " to the scanned surface, but {n} move(s) pass beside the scan or over a hole \
+                 in it, where nothing is known of the part (named above)"
+            ),
+        };
+        let line = format!("{head}; no move comes closer than tol{off}{risk}");
         // Standard output carries the report written there, alone.
         if a.report.as_deref().is_some_and(is_stdout) {
             eprintln!("{line}");
