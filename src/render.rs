@@ -135,6 +135,10 @@ pub struct Renderer {
     cache_failed: bool,
     mesh: Option<(Drawable, WebGlBuffer)>,
     lines: Option<Drawable>,
+    /// The tool path's contact points (section 7), drawn as markers over
+    /// the lines: a few short red segments among hundreds were a few
+    /// pixels (QA round 8 F6); moved with the paths by `path_offset`.
+    contacts: Option<Drawable>,
     /// Holes found in the scan, and the printer points P drawn smaller on
     /// top (after a good registration they coincide).
     holes: Option<Drawable>,
@@ -192,6 +196,7 @@ impl Renderer {
             cache_failed: false,
             mesh: None,
             lines: None,
+            contacts: None,
             holes: None,
             printer: None,
             picked: None,
@@ -300,8 +305,14 @@ impl Renderer {
                 push(&w[1], SURFACE_PATH);
             }
         }
+        let mut contacts: Vec<f32> = Vec::new();
         for (k, piece) in paths.toolpath.iter().enumerate() {
             let defects = paths.defects.get(k);
+            for (j, p) in piece.iter().enumerate() {
+                if defects.and_then(|d| d.get(j)) == Some(&Defect::Contact) {
+                    contacts.extend(p.iter().map(|&v| v as f32));
+                }
+            }
             let color = |j: usize| {
                 defects
                     .and_then(|d| d.get(j))
@@ -314,7 +325,7 @@ impl Renderer {
                 push(&w[1], c);
             }
         }
-        self.set_lines(&pos, &col)
+        self.set_lines(&pos, &col, &contacts)
     }
 
     /// [`Renderer::set_paths`] from flat arrays; the lengths must agree.
@@ -332,6 +343,10 @@ impl Renderer {
         let segments = n.saturating_sub(a.pieces.len());
         let mut pos: Vec<f32> = Vec::with_capacity(12 * segments);
         let mut col: Vec<f32> = Vec::with_capacity(12 * segments);
+        let contacts: Vec<f32> = (0..n)
+            .filter(|&j| defect_of_code(a.defects[j]) == Defect::Contact)
+            .flat_map(|j| a.tool[3 * j..3 * j + 3].iter().copied())
+            .collect();
         let mut start = 0;
         for &k in a.pieces {
             let (lo, hi) = (start, start + k as usize);
@@ -349,7 +364,7 @@ impl Renderer {
             }
             start = hi;
         }
-        self.set_lines(&pos, &col)
+        self.set_lines(&pos, &col, &contacts)
     }
 
     /// A G-code program's straight moves in place of the paths: `moves`
@@ -395,7 +410,7 @@ impl Renderer {
             col.extend(c);
             col.extend(c);
         }
-        self.set_lines(moves, &col)
+        self.set_lines(moves, &col, &[])
     }
 
     /// Puts the preview's nozzle with its tip at `tip` (outer diameter
@@ -436,13 +451,22 @@ impl Renderer {
         }
     }
 
-    fn set_lines(&mut self, pos: &[f32], col: &[f32]) -> Result<(), String> {
-        if let Some(d) = self.lines.take() {
+    /// The lines in view, and the contact points marked over them.
+    fn set_lines(&mut self, pos: &[f32], col: &[f32], contacts: &[f32]) -> Result<(), String> {
+        for d in [self.lines.take(), self.contacts.take()]
+            .into_iter()
+            .flatten()
+        {
             d.delete(&self.gl);
         }
         self.path_offset = DVec3::ZERO;
         if !pos.is_empty() {
             self.lines = Some(colored(&self.gl, pos, col)?);
+        }
+        if !contacts.is_empty() {
+            let c = defect_rgb(Defect::Contact);
+            let col: Vec<f32> = contacts.chunks(3).flat_map(|_| c).collect();
+            self.contacts = Some(colored(&self.gl, contacts, &col)?);
         }
         Ok(())
     }
@@ -605,6 +629,15 @@ impl Renderer {
         gl.use_program(Some(&p.program));
         // Markers sit in holes: draw them over the surface.
         gl.disable(Gl::DEPTH_TEST);
+        if let Some(c) = &self.contacts {
+            // Where the nozzle meets the part, seen wherever it is.
+            let o = self.path_offset.as_vec3();
+            gl.uniform3f(p.offset.as_ref(), o.x, o.y, o.z);
+            gl.uniform1f(p.point_size.as_ref(), 6.0);
+            gl.bind_vertex_array(Some(&c.vao));
+            gl.draw_arrays(Gl::POINTS, 0, c.count);
+            gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
+        }
         if let Some((tip, _)) = self.nozzle {
             // The tip's place, seen even where the part hides the nozzle.
             let o = tip.as_vec3();

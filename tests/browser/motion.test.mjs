@@ -136,6 +136,10 @@ test('a plan whose G-code touches the part names its lines and offers nothing; a
   // The refused tool path is in the view (QA round 7 F3).
   assert.equal(await page.textContent('#plan-status'), 'no G-code: the refused tool path is shown where the drawing lies (see above)');
   assert.match(message, /the view shows the refused tool path/);
+  // Its contact points stand out: markers, not a few short red segments
+  // among hundreds of green ones (QA round 8 F6).
+  const px = await viewPixels(page);
+  assert.ok(px.defect > 400, JSON.stringify(px)); // 83 before
   // Settings, drawing and previous plan stay.
   const afterSettings = await page.evaluate(() => [...document.querySelectorAll('.side input, .side select, .side textarea')]
     .filter((el) => el.id && el.type !== 'file').map((el) => [el.id, el.type === 'checkbox' ? el.checked : el.value]));
