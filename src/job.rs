@@ -413,6 +413,34 @@ pub struct Report {
     pub motion: MotionReport,
 }
 
+impl Report {
+    /// The predicted quality for the G-code header and the CLI, with what
+    /// it describes: section 7 looks at the planned points, in the path's
+    /// vertical plane, so the waypoints between them and a tip offset
+    /// beside the drawn line are not in its figures (QA round 6 F4, F5:
+    /// the header's figures were read as the commanded motion's).
+    pub fn quality_line(&self) -> String {
+        let mut not = Vec::new();
+        if self.motion.waypoints > 0 {
+            not.push(format!("not the {} waypoint(s)", self.motion.waypoints));
+        }
+        let sideways = if self.motion.max_sideways_mm >= 0.0005 {
+            format!(
+                "; the tip up to {:.3} mm beside the drawn line, which section 7 does not see",
+                self.motion.max_sideways_mm
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{} (section 7, at the {} planned points{}{sideways})",
+            self.quality,
+            self.stats.points,
+            not.iter().map(|n| format!(", {n}")).collect::<String>()
+        )
+    }
+}
+
 /// The safe-motion part of a report (spec section 6f).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct MotionReport {
@@ -906,7 +934,7 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             st.print_time_s
         ),
     ));
-    h.push(("predicted quality".into(), report.quality.to_string()));
+    h.push(("predicted quality".into(), report.quality_line()));
     h.push(("safe motion".into(), report.motion.summary_line()));
     h.push(("warnings".into(), report.warnings.len().to_string()));
     // Their text, where the operator reads the program ("warnings: 2" hid

@@ -125,6 +125,42 @@ fn demo_file(name: &str) -> PathBuf {
     demo_dir().join(name)
 }
 
+/// QA round 6 F4, F5: the header's quality figures were read as the
+/// commanded motion's; they are section 7's at the planned points, and the
+/// line says so, with the waypoints and the tip's sideways offset it does
+/// not see.
+#[test]
+fn the_quality_line_says_what_its_figures_describe() {
+    let mut settings = JobSettings::default();
+    settings.plan.placement = test_part::placement();
+    let out = job::run(
+        &demo::demo_scan_bytes(),
+        demo::DEMO_SCAN_NAME,
+        test_part::test_part_svg().as_bytes(),
+        demo::DEMO_PATH_NAME,
+        &settings,
+        &MachineProfile::builtin("marlin").unwrap(),
+        false,
+    )
+    .unwrap();
+    let r = &out.report;
+    assert!(
+        r.motion.waypoints > 0 && r.motion.max_sideways_mm > 0.01,
+        "{:?}",
+        r.motion
+    );
+    let line = format!(
+        "; predicted quality: {} (section 7, at the {} planned points, not the {} waypoint(s); \
+         the tip up to {:.3} mm beside the drawn line, which section 7 does not see)",
+        r.quality, r.stats.points, r.motion.waypoints, r.motion.max_sideways_mm
+    );
+    assert!(
+        out.gcode.lines().any(|l| l == line),
+        "{line}\n{}",
+        &out.gcode[..2000]
+    );
+}
+
 #[test]
 fn golden_gcode_of_the_demo_in_each_dialect() {
     let scan = demo::demo_scan_bytes();

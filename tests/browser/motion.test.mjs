@@ -81,6 +81,11 @@ test('every planner is compared with its defects, backward moves, clearance and 
     + `G-code line ${motion.program.min_clearance_line}`);
   assert.equal(await page.textContent('#motion-waypoints'), `${motion.waypoints} (+${motion.extra_length_mm.toFixed(3)} mm)`);
   assert.equal(await page.textContent('#motion-backward'), '0');
+  // What the quality figures describe, as the G-code's header says (QA
+  // round 6 F4, F5).
+  assert.match(await page.textContent('#motion-quality'),
+    new RegExp(`; section 7, at the ${report.stats.points} planned points, not the ${motion.waypoints} waypoint\\(s\\); `
+      + `the tip up to ${motion.max_sideways_mm.toFixed(3).replace('.', '\\.')} mm beside the drawn line, which section 7 does not see$`));
   assert.match(await page.textContent('#motion-touching'), /^0 of \d+ \(tol 0\.1 mm\)$/);
   assert.equal(await page.isHidden('#risk-warning'), true);
 

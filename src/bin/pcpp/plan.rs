@@ -289,7 +289,7 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
         );
     }
     let _ = writeln!(s, "scan: {}", output.report.registration.status);
-    let _ = writeln!(s, "predicted quality: {}", output.report.quality);
+    let _ = writeln!(s, "predicted quality: {}", output.report.quality_line());
     let _ = writeln!(s, "safe motion: {}", output.report.motion.summary_line());
     if let Some(r) = &a.report {
         let _ = writeln!(s, "report: {}", shown(r));
