@@ -22,7 +22,10 @@ use crate::motion::{
 use crate::params::{Nozzle, Process};
 use crate::planners::{plan_points, PlannerKind};
 use crate::projection::project_subpath;
-use crate::quality::{predict, summarize, PointQuality, QualitySummary};
+use crate::quality::{
+    nozzle_contacts, predict, predict_given_contact, summarize, Defect, PointQuality,
+    QualitySummary,
+};
 use crate::registration::Registration;
 use crate::sampling::try_sample_subpath;
 use crate::spacing::{blobs, close_lines, Line};
@@ -577,6 +580,10 @@ fn plan_stage(
             nozzle,
             process,
         );
+        // The planned moves the G-code makes as they are (see
+        // `nozzle_contacts`): a guarded planner's get waypoints, but for
+        // those it could not make safe.
+        let mut unresolved: Vec<usize> = Vec::new();
         let moves = if safe_motion && planner.is_guarded() {
             let planning = clearance.with_margin(PLANNING_MARGIN_MM);
             let safe = insert_waypoints_capped(surface, &planned.toolpath, &planning, cap);
@@ -586,6 +593,7 @@ fn plan_stage(
             };
             motion.waypoints += safe.waypoints;
             motion.extra_length_mm += safe.extra_length_mm;
+            unresolved.clone_from(&safe.unresolved);
             for &j in &safe.unresolved {
                 if !planned.uncleared.contains(&j) {
                     uncleared.push((k, j, planned.toolpath[j]));
@@ -655,7 +663,7 @@ fn plan_stage(
         for &j in &planned.uncleared {
             uncleared.push((k, j, planned.toolpath[j]));
         }
-        let quality = match planned.quality {
+        let mut quality = match planned.quality {
             Some(q) => q,
             None => predict(
                 surface,
@@ -666,6 +674,34 @@ fn plan_stage(
                 process,
             ),
         };
+        // Contacts of the whole nozzle and of the moves, which section 7's
+        // disk test does not see (spec 6d, 6f): a guarded planner's points
+        // clear by tol, but for those it could not clear.
+        let guarded = safe_motion && planner.is_guarded();
+        let into = nozzle_contacts(
+            surface,
+            &planned.toolpath,
+            0.5 * nozzle.outer_diameter_mm,
+            |j| !guarded || planned.uncleared.contains(&j),
+            |j| !guarded || unresolved.contains(&j),
+        );
+        if into.iter().any(|&j| quality[j].defect != Defect::Contact) {
+            let mut contact: Vec<bool> = quality
+                .iter()
+                .map(|q| q.defect == Defect::Contact)
+                .collect();
+            for &j in &into {
+                contact[j] = true;
+            }
+            quality = predict_given_contact(
+                &piece.ta,
+                &piece.geometry,
+                &planned.toolpath,
+                &contact,
+                nozzle,
+                process,
+            );
+        }
         pieces.push(PlannedPiece {
             source: piece.source.clone(),
             surface_path: piece.ta.clone(),

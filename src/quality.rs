@@ -111,6 +111,40 @@ pub fn predict(
     predict_given_contact(ta, geometry, toolpath, &contact, nozzle, process)
 }
 
+/// The points where the nozzle runs into the part beyond what section 7's
+/// disk test sees (spec 6d: the whole nozzle, tip disk and body; 6f: the
+/// moves, not only the points), to be counted as contacts: a point `point(j)`
+/// asks whose nozzle lies below the surface within its radius (the body
+/// buried under a sheet the tip's plane does not cut: QA round 9, the
+/// paper's `pcpp` 1.8 mm under a teapot's lid, "contact 0.00%"), and each
+/// straight move j -> j + 1 that `commanded(j)` says the G-code makes as
+/// planned whose nozzle goes into the surface, at the end nearer its deepest
+/// place. A planner whose moves gouge the part is not shown printing even
+/// filament there. Contact means the nozzle meets the surface (clearance
+/// below 0), not within tol of it, as the disk test does.
+pub fn nozzle_contacts(
+    surface: &Surface,
+    toolpath: &[DVec3],
+    radius: f64,
+    point: impl Fn(usize) -> bool + Sync,
+    commanded: impl Fn(usize) -> bool + Sync,
+) -> Vec<usize> {
+    let n = toolpath.len();
+    let touched = crate::parallel::map(n, 256, |j| {
+        let t = toolpath[j];
+        if !t.is_finite() {
+            return false;
+        }
+        let into = |a: DVec3, b: DVec3| surface.nozzle_gap(a, b, radius, 0.0, 0.0);
+        (point(j) && into(t, t).is_some())
+            || (j > 0 && commanded(j - 1) && toolpath[j - 1].is_finite())
+                && into(toolpath[j - 1], t).is_some_and(|g| g.at >= 0.5)
+            || (j + 1 < n && commanded(j) && toolpath[j + 1].is_finite())
+                && into(t, toolpath[j + 1]).is_some_and(|g| g.at < 0.5)
+    });
+    (0..n).filter(|&j| touched[j]).collect()
+}
+
 /// [`predict`] where it is known which points the tip disk touches the
 /// surface at (`contact`, one per point): a planner that has cleared its
 /// points by tol already knows there is no contact anywhere.
@@ -422,5 +456,59 @@ mod tests {
         assert_eq!(s.points, 20);
         assert!(s.mean_negative_error_mm < -0.2 && s.mean_positive_error_mm == 0.0);
         assert!(s.flattening_pct > 50.0);
+    }
+
+    /// A plate with a sheet (a lid's rim, a wall's top) held above it,
+    /// from y = 0.3 on, and a wall across x = 4 standing 3 mm high.
+    fn lid_and_wall() -> Surface {
+        let mut m = crate::mesh::TriMesh::height_field(&[-10.0, 10.0], &[-10.0, 10.0], |_, _| 0.0);
+        for (x0, x1, y0, y1, z) in [
+            (-10.0, 10.0, 0.3, 10.0, 1.5),
+            (3.95, 4.05, -10.0, -1.0, 3.0),
+        ] {
+            let k = m.vertices.len() as u32;
+            m.vertices.extend([
+                DVec3::new(x0, y0, z),
+                DVec3::new(x1, y0, z),
+                DVec3::new(x1, y1, z),
+                DVec3::new(x0, y1, z),
+            ]);
+            m.triangles.extend([[k, k + 1, k + 2], [k, k + 2, k + 3]]);
+        }
+        Surface::new(m).unwrap()
+    }
+
+    /// QA round 9: the paper's `pcpp` ran the nozzle 1.8 mm under a
+    /// teapot's lid and through features between its points, and section
+    /// 7's disk test said "contact 0.00%". The whole nozzle at a point, and
+    /// the moves the G-code makes as planned, are asked too.
+    #[test]
+    fn a_nozzle_buried_under_a_sheet_or_gouging_between_points_is_a_contact() {
+        let s = lid_and_wall();
+        let r = 0.5 * Nozzle::DEFAULT.outer_diameter_mm;
+        // Under the lid's rim (0.3 mm from the axis, 0.9 mm above the
+        // tip): the tip's plane cuts nothing within the disk.
+        let under = [DVec3::new(-1.0, 0.0, 0.6), DVec3::new(1.0, 0.0, 0.6)];
+        assert!(s.disk_contact(under[0], r).is_none());
+        assert_eq!(nozzle_contacts(&s, &under, r, |_| true, |_| false), [0, 1]);
+        // Asked of no point and no move: nothing.
+        assert!(nozzle_contacts(&s, &under, r, |_| false, |_| false).is_empty());
+        // Clear points at x 3 and 7, the move between them through the
+        // wall at x 4: its deepest place is nearer the first.
+        let across = [
+            DVec3::new(3.0, -5.0, 0.6),
+            DVec3::new(7.0, -5.0, 0.6),
+            DVec3::new(9.0, -5.0, 0.6),
+        ];
+        for t in across {
+            assert!(s.disk_contact(t, r).is_none() && s.nozzle_gap(t, t, r, 0.0, 0.0).is_none());
+        }
+        assert_eq!(nozzle_contacts(&s, &across, r, |_| true, |_| true), [0]);
+        // A move the G-code does not make as planned (a guarded planner's,
+        // given waypoints) is not asked.
+        assert!(nozzle_contacts(&s, &across, r, |_| true, |j| j != 0).is_empty());
+        // Reversed, the deepest place is nearer the move's end.
+        let back: Vec<DVec3> = across.iter().rev().copied().collect();
+        assert_eq!(nozzle_contacts(&s, &back, r, |_| true, |_| true), [2]);
     }
 }

@@ -1234,3 +1234,37 @@ fn pieces_too_small_to_print_are_one_warning_a_path() {
         "{small:?}"
     );
 }
+
+/// QA round 9: on a teapot whose lid overhangs its body, the paper's
+/// `pcpp` ran the nozzle 1.8 mm under the lid's rim and its quality said
+/// "contact 0.00%" (section 7's disk test: the tip's plane cuts nothing
+/// there), so it looked more even than `even`, which rises over the rim. A
+/// plate with a sheet held 1.5 mm above it from y = 0.3 on, a line drawn
+/// along y = 0 (SVG y points down: printer y = -y): the paper's planners' points are all contacts now, and
+/// `even` has none and fewer defects.
+#[test]
+fn regression_a_nozzle_under_an_overhang_was_counted_good() {
+    let mut m = TriMesh::height_field(&[-20.0, 20.0], &[-20.0, 20.0], |_, _| 0.0);
+    m.vertices.extend([
+        DVec3::new(-20.0, 0.3, 1.5),
+        DVec3::new(20.0, 0.3, 1.5),
+        DVec3::new(20.0, 20.0, 1.5),
+        DVec3::new(-20.0, 20.0, 1.5),
+    ]);
+    m.triangles.extend([[4, 5, 6], [4, 6, 7]]);
+    let s = Surface::new(m).unwrap();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="M 0 0 L 15 0"/></svg>"#;
+    let drawn = pipeline::load_path(svg.as_bytes(), "line.svg").unwrap();
+    let plans = pipeline::compare(&s, &drawn.subpaths, &PlanSettings::default()).unwrap();
+    let by = |k: PlannerKind| plans.iter().find(|p| p.planner == k).unwrap();
+    for k in [PlannerKind::Constant, PlannerKind::Pcpp] {
+        let q = &by(k).quality;
+        assert!(q.contact_pct > 90.0, "{k}: {q:?}");
+    }
+    let even = &by(PlannerKind::Even).quality;
+    assert_eq!(even.contact_pct, 0.0);
+    assert!(
+        even.defect_pct() < by(PlannerKind::Pcpp).quality.defect_pct(),
+        "{even:?}"
+    );
+}
