@@ -391,7 +391,38 @@ impl LocalGeometry {
 /// each of them.
 pub fn local_geometry(points: &[DVec3]) -> Result<Vec<LocalGeometry>> {
     let spline = Spline::interpolate(points)?;
-    Ok(geometry_of(&spline))
+    let mut geometry = geometry_of(&spline);
+    follow_the_drawing(points, &mut geometry);
+    Ok(geometry)
+}
+
+/// Where the spline's horizontal direction runs against the drawn path's
+/// (its chord through the neighbouring points, one-sided at an end), the
+/// geometry is taken mirrored: V along the path, t and N turned with it,
+/// the profile's curvature of the opposite sign. A cubic through a sudden
+/// drop overshoots: at a piece's last point, 1.08 mm below the one before
+/// it over 0.29 mm, C' pointed back along the path, V with it, and every
+/// planner's shift along V went the wrong way (QA round 9 M1: `even`'s
+/// last dispensing move 1.29 mm back over the line already printed).
+/// V is the direction of travel (spec section 5).
+fn follow_the_drawing(points: &[DVec3], geometry: &mut [LocalGeometry]) {
+    let n = points.len().min(geometry.len());
+    if n < 2 {
+        return;
+    }
+    for (j, g) in geometry.iter_mut().enumerate().take(n) {
+        let chord = (points[(j + 1).min(n - 1)] - points[j.saturating_sub(1)]).truncate();
+        // (Out and back along one line, the chord is nothing: a cusp,
+        // whose geometry is its neighbour's.)
+        if chord.length_squared() <= 1e-18 || g.v.truncate().dot(chord) >= 0.0 {
+            continue;
+        }
+        g.v = -g.v;
+        g.tangent = DVec3::new(-g.tangent.x, -g.tangent.y, g.tangent.z);
+        let a = g.tangent.truncate().length();
+        g.n = (-g.tangent.z * g.v + a * DVec3::Z).normalize_or(DVec3::Z);
+        g.kappa = -g.kappa;
+    }
 }
 
 /// The local geometry at each interpolated point of `spline`.
@@ -548,6 +579,35 @@ mod tests {
         assert_eq!(g[0].kappa, 0.0);
         let g = local_geometry(&[DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)]).unwrap();
         assert!(g.iter().all(|g| g.kappa.abs() < 1e-12));
+    }
+
+    /// QA round 9 M1: a piece whose last point lies 1.08 mm below the one
+    /// before it, 0.29 mm on (snowden's feather): the spline overshoots
+    /// and its C' there points back along the path. V follows the drawing,
+    /// N leans forward off the drop, and the slope stays the spline's.
+    #[test]
+    fn a_sudden_drop_at_a_pieces_end_does_not_turn_v_back() {
+        let dir = DVec3::new(-1.0, -1.0, 0.0).normalize();
+        let mut pts: Vec<DVec3> = (0..13)
+            .map(|i| DVec3::new(111.0, 111.0, 3.8) + dir * (0.29 * i as f64))
+            .collect();
+        pts.push(*pts.last().unwrap() + dir * 0.29 - DVec3::Z * 1.08);
+        let raw = geometry_of(&Spline::interpolate(&pts).unwrap());
+        let last = raw.len() - 1;
+        // The spline's own direction there is backwards (what this mends).
+        assert!(raw[last].v.dot(dir) < 0.0, "{:?}", raw[last].v);
+        let g = local_geometry(&pts).unwrap();
+        for (j, g) in g.iter().enumerate() {
+            assert!(g.v.dot(dir) > 0.99, "{j}: {:?}", g.v);
+        }
+        let end = &g[last];
+        assert!(
+            end.descending() && end.n.dot(dir) > 0.5 && end.n.z > 0.0,
+            "{end:?}"
+        );
+        assert_eq!(end.slope_rad, raw[last].slope_rad);
+        assert_eq!(end.kappa, -raw[last].kappa);
+        assert!((end.n.dot(end.tangent)).abs() < 1e-12);
     }
 
     fn arc(r: f64, concave_up: bool) -> Vec<DVec3> {

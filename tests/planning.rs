@@ -1268,3 +1268,45 @@ fn regression_a_nozzle_under_an_overhang_was_counted_good() {
         "{even:?}"
     );
 }
+
+/// QA round 9 M1: a drawn line whose last point falls over a cliff's edge
+/// (1.1 mm down, 0.3 mm on): the spline's direction there turned back,
+/// and `even` put its last dispensing point behind the one before it, the
+/// filament's end laid back over the line already printed. Every planner's
+/// tool path now keeps going along the drawing there.
+#[test]
+fn regression_a_line_ending_over_a_cliff_turned_back() {
+    let xs: Vec<f64> = (0..=40).map(|i| f64::from(i) * 0.5).collect();
+    let mut xs = xs;
+    xs.push(10.05);
+    xs.sort_by(f64::total_cmp);
+    let m = TriMesh::height_field(
+        &xs,
+        &[-10.0, 10.0],
+        |x, _| if x <= 10.0 { 4.0 } else { 2.9 },
+    );
+    let s = Surface::new(m).unwrap();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20"><path d="M 1 5 L 10.2 5"/></svg>"#;
+    let drawn = pipeline::load_path(svg.as_bytes(), "cliff.svg").unwrap();
+    let plans = pipeline::compare(&s, &drawn.subpaths, &PlanSettings::default()).unwrap();
+    let even = plans
+        .iter()
+        .find(|p| p.planner == PlannerKind::Even)
+        .unwrap();
+    let piece = &even.pieces[0];
+    let (ta, tp) = (&piece.surface_path, &piece.toolpath);
+    let n = ta.len();
+    // The drawing's last point is down the cliff, the one before on top.
+    assert!(ta[n - 1].z < 3.0 && ta[n - 2].z > 3.9, "{:?}", &ta[n - 2..]);
+    for p in &plans {
+        let tp = &p.pieces[0].toolpath;
+        assert!(
+            tp[n - 1].x >= tp[n - 2].x,
+            "{}: {:?}",
+            p.planner,
+            &tp[n - 3..]
+        );
+    }
+    assert_eq!(even.motion.backward_moves, 0);
+    assert!(tp[n - 1].x > ta[n - 2].x, "{:?}", &tp[n - 2..]);
+}
