@@ -346,10 +346,15 @@ fn rise_over(surface: &Surface, c: &Clearance, p: DVec3, q: DVec3) -> Vec<DVec3>
 /// by 2 or more samples from the furthest one reached before it. `ta` and
 /// `toolpath` have one point per sample.
 pub fn backward_moves(ta: &[DVec3], toolpath: &[DVec3]) -> usize {
+    backward_points(ta, toolpath).len()
+}
+
+/// The tool-path points [`backward_moves`] counts, in order.
+pub fn backward_points(ta: &[DVec3], toolpath: &[DVec3]) -> Vec<usize> {
     // The nearest sample is searched near the last one found: a point
     // further back than the window still counts as a step back.
     const WINDOW: usize = 8;
-    let mut count = 0;
+    let mut back = Vec::new();
     let mut reached = 0usize;
     let mut prev = 0usize;
     for (j, t) in toolpath.iter().enumerate() {
@@ -363,12 +368,12 @@ pub fn backward_moves(ta: &[DVec3], toolpath: &[DVec3]) -> usize {
             })
             .unwrap_or(0);
         if j > 0 && nearest + 2 <= reached {
-            count += 1;
+            back.push(j);
         }
         reached = reached.max(nearest);
         prev = nearest;
     }
-    count
+    back
 }
 
 /// What the motion check found over a set of moves.

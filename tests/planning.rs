@@ -1310,3 +1310,44 @@ fn regression_a_line_ending_over_a_cliff_turned_back() {
     assert_eq!(even.motion.backward_moves, 0);
     assert!(tp[n - 1].x > ta[n - 2].x, "{:?}", &tp[n - 2..]);
 }
+
+/// QA round 9 M1: where a tool path falls back along the drawn path (here
+/// a loop and a hairpin narrower than the nozzle: the paper's `slope`
+/// does), the plan says so with the first such point; the count was only
+/// in `compare` and the JSON report.
+#[test]
+fn backward_moves_are_said_in_the_plans_warnings() {
+    let s = Surface::new(TriMesh::height_field(
+        &[-20.0, 40.0],
+        &[-20.0, 20.0],
+        |_, _| 0.0,
+    ))
+    .unwrap();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20"><circle cx="5" cy="5" r="0.45"/><path d="M 1 9 L 8 9 L 1 9.2"/></svg>"#;
+    let drawn = pipeline::load_path(svg.as_bytes(), "hairpin.svg").unwrap();
+    let plans = pipeline::compare(&s, &drawn.subpaths, &PlanSettings::default()).unwrap();
+    let mut said = 0;
+    for p in &plans {
+        let w: Vec<&String> = p
+            .warnings
+            .iter()
+            .filter(|w| w.contains("fall back along the drawn path"))
+            .collect();
+        if p.motion.backward_moves == 0 {
+            assert!(w.is_empty(), "{}: {w:?}", p.planner);
+        } else {
+            said += 1;
+            assert_eq!(w.len(), 1, "{}: {:?}", p.planner, p.warnings);
+            assert!(
+                w[0].starts_with(&format!(
+                    "{}: {} point(s) of the tool path fall back along the drawn path, the first at (",
+                    p.planner.name(),
+                    p.motion.backward_moves
+                )),
+                "{}",
+                w[0]
+            );
+        }
+    }
+    assert!(said > 0, "no planner fell back on the loop or the hairpin");
+}
