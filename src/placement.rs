@@ -230,7 +230,9 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
                 .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
             format!(
                 "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm): \
-                 check the scan's units and up axis, or use a profile whose build volume holds it",
+                 check the scan's units and up axis, or use a profile whose build volume holds \
+                 it (pcpp does not scale a scan: one too large even read in mm, the smallest \
+                 unit it reads, must be scaled down in the program that exported it)",
                 size[k], room[k]
             )
         }
@@ -590,7 +592,12 @@ mod tests {
         assert!(
             fit.message
                 .contains("it is larger than the volume (z 260.4 mm, the volume 250.0 mm)")
-                && !fit.message.contains("place it on the bed"),
+                && !fit.message.contains("place it on the bed")
+                // (QA round 9 L2: a 1.1 m model in every unit offered.)
+                && fit.message.ends_with(
+                    "pcpp does not scale a scan: one too large even read in mm, the smallest \
+                     unit it reads, must be scaled down in the program that exported it)"
+                ),
             "{}",
             fit.message
         );
