@@ -1838,6 +1838,21 @@ pub fn planned_nozzle(text: &str) -> (Option<crate::params::Nozzle>, Option<f64>
 
 /// The leading comment block of a G-code program, each line without its
 /// comment mark (`;`, or `'` for Aerotech) and trimmed.
+/// The machine profile a pcpp program's header says it was written for
+/// (`; profile: NAME`, `' profile: NAME` for Aerotech, `( profile: NAME )`
+/// for Grbl), if it says.
+pub fn planned_profile(text: &str) -> Option<&str> {
+    text.lines()
+        .map(str::trim)
+        .take_while(|l| l.starts_with(';') || l.starts_with('\'') || l.starts_with('('))
+        .find_map(|l| {
+            let l = l.strip_suffix(')').unwrap_or(l);
+            l[1..].trim().strip_prefix("profile: ")
+        })
+        .map(str::trim)
+        .filter(|p| !p.is_empty())
+}
+
 fn header_lines(text: &str) -> impl Iterator<Item = &str> {
     text.lines()
         .map(str::trim)

@@ -975,6 +975,30 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
                 && start[0].contains("clear wherever they are"),
             "{dialect}: {err}"
         );
+        // Checked as marlin's (no --dialect), another dialect's program is
+        // told which flag checks it as planned (QA round 9 L1: refused as
+        // "not in one frame" with no word of the header's profile).
+        let other = format!(
+            "the program's header says it was written for profile {dialect}, and this check \
+             reads it for profile marlin (its bed, its reading of the G-code): give --dialect \
+             {dialect}"
+        );
+        assert_eq!(
+            err.contains(&other),
+            dialect != "marlin",
+            "{dialect}: {err}"
+        );
+        let o = check_on(
+            &demo_file(demo::DEMO_SCAN_NAME),
+            &golden_path(dialect),
+            &["--dialect", dialect],
+        );
+        assert_eq!(code(&o), 0, "{dialect}: {}", stderr(&o));
+        assert!(
+            !stderr(&o).contains("written for profile"),
+            "{dialect}: {}",
+            stderr(&o)
+        );
     }
 }
 

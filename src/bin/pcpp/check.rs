@@ -53,6 +53,20 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             from_header.join(", ")
         )
     });
+    // Checked as another machine's program than the header's (its bed
+    // places the scan, Grbl reads some lines its own way): said, with the
+    // flag that checks it as planned (QA round 9 L1: refused as "not in
+    // one frame" with no word of the header's profile).
+    let other_profile = job::planned_profile(&text)
+        .filter(|p| *p != profile.name)
+        .map(|p| {
+            format!(
+                "the program's header says it was written for profile {p}, and this check \
+                 reads it for profile {} (its bed, its reading of the G-code): give --dialect \
+                 {p} (or that profile's --profile) to check it as it was planned",
+                profile.name
+            )
+        });
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
@@ -72,12 +86,20 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             // units than the program was planned with: QA).
             progress.finish();
             progress.warn(&prepared.warnings);
-            return Err(Failure::Input(in_file(gcode_path, &name, &e.to_string())));
+            let e = match &other_profile {
+                Some(p) => format!("{e}; {p}"),
+                None => e.to_string(),
+            };
+            return Err(Failure::Input(in_file(gcode_path, &name, &e)));
         }
     };
-    check
-        .notes
-        .splice(0..0, encoding.into_iter().chain(header_nozzle));
+    check.notes.splice(
+        0..0,
+        encoding
+            .into_iter()
+            .chain(header_nozzle)
+            .chain(other_profile),
+    );
     check.notes.extend(check.outside_volume(&profile));
     if let Some(r) = &a.report {
         write_one(r, to_json(&check)?.as_bytes())?;
