@@ -684,12 +684,23 @@ fn plan_stage(
         // disk test does not see (spec 6d, 6f): a guarded planner's points
         // clear by tol, but for those it could not clear.
         let guarded = safe_motion && planner.is_guarded();
+        // (As flags: a lookup per point, however many there are.)
+        let flags = |list: &[usize]| {
+            let mut f = vec![!guarded; planned.toolpath.len()];
+            for &j in list {
+                if let Some(x) = f.get_mut(j) {
+                    *x = true;
+                }
+            }
+            f
+        };
+        let (asked, commanded) = (flags(&planned.uncleared), flags(&unresolved));
         let into = nozzle_contacts(
             surface,
             &planned.toolpath,
             0.5 * nozzle.outer_diameter_mm,
-            |j| !guarded || planned.uncleared.contains(&j),
-            |j| !guarded || unresolved.contains(&j),
+            |j| asked[j],
+            |j| commanded[j],
         );
         if into.iter().any(|&j| quality[j].defect != Defect::Contact) {
             let mut contact: Vec<bool> = quality
