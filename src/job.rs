@@ -1836,8 +1836,6 @@ pub fn planned_nozzle(text: &str) -> (Option<crate::params::Nozzle>, Option<f64>
     (nozzle, tol)
 }
 
-/// The leading comment block of a G-code program, each line without its
-/// comment mark (`;`, or `'` for Aerotech) and trimmed.
 /// The machine profile a pcpp program's header says it was written for
 /// (`; profile: NAME`, `' profile: NAME` for Aerotech, `( profile: NAME )`
 /// for Grbl), if it says.
@@ -1853,6 +1851,8 @@ pub fn planned_profile(text: &str) -> Option<&str> {
         .filter(|p| !p.is_empty())
 }
 
+/// The leading comment block of a G-code program, each line without its
+/// comment mark (`;`, or `'` for Aerotech) and trimmed.
 fn header_lines(text: &str) -> impl Iterator<Item = &str> {
     text.lines()
         .map(str::trim)

@@ -412,9 +412,11 @@ fn follow_the_drawing(points: &[DVec3], geometry: &mut [LocalGeometry]) {
     }
     for (j, g) in geometry.iter_mut().enumerate().take(n) {
         let chord = (points[(j + 1).min(n - 1)] - points[j.saturating_sub(1)]).truncate();
-        // (Out and back along one line, the chord is nothing: a cusp,
-        // whose geometry is its neighbour's.)
-        if chord.length_squared() <= 1e-18 || g.v.truncate().dot(chord) >= 0.0 {
+        // Only a direction that runs against the chord, not one across it
+        // (at a hairpin's apex the chord runs across the path, and out and
+        // back along one line it is nothing: a cusp, whose geometry is its
+        // neighbour's).
+        if g.v.truncate().dot(chord) >= -0.5 * chord.length() {
             continue;
         }
         g.v = -g.v;
