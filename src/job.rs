@@ -420,6 +420,12 @@ impl Report {
     /// beside the drawn line are not in its figures (QA round 6 F4, F5:
     /// the header's figures were read as the commanded motion's).
     pub fn quality_line(&self) -> String {
+        format!("{} ({})", self.quality, self.quality_scope())
+    }
+
+    /// What the quality figures describe ([`Self::quality_line`]'s
+    /// parenthesis; the page shows it beside its own figures).
+    pub fn quality_scope(&self) -> String {
         let mut not = Vec::new();
         if self.motion.waypoints > 0 {
             not.push(format!("not the {} waypoint(s)", self.motion.waypoints));
@@ -433,8 +439,7 @@ impl Report {
             String::new()
         };
         format!(
-            "{} (section 7, at the {} planned points{}{sideways})",
-            self.quality,
+            "section 7, at the {} planned points{}{sideways}",
             self.stats.points,
             not.iter().map(|n| format!(", {n}")).collect::<String>()
         )

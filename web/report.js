@@ -227,10 +227,8 @@ function showMotion(summary) {
     ['predicted quality', `mean |e| ${fmt(q.mean_abs_error_mm, 4)} mm; defects `
       + `${fmt(q.contact_pct + q.flattening_pct + q.floating_pct, 1)}% (contact ${fmt(q.contact_pct, 1)}%, `
       + `flattening ${fmt(q.flattening_pct, 1)}%, floating ${fmt(q.floating_pct, 1)}%); `
-      // What the figures describe, as the G-code header says (QA round 6 F4, F5).
-      + `section 7, at the ${summary.stats.points} planned points`
-      + `${m.waypoints > 0 ? `, not the ${m.waypoints} waypoint(s)` : ''}`
-      + `${m.max_sideways_mm >= 0.0005 ? `; the tip up to ${fmt(m.max_sideways_mm)} mm beside the drawn line, which section 7 does not see` : ''}`,
+      // What the figures describe, in the G-code header's words (QA round 6 F4, F5).
+      + summary.quality_scope,
     'motion-quality'],
     ['min clearance, all moves', clear, 'motion-min-clear', touching ? 'bad' : ''],
     ['moves too close (< tol)', `${p.touching_moves} of ${p.moves} (tol ${m.tol_mm} mm)`, 'motion-touching',

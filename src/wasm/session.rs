@@ -90,6 +90,9 @@ struct PlanSummary<'a> {
     /// Its line in the G-code header (`safe motion: ...`; it starts with
     /// `WARNING` when the risk was accepted for touching moves).
     motion_line: String,
+    /// What the quality figures describe, as the header's quality line
+    /// says it (`Report::quality_scope`).
+    quality_scope: String,
 }
 
 impl Session {
@@ -541,6 +544,7 @@ impl Session {
             registration_rms_mm: report.registration.rms_mm,
             motion: &report.motion,
             motion_line: report.motion.summary_line(),
+            quality_scope: report.quality_scope(),
         };
         set(&out, "summary", &to_js(&summary)?);
         set(&out, "view", &plan_arrays(&plan).into());
