@@ -430,10 +430,11 @@ impl Report {
         if self.motion.waypoints > 0 {
             not.push(format!("not the {} waypoint(s)", self.motion.waypoints));
         }
-        let sideways = if self.motion.max_sideways_mm >= 0.0005 {
+        let sideways = if self.motion.max_off_line_mm >= 0.0005 {
             format!(
-                "; the tip up to {:.3} mm beside the drawn line, which section 7 does not see",
-                self.motion.max_sideways_mm
+                "; the tip up to {:.3} mm off the drawn line, stepped sideways or leading its \
+                 point round a corner, which section 7 does not see",
+                self.motion.max_off_line_mm
             )
         } else {
             String::new()
@@ -460,8 +461,13 @@ pub struct MotionReport {
     /// Tool-path points that fall back along the drawn path.
     pub backward_moves: usize,
     /// The largest sideways offset of a tool-path point from the drawn
-    /// path (mm).
+    /// path (mm), across the printing direction.
     pub max_sideways_mm: f64,
+    /// The largest distance of a tool-path point from the drawn line seen
+    /// from above (its steps sideways, and its lead ahead of its point
+    /// round corners), but past a piece's ends (mm).
+    #[serde(default)]
+    pub max_off_line_mm: f64,
     /// Whether the G-code was written only because the user accepted the
     /// risk: moves closer than tol, or one of `accepted_risks`.
     pub risk_accepted: bool,
@@ -823,6 +829,7 @@ pub fn report(
             extra_length_mm: plan.motion.extra_length_mm,
             backward_moves: plan.motion.backward_moves,
             max_sideways_mm: plan.motion.max_sideways_mm,
+            max_off_line_mm: plan.motion.max_off_line_mm,
             ..Default::default()
         },
     }

@@ -144,15 +144,16 @@ fn the_quality_line_says_what_its_figures_describe() {
     )
     .unwrap();
     let r = &out.report;
-    assert!(
-        r.motion.waypoints > 0 && r.motion.max_sideways_mm > 0.01,
-        "{:?}",
-        r.motion
-    );
+    let m = &r.motion;
+    assert!(m.waypoints > 0 && m.max_sideways_mm > 0.01, "{m:?}");
+    // Off the line by the sideways step at least (QA round 10 L1: the
+    // sideways step alone was said).
+    assert!(m.max_off_line_mm >= m.max_sideways_mm - 1e-9, "{m:?}");
     let line = format!(
         "; predicted quality: {} (section 7, at the {} planned points, not the {} waypoint(s); \
-         the tip up to {:.3} mm beside the drawn line, which section 7 does not see)",
-        r.quality, r.stats.points, r.motion.waypoints, r.motion.max_sideways_mm
+         the tip up to {:.3} mm off the drawn line, stepped sideways or leading its point round \
+         a corner, which section 7 does not see)",
+        r.quality, r.stats.points, m.waypoints, m.max_off_line_mm
     );
     assert!(
         out.gcode.lines().any(|l| l == line),

@@ -85,7 +85,7 @@ test('every planner is compared with its defects, backward moves, clearance and 
   // round 6 F4, F5).
   assert.match(await page.textContent('#motion-quality'),
     new RegExp(`; section 7, at the ${report.stats.points} planned points, not the ${motion.waypoints} waypoint\\(s\\); `
-      + `the tip up to ${motion.max_sideways_mm.toFixed(3).replace('.', '\\.')} mm beside the drawn line, which section 7 does not see$`));
+      + `the tip up to ${motion.max_off_line_mm.toFixed(3).replace('.', '\\.')} mm off the drawn line, stepped sideways or leading its point round a corner, which section 7 does not see$`));
   assert.match(await page.textContent('#motion-touching'), /^0 of \d+ \(tol 0\.1 mm\)$/);
   assert.equal(await page.isHidden('#risk-warning'), true);
 
