@@ -847,6 +847,10 @@ fn near_drawn_line(ta: &[DVec3], j: usize, t: DVec3) -> bool {
 /// step only, 0.023 mm where the tip led 0.485 mm off the line round a
 /// corner.
 fn off_line(ta: &[DVec3], j: usize, t: DVec3, beyond: f64) -> Option<f64> {
+    // (A point the planner could not clear is NaN: not a distance.)
+    if !t.is_finite() {
+        return None;
+    }
     let p = t.truncate();
     let last = ta.len().checked_sub(1).filter(|&l| l > 0)?;
     let mut best: Option<(f64, usize, f64)> = None;
@@ -930,7 +934,9 @@ mod tests {
         // Past the first and the last point: the lead, not counted.
         assert_eq!(off_line(&ta, 0, DVec3::new(-0.3, 0.0, 3.6), 0.0), None);
         assert_eq!(off_line(&ta, 4, DVec3::new(2.0, 2.3, 3.6), 0.0), None);
-        // A one-point piece has no line.
+        // A one-point piece has no line; a tip not cleared (NaN) is no
+        // distance (it made the figure NaN, then any later point's).
         assert_eq!(off_line(&ta[..1], 0, t, 0.0), None);
+        assert_eq!(off_line(&ta, 2, DVec3::NAN, 0.0), None);
     }
 }
