@@ -831,11 +831,16 @@ fn near_drawn_line(ta: &[DVec3], j: usize, t: DVec3) -> bool {
         let on = a + crate::spacing::nearest_on_segment(p, a, b) * (b - a);
         on.distance_squared(p) <= ON_LINE_MM * ON_LINE_MM
     };
-    // The segments nearest the point first: the one ahead, the one behind.
+    line_window(j, last).any(near)
+}
+
+/// The segments k (from sample k to k + 1, of `last` + 1 samples) within
+/// [`LINE_WINDOW`] of point j, nearest first: the one ahead, the one
+/// behind.
+fn line_window(j: usize, last: usize) -> impl Iterator<Item = usize> {
     (0..LINE_WINDOW)
-        .flat_map(|i| [(j + i < last).then_some(j + i), j.checked_sub(i + 1)])
+        .flat_map(move |i| [(j + i < last).then_some(j + i), j.checked_sub(i + 1)])
         .flatten()
-        .any(near)
 }
 
 /// How far the tip `t` of point j lies from the drawn line (the surface
@@ -856,10 +861,7 @@ fn off_line(ta: &[DVec3], j: usize, t: DVec3, beyond: f64) -> Option<f64> {
     let mut best: Option<(f64, usize, f64)> = None;
     // The segments nearest the point first; a segment within `beyond`
     // answers the question.
-    for k in (0..LINE_WINDOW)
-        .flat_map(|i| [(j + i < last).then_some(j + i), j.checked_sub(i + 1)])
-        .flatten()
-    {
+    for k in line_window(j, last) {
         let (a, b) = (ta[k].truncate(), ta[k + 1].truncate());
         let ab = b - a;
         let len2 = ab.length_squared();
