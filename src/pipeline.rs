@@ -689,11 +689,12 @@ fn plan_stage(
         };
         // Contacts of the whole nozzle and of the moves, which section 7's
         // disk test does not see (spec 6d, 6f): a guarded planner's points
-        // clear by tol, but for those it could not clear.
-        let guarded = safe_motion && planner.is_guarded();
+        // clear by tol, but for those it could not clear, with or without
+        // the safe-motion stage; its moves are made safe by that stage,
+        // but for those it could not resolve.
         // (As flags: a lookup per point, however many there are.)
-        let flags = |list: &[usize]| {
-            let mut f = vec![!guarded; planned.toolpath.len()];
+        let flags = |all: bool, list: &[usize]| {
+            let mut f = vec![all; planned.toolpath.len()];
             for &j in list {
                 if let Some(x) = f.get_mut(j) {
                     *x = true;
@@ -701,7 +702,8 @@ fn plan_stage(
             }
             f
         };
-        let (asked, commanded) = (flags(&planned.uncleared), flags(&unresolved));
+        let asked = flags(!planner.is_guarded(), &planned.uncleared);
+        let commanded = flags(!(safe_motion && planner.is_guarded()), &unresolved);
         let into = nozzle_contacts(
             surface,
             &planned.toolpath,
