@@ -629,15 +629,6 @@ impl Renderer {
         gl.use_program(Some(&p.program));
         // Markers sit in holes: draw them over the surface.
         gl.disable(Gl::DEPTH_TEST);
-        if let Some(c) = &self.contacts {
-            // Where the nozzle meets the part, seen wherever it is.
-            let o = self.path_offset.as_vec3();
-            gl.uniform3f(p.offset.as_ref(), o.x, o.y, o.z);
-            gl.uniform1f(p.point_size.as_ref(), 6.0);
-            gl.bind_vertex_array(Some(&c.vao));
-            gl.draw_arrays(Gl::POINTS, 0, c.count);
-            gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
-        }
         if let Some((tip, _)) = self.nozzle {
             // The tip's place, seen even where the part hides the nozzle.
             let o = tip.as_vec3();
@@ -657,6 +648,16 @@ impl Renderer {
                 gl.bind_vertex_array(Some(&m.vao));
                 gl.draw_arrays(Gl::POINTS, 0, m.count);
             }
+        }
+        if let Some(c) = &self.contacts {
+            // Where the nozzle meets the part, seen wherever it is, over
+            // every other marker too.
+            let o = self.path_offset.as_vec3();
+            gl.uniform3f(p.offset.as_ref(), o.x, o.y, o.z);
+            gl.uniform1f(p.point_size.as_ref(), 6.0);
+            gl.bind_vertex_array(Some(&c.vao));
+            gl.draw_arrays(Gl::POINTS, 0, c.count);
+            gl.uniform3f(p.offset.as_ref(), 0.0, 0.0, 0.0);
         }
         gl.bind_vertex_array(None);
     }
