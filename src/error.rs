@@ -31,6 +31,14 @@ pub enum Error {
     /// A G-code program could not be read (names the file, line and word).
     #[error(transparent)]
     GcodeRead(#[from] GcodeReadError),
+    /// A G-code program could not be read for the machine profile it was
+    /// read for, and its header says it was written for another (QA round
+    /// 9 L1): the reading's error, then the header's profile.
+    #[error("{source}; {note}")]
+    GcodeReadForOtherProfile {
+        source: Box<GcodeReadError>,
+        note: String,
+    },
     /// A parameter is out of its valid range (names the parameter and value).
     #[error("invalid parameter {name} = {value}: {reason}")]
     Parameter {

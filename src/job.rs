@@ -418,7 +418,8 @@ impl Report {
     /// it describes: section 7 looks at the planned points, in the path's
     /// vertical plane, so the waypoints between them and a tip offset
     /// beside the drawn line are not in its figures (QA round 6 F4, F5:
-    /// the header's figures were read as the commanded motion's).
+    /// the header's figures were read as the commanded motion's), and its
+    /// contact is counted for the whole nozzle and the moves too.
     pub fn quality_line(&self) -> String {
         format!("{} ({})", self.quality, self.quality_scope())
     }
@@ -439,8 +440,12 @@ impl Report {
         } else {
             String::new()
         };
+        // Contact counts more than section 7's disk test (spec 6d, 6f:
+        // `quality::nozzle_contacts`), so a figure set beside the paper's
+        // is not misread.
         format!(
-            "section 7, at the {} planned points{}{sideways}",
+            "section 7, at the {} planned points{}, with contact also where the nozzle's body \
+             or a straight move meets the part{sideways}",
             self.stats.points,
             not.iter().map(|n| format!(", {n}")).collect::<String>()
         )
@@ -1489,6 +1494,41 @@ impl GcodeCheck {
             && self.planned_nozzle.is_none()
     }
 
+    /// The verdict of a check that [`Self::is_clear`] passes, in the same
+    /// words in the CLI and the page (review of stop 44: they differed),
+    /// or `None`: clear of the scanned surface only where moves pass
+    /// beside it or over a hole in it (QA round 8 F4), and what the
+    /// header says of an accepted risk (QA round 7 F13).
+    pub fn clear_verdict(&self) -> Option<String> {
+        if !self.is_clear() {
+            return None;
+        }
+        let moves = match self.summary.moves {
+            1 => "the 1 move does not come".to_string(),
+            n => format!("none of the {n} moves comes"),
+        };
+        let mut verdict = match self.off_scan_moves {
+            0 => format!("clear: {moves} closer than tol"),
+            n => format!(
+                "clear of the scanned surface: {moves} closer than tol, but {n} move(s) pass \
+                 beside the scan or over a hole in it, where nothing is known of the part \
+                 (named in the notes)"
+            ),
+        };
+        if let Some(risks) = &self.written_at_risk {
+            let and = if self.off_scan_moves > 0 {
+                "and"
+            } else {
+                "but"
+            };
+            verdict.push_str(&format!(
+                "; {and} its header says it was written only because the risk was accepted: \
+                 {risks}"
+            ));
+        }
+        Some(verdict)
+    }
+
     /// A note on the moves that leave `profile`'s build volume (the scan
     /// says nothing of the bed beside it: a program driving the nozzle to
     /// Z -5 beside the part passed clear), or `None`. A note, not a
@@ -1549,20 +1589,23 @@ pub fn check_gcode(
     nozzle: &crate::params::Nozzle,
     tol_mm: f64,
 ) -> Result<GcodeCheck> {
-    check_gcode_as(scan, text, file, nozzle, tol_mm, false)
+    check_gcode_as(scan, text, file, nozzle, tol_mm, "marlin")
 }
 
-/// [`check_gcode`] of a program for a Grbl controller when `grbl`
+/// [`check_gcode`] of a program read for the machine profile named
+/// `profile`: as a Grbl controller reads it for `grbl`
 /// ([`crate::gcode::read_gcode_grbl`]: X/Y/Z beside a spindle or coolant
-/// M-code are a move whose end is known).
+/// M-code are a move whose end is known). Where a pcpp program's header
+/// names another profile, a note says so, and so does a reading error.
 pub fn check_gcode_as(
     scan: &PreparedScan,
     text: &str,
     file: &str,
     nozzle: &crate::params::Nozzle,
     tol_mm: f64,
-    grbl: bool,
+    profile: &str,
 ) -> Result<GcodeCheck> {
+    let grbl = profile == "grbl";
     nozzle.validate()?;
     crate::params::Process::DEFAULT
         .with_tolerance_mm(tol_mm)
@@ -1575,11 +1618,19 @@ pub fn check_gcode_as(
              G-code file the printer runs as the program"
         )));
     }
+    let other_profile = other_profile_note(text, profile);
     let program = if grbl {
-        crate::gcode::read_gcode_grbl(text, file)?
+        crate::gcode::read_gcode_grbl(text, file)
     } else {
-        crate::gcode::read_gcode(text, file)?
-    };
+        crate::gcode::read_gcode(text, file)
+    }
+    .map_err(|source| match &other_profile {
+        Some(note) => Error::GcodeReadForOtherProfile {
+            source: Box::new(source),
+            note: note.clone(),
+        },
+        None => Error::GcodeRead(source),
+    })?;
     // A file without a single move (empty, comments only, or not G-code
     // at all) shows nothing about the nozzle: it is not "clear".
     if program.moves.is_empty() && program.unknown_moves.is_empty() {
@@ -1769,7 +1820,13 @@ pub fn check_gcode_as(
     }
     // What the program's header says against this scan and nozzle, first.
     let planned_nozzle = smaller_nozzle(planned_nozzle(text), nozzle.outer_diameter_mm, tol_mm);
-    notes.splice(0..0, frame_notes.into_iter().chain(planned_nozzle.clone()));
+    notes.splice(
+        0..0,
+        other_profile
+            .into_iter()
+            .chain(frame_notes)
+            .chain(planned_nozzle.clone()),
+    );
     Ok(GcodeCheck {
         file: InputFile::new(file, text.as_bytes()),
         lines: program.lines,
@@ -1851,25 +1908,49 @@ pub fn planned_nozzle(text: &str) -> (Option<crate::params::Nozzle>, Option<f64>
 /// The machine profile a pcpp program's header says it was written for
 /// (`; profile: NAME`, `' profile: NAME` for Aerotech, `( profile: NAME )`
 /// for Grbl), if it says.
-pub fn planned_profile(text: &str) -> Option<&str> {
-    text.lines()
-        .map(str::trim)
-        .take_while(|l| l.starts_with(';') || l.starts_with('\'') || l.starts_with('('))
-        .find_map(|l| {
-            let l = l.strip_suffix(')').unwrap_or(l);
-            l[1..].trim().strip_prefix("profile: ")
-        })
-        .map(str::trim)
+pub fn planned_profile(text: &str) -> Option<String> {
+    header_lines(text)
+        .find_map(|l| l.strip_prefix("profile: ").map(|p| p.trim().to_string()))
         .filter(|p| !p.is_empty())
 }
 
-/// The leading comment block of a G-code program, each line without its
-/// comment mark (`;`, or `'` for Aerotech) and trimmed.
-fn header_lines(text: &str) -> impl Iterator<Item = &str> {
-    text.lines()
-        .map(str::trim)
-        .take_while(|l| l.starts_with(';') || l.starts_with('\''))
-        .map(|l| l[1..].trim())
+/// What a check reading the program for the machine profile `profile`
+/// says when the program's header names another (QA round 9 L1: a Grbl
+/// program checked as Marlin's was refused as "not in one frame" with no
+/// word of its header): the flag or control that checks it as planned.
+pub fn other_profile_note(text: &str, profile: &str) -> Option<String> {
+    let p = planned_profile(text).filter(|p| p != profile)?;
+    let how = if crate::gcode::MachineProfile::builtin(&p).is_some() {
+        format!("(--dialect {p})")
+    } else {
+        "(--profile with that profile's file)".to_string()
+    };
+    Some(format!(
+        "the program's header says it was written for profile {p}, and this check reads it for \
+         profile {profile} (its bed, its reading of the G-code): check it for profile {p} {how} \
+         to check it as it was planned"
+    ))
+}
+
+/// The leading comment block of a pcpp program (its first line `pcpp
+/// VERSION`; another tool's comments are not read as pcpp's header), each
+/// line without its comment marks and trimmed: `;`, `'` for Aerotech, `(
+/// ... )` for Grbl, whose header has each comma written as a space
+/// ([`crate::gcode`]'s comment sanitizing), turned back into `, `.
+fn header_lines(text: &str) -> impl Iterator<Item = std::borrow::Cow<'_, str>> {
+    let lines = text.lines().map(str::trim).map_while(|l| {
+        if let Some(inner) = l.strip_prefix('(') {
+            let inner = inner.strip_suffix(')').unwrap_or(inner).trim();
+            Some(std::borrow::Cow::Owned(inner.replace("  ", ", ")))
+        } else if l.starts_with(';') || l.starts_with('\'') {
+            Some(std::borrow::Cow::Borrowed(l[1..].trim()))
+        } else {
+            None
+        }
+    });
+    let mut lines = lines.peekable();
+    let ours = lines.peek().is_some_and(|l| l.starts_with("pcpp "));
+    lines.filter(move |_| ours)
 }
 
 /// [`GcodeCheck::planned_nozzle`]: the header's nozzle and tol
@@ -1915,13 +1996,16 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
             let planned = v
                 .split("sha256 ")
                 .nth(1)
-                .map(|h| h.trim_end_matches(')').trim());
+                .map(|h| h.trim_end_matches([')', ']']).trim());
             if let Some(h) = planned.filter(|h| *h != scan.file.sha256) {
                 notes.push(format!(
                     "the program was planned on another scan file: its header names {} (sha256 \
                      {}...), this check's scan is {} (sha256 {}...): its moves may not fit this \
                      scan",
-                    v.split(" (").next().unwrap_or(v),
+                    v.split(" (")
+                        .next()
+                        .and_then(|n| n.split(" [").next())
+                        .unwrap_or(v),
                     &h[..h.len().min(12)],
                     scan.file.name,
                     &scan.file.sha256[..scan.file.sha256.len().min(12)]
@@ -2133,6 +2217,37 @@ mod tests {
         assert!(smaller_nozzle(planned_nozzle(ours), 1.6, 0.1).is_some());
         assert!(smaller_nozzle(planned_nozzle(ours), 1.6, 0.25).is_none());
         assert!(smaller_nozzle(planned_nozzle(ours), 2.0, 0.3).is_none());
+        // Grbl's `( ... )` comments, their commas written as spaces.
+        let grbl = "( pcpp 0.1.0 )\n( nozzle: d 1.2 mm  do 1.6 mm )\n( process: tol 0.25 mm  \
+                    speed 5 mm/s )\n( profile: grbl )\nG21\n";
+        assert_eq!(planned_nozzle(grbl), planned_nozzle(ours));
+        assert_eq!(planned_profile(grbl).as_deref(), Some("grbl"));
+        // Only pcpp's own header is read.
+        let foreign = ours.replace("pcpp 0.1.0", "othertool 2.0");
+        assert_eq!(planned_nozzle(&foreign), (None, None));
+        assert_eq!(planned_profile(&grbl.replace("pcpp", "cam")), None);
+    }
+
+    /// Review of stop 44: `( ... )` was stripped from every comment line,
+    /// so `; profile: my-printer (v2)` read `my-printer (v2`; and a user's
+    /// own profile was told to `--dialect`, which takes built-in names.
+    #[test]
+    fn another_profile_in_the_header_is_named_with_how_to_check_it() {
+        let header = |p: &str| format!("; pcpp 0.1.0\n; profile: {p}\nG21\n");
+        let custom = header("my-printer (v2)");
+        assert_eq!(planned_profile(&custom).as_deref(), Some("my-printer (v2)"));
+        let note = other_profile_note(&custom, "marlin").expect("another profile");
+        assert!(
+            note.contains(
+                "written for profile my-printer (v2), and this check reads it for \
+                 profile marlin"
+            ) && note.contains("(--profile with that profile's file)"),
+            "{note}"
+        );
+        let note = other_profile_note(&header("aerotech"), "marlin").expect("another profile");
+        assert!(note.contains("(--dialect aerotech)"), "{note}");
+        assert_eq!(other_profile_note(&header("marlin"), "marlin"), None);
+        assert_eq!(other_profile_note("G21\nG1 X0 Y0 Z1\n", "grbl"), None);
     }
 
     use super::*;

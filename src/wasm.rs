@@ -93,7 +93,10 @@ fn core_err(e: crate::Error) -> JsValue {
         "svg"
     } else if matches!(e, Error::Registration(_)) {
         "registration"
-    } else if matches!(e, Error::GcodeRead(_)) {
+    } else if matches!(
+        e,
+        Error::GcodeRead(_) | Error::GcodeReadForOtherProfile { .. }
+    ) {
         "gcode"
     } else if matches!(e, Error::Touching(_)) {
         "touching"

@@ -128,7 +128,8 @@ fn demo_file(name: &str) -> PathBuf {
 /// QA round 6 F4, F5: the header's quality figures were read as the
 /// commanded motion's; they are section 7's at the planned points, and the
 /// line says so, with the waypoints and the tip's sideways offset it does
-/// not see.
+/// not see, and (review of stop 44) the contacts it counts beyond section
+/// 7's disk test.
 #[test]
 fn the_quality_line_says_what_its_figures_describe() {
     let mut settings = JobSettings::default();
@@ -150,8 +151,8 @@ fn the_quality_line_says_what_its_figures_describe() {
     // sideways step alone was said).
     assert!(m.max_off_line_mm >= m.max_sideways_mm - 1e-9, "{m:?}");
     let line = format!(
-        "; predicted quality: {} (section 7, at the {} planned points, not the {} waypoint(s); \
-         the tip up to {:.3} mm off the drawn line, stepped sideways or leading its point round \
+        "; predicted quality: {} (section 7, at the {} planned points, not the {} waypoint(s), \
+         with contact also where the nozzle's body or a straight move meets the part; the tip up to {:.3} mm off the drawn line, stepped sideways or leading its point round \
          a corner, which section 7 does not see)",
         r.quality, r.stats.points, m.waypoints, m.max_off_line_mm
     );
@@ -933,8 +934,9 @@ fn check_verdict_says_the_moves_beside_the_scan() {
     let out = stdout(&o);
     assert!(
         out.contains(
-            "no move comes closer than tol to the scanned surface, but 3 move(s) pass beside \
-             the scan or over a hole in it, where nothing is known of the part (named above)"
+            "; clear of the scanned surface: none of the 4 moves comes closer than tol, but 3 \
+             move(s) pass beside the scan or over a hole in it, where nothing is known of the \
+             part (named in the notes)"
         ),
         "{out}"
     );
@@ -942,7 +944,7 @@ fn check_verdict_says_the_moves_beside_the_scan() {
     let o = check_on_demo(&demo_file("demo-even.gcode"), None);
     let out = stdout(&o);
     assert!(
-        out.contains("no move comes closer than tol") && !out.contains("beside"),
+        out.contains("; clear: none of the ") && !out.contains("beside"),
         "{out}"
     );
 }
@@ -953,7 +955,7 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
         let o = check_on_demo(&demo_file(name), None);
         assert_eq!(code(&o), 0, "{name}: {}{}", stdout(&o), stderr(&o));
         let out = stdout(&o);
-        assert!(out.contains("no move comes closer than tol"), "{out}");
+        assert!(out.contains("; clear: none of the "), "{out}");
         assert!(out.contains("min clearance 0.10"), "{out}");
     }
     // The golden programs in the three dialects check alike, each with one
@@ -981,8 +983,8 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
         // "not in one frame" with no word of the header's profile).
         let other = format!(
             "the program's header says it was written for profile {dialect}, and this check \
-             reads it for profile marlin (its bed, its reading of the G-code): give --dialect \
-             {dialect}"
+             reads it for profile marlin (its bed, its reading of the G-code): check it for \
+             profile {dialect} (--dialect {dialect}) to check it as it was planned"
         );
         assert_eq!(
             err.contains(&other),
@@ -995,10 +997,15 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
             &["--dialect", dialect],
         );
         assert_eq!(code(&o), 0, "{dialect}: {}", stderr(&o));
+        // Its header read in its own comments: the same scan, frame and
+        // profile.
+        let err = stderr(&o);
         assert!(
-            !stderr(&o).contains("written for profile"),
-            "{dialect}: {}",
-            stderr(&o)
+            !err.contains("written for profile")
+                && !err.contains("another scan file")
+                && !err.contains("another frame")
+                && !err.contains("read in"),
+            "{dialect}: {err}"
         );
     }
 }
@@ -1103,6 +1110,61 @@ fn check_takes_the_nozzle_the_programs_header_names() {
         stderr(&o)
     );
     assert!(!stderr(&o).contains("header names"), "{}", stderr(&o));
+    // A Grbl program's header, in `( ... )` comments with its commas
+    // written as spaces, is read too (review of stop 44: its profile was,
+    // its nozzle and tol were not, so it was checked with the defaults),
+    // with no note of another scan or frame.
+    let grbl = dir.join("big-grbl.gcode");
+    let mut args = vec![
+        "--place",
+        "0,80,0,1",
+        "--nozzle-id",
+        "1.2",
+        "--nozzle-od",
+        "1.6",
+        "--tol",
+        "0.25",
+        "--dialect",
+        "grbl",
+        "-o",
+    ];
+    args.push(s(&grbl));
+    let o = plan_demo(&args);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&grbl).unwrap();
+    assert!(
+        text.contains("\n( nozzle: d 1.2 mm  do 1.6 mm )\n"),
+        "{}",
+        &text[..600]
+    );
+    let o = check_on(&scan, &grbl, &["--dialect", "grbl"]);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("(nozzle outer diameter 1.6 mm, tol 0.25 mm): min clearance 0.25"),
+        "{}",
+        stdout(&o)
+    );
+    let err = stderr(&o);
+    assert!(
+        err.contains("checked with the nozzle the program's header names"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("another scan file") && !err.contains("another frame"),
+        "{err}"
+    );
+    // Another tool's comments are not read as pcpp's header: the same
+    // lines under another first line are not believed.
+    let foreign = text.replacen("( pcpp ", "( othertool ", 1);
+    let other = dir.join("foreign-grbl.gcode");
+    std::fs::write(&other, foreign).unwrap();
+    let o = check_on(&scan, &other, &["--dialect", "grbl"]);
+    assert!(
+        stdout(&o).contains("(nozzle outer diameter 0.908 mm, tol 0.1 mm)"),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -1133,8 +1195,8 @@ fn check_repeats_the_risk_a_programs_header_says_was_accepted() {
     assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
     assert!(
         stdout(&o).ends_with(
-            "no move comes closer than tol; but its header says it was written only because the \
-             risk was accepted: the tool path dispenses 9.518 mm above the surface\n"
+            "comes closer than tol; but its header says it was written only because the risk was \
+             accepted: the tool path dispenses 9.518 mm above the surface\n"
         ),
         "{}",
         stdout(&o)
@@ -2401,7 +2463,7 @@ fn regression_outputs_replaced_links_pipes_and_devices_with_files() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(json["summary"].is_object(), "{json}");
-    assert!(stderr(&o).contains("no move comes closer than tol"));
+    assert!(stderr(&o).contains("; clear: none of the "));
     let mut names = listing(&dir);
     names.sort();
     assert_eq!(
@@ -3013,7 +3075,7 @@ fn check_reads_a_grbl_program_as_grbl_does() {
     let out = stdout(&o);
     assert!(
         out.contains("laser.nc: 5 moves checked against")
-            && out.contains("no move comes closer than tol"),
+            && out.contains("; clear: none of the 5 moves comes closer than tol"),
         "{out}\n{}",
         stderr(&o)
     );

@@ -4,7 +4,7 @@
 // program's moves drawn in the 3-D view on request.
 import { checkGcodeSize } from '../pkg/pcpp.js';
 import {
-  $, cell, el, fmt, fmtPoint, hooks, num, pageText, settings, state,
+  $, cell, el, fmt, fmtPoint, hooks, num, pageText, profile, settings, state,
 } from './page.js';
 import { clearError, showError } from './status.js';
 import { drawPlanPaths, setViewShows } from './view.js';
@@ -30,8 +30,9 @@ export function checkGcodeFile(file) {
   $('check-verdict').textContent = `checking ${file.name}…`;
   $('check-verdict').className = 'verdict';
   $('check-details').replaceChildren();
-  // A Grbl program is read as Grbl reads it (the dialect chosen).
-  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol, dialect: s.dialect });
+  // Read for the profile chosen (a Grbl program as Grbl reads it), by its
+  // name, which a pcpp program's header names too.
+  state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol, dialect: profile().name });
 }
 
 function showCheckError(name, message) {
@@ -67,14 +68,9 @@ export function onCheck(m) {
   const against = `${c.file.name} against ${m.scan} (nozzle outer diameter ${c.outer_diameter_mm} mm, tol ${c.tol_mm} mm)`;
   // Clear of what was scanned, not of what was not (QA round 8 F4).
   const off = c.off_scan_moves || 0;
-  verdict.textContent = c.clear && off
-    ? `clear of the scanned surface: none of the ${sum.moves} moves comes closer than tol, but ${off} `
-      + `move(s) pass beside the scan or over a hole in it, where nothing is known of the part (named below); `
-      + `${against}${c.written_at_risk
-      ? `; and its header says it was written only because the risk was accepted: ${c.written_at_risk}` : ''}`
-    : c.clear
-    ? `clear: none of the ${sum.moves} moves comes closer than tol; ${against}${c.written_at_risk
-      ? `; but its header says it was written only because the risk was accepted: ${c.written_at_risk}` : ''}`
+  // A clear check's verdict in the core's words, as the CLI says it.
+  verdict.textContent = c.clear
+    ? `${c.clear_verdict}; ${against}`
     // Planned for a larger nozzle or tol than this check's (QA round 6 F1).
     : sum.touching_moves === 0 && c.unchecked_lines.length === 0 && !(c.planned_otherwise || []).length
       && c.planned_nozzle

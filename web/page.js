@@ -84,6 +84,8 @@ const PAGE_WORDS = [
   [/\(--accept-risk\)/g, "(the box 'write G-code even where it is refused (at my risk)')"],
   [/keep it next to \S+ \(command line\) or select both files together \(page\)/g, 'select both files together'],
   [/e\.g\. placed on the bed: --place-scan bed\)/g, "e.g. placed on the bed: 'Place on the bed')"],
+  [/\(--dialect ([\w-]+)\)/g, '(Dialect: $1)'],
+  [/\(--profile with that profile's file\)/g, "('Machine profile…' with that profile's file)"],
 ];
 
 export function pageText(text) {

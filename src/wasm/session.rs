@@ -561,8 +561,11 @@ impl Session {
     /// Checks a G-code file (`bytes`, UTF-8 text, any program: ours or
     /// another tool's) against this scan ([`job::check_gcode`]): every
     /// straight move along its length, the nozzle `nozzle` (`{inner_diameter_mm,
-    /// outer_diameter_mm}`) kept `tol_mm` from the surface. Returns the
-    /// `job::GcodeCheck` with `clear` (no move closer than tol) and, for
+    /// outer_diameter_mm}`) kept `tol_mm` from the surface, the program
+    /// read for the machine profile named `dialect` (its name, built-in or
+    /// the user's; Marlin's when none: [`job::check_gcode_as`]). Returns the
+    /// `job::GcodeCheck` with `clear` (no move closer than tol),
+    /// `clear_verdict` (its words, or null) and, for
     /// the view, up to [`PAGE_MAX_DRAWN_MOVES`] of the moves checked:
     /// `moves` (xyz from and to, Float32Array) and `kinds` (0 feed, 1 rapid,
     /// 2 listed as too close; only the check's first
@@ -582,13 +585,21 @@ impl Session {
         let nozzle: Nozzle = from_js("nozzle", nozzle)?;
         let text = gcode_text(bytes, name)?;
         self.digest_known()?;
-        // The grbl profile's programs read as Grbl reads them.
-        let grbl = dialect.as_deref() == Some("grbl");
-        let check =
-            job::check_gcode_as(&self.scan, text, name, &nozzle, tol_mm, grbl).map_err(core_err)?;
+        // Read for the profile named (the grbl profile's programs as Grbl
+        // reads them); the default dialect's when none is named.
+        let profile = dialect.as_deref().unwrap_or("marlin");
+        let check = job::check_gcode_as(&self.scan, text, name, &nozzle, tol_mm, profile)
+            .map_err(core_err)?;
         let out = to_js(&check)?;
         let o: &js_sys::Object = out.unchecked_ref();
         set(o, "clear", &JsValue::from_bool(check.is_clear()));
+        // The CLI's words for a clear check.
+        let verdict = check.clear_verdict();
+        set(
+            o,
+            "clear_verdict",
+            &verdict.map_or(JsValue::NULL, JsValue::from),
+        );
         let (mut moves, mut kinds) = (JsValue::NULL, JsValue::NULL);
         if check.summary.moves <= PAGE_MAX_DRAWN_MOVES {
             // The check's own moves: its touching moves index into them.

@@ -84,7 +84,8 @@ test('every planner is compared with its defects, backward moves, clearance and 
   // What the quality figures describe, as the G-code's header says (QA
   // round 6 F4, F5).
   assert.match(await page.textContent('#motion-quality'),
-    new RegExp(`; section 7, at the ${report.stats.points} planned points, not the ${motion.waypoints} waypoint\\(s\\); `
+    new RegExp(`; section 7, at the ${report.stats.points} planned points, not the ${motion.waypoints} waypoint\\(s\\), `
+      + `with contact also where the nozzle's body or a straight move meets the part; `
       + `the tip up to ${motion.max_off_line_mm.toFixed(3).replace('.', '\\.')} mm off the drawn line, stepped sideways or leading its point round a corner, which section 7 does not see$`));
   assert.match(await page.textContent('#motion-touching'), /^0 of \d+ \(tol 0\.1 mm\)$/);
   assert.equal(await page.isHidden('#risk-warning'), true);
@@ -292,8 +293,21 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
     return /risky\.gcode/.test(v) && !/^checking /.test(v);
   });
   assert.match(await page.textContent('#check-verdict'),
-    /^clear: none of the \d+ moves comes closer than tol; risky\.gcode against .*; but its header says it was written only because the risk was accepted: the tool path dispenses 9\.518 mm above the surface$/);
+    /^clear: none of the \d+ moves comes closer than tol; but its header says it was written only because the risk was accepted: the tool path dispenses 9\.518 mm above the surface; risky\.gcode against /);
   assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('bad')), true);
+
+  // A header naming another machine profile: the note says which, with
+  // the page's control that checks it as planned (review of stop 44: the
+  // command line's alone said it).
+  const other = own.bytes.toString('utf8').replace('\n; profile: marlin\n', '\n; profile: aerotech\n');
+  assert.notEqual(other, own.bytes.toString('utf8'));
+  await page.setInputFiles('#gcode-input', gcodeFile('other.gcode', Buffer.from(other)));
+  await page.waitForFunction(() => {
+    const v = document.getElementById('check-verdict').textContent;
+    return /other\.gcode/.test(v) && !/^checking /.test(v);
+  });
+  assert.match(await page.textContent('#check-notes'),
+    /the program's header says it was written for profile aerotech, and this check reads it for profile marlin \(its bed, its reading of the G-code\): check it for profile aerotech \(Dialect: aerotech\) to check it as it was planned/);
 
   // Down beside the scan and along there: clear of what was scanned, but
   // not a green "clear" (QA round 8 F4); the moves named below it.
@@ -304,7 +318,7 @@ test('a G-code file is checked against the scan: the demo\'s own is clear, a cut
     return /beside\.gcode/.test(v) && !/^checking /.test(v);
   });
   assert.match(await page.textContent('#check-verdict'),
-    /^clear of the scanned surface: none of the 4 moves comes closer than tol, but 3 move\(s\) pass beside the scan or over a hole in it, where nothing is known of the part \(named below\); beside\.gcode against demo-test-part\.ply/);
+    /^clear of the scanned surface: none of the 4 moves comes closer than tol, but 3 move\(s\) pass beside the scan or over a hole in it, where nothing is known of the part \(named in the notes\); beside\.gcode against demo-test-part\.ply/);
   assert.deepEqual(await page.$eval('#check-verdict', (e) => [...e.classList]), ['verdict', 'warn']);
   assert.match(await page.textContent('#check-notes'), /3 move\(s\) pass beside the scan or over a hole in it lower than tol above its top \(lines 4, 5, 6;/);
 

@@ -9,7 +9,7 @@
 ( registration: unregistered  taken as it is [the scan's frame is the printer's]; G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000] )
 ( residuals: [] mm  rms 0.0000 mm )
 ( path: 6 piece[s]  1362 points  457.592 mm  height change 4.504 mm  max inclination 86.9 deg  min radius 0.145 mm  print time 91.5 s )
-( predicted quality: mean |e| 0.0110 mm  mean e- -0.0043 mm  mean e+ 0.0225 mm  contact 0.00%  flattening 0.44%  floating 1.76% [section 7  at the 1362 planned points  not the 70 waypoint[s]; the tip up to 0.091 mm off the drawn line  stepped sideways or leading its point round a corner  which section 7 does not see] )
+( predicted quality: mean |e| 0.0110 mm  mean e- -0.0043 mm  mean e+ 0.0225 mm  contact 0.00%  flattening 0.44%  floating 1.76% [section 7  at the 1362 planned points  not the 70 waypoint[s]  with contact also where the nozzle's body or a straight move meets the part; the tip up to 0.091 mm off the drawn line  stepped sideways or leading its point round a corner  which section 7 does not see] )
 ( safe motion: min clearance 0.101 mm [tol 0.1 mm] along all 1443 moves; 70 waypoint[s] added [+3.321 mm] )
 ( warnings: 1 )
 ( warning 1: even: 22 point[s] of the tool path lifted where the nozzle [outer diameter 0.908 mm] is wider than the feature it must pass  or rising over one between points  dispense more than 1.206 mm [2 d] above the surface right under the tip; the highest  3.102 mm above it  is at [60.556  16.000  8.102]: expect floating filament there )

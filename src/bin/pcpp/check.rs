@@ -53,20 +53,6 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             from_header.join(", ")
         )
     });
-    // Checked as another machine's program than the header's (its bed
-    // places the scan, Grbl reads some lines its own way): said, with the
-    // flag that checks it as planned (QA round 9 L1: refused as "not in
-    // one frame" with no word of the header's profile).
-    let other_profile = job::planned_profile(&text)
-        .filter(|p| *p != profile.name)
-        .map(|p| {
-            format!(
-                "the program's header says it was written for profile {p}, and this check \
-                 reads it for profile {} (its bed, its reading of the G-code): give --dialect \
-                 {p} (or that profile's --profile) to check it as it was planned",
-                profile.name
-            )
-        });
     let prepared = load_scan(&a.scan, &settings, &outputs, progress)?;
     progress.step("checking every move...");
     let name = file_name(gcode_path);
@@ -77,7 +63,7 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         &name,
         &settings.plan.nozzle,
         settings.plan.process.tolerance_mm,
-        profile.name == "grbl",
+        &profile.name,
     );
     let mut check = match checked {
         Ok(check) => check,
@@ -86,20 +72,12 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
             // units than the program was planned with: QA).
             progress.finish();
             progress.warn(&prepared.warnings);
-            let e = match &other_profile {
-                Some(p) => format!("{e}; {p}"),
-                None => e.to_string(),
-            };
-            return Err(Failure::Input(in_file(gcode_path, &name, &e)));
+            return Err(Failure::Input(in_file(gcode_path, &name, &e.to_string())));
         }
     };
-    check.notes.splice(
-        0..0,
-        encoding
-            .into_iter()
-            .chain(header_nozzle)
-            .chain(other_profile),
-    );
+    check
+        .notes
+        .splice(0..0, encoding.into_iter().chain(header_nozzle));
     check.notes.extend(check.outside_volume(&profile));
     if let Some(r) = &a.report {
         write_one(r, to_json(&check)?.as_bytes())?;
@@ -128,19 +106,8 @@ pub fn cmd_check(a: &CheckArgs, progress: &Progress) -> CliResult<()> {
         check.outer_diameter_mm,
         check.tol_mm
     );
-    if check.is_clear() {
-        let risk = check.written_at_risk.as_ref().map_or(String::new(), |r| {
-            format!("; but its header says it was written only because the risk was accepted: {r}")
-        });
-        // Clear of what was scanned, not of what was not (QA round 8 F4).
-        let off = match check.off_scan_moves {
-            0 => String::new(),
-            n => format!(
-                " to the scanned surface, but {n} move(s) pass beside the scan or over a hole \
-                 in it, where nothing is known of the part (named above)"
-            ),
-        };
-        let line = format!("{head}; no move comes closer than tol{off}{risk}");
+    if let Some(verdict) = check.clear_verdict() {
+        let line = format!("{head}; {verdict}");
         // Standard output carries the report written there, alone.
         if a.report.as_deref().is_some_and(is_stdout) {
             eprintln!("{line}");
