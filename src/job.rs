@@ -1932,25 +1932,29 @@ pub fn other_profile_note(text: &str, profile: &str) -> Option<String> {
     ))
 }
 
-/// The leading comment block of a pcpp program (its first line `pcpp
-/// VERSION`; another tool's comments are not read as pcpp's header), each
-/// line without its comment marks and trimmed: `;`, `'` for Aerotech, `(
-/// ... )` for Grbl, whose header has each comma written as a space
+/// The leading comment block of a pcpp program (one of its lines `pcpp
+/// VERSION`, the first as written, or under a comment a user put above
+/// it; another tool's comments are not read as pcpp's header), each line
+/// without its comment marks and trimmed: `;`, `'` for Aerotech, `( ... )`
+/// for Grbl, whose header has each comma written as a space
 /// ([`crate::gcode`]'s comment sanitizing), turned back into `, `.
 fn header_lines(text: &str) -> impl Iterator<Item = std::borrow::Cow<'_, str>> {
-    let lines = text.lines().map(str::trim).map_while(|l| {
-        if let Some(inner) = l.strip_prefix('(') {
-            let inner = inner.strip_suffix(')').unwrap_or(inner).trim();
-            Some(std::borrow::Cow::Owned(inner.replace("  ", ", ")))
-        } else if l.starts_with(';') || l.starts_with('\'') {
-            Some(std::borrow::Cow::Borrowed(l[1..].trim()))
-        } else {
-            None
-        }
-    });
-    let mut lines = lines.peekable();
-    let ours = lines.peek().is_some_and(|l| l.starts_with("pcpp "));
-    lines.filter(move |_| ours)
+    let lines: Vec<std::borrow::Cow<'_, str>> = text
+        .lines()
+        .map(str::trim)
+        .map_while(|l| {
+            if let Some(inner) = l.strip_prefix('(') {
+                let inner = inner.strip_suffix(')').unwrap_or(inner).trim();
+                Some(std::borrow::Cow::Owned(inner.replace("  ", ", ")))
+            } else if l.starts_with(';') || l.starts_with('\'') {
+                Some(std::borrow::Cow::Borrowed(l[1..].trim()))
+            } else {
+                None
+            }
+        })
+        .collect();
+    let ours = lines.iter().any(|l| l.starts_with("pcpp "));
+    lines.into_iter().filter(move |_| ours)
 }
 
 /// [`GcodeCheck::planned_nozzle`]: the header's nozzle and tol
@@ -2225,6 +2229,9 @@ mod tests {
         // Only pcpp's own header is read.
         let foreign = ours.replace("pcpp 0.1.0", "othertool 2.0");
         assert_eq!(planned_nozzle(&foreign), (None, None));
+        // A comment a user put above pcpp's header leaves it pcpp's.
+        let edited = format!("; checked by hand\n{ours}");
+        assert_eq!(planned_nozzle(&edited), planned_nozzle(ours));
         assert_eq!(planned_profile(&grbl.replace("pcpp", "cam")), None);
     }
 

@@ -133,12 +133,15 @@ pub fn nozzle_contacts(
     let into = |a: DVec3, b: DVec3| surface.nozzle_gap(a, b, radius, 0.0, 0.0);
     let mut touched = crate::parallel::map(n, 256, |j| {
         let t = toolpath[j];
-        t.is_finite() && point(j) && into(t, t).is_some()
+        point(j) && t.is_finite() && into(t, t).is_some()
     });
     // Each move asked once, its contact given to the nearer end.
     let moves = crate::parallel::map(n.saturating_sub(1), 256, |j| {
+        if !commanded(j) {
+            return None;
+        }
         let (a, b) = (toolpath[j], toolpath[j + 1]);
-        if !(commanded(j) && a.is_finite() && b.is_finite()) {
+        if !(a.is_finite() && b.is_finite()) {
             return None;
         }
         into(a, b).map(|g| j + usize::from(g.at >= 0.5))

@@ -734,7 +734,7 @@ fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
     );
     let plain = check_gcode(&scan, &moves, "a.gcode", &nozzle, 0.1).unwrap();
     assert!(plain.is_clear() && plain.planned_otherwise.is_empty());
-    let text = format!("; scan read in: in, +Y up\n{moves}");
+    let text = format!("; pcpp 0.1.0\n; scan read in: in, +Y up\n{moves}");
     let check = check_gcode(&scan, &text, "a.gcode", &nozzle, 0.1).unwrap();
     assert_eq!(check.summary.touching_moves, 0);
     assert!(!check.is_clear());
@@ -751,6 +751,10 @@ fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
         "{:?}",
         check.planned_otherwise
     );
+    // Another tool's comment that reads alike is not pcpp's header.
+    let foreign = format!("; scan read in: in, +Y up\n{moves}");
+    let check = check_gcode(&scan, &foreign, "a.gcode", &nozzle, 0.1).unwrap();
+    assert!(check.is_clear(), "{:?}", check.notes);
 }
 
 /// QA round 3: a pen plotter's program (X and Y only, svg2gcode) was told
