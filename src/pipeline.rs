@@ -540,7 +540,8 @@ pub fn plan_surface_path(
 }
 
 /// [`plan_surface_path`] without the safe-motion stage: the planner's points
-/// as they are, no waypoints, no move checked (`motion` stays empty). For
+/// as they are, no waypoints, no move checked (`motion` stays empty, and
+/// the quality's contacts are the points' alone). For
 /// benchmarks that measure what the motion stage costs; G-code from such a
 /// plan is still checked when it is written.
 pub fn plan_surface_path_without_motion(
@@ -691,7 +692,8 @@ fn plan_stage(
         // disk test does not see (spec 6d, 6f): a guarded planner's points
         // clear by tol, but for those it could not clear, with or without
         // the safe-motion stage; its moves are made safe by that stage,
-        // but for those it could not resolve.
+        // but for those it could not resolve. Without the stage no move is
+        // asked (a benchmark of what the stage costs).
         // (As flags: a lookup per point, however many there are.)
         let flags = |all: bool, list: &[usize]| {
             let mut f = vec![all; planned.toolpath.len()];
@@ -703,7 +705,11 @@ fn plan_stage(
             f
         };
         let asked = flags(!planner.is_guarded(), &planned.uncleared);
-        let commanded = flags(!(safe_motion && planner.is_guarded()), &unresolved);
+        let commanded = if safe_motion {
+            flags(!planner.is_guarded(), &unresolved)
+        } else {
+            vec![false; planned.toolpath.len()]
+        };
         let into = nozzle_contacts(
             surface,
             &planned.toolpath,
