@@ -1019,7 +1019,7 @@ fn check_passes_the_demos_default_gcode_and_its_other_dialects() {
 fn check_takes_the_nozzle_the_programs_header_names() {
     let dir = temp_dir("check-nozzle");
     let gcode = dir.join("big.gcode");
-    let o = plan_demo(&[
+    let big = [
         "--place",
         "0,80,0,1",
         "--nozzle-id",
@@ -1028,9 +1028,8 @@ fn check_takes_the_nozzle_the_programs_header_names() {
         "1.6",
         "--tol",
         "0.25",
-        "-o",
-        s(&gcode),
-    ]);
+    ];
+    let o = plan_demo(&[&big[..], &["-o", s(&gcode)]].concat());
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&gcode).unwrap();
     assert!(
@@ -1115,21 +1114,7 @@ fn check_takes_the_nozzle_the_programs_header_names() {
     // its nozzle and tol were not, so it was checked with the defaults),
     // with no note of another scan or frame.
     let grbl = dir.join("big-grbl.gcode");
-    let mut args = vec![
-        "--place",
-        "0,80,0,1",
-        "--nozzle-id",
-        "1.2",
-        "--nozzle-od",
-        "1.6",
-        "--tol",
-        "0.25",
-        "--dialect",
-        "grbl",
-        "-o",
-    ];
-    args.push(s(&grbl));
-    let o = plan_demo(&args);
+    let o = plan_demo(&[&big[..], &["--dialect", "grbl", "-o", s(&grbl)]].concat());
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&grbl).unwrap();
     assert!(
