@@ -1504,6 +1504,8 @@ impl GcodeCheck {
             return None;
         }
         let moves = match self.summary.moves {
+            // (Only moves the file does not place, high above the scan.)
+            0 => "no move comes".to_string(),
             1 => "the 1 move does not come".to_string(),
             n => format!("none of the {n} moves comes"),
         };

@@ -1289,6 +1289,16 @@ fn regression_check_passed_a_program_none_of_whose_moves_it_could_check() {
     assert!(!err.contains("no move comes closer"), "{err}");
     let v: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert_eq!(v["unchecked_lines"].as_array().unwrap().len(), 4, "{v}");
+    // A rise from wherever the head stands, high above the scan, is all
+    // there is: clear, said of no move rather than "none of the 0 moves".
+    std::fs::write(&g, "G21\nG90\nG0 Z50\n").unwrap();
+    let o = check_on_demo(&g, None);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).ends_with("; clear: no move comes closer than tol\n"),
+        "{}",
+        stdout(&o)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
