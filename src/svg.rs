@@ -854,7 +854,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             *p *= prepared.px_scale;
         }
     }
-    notes.extend(off_page(&out, &tree, prepared.has_page, prepared.px_scale));
+    notes.extend(off_page(
+        &out,
+        &tree,
+        prepared.has_page,
+        prepared.page_px_scale,
+    ));
     Ok(SvgImport {
         subpaths: out,
         notes,
@@ -878,13 +883,18 @@ fn px_words(px_scale: f64) -> &'static str {
 /// a viewer shows only the page, and what lies beyond it is printed as
 /// drawn. The page is the root's size (its viewBox or width and height; a
 /// document with neither has none), in mm with y up: x 0..w, y -h..0.
-fn off_page(out: &[Subpath2], tree: &usvg::Tree, has_page: bool, px_scale: f64) -> Option<String> {
+fn off_page(
+    out: &[Subpath2],
+    tree: &usvg::Tree,
+    has_page: bool,
+    px_scale: [f64; 2],
+) -> Option<String> {
     if !has_page {
         return None;
     }
     let size = tree.size();
-    let w = f64::from(size.width()) * MM_PER_PX * px_scale;
-    let h = f64::from(size.height()) * MM_PER_PX * px_scale;
+    let w = f64::from(size.width()) * MM_PER_PX * px_scale[0];
+    let h = f64::from(size.height()) * MM_PER_PX * px_scale[1];
     // usvg keeps the size in f32, and a stroke along the page's edge is on it.
     let slack = 1e-5 * (w + h) + 1e-6;
     let off = |p: &DVec2| p.x < -slack || p.x > w + slack || p.y > slack || p.y < -h - slack;
@@ -977,6 +987,11 @@ struct Prepared {
     missing_size: Vec<&'static str>,
     /// [`RootSize::px_scale`].
     px_scale: f64,
+    /// The factor on the page's width and height in mm: `px_scale` where
+    /// the root gives that side in px (unitless, px, a percentage, or not
+    /// at all), 1 where it gives it in an absolute unit (QA round 11 L2:
+    /// an Inkscape 0.39 page of width="210mm" was said to be 224 mm wide).
+    page_px_scale: [f64; 2],
 }
 
 /// Elements whose content is only drawn where something refers to it.
@@ -2335,6 +2350,17 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         percent_size: root_size.percent,
         missing_size: root_size.missing,
         px_scale: root_size.px_scale,
+        page_px_scale: ["width", "height"].map(|name| {
+            let absolute = root.attribute(name).and_then(root_length).is_some_and(|l| {
+                use svgtypes::LengthUnit as U;
+                !matches!(l.unit, U::None | U::Px | U::Percent)
+            });
+            if absolute {
+                1.0
+            } else {
+                root_size.px_scale
+            }
+        }),
     })
 }
 

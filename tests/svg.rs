@@ -2009,6 +2009,36 @@ fn shapes_off_the_page_are_named() {
         .any(|n| n.contains("off the page")));
 }
 
+/// QA round 11 L2: an Inkscape 0.39 file's A4 page (width="210mm"
+/// height="297mm", user units drawn at 90 px per inch) was said to be
+/// 224.0 x 316.8 mm, and a shape just past its edge was not named: the
+/// 90 px rule is for the drawing's user units, not for a page in mm.
+#[test]
+fn an_old_inkscapes_page_in_mm_keeps_its_size() {
+    let text = r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" inkscape:version="0.39" width="210mm" height="297mm">
+        <path id="inside" d="M 10 10 H 700" stroke="black"/>
+        <path id="past" d="M 700 20 H 770" stroke="black"/></svg>"#;
+    let (subs, notes) = notes_of(text);
+    // 770 px at 90 per inch is 217.3 mm: the drawing is read at 90.
+    let right = subs
+        .iter()
+        .flat_map(|s| &s.points)
+        .map(|p| p.x)
+        .fold(0.0, f64::max);
+    assert!((right - 770.0 * 25.4 / 90.0).abs() < 1e-6, "{right}");
+    let off: Vec<&String> = notes
+        .iter()
+        .filter(|n| n.contains("off the page"))
+        .collect();
+    assert_eq!(off.len(), 1, "{notes:?}");
+    assert!(
+        off[0].starts_with("1 shape(s) lie partly or wholly off the page (210.0 x 297.0 mm)")
+            && off[0].contains("(the first: 'past')"),
+        "{}",
+        off[0]
+    );
+}
+
 /// `<use>`s that refer to each other in a loop ('a' uses 'b', 'b' uses
 /// 'a') made usvg give up with "SVG data parsing failed cause nodes limit
 /// reached"; the error names the loop's ids and lines. A `<use>` of
