@@ -126,11 +126,15 @@ pub enum Error {
         limit_mm: f64,
     },
     /// A refusal that accepting the risk lifts, with the other risks that
-    /// the same acceptance would take (each would be refused on its own).
-    #[error("{first}; accepting the risk would also accept: {}", .others.join("; "))]
+    /// the same acceptance would take (each would be refused on its own),
+    /// and why accepting it would still write no G-code, where it would not
+    /// (QA round 11 L1: the tool path outside the build volume, which no
+    /// acceptance lifts, and `--accept-risk` was offered as writing it).
+    #[error("{first}{}{}", also_accepts(others), blocked_anyway(blocked))]
     AlsoRisks {
         first: Box<Error>,
         others: Vec<String>,
+        blocked: Option<String>,
     },
     /// G-code refused for a drawing most of which lies beside the scan or
     /// over its holes ([`crate::pipeline::MIN_PRINTED_SHARE`]).
@@ -164,6 +168,25 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// marlin (...): check the registration ...; the scan lies outside the
 /// build volume of profile marlin (...)"). `fit` is kept whole: the page
 /// finds its banner's sentence in the message.
+/// [`Error::AlsoRisks`]' other risks.
+fn also_accepts(others: &[String]) -> String {
+    if others.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; accepting the risk would also accept: {}",
+            others.join("; ")
+        )
+    }
+}
+
+/// [`Error::AlsoRisks`]' reason no acceptance writes G-code.
+fn blocked_anyway(blocked: &Option<String>) -> String {
+    blocked.as_ref().map_or(String::new(), |b| {
+        format!("; but accepting the risk would write no G-code either: {b}")
+    })
+}
+
 fn outside_volume(source: &GcodeError, fit: &str) -> String {
     let GcodeError::OutOfVolume {
         subpath,

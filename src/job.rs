@@ -1282,18 +1282,31 @@ pub fn write_outputs(
     // page's box was ticked for a whole object's cloud, and the G-code
     // dispensed 134 mm above the surface, a refusal of its own never
     // shown).
+    let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
+    let job = |header| GcodeJob {
+        toolpaths: &toolpaths,
+        speed_mm_s: settings.process.speed_mm_s,
+        dwell_s: settings.process.dwell_s,
+        header,
+        scan_top_z_mm: scan.surface.top_z(),
+    };
     let refused = |e: Error, risk: Option<Risk>| -> Error {
         let others: Vec<String> = risks
             .iter()
             .filter(|(r, _)| Some(*r) != risk)
             .map(|(_, text)| text.clone())
             .collect();
-        if others.is_empty() {
+        // What writing would fail with, accepted or not (QA round 11 L1).
+        let blocked = crate::gcode::checked_safe_height(&job(&[]), profile)
+            .err()
+            .map(|g| g.to_string());
+        if others.is_empty() && blocked.is_none() {
             e
         } else {
             Error::AlsoRisks {
                 first: Box::new(e),
                 others,
+                blocked,
             }
         }
     };
@@ -1313,14 +1326,6 @@ pub fn write_outputs(
         }
     }
     report.motion.accepted_risks = risks.iter().map(|(_, text)| text.clone()).collect();
-    let toolpaths: Vec<Vec<DVec3>> = plan.pieces.iter().map(|p| p.moves.clone()).collect();
-    let job = |header| GcodeJob {
-        toolpaths: &toolpaths,
-        speed_mm_s: settings.process.speed_mm_s,
-        dwell_s: settings.process.dwell_s,
-        header,
-        scan_top_z_mm: scan.surface.top_z(),
-    };
     // The header has the same lines whatever the check finds, so the moves'
     // line numbers from this first writing hold for the final one.
     let draft = provenance(&report);

@@ -80,9 +80,12 @@ fn core_err(e: crate::Error) -> JsValue {
     // The other risks accepting this one would accept: the kind and fields
     // are the refusal's own, the message says them too.
     let message = e.to_string();
-    if let Error::AlsoRisks { first, .. } = e {
+    if let Error::AlsoRisks { first, blocked, .. } = e {
         let err = core_err(*first);
         let _ = js_sys::Reflect::set(&err, &"message".into(), &message.into());
+        // Accepting the risk would write no G-code either: the page does
+        // not offer its box.
+        let _ = js_sys::Reflect::set(&err, &"blocked".into(), &blocked.is_some().into());
         return err;
     }
     // `matches!` rather than a `match`, so a variant added to the core later

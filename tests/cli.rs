@@ -2806,6 +2806,37 @@ fn a_scan_larger_than_the_printer_placed_on_the_bed_is_refused() {
         "{}",
         &text[..2000.min(text.len())]
     );
+    // Read in m, its top far above the volume's: the tool path leaves the
+    // volume too, which no acceptance lifts, and the refusal says so
+    // rather than offering --accept-risk as writing it (QA round 11 L1).
+    let metres = [
+        "--scan-units",
+        "m",
+        "--place-scan",
+        "bed",
+        "--place",
+        "centre",
+        "-o",
+    ];
+    let o = plan_on(&scan, &svg, &[&metres[..], &[s(&gcode)]].concat());
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("; but --accept-risk would write no G-code either: subpath ")
+            && err.contains("lies outside the build volume"),
+        "{err}"
+    );
+    let o = plan_on(
+        &scan,
+        &svg,
+        &[&metres[..], &[s(&gcode), "--accept-risk"]].concat(),
+    );
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("lies outside the build volume"),
+        "{}",
+        stderr(&o)
+    );
     // Read in mm it fits, and is planned with no such word.
     let o = plan_on(
         &scan,

@@ -732,7 +732,7 @@ fn regression_gcode_dispensing_far_above_the_surface_was_written() {
     .err()
     .expect("refused");
     match &e {
-        pcpp::Error::AlsoRisks { first, others } => {
+        pcpp::Error::AlsoRisks { first, others, .. } => {
             assert!(matches!(**first, pcpp::Error::MostlyOffScan { .. }), "{e}");
             assert_eq!(others.len(), 1, "{others:?}");
             assert!(

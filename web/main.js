@@ -582,7 +582,8 @@ function onPlanError(m, busy) {
   } else if (RISKS[m.kind]) {
     // Refused unless the risk is accepted: the box that accepts it.
     title = RISKS[m.kind];
-    message = ended(message) + '\nTo write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).';
+    // (Not where accepting it would write no G-code either: QA round 11 L1.)
+    if (!m.blocked) message = ended(message) + '\nTo write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).';
   } else if (m.kind === 'volume') {
     // (QA round 5 N3: "Planning failed" for a scan larger than the volume;
     // QA round 8 F5: the tool path blamed for the scan's place or size.)
@@ -598,8 +599,8 @@ function onPlanError(m, busy) {
     // Refused at planning: fiducials far off their printer points, or the
     // scan turned upside down (printer points in the other order).
     title = 'The registration puts the scan where the part is not: no G-code';
-    message = ended(message) + '\nCheck the printer points (their order and values); to write it anyway, tick '
-      + '"write G-code even where it is refused (at my risk)" (Nozzle and process).';
+    message = ended(message) + '\nCheck the printer points (their order and values)'
+      + (m.blocked ? '.' : '; to write it anyway, tick "write G-code even where it is refused (at my risk)" (Nozzle and process).');
   }
   // A plan refused for its motion still compared the planners on the
   // settings that failed: the table shows why.

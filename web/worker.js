@@ -52,6 +52,8 @@ function errorOf(err) {
   // G-code refused for its motion: the check's summary, and the planners
   // compared on the same settings.
   if (err && err.touching) out.touching = err.touching;
+  // A refusal that accepting the risk would not lift either.
+  if (err && err.blocked) out.blocked = true;
   if (err && err.comparison) out.comparison = err.comparison;
   // A refused plan's paths and placement: the page shows them.
   if (err && err.view) out.view = err.view;

@@ -340,8 +340,10 @@ fn check_job(job: &GcodeJob) -> Result<(), GcodeError> {
 
 /// Checks every point, then returns the travel height: above the scan and
 /// above every tool-path point by the clearance, so that travel can touch
-/// neither the part nor a path planned above it.
-fn checked_safe_height(job: &GcodeJob, profile: &MachineProfile) -> Result<f64, GcodeError> {
+/// neither the part nor a path planned above it. The error is what writing
+/// the job would fail with (a point not finite, or outside the build
+/// volume, or the travel height above it).
+pub fn checked_safe_height(job: &GcodeJob, profile: &MachineProfile) -> Result<f64, GcodeError> {
     let volume = profile.build_volume;
     let mut top = job.scan_top_z_mm;
     for (subpath, points) in job.toolpaths.iter().enumerate() {

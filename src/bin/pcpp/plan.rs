@@ -149,12 +149,26 @@ fn centre_on_scan(
 /// be the cause (a scan read in the wrong units leaves nothing to print).
 fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
     // The other risks the flag would accept, said after the refusal.
-    if let Error::AlsoRisks { first, others } = e {
+    if let Error::AlsoRisks {
+        first,
+        others,
+        blocked,
+    } = e
+    {
         return match plan_failure(inputs, *first, progress) {
-            Failure::Input(m) => Failure::Input(format!(
-                "{m}; --accept-risk would also accept: {}",
-                others.join("; ")
-            )),
+            Failure::Input(mut m) => {
+                if !others.is_empty() {
+                    m = format!(
+                        "{m}; --accept-risk would also accept: {}",
+                        others.join("; ")
+                    );
+                }
+                // (QA round 11 L1: offered as writing it, then refused.)
+                if let Some(b) = blocked {
+                    m = format!("{m}; but --accept-risk would write no G-code either: {b}");
+                }
+                Failure::Input(m)
+            }
             usage => usage,
         };
     }
