@@ -1186,6 +1186,25 @@ pub fn write_outputs(
             fit.message
         });
     }
+    // A cloud sparser than the nozzle is wide: the surface the motion
+    // check keeps tol from is the meshing's flat guess between points
+    // further apart than the nozzle, under which the part may rise (QA
+    // round 11 L4: 397 points 4 mm apart planned with no word; a whole
+    // object's cloud is refused for the same guess).
+    if let Some(cloud) = scan
+        .cloud
+        .as_ref()
+        .filter(|c| c.spacing_mm > settings.nozzle.outer_diameter_mm)
+    {
+        report.warnings.push(format!(
+            "{}: the point cloud's points lie a median {:.3} mm apart, more than the nozzle's \
+             outer diameter ({} mm): between them the surface is the meshing's guess (flat \
+             triangles, edges up to {:.3} mm), and the part may rise above it there by more \
+             than tol, which no check of the moves against the scan can see; scan it denser, \
+             or make sure the part is that smooth",
+            scan.file.name, cloud.spacing_mm, settings.nozzle.outer_diameter_mm, cloud.max_edge_mm
+        ));
+    }
     // Spec 6(f): every move is checked but those that start where nothing
     // says; the header names the first rise, this the profile's own.
     if let Some(line) = crate::gcode::start_block_motion(profile) {
