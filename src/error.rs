@@ -65,11 +65,13 @@ pub enum Error {
     /// sides is a guess, so the motion check does not hold for the part.
     #[error(
         "{file}: {hidden} of its {points} points lie under the surface seen from above: \
-         a scan of a whole object, not of a surface. Meshed from above, its surface between \
-         the points on steep sides and thin features is a guess, so the clearance checked \
-         along the moves does not hold for the real part; no G-code written. Export the \
-         scan as a mesh (PLY, OBJ, STL or glTF: the scanner's software makes one) and plan \
-         on that, or accept the risk"
+         a scan of a whole object, or a camera's view in perspective (at the edges of what \
+         a depth camera sees, its rays reach under them), not of a surface seen straight \
+         from above. Meshed from above, its surface between the points on steep sides \
+         and thin features is a guess, so the clearance checked along the moves does not \
+         hold for the real part; no G-code written. Export the scan as a mesh (PLY, OBJ, STL \
+         or glTF, if the scanner's software makes one), or scan the part straight from \
+         above, and plan on that, or accept the risk"
     )]
     WholeObjectCloud {
         file: String,

@@ -417,7 +417,12 @@ fn a_whole_objects_cloud_is_meshed_from_above_and_its_gcode_needs_the_risk_accep
     assert!(matches!(e, pcpp::Error::WholeObjectCloud { .. }), "{e}");
     let msg = e.to_string();
     assert!(
-        msg.contains("pebble.xyz") && msg.contains("as a mesh"),
+        msg.contains("pebble.xyz")
+            && msg.contains("as a mesh")
+            // (QA round 11 L3: a depth camera's single frame was told
+            // only of a whole object and its scanner's mesh export.)
+            && msg.contains("or a camera's view in perspective")
+            && msg.contains("or scan the part straight from above"),
         "{msg}"
     );
 
