@@ -285,7 +285,19 @@ test('a scan placed on the bed and read larger than the printer is refused', asy
   await waitIdle(page);
   assert.equal(await page.textContent('#error-title'), 'The scan is larger than the printer: no G-code');
   assert.match(await page.textContent('#error-message'), /it is larger than the volume \(x 600\.0 mm, the volume 220\.0 mm\)/);
+  assert.match(await page.textContent('#error-message'), /To write it anyway, tick/);
   assert.equal(await page.isHidden('#dl-gcode'), true);
+  // Read in metres, 3 m tall: the tool path leaves the volume too, which
+  // the box does not lift; the refusal says so and does not offer the box
+  // (QA round 11 L1).
+  await page.selectOption('#scan-units', 'm');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'm', null, { timeout: 120_000 });
+  await page.waitForFunction(() => /would write no G-code either/.test(document.getElementById('error-message').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const said = await page.textContent('#error-message');
+  assert.match(said, /; but accepting the risk would write no G-code either: subpath \d+, point \d+ at .* lies outside the build volume/);
+  assert.doesNotMatch(said, /To write it anyway, tick/);
   assert.deepEqual(problems, []);
   await context.close();
 });
