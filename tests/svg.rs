@@ -1972,6 +1972,16 @@ fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_at_72() {
     assert!(notes.iter().all(|n| !n.contains("72 px")), "{notes:?}");
 }
 
+/// The one off-page note among `notes`.
+fn the_off_page_note(notes: &[String]) -> &String {
+    let off: Vec<&String> = notes
+        .iter()
+        .filter(|n| n.contains("off the page"))
+        .collect();
+    assert_eq!(off.len(), 1, "{notes:?}");
+    off[0]
+}
+
 /// Found by QA: scraps beside an Inkscape page (a line from x 30 to 70 on
 /// a 40 mm page) were printed with nothing said. Shapes off the page are
 /// named once each; a page's edge is on it; a document with no size has no
@@ -1986,16 +1996,11 @@ fn shapes_off_the_page_are_named() {
     );
     let (subs, notes) = notes_of(&text);
     assert_eq!(subs.len(), 4);
-    let off: Vec<&String> = notes
-        .iter()
-        .filter(|n| n.contains("off the page"))
-        .collect();
-    assert_eq!(off.len(), 1, "{notes:?}");
+    let off = the_off_page_note(&notes);
     assert!(
-        off[0].starts_with("2 shape(s) lie partly or wholly off the page (40.0 x 20.0 mm)")
-            && off[0].contains("(the first: 'offpage')"),
-        "{}",
-        off[0]
+        off.starts_with("2 shape(s) lie partly or wholly off the page (40.0 x 20.0 mm)")
+            && off.contains("(the first: 'offpage')"),
+        "{off}"
     );
     let inside = doc(
         PAGE_40,
@@ -2026,16 +2031,11 @@ fn an_old_inkscapes_page_in_mm_keeps_its_size() {
         .map(|p| p.x)
         .fold(0.0, f64::max);
     assert!((right - 770.0 * 25.4 / 90.0).abs() < 1e-6, "{right}");
-    let off: Vec<&String> = notes
-        .iter()
-        .filter(|n| n.contains("off the page"))
-        .collect();
-    assert_eq!(off.len(), 1, "{notes:?}");
+    let off = the_off_page_note(&notes);
     assert!(
-        off[0].starts_with("1 shape(s) lie partly or wholly off the page (210.0 x 297.0 mm)")
-            && off[0].contains("(the first: 'past')"),
-        "{}",
-        off[0]
+        off.starts_with("1 shape(s) lie partly or wholly off the page (210.0 x 297.0 mm)")
+            && off.contains("(the first: 'past')"),
+        "{off}"
     );
 }
 
