@@ -1309,16 +1309,20 @@ pub fn write_outputs(
         header,
         scan_top_z_mm: scan.surface.top_z(),
     };
-    let refused = |e: Error, risk: Option<Risk>| -> Error {
+    // What writing would fail with, accepted or not (QA round 11 L1):
+    // asked of the refusals made before the G-code is written (those after
+    // it were written).
+    let unwritable = || {
+        crate::gcode::checked_safe_height(&job(&[]), profile)
+            .err()
+            .map(|g| g.to_string())
+    };
+    let refused = |e: Error, risk: Option<Risk>, blocked: Option<String>| -> Error {
         let others: Vec<String> = risks
             .iter()
             .filter(|(r, _)| Some(*r) != risk)
             .map(|(_, text)| text.clone())
             .collect();
-        // What writing would fail with, accepted or not (QA round 11 L1).
-        let blocked = crate::gcode::checked_safe_height(&job(&[]), profile)
-            .err()
-            .map(|g| g.to_string());
         if others.is_empty() && blocked.is_none() {
             e
         } else {
@@ -1331,16 +1335,22 @@ pub fn write_outputs(
     };
     if !accept_risk {
         refuse_bad_registration(&scan.registration, &settings.nozzle, false)
-            .map_err(|e| refused(e, Some(Risk::Registration)))?;
-        refuse_whole_object_cloud(scan, false).map_err(|e| refused(e, Some(Risk::WholeObject)))?;
-        refuse_unit_doubt(scan, false).map_err(|e| refused(e, Some(Risk::Units)))?;
+            .map_err(|e| refused(e, Some(Risk::Registration), unwritable()))?;
+        refuse_whole_object_cloud(scan, false)
+            .map_err(|e| refused(e, Some(Risk::WholeObject), unwritable()))?;
+        refuse_unit_doubt(scan, false).map_err(|e| refused(e, Some(Risk::Units), unwritable()))?;
         if let Some(depth_mm) = below_bed_mm(scan) {
-            return Err(refused(Error::BelowBed { depth_mm }, Some(Risk::BelowBed)));
+            return Err(refused(
+                Error::BelowBed { depth_mm },
+                Some(Risk::BelowBed),
+                unwritable(),
+            ));
         }
         if let Some(message) = too_large {
             return Err(refused(
                 Error::LargerThanVolume(message),
                 Some(Risk::TooLarge),
+                unwritable(),
             ));
         }
     }
@@ -1420,7 +1430,7 @@ pub fn write_outputs(
             drawing_xy: c.drawing_xy,
             scan_xy: [lo.x, lo.y, hi.x, hi.y],
         };
-        return Err(refused(e, Some(Risk::MostlyOff)));
+        return Err(refused(e, Some(Risk::MostlyOff), None));
     }
     if let (Some((height_mm, at)), false) = (far_above(plan, settings), accept_risk) {
         let e = Error::FarAbove {
@@ -1428,7 +1438,7 @@ pub fn write_outputs(
             at: at.to_array(),
             limit_mm: pipeline::REFUSED_HEIGHT_PER_D * settings.nozzle.inner_diameter_mm,
         };
-        return Err(refused(e, Some(Risk::FarAbove)));
+        return Err(refused(e, Some(Risk::FarAbove), None));
     }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
@@ -1439,7 +1449,7 @@ pub fn write_outputs(
             tol_mm: settings.process.tolerance_mm,
             summary: checked,
         }));
-        return Err(refused(e, None));
+        return Err(refused(e, None, None));
     }
     report.motion.risk_accepted =
         checked.touching_moves > 0 || !report.motion.accepted_risks.is_empty();
