@@ -186,8 +186,9 @@ pub fn surface_path(
     // Whether any subpath was large enough to print.
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    // Each subpath's samples as placed, for `close_lines` and `blobs`.
-    let mut sampled: Vec<(&str, Vec<DVec2>, bool)> = Vec::with_capacity(drawn.len());
+    // Each subpath's samples as placed, for `close_lines` and `blobs`, and
+    // it as drawn (placed), for the figures `blobs` gives.
+    let mut sampled: Vec<(&str, Vec<DVec2>, bool, Vec<DVec2>)> = Vec::with_capacity(drawn.len());
     // The drawing's length as sampled, and the part of it over the scan.
     let xy_length =
         |points: &[DVec2]| -> f64 { points.windows(2).map(|w| w[0].distance(w[1])).sum() };
@@ -238,7 +239,7 @@ pub fn surface_path(
                 geometry,
             });
         }
-        sampled.push((sub.source.as_str(), samples, placed.closed));
+        sampled.push((sub.source.as_str(), samples, placed.closed, placed.points));
     }
     // The one warning for every part too small to print (QA: a set of
     // icons gave 680).
@@ -279,10 +280,11 @@ pub fn surface_path(
     // Lines closer together than the filament is wide merge (`spacing`).
     let lines: Vec<Line> = sampled
         .iter()
-        .map(|(source, points, closed)| Line {
+        .map(|(source, points, closed, drawn)| Line {
             source,
             points,
             closed: *closed,
+            drawn,
         })
         .collect();
     if let Some(close) = close_lines(&lines, nozzle.inner_diameter_mm) {

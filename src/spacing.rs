@@ -25,8 +25,32 @@ pub const APART_PER_D: f64 = 3.0;
 /// One sampled subpath as placed (printer mm).
 pub struct Line<'a> {
     pub source: &'a str,
+    /// Its samples: what the tests judge, as what prints.
     pub points: &'a [DVec2],
     pub closed: bool,
+    /// The subpath as drawn (its flattened polyline, placed): the length
+    /// and box a warning gives, those the user can measure in the drawing
+    /// (QA round 7 F9: a drawing of 2.42 mm of line in a 0.27 x 0.31 mm
+    /// box was said to be 1.13 mm in 0.18 x 0.24 mm, its samples' figures).
+    pub drawn: &'a [DVec2],
+}
+
+/// The length of a polyline (closed: back to its first point too) and its
+/// box.
+fn extent(points: &[DVec2], closed: bool) -> (f64, DVec2, DVec2) {
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    let mut length = 0.0;
+    for (k, &p) in points.iter().enumerate() {
+        if k > 0 {
+            length += points[k - 1].distance(p);
+        }
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    if let (true, Some(first), Some(last)) = (closed, points.first(), points.last()) {
+        length += last.distance(*first);
+    }
+    (length, lo, hi)
 }
 
 /// Where the drawing's lines come within d of each other.
@@ -90,7 +114,8 @@ pub struct Blobs {
     pub whole: bool,
     /// How many pieces: the blobs, or for a whole drawing its pieces.
     pub count: usize,
-    /// The first one's subpath, place (its box's middle), length and box.
+    /// The first one's subpath, place (its box's middle), length and box,
+    /// as drawn ([`Line::drawn`]).
     pub source: String,
     pub at: DVec2,
     pub length_mm: f64,
@@ -98,6 +123,19 @@ pub struct Blobs {
 }
 
 impl Blobs {
+    /// The blob with the figures of `drawn`, (length, box) as drawn.
+    fn of(whole: bool, count: usize, source: String, drawn: (f64, DVec2, DVec2)) -> Blobs {
+        let (length_mm, lo, hi) = drawn;
+        Blobs {
+            whole,
+            count,
+            source,
+            at: 0.5 * (lo + hi),
+            length_mm,
+            size_mm: hi - lo,
+        }
+    }
+
     /// The plan's warning.
     pub fn message(&self, d: f64) -> String {
         let first = format!(
@@ -152,58 +190,36 @@ pub fn blobs(lines: &[Line], d: f64) -> Option<Blobs> {
         folded || crowded
     };
     let mut found: Option<Blobs> = None;
-    // The whole drawing: its pieces, length and box.
-    let mut all: Option<(usize, String, f64, DVec2, DVec2)> = None;
+    // The whole drawing: its pieces, then the length and box of its
+    // samples and of it as drawn.
+    type Extent = (f64, DVec2, DVec2);
+    let mut all: Option<(usize, String, Extent, Extent)> = None;
+    let joined = |(l0, lo0, hi0): Extent, (l1, lo1, hi1): Extent| -> Extent {
+        (l0 + l1, lo0.min(lo1), hi0.max(hi1))
+    };
     for line in lines {
-        let (Some(&first), true) = (line.points.first(), line.points.len() >= 2) else {
+        if line.points.len() < 2 {
             continue;
-        };
-        let (mut lo, mut hi) = (first, first);
-        let mut length = 0.0;
-        for w in line.points.windows(2) {
-            length += w[0].distance(w[1]);
-            lo = lo.min(w[1]);
-            hi = hi.max(w[1]);
         }
-        if line.closed {
-            length += line.points[line.points.len() - 1].distance(first);
-        }
-        match &mut all {
-            Some((n, _, l, alo, ahi)) => {
-                *n += 1;
-                *l += length;
-                *alo = alo.min(lo);
-                *ahi = ahi.max(hi);
-            }
-            None => all = Some((1, line.source.to_string(), length, lo, hi)),
-        }
-        let size = hi - lo;
-        if !is_blob(length, size) {
+        let sampled = extent(line.points, line.closed);
+        let drawn = extent(line.drawn, line.closed);
+        all = Some(match all.take() {
+            Some((n, source, s, d)) => (n + 1, source, joined(s, sampled), joined(d, drawn)),
+            None => (1, line.source.to_string(), sampled, drawn),
+        });
+        let (length, lo, hi) = sampled;
+        if !is_blob(length, hi - lo) {
             continue;
         }
         match &mut found {
             Some(b) => b.count += 1,
-            None => {
-                found = Some(Blobs {
-                    whole: false,
-                    count: 1,
-                    source: line.source.to_string(),
-                    at: 0.5 * (lo + hi),
-                    length_mm: length,
-                    size_mm: size,
-                })
-            }
+            None => found = Some(Blobs::of(false, 1, line.source.to_string(), drawn)),
         }
     }
     match all {
-        Some((count, source, length, lo, hi)) if is_blob(length, hi - lo) => Some(Blobs {
-            whole: true,
-            count,
-            source,
-            at: 0.5 * (lo + hi),
-            length_mm: length,
-            size_mm: hi - lo,
-        }),
+        Some((count, source, (length, lo, hi), drawn)) if is_blob(length, hi - lo) => {
+            Some(Blobs::of(true, count, source, drawn))
+        }
         _ => found,
     }
 }
@@ -417,6 +433,7 @@ mod tests {
             source,
             points,
             closed,
+            drawn: points,
         };
         let leak = |v: Vec<DVec2>| -> &'static [DVec2] { Box::leak(v.into_boxed_slice()) };
         let (zigzag, circle, raster, spiral) =
@@ -506,6 +523,7 @@ mod tests {
                 source: "flake",
                 points,
                 closed: false,
+                drawn: points,
             })
             .collect();
         for piece in &pieces {
@@ -530,6 +548,7 @@ mod tests {
             source: "p",
             points,
             closed,
+            drawn: points,
         }
     }
 
@@ -623,11 +642,13 @@ mod tests {
                     source: "a",
                     points: &a,
                     closed: false,
+                    drawn: &a,
                 },
                 Line {
                     source: "b",
                     points: &b,
                     closed: false,
+                    drawn: &b,
                 },
             ],
             d,

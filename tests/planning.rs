@@ -1079,6 +1079,36 @@ fn regression_a_drawing_folded_up_smaller_than_the_filament_was_planned_without_
     }
 }
 
+/// QA round 7 F9: a blob's figures were its samples' (d/2 apart, they cut
+/// a small curve's corners: a drawing of 2.42 mm of line in a 0.27 x 0.31
+/// mm box was said to be 1.13 mm in 0.18 x 0.24 mm). They are the drawing's
+/// as placed, which the user can measure.
+#[test]
+fn regression_a_blobs_figures_were_its_samples() {
+    let xs = range(0.0, 10.0, 50);
+    let mesh = height_field(&xs, &xs, |_, _| 1.0);
+    let scan = prepared_ply(&mesh, "plate.ply");
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    // A circle 0.4 mm across, drawn in mm: smaller than the filament.
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"
+        viewBox="0 0 10 10"><circle cx="5" cy="5" r="0.2" fill="none" stroke="black"/></svg>"#;
+    let mut settings = PlanSettings::default();
+    settings.placement.offset_mm = DVec2::new(0.0, 10.0);
+    let out = pcpp::job::run_on(&scan, svg.as_bytes(), "dot.svg", &settings, &profile, false)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let w = out
+        .report
+        .warnings
+        .iter()
+        .find(|w| w.contains("print as one blob"))
+        .unwrap_or_else(|| panic!("no blob warning: {:?}", out.report.warnings));
+    // 2 pi 0.2 mm = 1.257 mm (its flattening a hair less), in a 0.4 mm box.
+    assert!(
+        w.starts_with("the whole drawing, 1.26 mm of line in one piece within a 0.400 x 0.400 mm box at (5.000, 5.000)"),
+        "{w}"
+    );
+}
+
 /// QA round 5 N4: a plate lying on its side in the file (100 x 1.5 mm seen
 /// from above, 100 mm tall) took a drawing along its top edge with no word
 /// of its up axis. It is planned, and said to be seen edge-on; a plate
