@@ -183,9 +183,21 @@ pub(crate) fn predict_given_contact(
         None => (0..back.len()).map(|i| i as f64).collect(),
     };
     let hint = std::cell::Cell::new(usize::MAX);
+    // The last point evaluated: a root search's last step is usually the
+    // root, which is then evaluated again for the crossing (the same u,
+    // so the same point).
+    let last = std::cell::Cell::new((f64::NAN.to_bits(), DVec3::ZERO));
     let eval = |u: f64| -> DVec3 {
         match &curve {
-            Some(c) => c.eval_near(u, &hint),
+            Some(c) => {
+                let (bits, at) = last.get();
+                if bits == u.to_bits() {
+                    return at;
+                }
+                let at = c.eval_near(u, &hint);
+                last.set((u.to_bits(), at));
+                at
+            }
             None => {
                 let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
                 let f = u - i as f64;
@@ -260,7 +272,6 @@ fn crossing_near(
     let hi = (pj + SEARCH).min(back.len() - 1);
     // The crossing span nearest to j (the first found on a tie), then
     // its root: one root search per point.
-    let mut nearest: Option<(usize, usize, f64, f64)> = None;
     // The curve passes through F_k at u_k, so the window is scanned on
     // the F_k themselves; only the crossing span is searched. Where the
     // curve crosses three times within one span (the spline overshoots
@@ -279,19 +290,22 @@ fn crossing_near(
             f
         }
     };
-    let mut f1 = fk(lo);
-    for k in lo..hi {
-        let f0 = f1;
-        f1 = fk(k + 1);
-        if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
-            let dist = k.abs_diff(pj).min((k + 1).abs_diff(pj));
-            if nearest.is_none_or(|(bd, ..)| dist < bd) {
-                nearest = Some((dist, k, f0, f1));
-            }
+    // The span k (from F_k to F_k+1) lies min(|k - j|, |k + 1 - j|) from
+    // point j: the spans m away are k = j - 1 - m and k = j + m, tried in
+    // that order outwards, so the first crossing found is the nearest,
+    // the lower on a tie (the window's spans in order, keeping only a
+    // nearer one, found the same), and most points look at the two spans
+    // beside them only.
+    let crossing = |k: usize| {
+        let (f0, f1) = (fk(k), fk(k + 1));
+        (f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0)).then_some((k, f0, f1))
+    };
+    for m in 0..=SEARCH {
+        let below = (pj >= lo + 1 + m).then(|| crossing(pj - 1 - m)).flatten();
+        let found = below.or_else(|| (pj + m < hi).then(|| crossing(pj + m)).flatten());
+        if let Some((k, f0, f1)) = found {
+            return Some(eval(find_root(&f, params[k], params[k + 1], f0, f1)));
         }
-    }
-    if let Some((_, k, f0, f1)) = nearest {
-        return Some(eval(find_root(&f, params[k], params[k + 1], f0, f1)));
     }
     // At the path's end the curve of F_j stops short of the last normals:
     // the filament runs on to the tip, so extend c along its last chord.
@@ -419,6 +433,82 @@ mod tests {
         let r = find_root(&h, 0.0, 1.0, -1e-3, h(1.0));
         assert!((r - 0.3).abs() < 1e-9, "{r}");
     }
+
+    /// The crossing nearest to a point, the lower span on a tie, as the
+    /// scan of every span of the window in order found it (the search
+    /// now looks outwards from the point and stops at the first).
+    #[test]
+    fn the_nearest_crossing_is_the_one_a_scan_of_the_window_finds() {
+        // The scan it replaced: every span of the window in order, a
+        // nearer one kept.
+        fn scanned(back: &[DVec3], pj: usize, a: DVec3, t: DVec3) -> Option<usize> {
+            let fk = |k: usize| {
+                let f = (back[k] - a).dot(t);
+                if f.abs() <= ON_PLANE_MM {
+                    0.0
+                } else {
+                    f
+                }
+            };
+            let (lo, hi) = (pj.saturating_sub(SEARCH), (pj + SEARCH).min(back.len() - 1));
+            let mut nearest: Option<(usize, usize)> = None;
+            for k in lo..hi {
+                let (f0, f1) = (fk(k), fk(k + 1));
+                if f0 == 0.0 || (f0 < 0.0) != (f1 < 0.0) {
+                    let dist = k.abs_diff(pj).min((k + 1).abs_diff(pj));
+                    if nearest.is_none_or(|(bd, _)| dist < bd) {
+                        nearest = Some((dist, k));
+                    }
+                }
+            }
+            nearest.map(|(_, k)| k)
+        }
+        // Points wandering about a plane (x = 0), some on it exactly, so
+        // that crossings come on both sides, at ties and not at all.
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut found = [0usize; 2];
+        for _ in 0..300 {
+            let n = 2 + (next() * 40.0) as usize;
+            let back: Vec<DVec3> = (0..n)
+                .map(|k| {
+                    let x = if next() < 0.1 { 0.0 } else { next() - 0.3 };
+                    DVec3::new(x, k as f64, 0.0)
+                })
+                .collect();
+            let params: Vec<f64> = (0..n).map(|k| k as f64).collect();
+            // The polyline through them: its span k is a straight segment.
+            let eval = |u: f64| {
+                let k = (u.floor().max(0.0) as usize).min(n - 2);
+                back[k].lerp(back[k + 1], u - k as f64)
+            };
+            for pj in 0..n {
+                let got = crossing_near(&back, &params, &eval, pj, DVec3::ZERO, DVec3::X);
+                match scanned(&back, pj, DVec3::ZERO, DVec3::X) {
+                    Some(k) => {
+                        let p = got.expect("a crossing");
+                        assert!(
+                            p.y >= k as f64 && p.y <= (k + 1) as f64,
+                            "{pj}: {p} not in {k}"
+                        );
+                        found[0] += 1;
+                    }
+                    // None in the window: only the path's end extends.
+                    None => {
+                        assert!(got.is_none() || pj + SEARCH >= n, "{pj}");
+                        found[1] += 1;
+                    }
+                }
+            }
+        }
+        assert!(found[0] > 1000 && found[1] > 10, "{found:?}");
+    }
+
     use crate::planners::{plan_points, PlannerKind};
 
     use crate::surface::tests::flat;

@@ -89,49 +89,65 @@ impl Spline {
     fn solve_control_points(&self, q: &[DVec3]) -> Result<Vec<DVec3>> {
         let n = q.len();
         let p = self.degree;
-        // Band storage: a[k][c - k + p] for columns c in [k - p, k + p].
-        let w = 2 * p + 1;
-        let mut a = vec![0.0; n * w];
+        // Band storage: a[k][c - k + p] for columns c in [k - p, k + p]
+        // (2 p + 1 <= 7 of each row used).
+        let mut a = vec![[0.0; 7]; n];
         let mut rhs = q.to_vec();
         let mut basis = [0.0; 4];
-        let hint = std::cell::Cell::new(usize::MAX);
-        for k in 0..n {
-            let span = self.span_near(self.params[k], &hint);
-            self.basis_funs(span, self.params[k], &mut basis);
+        // The points' parameters rise, so each one's knot span is found
+        // from the one before by walking forward: the span holding u is
+        // unique (`find_span`'s).
+        let last = n - 1;
+        let mut span = p;
+        for (k, row) in a.iter_mut().enumerate() {
+            let u = self.params[k];
+            if u >= self.knots[last + 1] {
+                span = last;
+            } else {
+                while span < last && u >= self.knots[span + 1] {
+                    span += 1;
+                }
+            }
+            debug_assert_eq!(span, self.find_span(u));
+            self.basis_funs(span, u, &mut basis);
             for (r, &b) in basis.iter().enumerate().take(p + 1) {
-                let col = span - p + r;
-                let off = (col + p)
+                let off = (span + r)
                     .checked_sub(k)
-                    .filter(|&o| o < w)
+                    .filter(|&o| o <= 2 * p)
                     .ok_or_else(|| Error::Plan("spline system is not banded".into()))?;
-                a[k * w + off] = b;
+                row[off] = b;
             }
         }
+        // The same operations in the same order as the textbook's loops
+        // over the band (so the same bits), each row read as an array.
         for k in 0..n {
-            let pivot = a[k * w + p];
+            let pivot = a[k][p];
             if pivot.abs() < 1e-300 {
                 return Err(Error::Plan(format!(
                     "spline system is singular at point {k}"
                 )));
             }
-            for i in k + 1..(k + p + 1).min(n) {
-                let f = a[i * w + (k + p - i)] / pivot;
+            let (done, below) = a.split_at_mut(k + 1);
+            let top = &done[k];
+            let rk = rhs[k];
+            for (i, row) in below.iter_mut().enumerate().take(p) {
+                // Row k + 1 + i; column c lies at c + p - (k + 1 + i).
+                let f = row[p - 1 - i] / pivot;
                 if f == 0.0 {
                     continue;
                 }
-                for c in k..(k + p + 1).min(n) {
-                    a[i * w + (c + p - i)] -= f * a[k * w + (c + p - k)];
+                for c in 0..(p + 1).min(n - k) {
+                    row[c + p - 1 - i] -= f * top[c + p];
                 }
-                let rk = rhs[k];
-                rhs[i] -= rk * f;
+                rhs[k + 1 + i] -= rk * f;
             }
         }
         for k in (0..n).rev() {
             let mut v = rhs[k];
-            for c in k + 1..(k + p + 1).min(n) {
-                v -= rhs[c] * a[k * w + (c + p - k)];
+            for c in 1..(p + 1).min(n - k) {
+                v -= rhs[k + c] * a[k][c + p];
             }
-            rhs[k] = v / a[k * w + p];
+            rhs[k] = v / a[k][p];
         }
         Ok(rhs)
     }
@@ -196,8 +212,11 @@ impl Spline {
     }
 
     /// Basis functions and their first two derivatives (NURBS Book A2.3).
-    fn ders_basis_funs(&self, span: usize, u: f64) -> [[f64; 4]; 3] {
-        let p = self.degree;
+    /// The degree is `P`, a constant, so the loops have known bounds and
+    /// unroll (the same operations in the same order, so the same bits).
+    fn ders_basis_funs<const P: usize>(&self, span: usize, u: f64) -> [[f64; 4]; 3] {
+        debug_assert_eq!(self.degree, P);
+        let p = P;
         let mut ndu = [[0.0; 4]; 4];
         let mut left = [0.0; 4];
         let mut right = [0.0; 4];
@@ -322,7 +341,11 @@ impl Spline {
         let u = u.clamp(0.0, 1.0);
         let p = self.degree;
         let span = self.span_near(u, hint);
-        let d = self.ders_basis_funs(span, u);
+        let d = match p {
+            1 => self.ders_basis_funs::<1>(span, u),
+            2 => self.ders_basis_funs::<2>(span, u),
+            _ => self.ders_basis_funs::<3>(span, u),
+        };
         let mut out = [DVec3::ZERO; 3];
         for (k, o) in out.iter_mut().enumerate() {
             for (c, w) in self.ctrl[span - p..=span].iter().zip(&d[k]) {
