@@ -317,16 +317,19 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         });
     }
     let mut notes = prepared.notes;
-    if !undeclared.is_empty() {
+    // XLink's links are read as HTML reads them, with no word: an inline
+    // SVG needs no declaration there.
+    let editors: Vec<String> = undeclared
+        .iter()
+        .filter(|p| p.as_str() != "xlink")
+        .map(|p| format!("'{p}:'"))
+        .collect();
+    if !editors.is_empty() {
         notes.push(format!(
             "the drawing uses the XML prefix(es) {} without declaring them, which is not \
              well-formed XML; read as if they were declared (their attributes are an \
              editor's own and are not printed)",
-            undeclared
-                .iter()
-                .map(|p| format!("'{p}:'"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            editors.join(", ")
         ));
     }
 
@@ -1666,7 +1669,15 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
         let (true, Some(at), false) = (name_ok, root, declared.contains(&prefix)) else {
             break;
         };
-        let insert = format!(" xmlns:{prefix}=\"urn:pcpp:undeclared:{prefix}\"");
+        // XLink's own name (an inline SVG copied out of an HTML page, where
+        // no declaration is needed, links its `<use>` by `xlink:href`:
+        // under a made-up namespace every `<use>` drew nothing; QA round 12
+        // M1); an editor's prefix gets a namespace of its own.
+        let namespace = match prefix.as_str() {
+            "xlink" => XLINK_NS.to_string(),
+            _ => format!("urn:pcpp:undeclared:{prefix}"),
+        };
+        let insert = format!(" xmlns:{prefix}=\"{namespace}\"");
         out = std::borrow::Cow::Owned(format!("{}{insert}{}", &out[..at + 4], &out[at + 4..]));
         declared.push(prefix);
     }
@@ -3351,6 +3362,17 @@ mod tests {
             got.notes
                 .iter()
                 .any(|n| n.contains("'inkscape:', 'sodipodi:'")),
+            "{:?}",
+            got.notes
+        );
+        // `xlink:href` undeclared, as in an inline SVG copied out of an
+        // HTML page: its `<use>` draws what it links to (QA round 12 M1:
+        // every `<use>` drew nothing, and the note said it was read).
+        let text = r##"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100"><defs><path id="p" d="M 0 0 L 10 0" stroke="black" fill="none"/></defs><use xlink:href="#p"/><use xlink:href="#p" y="20"/></svg>"##;
+        let got = import_svg_with_notes(text.as_bytes(), "inline.svg").unwrap();
+        assert_eq!(got.subpaths.len(), 2, "{:?}", got.notes);
+        assert!(
+            !got.notes.iter().any(|n| n.contains("prefix")),
             "{:?}",
             got.notes
         );
