@@ -1709,8 +1709,12 @@ pub fn check_gcode_as(
             shi.x,
             slo.y,
             shi.y,
-            frame_notes
+            // The header's profile first: its bed places the scan (QA
+            // round 12 L1: said only as another frame, with the flag
+            // that checks it as planned left out).
+            other_profile
                 .iter()
+                .chain(&frame_notes)
                 .map(|n| format!("; {n}"))
                 .collect::<String>()
         )));

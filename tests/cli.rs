@@ -1302,6 +1302,40 @@ fn regression_check_passed_a_program_none_of_whose_moves_it_could_check() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// QA round 12 L1: a Grbl program planned with the scan placed on Grbl's
+/// bed, checked as Marlin's (whose bed places the scan elsewhere), passes
+/// over none of the scan: the refusal named only another frame, not the
+/// header's profile and the flag that checks it as planned.
+#[test]
+fn regression_a_check_that_placed_the_scan_on_another_profiles_bed_did_not_name_it() {
+    let dir = temp_dir("check-other-bed");
+    let g = dir.join("grbl.gcode");
+    let o = plan_demo(&[
+        "--place-scan",
+        "bed",
+        "--place",
+        "centre",
+        "--dialect",
+        "grbl",
+        "-o",
+        s(&g),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let scan = demo_file(demo::DEMO_SCAN_NAME);
+    let o = check_on(&scan, &g, &["--place-scan", "bed"]);
+    assert_eq!(code(&o), 1, "{}{}", stdout(&o), stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("passes over the scan")
+            && err.contains("written for profile grbl")
+            && err.contains("(--dialect grbl)"),
+        "{err}"
+    );
+    let o = check_on(&scan, &g, &["--place-scan", "bed", "--dialect", "grbl"]);
+    assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A hand-made program that climbs the region-1 block's wall in one
 /// straight move (issue 11's example): exit 1, naming the line.
 #[test]
