@@ -68,7 +68,10 @@ function linkBytes(el, bytes, type, name) {
 // into "Download anyway", the second downloads.
 export function offerDownloads(plan) {
   hideDownloads();
-  const stem = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
+  const drawing = plan.svgName.replace(/\.[^.]*$/, '') || 'path';
+  // A user's drawing on a demo part is named so, in the file and on the
+  // button: not for the user's own part.
+  const stem = plan.onDemoPart ? `${drawing}-on-the-demo-part` : drawing;
   const gcodeName = `${stem}-${plan.planner}.gcode`;
   const motion = plan.summary.motion;
   if (motion.risk_accepted) {
@@ -84,6 +87,7 @@ export function offerDownloads(plan) {
     $('risk-warning').hidden = false;
   } else {
     linkBytes($('dl-gcode'), plan.gcodeBytes, 'text/plain', gcodeName);
+    if (plan.onDemoPart) $('dl-gcode').textContent = `${GCODE_LABEL} (for the demo part)`;
   }
   // No link until the report is written: focusable and pressed as one.
   // A plan whose worker has ended since (a cancel offers the plan on

@@ -351,6 +351,10 @@ function keptPlan(m, busy) {
     summary: m.summary,
     view: m.view,
     svgName: busy.svg.name,
+    // The user's drawing planned on a demo part (no scan of theirs is
+    // loaded: one that failed to read leaves the demo's): its download
+    // says so (QA round 12 L2).
+    onDemoPart: !busy.scan.blob && settings.pathSource !== 'demo',
     planner: busy.planner,
     // What the worker planned (it may have centred the drawing).
     placement: m.summary.settings.placement,

@@ -182,3 +182,31 @@ test('a built-in antenna plans on an uploaded scan, centred on it', async () => 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 12 L2: a scan that could not be read leaves the demo part's, and
+// the drawing opened next was planned on the demo part with its download
+// named after the drawing alone: the file and the button now say which
+// part it is for.
+test('a drawing planned on the demo part after a scan failed to read says so in its download', async () => {
+  const cutPath = join(dir, 'cut-short.stl');
+  const svgPath = join(dir, 'track.svg');
+  writeFileSync(cutPath, 'solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n');
+  writeFileSync(svgPath, TRACK_SVG);
+  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#scan-input', cutPath);
+  await page.waitForSelector('#error-panel:not([hidden])');
+  assert.match(await page.textContent('#error-message'), /cut-short\.stl/);
+  await page.setInputFiles('#svg-input', svgPath);
+  await page.waitForFunction(() => document.querySelector('#svg-name').textContent === 'track.svg');
+  await waitIdle(page);
+  await waitForPlan(page);
+  const gcode = await download(page, 'dl-gcode');
+  assert.equal(gcode.name, 'track-on-the-demo-part-even.gcode');
+  assert.equal(await page.textContent('#dl-gcode'), 'Download G-code (for the demo part)');
+  assert.match(gcode.bytes.toString('utf8'), /demo-test-part\.ply/);
+  const report = await download(page, 'dl-report');
+  assert.equal(report.name, 'track-on-the-demo-part-even.json');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
