@@ -346,6 +346,9 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         | usvg::Error::ParsingFailed(roxmltree::Error::NodesLimitReached) => {
             parse_err(use_expansion(&prepared.text))
         }
+        // usvg says only "invalid size": the root's attributes are named
+        // (QA round 12 L3: width="-40mm").
+        usvg::Error::InvalidSize => parse_err(root_size_words(&prepared.text)),
         e => parse_err(format!("not a usable SVG: {e}")),
     })?;
     // (One of them given sets the size, the other following the viewBox's
@@ -1639,6 +1642,36 @@ fn compose_transform(text: &str) -> Option<[f64; 6]> {
 
 /// Most prefixes [`declare_prefixes`] declares in one document.
 const MAX_UNDECLARED_PREFIXES: usize = 8;
+
+/// What is wrong with the size of the drawing in `text`, whose root
+/// `<svg>` usvg found no usable size in: its width, height and viewBox as
+/// written.
+fn root_size_words(text: &str) -> String {
+    let opt = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    let given = roxmltree::Document::parse_with_options(text, opt)
+        .ok()
+        .map(|doc| {
+            let root = doc.root_element();
+            ["width", "height", "viewBox"]
+                .iter()
+                .filter_map(|a| root.attribute(*a).map(|v| format!("{a}=\"{v}\"")))
+                .collect::<Vec<_>>()
+        })
+        .unwrap_or_default();
+    let given = if given.is_empty() {
+        "no width, height or viewBox".to_string()
+    } else {
+        given.join(" ")
+    };
+    format!(
+        "the drawing has no usable size: its root <svg> gives {given}; a width and height \
+         must be positive lengths (e.g. width=\"40mm\") and a viewBox's width and height \
+         positive numbers"
+    )
+}
 
 /// The document with a declaration added on its root `<svg>` for each
 /// namespace prefix it uses without declaring (Fritzing's ws2812b_pcb.svg
@@ -3393,6 +3426,21 @@ mod tests {
         .to_string();
         assert!(
             e.contains("the file ends at line 3 before its elements are closed (is it cut short?)"),
+            "{e}"
+        );
+    }
+
+    /// QA round 12 L3: a negative size was "SVG has an invalid size".
+    #[test]
+    fn a_negative_size_is_named_with_its_attribute() {
+        let text = r#"<svg xmlns="http://www.w3.org/2000/svg" width="-40mm" height="40mm"><path d="M 0 0 L 10 0" stroke="black"/></svg>"#;
+        let e = import_svg(text.as_bytes(), "neg.svg")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("neg.svg")
+                && e.contains(r#"width="-40mm" height="40mm""#)
+                && e.contains("positive lengths"),
             "{e}"
         );
     }

@@ -44,6 +44,27 @@ pub(super) fn parse(
     } else {
         (bytes, None)
     };
+    // Neither a GLB's magic nor JSON's first character: the JSON reader
+    // would say "expected value at line 1 column 1" (QA round 12 L3: a GLB
+    // whose magic read "glTX").
+    let text = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
+    if blob.is_none() && text.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
+        let head: String = json
+            .iter()
+            .take(4)
+            .map(|&b| match b {
+                b' '..=b'~' => (b as char).to_string(),
+                _ => format!("\\x{b:02X}"),
+            })
+            .collect();
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "not a valid glTF 2.0 file: a binary glTF (.glb) starts with the 4 bytes 'glTF' and a \
+                 text glTF (.gltf) with '{{', this file with '{head}': is it whole, and a glTF?"
+            ),
+        ));
+    }
     let mut root = gltf::json::Root::from_slice(json).map_err(|e| {
         // A glTF 1.0 file fails the 2.0 schema with an opaque serde message;
         // name the version instead.

@@ -1155,6 +1155,33 @@ mod tests {
         assert_eq!(detect_format(b"", "scan.glb"), Some(MeshFormat::Glb));
     }
 
+    /// QA round 12 L3: messages that did not say what is wrong.
+    #[test]
+    fn a_glb_with_another_magic_and_an_stl_without_endsolid_say_what_is_wrong() {
+        let mut glb = b"glTX\x02\x00\x00\x00\x14\x00\x00\x00".to_vec();
+        glb.extend_from_slice(&[0u8; 8]);
+        let e = import_mesh(&glb, "part.glb", &ImportOptions::DEFAULT)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("part.glb")
+                && e.contains("starts with the 4 bytes 'glTF'")
+                && e.contains("'glTX'"),
+            "{e}"
+        );
+        // A text glTF with white space first is still read as JSON.
+        let e = import_mesh(b"  \n{\"asset\": 3}", "part.gltf", &ImportOptions::DEFAULT)
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains("4 bytes"), "{e}");
+        let stl = "solid part\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
+                   vertex 0 1 0\nendloop\nendfacet\n";
+        let e = import_mesh(stl.as_bytes(), "part.stl", &ImportOptions::DEFAULT)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'endsolid' is missing: add it"), "{e}");
+    }
+
     #[test]
     fn an_svg_given_as_the_scan_is_named() {
         for (name, text) in [

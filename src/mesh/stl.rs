@@ -214,7 +214,8 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
                     return Err(MeshError::syntax(
                         file,
                         t.line,
-                        "file ends before 'endsolid' (truncated file?)",
+                        "file ends before 'endsolid' (truncated file? if the file is whole, its \
+                         last line 'endsolid' is missing: add it)",
                     ))
                 }
             }
