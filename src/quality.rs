@@ -186,18 +186,17 @@ pub(crate) fn predict_given_contact(
     // The last point evaluated: a root search's last step is usually the
     // root, which is then evaluated again for the crossing (the same u,
     // so the same point).
-    let last = std::cell::Cell::new((f64::NAN.to_bits(), DVec3::ZERO));
+    let last: std::cell::Cell<Option<(u64, DVec3)>> = std::cell::Cell::new(None);
     let eval = |u: f64| -> DVec3 {
         match &curve {
-            Some(c) => {
-                let (bits, at) = last.get();
-                if bits == u.to_bits() {
-                    return at;
+            Some(c) => match last.get() {
+                Some((bits, at)) if bits == u.to_bits() => at,
+                _ => {
+                    let at = c.eval_near(u, &hint);
+                    last.set(Some((u.to_bits(), at)));
+                    at
                 }
-                let at = c.eval_near(u, &hint);
-                last.set((u.to_bits(), at));
-                at
-            }
+            },
             None => {
                 let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
                 let f = u - i as f64;

@@ -1643,14 +1643,20 @@ fn compose_transform(text: &str) -> Option<[f64; 6]> {
 /// Most prefixes [`declare_prefixes`] declares in one document.
 const MAX_UNDECLARED_PREFIXES: usize = 8;
 
+/// How every parse of the document here reads it: a DTD allowed (editors
+/// write one).
+fn xml_options<'input>() -> roxmltree::ParsingOptions<'input> {
+    roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    }
+}
+
 /// What is wrong with the size of the drawing in `text`, whose root
 /// `<svg>` usvg found no usable size in: its width, height and viewBox as
 /// written.
 fn root_size_words(text: &str) -> String {
-    let opt = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
+    let opt = xml_options();
     let given = roxmltree::Document::parse_with_options(text, opt)
         .ok()
         .map(|doc| {
@@ -1683,10 +1689,7 @@ fn declare_prefixes(text: &str) -> (std::borrow::Cow<'_, str>, Vec<String>) {
     let mut out = std::borrow::Cow::Borrowed(text);
     let mut declared = Vec::new();
     while declared.len() < MAX_UNDECLARED_PREFIXES {
-        let opt = roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        };
+        let opt = xml_options();
         let prefix = match roxmltree::Document::parse_with_options(&out, opt) {
             Err(roxmltree::Error::UnknownNamespace(prefix, _)) => prefix,
             _ => break,
@@ -1865,10 +1868,7 @@ fn scan_kind(bytes: &[u8]) -> Option<&'static str> {
 fn use_expansion(text: &str) -> String {
     // The links of a loop named in the message; a longer loop is cut.
     const SHOWN_LINKS: usize = 6;
-    let opt = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
+    let opt = xml_options();
     let too_big = "the drawing expands to more than a million elements or nests deeper than \
                    1024 levels (<use>s of <use>s that multiply): not read; unlink the clones \
                    in the editor (Inkscape: Edit > Clone > Unlink Clone) or simplify the file"
@@ -1995,10 +1995,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     if let Some(e) = not_xml(text) {
         return Err(e);
     }
-    let opt = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
+    let opt = xml_options();
     let doc = roxmltree::Document::parse_with_options(text, opt).map_err(|e| match e {
         // The one error roxmltree gives no place for.
         roxmltree::Error::UnexpectedEndOfStream => format!(
