@@ -162,14 +162,6 @@ pub enum Error {
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-/// [`Error::OutsideVolume`]'s text: the point out of the volume, then what
-/// `fit` says of the scan and how to place it, in place of the point's own
-/// generic advice (check the registration or the profile). Where `fit`
-/// names the volume (a scan outside it), the point does not name it a
-/// second time (QA round 2: "... lies outside the build volume of profile
-/// marlin (...): check the registration ...; the scan lies outside the
-/// build volume of profile marlin (...)"). `fit` is kept whole: the page
-/// finds its banner's sentence in the message.
 /// [`Error::AlsoRisks`]' other risks.
 fn also_accepts(others: &[String]) -> String {
     if others.is_empty() {
@@ -189,6 +181,14 @@ fn blocked_anyway(blocked: &Option<String>) -> String {
     })
 }
 
+/// [`Error::OutsideVolume`]'s text: the point out of the volume, then what
+/// `fit` says of the scan and how to place it, in place of the point's own
+/// generic advice (check the registration or the profile). Where `fit`
+/// names the volume (a scan outside it), the point does not name it a
+/// second time (QA round 2: "... lies outside the build volume of profile
+/// marlin (...): check the registration ...; the scan lies outside the
+/// build volume of profile marlin (...)"). `fit` is kept whole: the page
+/// finds its banner's sentence in the message.
 fn outside_volume(source: &GcodeError, fit: &str) -> String {
     let GcodeError::OutOfVolume {
         subpath,
