@@ -15,18 +15,16 @@ const GCODE_LABEL = 'Download G-code';
 // risk, moves that touch the part or another refusal (dispensing far above
 // the surface, a scan below the bed, ...: the report's accepted risks).
 const RISKY = {
-  touching: {
-    head: 'The nozzle touches the part.',
-    label: 'Download G-code (the nozzle touches the part)…',
-    confirm: 'Download anyway (the nozzle touches the part)',
-  },
-  other: {
-    head: 'Written only because you accepted the risk.',
-    label: 'Download G-code (at your risk)…',
-    confirm: 'Download anyway (at your risk)',
-  },
+  touching: { head: 'The nozzle touches the part.', words: 'the nozzle touches the part' },
+  other: { head: 'Written only because you accepted the risk.', words: 'at your risk' },
 };
-const riskOf = (motion) => RISKY[motion.program.touching_moves > 0 ? 'touching' : 'other'];
+// The labels of a risky G-code's button: before and after the first click.
+// A plan on the demo part says so first, as the plain button does.
+function riskOf(plan) {
+  const risk = RISKY[plan.summary.motion.program.touching_moves > 0 ? 'touching' : 'other'];
+  const words = plan.onDemoPart ? `for the demo part; ${risk.words}` : risk.words;
+  return { head: risk.head, label: `${GCODE_LABEL} (${words})…`, confirm: `Download anyway (${words})` };
+}
 const REPORT_LABEL = 'Download report';
 const WRITING_LABEL = 'Writing the report…';
 
@@ -76,7 +74,7 @@ export function offerDownloads(plan) {
   const motion = plan.summary.motion;
   if (motion.risk_accepted) {
     const g = $('dl-gcode');
-    const risk = riskOf(motion);
+    const risk = riskOf(plan);
     state.risky = { plan, name: gcodeName, confirm: risk.confirm };
     g.textContent = risk.label;
     g.classList.add('risky');

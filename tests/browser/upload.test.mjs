@@ -210,3 +210,36 @@ test('a drawing planned on the demo part after a scan failed to read says so in 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// The risky download's button named its risk but not the demo part (left
+// from QA round 12 L2): a drawing mostly beside the demo part, written
+// because the risk was accepted, says both, before and after the first
+// click, and its file is named for the demo part.
+test('a drawing written at the user\'s risk on the demo part says so on its button', async () => {
+  const widePath = join(dir, 'wide.svg');
+  writeFileSync(widePath, `<svg xmlns="http://www.w3.org/2000/svg" width="400mm" height="10mm" viewBox="0 0 400 10">
+  <path d="M 1 5 L 399 5" fill="none" stroke="black"/>
+</svg>
+`);
+  const { page, context, problems } = await openPage(chrome.browser, server.url);
+  await waitForPlan(page);
+  await page.setInputFiles('#svg-input', widePath);
+  await page.waitForFunction(() => document.querySelector('#svg-name').textContent === 'wide.svg');
+  await waitIdle(page);
+  await waitForPlan(page);
+  // The page fits it to the part; at full size it lies mostly beside it.
+  await page.fill('#pl-scale', '1');
+  await page.press('#pl-scale', 'Enter');
+  await page.waitForSelector('#error-panel:not([hidden])');
+  assert.match(await page.textContent('#error-message'), /lie over the scan/);
+  await page.check('#accept-risk');
+  await waitIdle(page);
+  await waitForPlan(page);
+  assert.equal(await page.textContent('#dl-gcode'), 'Download G-code (for the demo part; at your risk)…');
+  await page.click('#dl-gcode');
+  assert.equal(await page.textContent('#dl-gcode'), 'Download anyway (for the demo part; at your risk)');
+  const gcode = await download(page, 'dl-gcode');
+  assert.equal(gcode.name, 'wide-on-the-demo-part-even.gcode');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
