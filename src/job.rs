@@ -2231,7 +2231,45 @@ pub fn comparison_table(rows: &[ComparisonRow]) -> String {
             r.motion.waypoints
         ));
     }
+    for note in comparison_notes(rows) {
+        s.push_str(&format!("note: {note}\n"));
+    }
     s
+}
+
+/// How to read the table where it misleads: a planner with fewer defects
+/// than `even` whose moves come closer than tol. Section 7 counts contact
+/// only where the nozzle meets the surface, so a point where the nozzle
+/// passes within tol of it is counted as filament; `even` keeps tol on
+/// every move (section 6f), which costs thickness where no position both
+/// keeps tol and lays filament within tol of d (QA round 12 H1: a
+/// controller's 42 deg facet, where `pcpp`'s points needed 0.054 mm more
+/// height to keep tol).
+pub fn comparison_notes(rows: &[ComparisonRow]) -> Vec<String> {
+    let Some(even) = rows.iter().find(|r| r.planner == PlannerKind::Even) else {
+        return Vec::new();
+    };
+    let ours = even.quality.defect_pct();
+    rows.iter()
+        .filter(|r| r.motion.touching_moves > 0 && r.quality.defect_pct() < ours)
+        .map(|r| {
+            let m = &r.motion;
+            let clear = m
+                .min_clearance_mm
+                .map_or_else(String::new, |c| format!(" (min clearance {c:.3} mm)"));
+            format!(
+                "{} shows fewer defects than even ({:.2}% against {ours:.2}%), but {} of its {} \
+                 print moves come closer than tol {} mm{clear}: section 7 counts as contact \
+                 only where the nozzle meets the part, not where it passes within tol, which \
+                 even never does",
+                r.planner.name(),
+                r.quality.defect_pct(),
+                m.touching_moves,
+                m.moves,
+                m.tol_mm,
+            )
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -2300,6 +2338,50 @@ mod tests {
     use super::*;
     use crate::demo::test_part;
     use glam::DMat4;
+
+    /// QA round 12 H1: `pcpp` showed fewer defects than `even` on a real
+    /// part while 48 of its moves came closer than tol, and the table gave
+    /// no hint why. A planner with fewer defects whose moves touch is now
+    /// named under the table; one that keeps tol, or has more defects, is
+    /// not.
+    #[test]
+    fn a_planner_with_fewer_defects_whose_moves_touch_is_noted() {
+        let row = |planner, floating_pct, touching_moves, min_clearance_mm| ComparisonRow {
+            planner,
+            quality: crate::quality::QualitySummary {
+                floating_pct,
+                ..Default::default()
+            },
+            motion: crate::pipeline::PlanMotion {
+                tol_mm: 0.05,
+                moves: 520,
+                touching_moves,
+                min_clearance_mm,
+                ..Default::default()
+            },
+        };
+        let rows = [
+            row(PlannerKind::Constant, 17.73, 40, Some(-3.074)),
+            row(PlannerKind::Pcpp, 7.32, 48, Some(-3.074)),
+            row(PlannerKind::PcppGuarded, 8.86, 0, Some(0.052)),
+            row(PlannerKind::Slope, 5.0, 0, Some(0.06)),
+            row(PlannerKind::Even, 9.06, 0, Some(0.052)),
+        ];
+        let notes = comparison_notes(&rows);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with(
+                "pcpp shows fewer defects than even (7.32% against 9.06%), but 48 of its 520 \
+                 print moves come closer than tol 0.05 mm (min clearance -3.074 mm)"
+            ),
+            "{}",
+            notes[0]
+        );
+        let table = comparison_table(&rows);
+        assert!(table.ends_with(&format!("note: {}\n", notes[0])), "{table}");
+        // Without `even` in the table there is nothing to compare with.
+        assert!(comparison_notes(&rows[..4]).is_empty());
+    }
 
     #[test]
     fn matrix_is_row_major() {

@@ -338,6 +338,7 @@ pub fn comparison_json(
         "inputs": inputs,
         "settings": settings,
         "planners": rows,
+        "notes": job::comparison_notes(rows),
     })
 }
 
