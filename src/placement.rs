@@ -351,6 +351,44 @@ pub fn centre_on_surface(
     current: &Placement,
     fit: bool,
 ) -> Option<(Placement, Option<String>)> {
+    let (placement, note) = centre_on_surface_exact(drawn, surface, current, fit)?;
+    Some((as_shown(placement, current.scale), note))
+}
+
+/// A placement as the page's fields show it, and so as the CLI plans it
+/// (QA round 13 F3: `--place centre` planned at an offset of
+/// -0.852996826171875 mm, the page at the -0.853 its field shows, and 63
+/// moves differed in the third decimal): the offset to 0.1 um, a fitted
+/// scale (one that is not `sent`) to six significant digits. Rounded as
+/// JavaScript's `Math.round` and `toPrecision(6)` would.
+pub fn as_shown(p: Placement, sent: f64) -> Placement {
+    let mm = |v: f64| {
+        let x = v * 1e4;
+        let mut r = x.round();
+        // Math.round takes halves up, Rust's round away from zero.
+        if r - x == -0.5 {
+            r += 1.0;
+        }
+        r / 1e4 + 0.0
+    };
+    let scale = if p.scale.to_bits() == sent.to_bits() {
+        p.scale
+    } else {
+        format!("{:.5e}", p.scale).parse().unwrap_or(p.scale)
+    };
+    Placement {
+        offset_mm: DVec2::new(mm(p.offset_mm.x), mm(p.offset_mm.y)),
+        scale,
+        ..p
+    }
+}
+
+fn centre_on_surface_exact(
+    drawn: &[Subpath2],
+    surface: &Surface,
+    current: &Placement,
+    fit: bool,
+) -> Option<(Placement, Option<String>)> {
     let (lo, hi) = surface.bbox();
     let (flo, fhi) = (lo.truncate(), hi.truncate());
     let (placement, note) = centre_drawing(drawn, (flo, fhi), current, fit)?;
@@ -762,6 +800,68 @@ mod tests {
             triangles,
         })
         .unwrap()
+    }
+
+    /// QA round 13 F3: the CLI's `--place centre` planned at the offset
+    /// as computed (-0.852996826171875 mm from a scan's single-precision
+    /// box), the page at what its field shows (-0.853): 63 moves of the
+    /// same drawing differed in the third decimal. Both now plan the
+    /// centred placement as the page shows it.
+    #[test]
+    fn a_centred_placement_is_the_one_the_page_shows() {
+        // A plate whose corners are not round numbers in binary.
+        let (x0, y0, x1, y1) = (
+            -58.7f32 as f64,
+            0.1f32 as f64,
+            57.0f32 as f64,
+            115.8f32 as f64,
+        );
+        let plate = Surface::new(crate::mesh::TriMesh {
+            vertices: vec![
+                DVec3::new(x0, y0, 1.0),
+                DVec3::new(x1, y0, 1.0),
+                DVec3::new(x1, y1, 1.0),
+                DVec3::new(x0, y1, 1.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        })
+        .unwrap();
+        let line = Subpath2 {
+            points: vec![DVec2::new(0.0, 0.0), DVec2::new(300.0, 7.0)],
+            corner: vec![true; 2],
+            closed: false,
+            source: "line".into(),
+        };
+        let drawn = std::slice::from_ref(&line);
+        let exact = centre_on_surface_exact(drawn, &plate, &Placement::IDENTITY, true)
+            .unwrap()
+            .0;
+        let (shown, note) = centre_on_surface(drawn, &plate, &Placement::IDENTITY, true).unwrap();
+        assert!(note.is_some(), "scaled to fit");
+        // The page's rounding (web/worker.js, shownPlacement).
+        let js_round4 = |v: f64| (v * 1e4 + 0.5).floor() / 1e4 + 0.0;
+        assert_eq!(shown.offset_mm.x, js_round4(exact.offset_mm.x));
+        assert_eq!(shown.offset_mm.y, js_round4(exact.offset_mm.y));
+        assert_ne!(shown.offset_mm, exact.offset_mm);
+        assert_eq!(
+            shown.scale,
+            format!("{:.5e}", exact.scale).parse::<f64>().unwrap()
+        );
+        assert_ne!(shown.scale, exact.scale);
+        // Idempotent, as the page's own rounding is of it.
+        assert_eq!(as_shown(shown, 1.0), shown);
+        // Halves: up, as Math.round; a kept scale is not touched.
+        let half = Placement {
+            offset_mm: DVec2::new(-0.00025, 0.00025),
+            rotation_deg: 0.0,
+            scale: 1.0 / 3.0,
+        };
+        let r = as_shown(half, 1.0 / 3.0);
+        assert_eq!(
+            (r.offset_mm.x, r.offset_mm.y),
+            (js_round4(-0.00025), js_round4(0.00025))
+        );
+        assert_eq!(r.scale, 1.0 / 3.0);
     }
 
     /// QA round 2 F9: a ring-shaped scan's footprint has a gap in its
