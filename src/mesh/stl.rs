@@ -165,6 +165,9 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     let mut triangles = Vec::new();
     let mut polygon: Vec<u32> = Vec::with_capacity(3);
     let mut facet = 0usize;
+    // Facets of more than 3 vertices, which STL does not have (a broken
+    // writer's, or a polygon): (how many, the first's facet, line and count).
+    let mut polygons = (0usize, None::<(usize, usize, usize)>);
     let expect = |t: &mut Tokens, word: &str| -> Result<(), MeshError> {
         match t.next() {
             Some(w) if is(w, word) => Ok(()),
@@ -225,6 +228,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             }
             expect(&mut t, "outer")?;
             expect(&mut t, "loop")?;
+            let loop_line = t.line;
             polygon.clear();
             loop {
                 match t.next() {
@@ -266,16 +270,35 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
                     format!("facet {facet} has {} vertices, needs 3", polygon.len()),
                 ));
             }
+            if polygon.len() > 3 {
+                polygons.0 += 1;
+                polygons.1.get_or_insert((facet, loop_line, polygon.len()));
+            }
             for pair in polygon.windows(2).skip(1) {
                 triangles.push([polygon[0], pair[0], pair[1]]);
             }
             facet += 1;
         }
     }
+    // QA round 13 F5: OpenSCAD's test of a 4-vertex facet was read
+    // silently as a quad.
+    let warnings = match polygons {
+        (n, Some((facet, line, k))) => vec![format!(
+            "{file}:{line}: facet {facet} has {k} vertices where an STL facet has 3{}: read as a \
+             polygon cut into triangles from its first vertex; if the file was written by a \
+             broken exporter, check the part in a viewer",
+            if n > 1 {
+                format!(" ({n} such facets, this the first)")
+            } else {
+                String::new()
+            }
+        )],
+        _ => Vec::new(),
+    };
     Ok(Parsed {
         vertices: welder.vertices,
         triangles,
-        warnings: Vec::new(),
+        warnings,
     })
 }
 
@@ -309,6 +332,46 @@ mod tests {
         let p = parse(TWO.as_bytes(), "t.stl").unwrap();
         assert_eq!(p.vertices.len(), 4);
         assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+    }
+
+    /// QA round 13 F5: a facet of 4 vertices (OpenSCAD's own test file of
+    /// a broken writer, `toomanyvertices.stl`) was read as a quad without a
+    /// word. It is still read (as the polygon it is), with a warning naming
+    /// its line.
+    #[test]
+    fn a_facet_of_more_than_three_vertices_is_warned_of() {
+        let quad =
+            "solid q\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   \
+             vertex 1 1 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid q\n";
+        let p = parse(quad.as_bytes(), "q.stl").unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(
+            p.warnings,
+            [
+                "q.stl:3: facet 0 has 4 vertices where an STL facet has 3: read as a polygon cut \
+                 into triangles from its first vertex; if the file was written by a broken \
+                 exporter, check the part in a viewer"
+            ]
+        );
+        let two = format!("{TWO}{}", quad.replace("solid q", "solid r"));
+        let p = parse(
+            two.replace(
+                "vertex 0 1 0\n  endloop",
+                "vertex 0 1 0\n vertex 0 2 0\n  endloop",
+            )
+            .as_bytes(),
+            "t.stl",
+        )
+        .unwrap();
+        assert!(
+            p.warnings[0].starts_with(
+                "t.stl:10: facet 1 has 4 vertices where an STL facet has 3 (2 such facets, \
+                 this the first)"
+            ),
+            "{:?}",
+            p.warnings
+        );
     }
 
     /// ASCII STL with its keywords in capitals (some CAD exporters), or
