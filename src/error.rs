@@ -80,16 +80,16 @@ pub enum Error {
     },
     /// G-code refused for a scan so small or so large that its units are
     /// likely wrong ([`crate::mesh::UnitsDoubt`]), none given.
-    #[error(
-        "{message}. No G-code written: give the scan's units (--scan-units {units} if it \
-         really is this {size})"
-    )]
+    #[error("{message}. No G-code written: {}", units_advice(*units, size, *stray))]
     UnitsDoubt {
         message: String,
         /// The units it was read in.
         units: crate::mesh::ScanUnits,
         /// "small" or "large".
         size: &'static str,
+        /// A few stray vertices make it large ([`crate::mesh::StrayVertices`]):
+        /// no units would mend it.
+        stray: bool,
     },
     /// G-code refused for a scan placed on the bed and then moved down
     /// (Move Z below 0): if the part stands on the bed, every move is that
@@ -207,6 +207,15 @@ fn outside_volume(source: &GcodeError, fit: &str) -> String {
         format!("{at} lies outside the build volume, and {fit}")
     } else {
         format!("{at} lies outside the build volume of profile {profile} ({volume}); {fit}")
+    }
+}
+
+/// What [`Error::UnitsDoubt`] asks of the user.
+fn units_advice(units: crate::mesh::ScanUnits, size: &str, stray: bool) -> String {
+    if stray {
+        "no units flag mends a stray vertex; mend the file first".into()
+    } else {
+        format!("give the scan's units (--scan-units {units} if it really is this {size})")
     }
 }
 

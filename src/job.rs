@@ -1093,6 +1093,7 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
             message: d.message(&scan.file.name),
             units: d.units,
             size: if d.too_large { "large" } else { "small" },
+            stray: d.stray.is_some(),
         }),
         _ => Ok(()),
     }
@@ -2034,13 +2035,23 @@ fn smaller_nozzle(
 fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut otherwise = Vec::new();
+    let file_hash = |v: &str| {
+        v.split("sha256 ")
+            .nth(1)
+            .map(|h| h.trim_end_matches([')', ']']).trim().to_string())
+    };
+    // Another scan file than the program's: its own format's units and up
+    // axis may rightly differ from the program's scan's (QA round 13 F1:
+    // a GLB's m and +Y were advised for the STL it was made from).
+    let another_file = header_lines(text).any(|line| {
+        line.strip_prefix("scan file: ")
+            .and_then(file_hash)
+            .is_some_and(|h| h != scan.file.sha256)
+    });
     // The leading comment block: `; key: value` (`'` for Aerotech).
     for line in header_lines(text) {
         if let Some(v) = line.strip_prefix("scan file: ") {
-            let planned = v
-                .split("sha256 ")
-                .nth(1)
-                .map(|h| h.trim_end_matches([')', ']']).trim());
+            let planned = file_hash(v);
             if let Some(h) = planned.filter(|h| *h != scan.file.sha256) {
                 notes.push(format!(
                     "the program was planned on another scan file: its header names {} (sha256 \
@@ -2062,7 +2073,14 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
             let ours = scan_reading(scan.units, scan.up_axis);
             let (units, up) = v.split_once(", ").unwrap_or((v, ""));
             let up = up.trim_end_matches(" up");
-            if v != ours {
+            if v != ours && another_file {
+                notes.push(format!(
+                    "the program's scan was read in {v}, this check reads {} in {ours}; as \
+                     they are different files, check this file's own units and up axis rather \
+                     than copying the program's",
+                    scan.file.name
+                ));
+            } else if v != ours {
                 let flags: Vec<String> = [
                     (units != scan.units.to_string()).then(|| format!("--scan-units {units}")),
                     (up != scan.up_axis.to_string()).then(|| {

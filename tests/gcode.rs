@@ -757,6 +757,61 @@ fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
     assert!(check.is_clear(), "{:?}", check.notes);
 }
 
+/// QA round 13 F1: a program planned on a GLB (read in m, +Y up), checked
+/// against the STL it was made from (read in mm, +Z up), was advised
+/// `--scan-units m --up-axis y`, which read the STL 1000 times too large.
+/// Another file's format may rightly read otherwise: the note says so and
+/// gives no flags, and the check is not refused for it; the same file read
+/// otherwise still is.
+#[test]
+fn another_scan_file_read_otherwise_is_not_advised_the_programs_reading() {
+    use pcpp::job::check_gcode;
+
+    let scan = demo_scan();
+    let nozzle = pcpp::Nozzle::DEFAULT;
+    let (_, hi) = scan.surface.bbox();
+    let moves = format!(
+        "G21\nG90\nG0 X40 Y40 Z{z}\nG1 X50 Y40 Z{z}\n",
+        z = hi.z + 5.0
+    );
+    let header = |sha: &str| {
+        format!(
+            "; pcpp 0.1.0\n; scan file: part.glb (1000 bytes, sha256 {sha})\n; scan read in: m, \
+             +Y up\n{moves}"
+        )
+    };
+    let other = header(&"ab".repeat(32));
+    let check = check_gcode(&scan, &other, "a.gcode", &nozzle, 0.1).unwrap();
+    assert!(
+        check.planned_otherwise.is_empty(),
+        "{:?}",
+        check.planned_otherwise
+    );
+    assert!(check.is_clear(), "{:?}", check.notes);
+    assert!(
+        check.notes.iter().any(|n| n.starts_with(
+            "the program's scan was read in m, +Y up, this check reads demo-test-part.ply in mm, \
+             +Z up; as they are different files, check this file's own units and up axis"
+        )),
+        "{:?}",
+        check.notes
+    );
+    assert!(
+        !check.notes.iter().any(|n| n.contains("--scan-units")),
+        "{:?}",
+        check.notes
+    );
+    // The same file read otherwise: advised and not shown clear.
+    let same = header(&scan.file.sha256);
+    let check = check_gcode(&scan, &same, "a.gcode", &nozzle, 0.1).unwrap();
+    assert!(!check.is_clear());
+    assert!(
+        check.planned_otherwise[0].ends_with("read it as it was then (--scan-units m --up-axis y)"),
+        "{:?}",
+        check.planned_otherwise
+    );
+}
+
 /// QA round 3: a pen plotter's program (X and Y only, svg2gcode) was told
 /// to give the position before its moves; it is said to never give Z.
 #[test]

@@ -625,6 +625,80 @@ pub struct UnitsDoubt {
     pub given: bool,
     /// Too large rather than too small.
     pub too_large: bool,
+    /// Set when a few vertices far from the rest make it too large, the
+    /// rest being of a printable size: the units are not the problem.
+    pub stray: Option<StrayVertices>,
+}
+
+/// A few vertices far from the rest of a scan (QA round 13 F2: one vertex
+/// of an STL at z = 1e30 made a 116 mm scan "larger than any printer's
+/// stage", and the user was told to check its units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StrayVertices {
+    /// How many vertices (used by triangles) lie far from the rest.
+    pub count: usize,
+    /// The first of them (mm, printer frame).
+    pub first: DVec3,
+    /// The size of the rest (mm).
+    pub rest_mm: DVec3,
+}
+
+/// Vertices more than this many times the spread of the middle 98 % of a
+/// scan's corners (per axis) from their median are stray ([`StrayVertices`]),
+/// when at most [`STRAY_SHARE`] of the corners are.
+const STRAY_SPREADS: f64 = 10.0;
+const STRAY_SHARE: f64 = 0.01;
+
+/// The stray corners of a mesh whose size is in doubt, if the rest is of a
+/// printable size (see [`StrayVertices`]). Runs only for a doubtful scan:
+/// it sorts a copy of each coordinate.
+fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
+    let corners: Vec<DVec3> = mesh
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| mesh.vertices[i as usize])
+        .collect();
+    let n = corners.len();
+    if n == 0 {
+        return None;
+    }
+    let mut median = DVec3::ZERO;
+    let mut reach = 0.0f64;
+    for k in 0..3 {
+        let mut c: Vec<f64> = corners.iter().map(|v| v[k]).collect();
+        c.sort_unstable_by(f64::total_cmp);
+        let at = |q: f64| c[((n - 1) as f64 * q).round() as usize];
+        median[k] = at(0.5);
+        reach = reach.max(at(0.99) - at(0.01));
+    }
+    let reach = STRAY_SPREADS * reach.max(SMALL_SCAN_MM);
+    let far = |v: &DVec3| (*v - median).abs().max_element() > reach;
+    if corners.iter().filter(|v| far(v)).count() as f64 > STRAY_SHARE * n as f64 {
+        return None;
+    }
+    // Each stray vertex once, however many triangles use it.
+    let mut stray: Vec<u32> = (mesh.triangles.iter().flatten().copied())
+        .filter(|&i| far(&mesh.vertices[i as usize]))
+        .collect();
+    let first = mesh.vertices[*stray.first()? as usize];
+    stray.sort_unstable();
+    stray.dedup();
+    let count = stray.len();
+    let (lo, hi) = corners
+        .iter()
+        .filter(|v| !far(v))
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    let rest_mm = hi - lo;
+    (SMALL_SCAN_MM..=LARGE_SCAN_MM)
+        .contains(&rest_mm.max_element())
+        .then_some(StrayVertices {
+            count,
+            first,
+            rest_mm,
+        })
 }
 
 impl UnitsDoubt {
@@ -652,11 +726,20 @@ impl UnitsDoubt {
         let (lo, hi) = mesh.bbox()?;
         let size_mm = hi - lo;
         let across = size_mm.max_element();
-        (!(SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&across)).then_some(UnitsDoubt {
+        if (SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&across) {
+            return None;
+        }
+        let too_large = across > LARGE_SCAN_MM;
+        Some(UnitsDoubt {
             size_mm,
             units,
             given,
-            too_large: across > LARGE_SCAN_MM,
+            too_large,
+            stray: if too_large {
+                stray_vertices(mesh)
+            } else {
+                None
+            },
         })
     }
 
@@ -665,6 +748,9 @@ impl UnitsDoubt {
     /// smaller ones (mm, cm, inches) for one too large; those in which it
     /// would be neither.
     pub fn offers(&self) -> Vec<(ScanUnits, DVec3)> {
+        if self.stray.is_some() {
+            return Vec::new();
+        }
         let as_read = self.units.to_mm();
         let candidates: &[ScanUnits] = if self.too_large {
             &[ScanUnits::Mm, ScanUnits::Cm, ScanUnits::In]
@@ -709,6 +795,25 @@ impl UnitsDoubt {
                 format!("{v:.3e}")
             }
         };
+        if let Some(st) = self.stray {
+            let f = st.first;
+            return format!(
+                "{file}: the scan is {} x {} x {} mm because {} vertex(es) lie far from the rest \
+                 (the first at ({}, {}, {}) mm); the rest is {:.1} x {:.1} x {:.1} mm, \
+                 so the units are not the problem: remove the stray vertices (and the \
+                 triangles that use them) from the file",
+                mm(s.x),
+                mm(s.y),
+                mm(s.z),
+                st.count,
+                mm(f.x),
+                mm(f.y),
+                mm(f.z),
+                st.rest_mm.x,
+                st.rest_mm.y,
+                st.rest_mm.z
+            );
+        }
         format!(
             "{file}: the scan is {only}{} x {} x {} mm, read in {}{larger}: check its units{}{}",
             mm(s.x),
@@ -1350,6 +1455,69 @@ mod tests {
             .units_doubt
             .unwrap();
         assert!(d.too_large && !d.given && d.offers().is_empty());
+    }
+
+    /// QA round 13 F2: one vertex of a 116 mm STL at z = 1e30 made it
+    /// "larger than any printer's stage: check its units", and the refusal
+    /// offered `--scan-units mm`. The stray vertex is named, with the size
+    /// of the rest, and no units are offered; a scan that is large all over
+    /// is still a units doubt.
+    #[test]
+    fn a_stray_vertex_is_named_not_blamed_on_the_units() {
+        let mut obj = String::new();
+        for i in 0..10 {
+            for j in 0..10 {
+                obj.push_str(&format!("v {} {} {}\n", 10 * i, 6 * j, (i + j) % 3));
+            }
+        }
+        for i in 0..9 {
+            for j in 0..9 {
+                let a = 10 * i + j + 1;
+                obj.push_str(&format!(
+                    "f {a} {} {}\nf {a} {} {}\n",
+                    a + 10,
+                    a + 11,
+                    a + 11,
+                    a + 1
+                ));
+            }
+        }
+        let wild = obj.replacen("v 0 0 0\n", "v 0 0 1e30\n", 1);
+        let m = import_mesh(wild.as_bytes(), "wild.obj", &ImportOptions::DEFAULT).unwrap();
+        let d = m.units_doubt.expect("too large");
+        let stray = d.stray.expect("a stray vertex");
+        assert_eq!(stray.count, 1);
+        assert_eq!(stray.first, DVec3::new(0.0, 0.0, 1e30));
+        assert_eq!(stray.rest_mm, DVec3::new(90.0, 54.0, 2.0));
+        assert!(d.offers().is_empty());
+        assert_eq!(
+            d.message("wild.obj"),
+            "wild.obj: the scan is 90.0 x 54.0 x 1.000e30 mm because 1 vertex(es) lie far from \
+             the rest (the first at (0.0, 0.0, 1.000e30) mm); the rest is 90.0 x 54.0 x \
+             2.0 mm, so the units are not the problem: remove the stray vertices (and the \
+             triangles that use them) from the file"
+        );
+        let e = crate::Error::UnitsDoubt {
+            message: d.message("wild.obj"),
+            units: d.units,
+            size: "large",
+            stray: true,
+        }
+        .to_string();
+        assert!(!e.contains("--scan-units"), "{e}");
+        // The same grid in metres is large all over: the units.
+        let m = import_mesh(
+            obj.as_bytes(),
+            "grid.obj",
+            &ImportOptions {
+                units: Some(ScanUnits::M),
+                ..ImportOptions::DEFAULT
+            },
+        )
+        .unwrap();
+        let d = m.units_doubt.expect("too large");
+        assert_eq!(d.stray, None);
+        assert_eq!(d.offers()[0].0, ScanUnits::Mm);
     }
 
     #[test]
