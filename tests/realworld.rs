@@ -386,6 +386,53 @@ fn gltf_meshopt_bunny_quantized_and_exponential_is_the_bunny() {
     }
 }
 
+/// QA round 13 F4: a Draco-compressed scan was planned on without a word,
+/// its positions rounded by over half of tol. Every compressed file says
+/// its geometry is rounded, naming the compression; the plain files do
+/// not.
+#[test]
+fn gltf_compressed_geometry_is_said_to_be_rounded() {
+    let said = |m: &ImportedMesh| {
+        m.warnings
+            .iter()
+            .find(|w| w.contains("its geometry is compressed"))
+            .cloned()
+    };
+    for (bytes, name, ext) in [
+        (
+            data!("mesh/bunny-draco.glb"),
+            "bunny-draco.glb",
+            "KHR_draco_mesh_compression",
+        ),
+        (
+            data!("mesh/bunny-meshopt.glb"),
+            "bunny-meshopt.glb",
+            "EXT_meshopt_compression",
+        ),
+        (
+            data!("mesh/BoxTextured-draco-sequential.glb"),
+            "BoxTextured-draco-sequential.glb",
+            "KHR_draco_mesh_compression",
+        ),
+    ] {
+        let w = said(&import(bytes, name)).unwrap_or_else(|| panic!("{name}: not said"));
+        assert!(
+            w.starts_with(&format!("{name}: its geometry is compressed (")) && w.contains(ext),
+            "{w}"
+        );
+        assert!(
+            w.contains("plan on the scan as it was before compression"),
+            "{w}"
+        );
+    }
+    for (bytes, name) in [
+        (data!("mesh/bunny.glb"), "bunny.glb"),
+        (data!("mesh/BoxTextured.glb"), "BoxTextured.glb"),
+    ] {
+        assert_eq!(said(&import(bytes, name)), None, "{name}");
+    }
+}
+
 /// glTF-Transform's meshopt box (SOURCES.md): its normals are unit vectors
 /// through the OCTAHEDRAL filter, which is not decoded, as nothing reads
 /// them; the box is the uncompressed one.

@@ -84,6 +84,11 @@ pub(super) fn parse(
             .chain(&root.extensions_required)
             .any(|e| e == ext)
     };
+    // Compression that rounds positions, said once the scene is read.
+    let rounding: Vec<&str> = [DRACO, meshopt::EXT, "KHR_mesh_quantization"]
+        .into_iter()
+        .filter(|e| uses(e))
+        .collect();
     let (compressed, fallbacks) = meshopt::views(json, uses(meshopt::EXT), file)?;
     // Instancing also where a file uses it without listing it (which the
     // spec asks for): a node's copies are never dropped.
@@ -229,6 +234,17 @@ pub(super) fn parse(
         }
     }
     let mut warnings = scene.warnings;
+    // QA round 13 F4: a scan Draco-compressed to upload it was planned on
+    // without a word; its positions were rounded by 0.056 mm, over half of
+    // tol, and the G-code came within tol of the uncompressed part.
+    if !rounding.is_empty() {
+        warnings.push(format!(
+            "{file}: its geometry is compressed ({}), which rounds vertex positions (commonly to \
+             the part's size over 2^11 to 2^14): the plan keeps tol from the rounded surface; \
+             where tol matters, plan on the scan as it was before compression",
+            rounding.join(", ")
+        ));
+    }
     let skipped = scene.skipped_primitives + scene.points.len();
     if skipped > 0 {
         warnings.push(format!(
