@@ -2035,38 +2035,37 @@ fn smaller_nozzle(
 fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
     let mut notes = Vec::new();
     let mut otherwise = Vec::new();
-    let file_hash = |v: &str| {
-        v.split("sha256 ")
-            .nth(1)
-            .map(|h| h.trim_end_matches([')', ']']).trim().to_string())
-    };
-    // Another scan file than the program's: its own format's units and up
-    // axis may rightly differ from the program's scan's (QA round 13 F1:
-    // a GLB's m and +Y were advised for the STL it was made from).
-    let another_file = header_lines(text).any(|line| {
-        line.strip_prefix("scan file: ")
-            .and_then(file_hash)
-            .is_some_and(|h| h != scan.file.sha256)
+    // Another scan file than the program's (its header's first line):
+    // said first, and then its own format's units and up axis may rightly
+    // differ from the program's scan's (QA round 13 F1: a GLB's m and +Y
+    // were advised for the STL it was made from).
+    let other_file = header_lines(text).find_map(|line| {
+        let v = line.strip_prefix("scan file: ")?;
+        let h = v
+            .split("sha256 ")
+            .nth(1)?
+            .trim_end_matches([')', ']'])
+            .trim();
+        (h != scan.file.sha256).then(|| {
+            format!(
+                "the program was planned on another scan file: its header names {} (sha256 \
+                 {}...), this check's scan is {} (sha256 {}...): its moves may not fit this \
+                 scan",
+                v.split(" (")
+                    .next()
+                    .and_then(|n| n.split(" [").next())
+                    .unwrap_or(v),
+                &h[..h.len().min(12)],
+                scan.file.name,
+                &scan.file.sha256[..scan.file.sha256.len().min(12)]
+            )
+        })
     });
+    let another_file = other_file.is_some();
+    notes.extend(other_file);
     // The leading comment block: `; key: value` (`'` for Aerotech).
     for line in header_lines(text) {
-        if let Some(v) = line.strip_prefix("scan file: ") {
-            let planned = file_hash(v);
-            if let Some(h) = planned.filter(|h| *h != scan.file.sha256) {
-                notes.push(format!(
-                    "the program was planned on another scan file: its header names {} (sha256 \
-                     {}...), this check's scan is {} (sha256 {}...): its moves may not fit this \
-                     scan",
-                    v.split(" (")
-                        .next()
-                        .and_then(|n| n.split(" [").next())
-                        .unwrap_or(v),
-                    &h[..h.len().min(12)],
-                    scan.file.name,
-                    &scan.file.sha256[..scan.file.sha256.len().min(12)]
-                ));
-            }
-        } else if let Some(v) = line
+        if let Some(v) = line
             .strip_prefix(SCAN_READ_KEY)
             .and_then(|v| v.strip_prefix(": "))
         {

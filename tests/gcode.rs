@@ -717,6 +717,15 @@ fn regression_moves_beside_the_scan_are_named() {
     assert_eq!(check.off_scan_moves, 0);
 }
 
+/// Two moves 5 mm above the scan's top: clear of it wherever they are.
+fn moves_above(scan: &pcpp::job::PreparedScan) -> String {
+    let (_, hi) = scan.surface.bbox();
+    format!(
+        "G21\nG90\nG0 X40 Y40 Z{z}\nG1 X50 Y40 Z{z}\n",
+        z = hi.z + 5.0
+    )
+}
+
 /// QA round 2: a program planned on a 44 mm cow (the scan read in inches,
 /// +Y up), checked with the scan read in mm, was "clear" (exit 0) against
 /// a 1.7 mm cow, the header's mismatch said only in a note. A program whose
@@ -727,11 +736,7 @@ fn regression_a_program_planned_on_the_scan_read_otherwise_is_not_clear() {
 
     let scan = demo_scan();
     let nozzle = pcpp::Nozzle::DEFAULT;
-    let (_, hi) = scan.surface.bbox();
-    let moves = format!(
-        "G21\nG90\nG0 X40 Y40 Z{z}\nG1 X50 Y40 Z{z}\n",
-        z = hi.z + 5.0
-    );
+    let moves = moves_above(&scan);
     let plain = check_gcode(&scan, &moves, "a.gcode", &nozzle, 0.1).unwrap();
     assert!(plain.is_clear() && plain.planned_otherwise.is_empty());
     let text = format!("; pcpp 0.1.0\n; scan read in: in, +Y up\n{moves}");
@@ -769,11 +774,7 @@ fn another_scan_file_read_otherwise_is_not_advised_the_programs_reading() {
 
     let scan = demo_scan();
     let nozzle = pcpp::Nozzle::DEFAULT;
-    let (_, hi) = scan.surface.bbox();
-    let moves = format!(
-        "G21\nG90\nG0 X40 Y40 Z{z}\nG1 X50 Y40 Z{z}\n",
-        z = hi.z + 5.0
-    );
+    let moves = moves_above(&scan);
     let header = |sha: &str| {
         format!(
             "; pcpp 0.1.0\n; scan file: part.glb (1000 bytes, sha256 {sha})\n; scan read in: m, \

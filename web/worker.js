@@ -230,15 +230,13 @@ async function loadScan(m) {
   return info;
 }
 
-// The centred placement as the page shows it in its fields and plans it.
-// The core's numbers carry the drawing's import noise: usvg holds an SVG's
-// mm-to-px scale in f32, so every coordinate comes in 1 + 2.8e-8 times too
-// large (a 40 mm track's box centre at 20.00000056 mm), and centred on the
-// demo part's middle (40 mm) it lay at 19.99999944368998 mm, shown with all
-// its digits where the user would type 20. Offsets are kept to 1e-4 mm (as
-// a drawing carried with its scan, placement.js), a scale the core fitted
-// to 6 significant digits; a scale it kept (`sent`) and the rotation are
-// the user's, untouched.
+// A drawing carried with its scan, as the page shows it in its fields and
+// plans it: offsets to 1e-4 mm, as the core rounds a centred placement
+// (placement::as_shown, which the CLI's --place centre plans too: a
+// centred drawing's numbers carry the drawing's import noise, usvg's f32
+// mm-to-px scale putting a track centred on 40 mm at 19.99999944368998 mm),
+// a scale that is not `sent` to 6 significant digits; a scale kept and the
+// rotation are the user's, untouched.
 function shownPlacement(p, sent) {
   const mm = (v) => Math.round(v * 1e4) / 1e4 + 0; // + 0: no -0 in a field
   return {
@@ -297,7 +295,8 @@ async function plan(m) {
       // (1 for a new drawing), not from one fitted to another scan.
       const c = session.centreDrawing({ ...m.plan.placement, scale: m.centre.scale });
       if (c) {
-        const placement = shownPlacement(c.placement, m.centre.scale);
+        // Already as the fields show it (the core's placement::as_shown).
+        const { placement } = c;
         m.plan.placement = placement;
         post({ type: 'centred', id, placement, note: c.note });
       }

@@ -637,36 +637,35 @@ pub struct UnitsDoubt {
 pub struct StrayVertices {
     /// How many vertices (used by triangles) lie far from the rest.
     pub count: usize,
-    /// The first of them (mm, printer frame).
+    /// The first of them in the mesh's vertex order (mm, printer frame).
     pub first: DVec3,
     /// The size of the rest (mm).
     pub rest_mm: DVec3,
 }
 
 /// Vertices more than this many times the spread of the middle 98 % of a
-/// scan's corners (per axis) from their median are stray ([`StrayVertices`]),
-/// when at most [`STRAY_SHARE`] of the corners are.
+/// scan's vertices (per axis) from their median are stray
+/// ([`StrayVertices`]), when at most [`STRAY_SHARE`] of them are.
 const STRAY_SPREADS: f64 = 10.0;
 const STRAY_SHARE: f64 = 0.01;
 
-/// The stray corners of a mesh whose size is in doubt, if the rest is of a
-/// printable size (see [`StrayVertices`]). Runs only for a doubtful scan:
-/// it sorts a copy of each coordinate.
+/// The stray vertices of a mesh whose size is in doubt (those its
+/// triangles use), if the rest is of a printable size (see
+/// [`StrayVertices`]). Runs only for a doubtful scan: it sorts a copy of
+/// each coordinate.
 fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
-    let corners: Vec<DVec3> = mesh
-        .triangles
-        .iter()
-        .flatten()
-        .map(|&i| mesh.vertices[i as usize])
-        .collect();
-    let n = corners.len();
+    let mut used: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    used.sort_unstable();
+    used.dedup();
+    let points: Vec<DVec3> = used.iter().map(|&i| mesh.vertices[i as usize]).collect();
+    let n = points.len();
     if n == 0 {
         return None;
     }
     let mut median = DVec3::ZERO;
     let mut reach = 0.0f64;
     for k in 0..3 {
-        let mut c: Vec<f64> = corners.iter().map(|v| v[k]).collect();
+        let mut c: Vec<f64> = points.iter().map(|v| v[k]).collect();
         c.sort_unstable_by(f64::total_cmp);
         let at = |q: f64| c[((n - 1) as f64 * q).round() as usize];
         median[k] = at(0.5);
@@ -674,20 +673,12 @@ fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
     }
     let reach = STRAY_SPREADS * reach.max(SMALL_SCAN_MM);
     let far = |v: &DVec3| (*v - median).abs().max_element() > reach;
-    if corners.iter().filter(|v| far(v)).count() as f64 > STRAY_SHARE * n as f64 {
+    let (stray, rest): (Vec<DVec3>, Vec<DVec3>) = points.iter().partition(|v| far(v));
+    if stray.is_empty() || stray.len() as f64 > STRAY_SHARE * n as f64 {
         return None;
     }
-    // Each stray vertex once, however many triangles use it.
-    let mut stray: Vec<u32> = (mesh.triangles.iter().flatten().copied())
-        .filter(|&i| far(&mesh.vertices[i as usize]))
-        .collect();
-    let first = mesh.vertices[*stray.first()? as usize];
-    stray.sort_unstable();
-    stray.dedup();
-    let count = stray.len();
-    let (lo, hi) = corners
+    let (lo, hi) = rest
         .iter()
-        .filter(|v| !far(v))
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(*v), hi.max(*v))
         });
@@ -695,8 +686,8 @@ fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
     (SMALL_SCAN_MM..=LARGE_SCAN_MM)
         .contains(&rest_mm.max_element())
         .then_some(StrayVertices {
-            count,
-            first,
+            count: stray.len(),
+            first: stray[0],
             rest_mm,
         })
 }
