@@ -453,9 +453,12 @@ function onWorkerMessage(e) {
           : 'settings changed: re-planning…', true);
       }
       if (m.comparison) {
-        showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm);
+        showComparison(m.comparison, busy.planner, m.summary.settings.process.tolerance_mm, m.comparisonNotes);
         labelComparison('current');
-      } else $('compare-table').classList.add('stale');
+      } else {
+        $('compare-table').classList.add('stale');
+        $('compare-notes').classList.add('stale');
+      }
       // A settled plan (compared, current) is what the preview plays.
       if (m.comparison && busy.gen === state.gen) previewPlanShown();
       break;
@@ -610,7 +613,7 @@ function onPlanError(m, busy) {
   // settings that failed: the table shows why.
   if (m.comparison) {
     state.lastComparison = { ...comparisonOf(m, busy, null), failed: true };
-    showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm);
+    showComparison(m.comparison, busy.planner, busy.job.plan.process.tolerance_mm, m.comparisonNotes);
     labelComparison('failed');
   }
   // A scan outside the build volume, with the banner on screen offering to

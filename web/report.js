@@ -114,12 +114,15 @@ export function labelComparison(mode) {
   if (!c) return;
   $('compare-of').textContent = `${COMPARISON_OF[mode]}${c.svgName} on ${c.scanName}`;
   $('compare-table').classList.toggle('stale', mode === 'previous');
+  $('compare-notes').classList.toggle('stale', mode === 'previous');
 }
 
 // No comparison on screen (the last one was of another scan).
 export function clearComparison() {
   $('compare-table').tBodies[0].replaceChildren();
+  $('compare-notes').replaceChildren();
   $('compare-table').classList.remove('stale');
+  $('compare-notes').classList.remove('stale');
   $('compare-of').textContent = '';
 }
 
@@ -184,8 +187,12 @@ function fmtClearance(c, tol) {
   return c === null || c === undefined ? `>${fmt(tol + clearanceCapAboveTolMm())}` : fmt(c);
 }
 
-export function showComparison(rows, selected, tol) {
+export function showComparison(rows, selected, tol, notes = []) {
   $('compare-table').classList.remove('stale');
+  $('compare-notes').classList.remove('stale');
+  // The core's notes on the table, as `pcpp compare` prints them under it:
+  // a planner with fewer defects whose moves come closer than tol.
+  $('compare-notes').replaceChildren(...(notes || []).map((n) => el('li', n)));
   const body = $('compare-table').tBodies[0];
   body.replaceChildren(...rows.map((r) => {
     const q = r.quality;

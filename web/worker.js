@@ -54,7 +54,10 @@ function errorOf(err) {
   if (err && err.touching) out.touching = err.touching;
   // A refusal that accepting the risk would not lift either.
   if (err && err.blocked) out.blocked = true;
-  if (err && err.comparison) out.comparison = err.comparison;
+  if (err && err.comparison) {
+    out.comparison = err.comparison;
+    out.comparisonNotes = err.comparisonNotes || [];
+  }
   // A refused plan's paths and placement: the page shows them.
   if (err && err.view) out.view = err.view;
   if (err && err.placement) out.placement = err.placement;
@@ -312,7 +315,7 @@ async function plan(m) {
     for (const sr of r.series || []) transfer.push(sr.error.buffer, sr.defects.buffer);
     post({
       type: 'result', id, gcode: r.gcode, reportId: r.reportId, summary: r.summary, view: v,
-      comparison: r.comparison, series: r.series, planMs, memory: memoryBytes(),
+      comparison: r.comparison, comparisonNotes: r.comparisonNotes, series: r.series, planMs, memory: memoryBytes(),
     }, transfer);
     post({ type: 'done', id });
   } catch (err) {

@@ -434,15 +434,16 @@ impl Session {
     /// settings, quality, stats, warnings, registration RMS, the report's
     /// `motion` and its header line `motion_line`), `view` (see
     /// [`plan_arrays`]), `comparison` (`[job::ComparisonRow]`, every
-    /// planner, or null) and `series` (per planner, see [`plan_series`],
-    /// or null). With `with_report` false, `report` is left out and `reportId`
+    /// planner, or null), `comparisonNotes` (`job::comparison_notes` of
+    /// those rows, the notes `pcpp compare` prints under its table, or
+    /// null) and `series` (per planner, see [`plan_series`], or null). With `with_report` false, `report` is left out and `reportId`
     /// names the report kept for [`Session::report_json`]: its JSON is
     /// written only if asked for (a page re-planning as the user drags
     /// would write tens of MB per plan of a large drawing for nothing).
     ///
     /// G-code whose moves come closer to the surface than tol is refused
     /// unless `accept_risk` (an `Error` of kind `touching`, see
-    /// [`core_err`]); that error also carries the `comparison` and `series`
+    /// [`core_err`]); that error also carries the `comparison`, its notes and `series`
     /// when they were asked for, so the page can compare the planners on the
     /// settings that failed. Every refusal of a plan made (touching, far
     /// above, mostly beside the scan, out of the volume, ...) carries its
@@ -475,7 +476,7 @@ impl Session {
             pipeline::plan_surface_path(surface, sp, k, &settings.nozzle, &settings.process)
         };
         let plan = plan_with(settings.planner);
-        let (comparison, series) = if compare {
+        let (comparison, series, notes) = if compare {
             let rows = js_sys::Array::new();
             let series = js_sys::Array::new();
             let mut table = Vec::with_capacity(PlannerKind::ALL.len());
@@ -494,9 +495,12 @@ impl Session {
             for r in &table {
                 rows.push(&to_js(r)?);
             }
-            (JsValue::from(rows), JsValue::from(series))
+            // The notes `pcpp compare` prints under its table, in the
+            // core's words (QA round 12 H1).
+            let notes = to_js(&job::comparison_notes(&table))?;
+            (JsValue::from(rows), JsValue::from(series), notes)
         } else {
-            (JsValue::NULL, JsValue::NULL)
+            (JsValue::NULL, JsValue::NULL, JsValue::NULL)
         };
         let path = self
             .path
@@ -528,6 +532,7 @@ impl Session {
                 }
                 if compare {
                     let _ = js_sys::Reflect::set(&err, &"comparison".into(), &comparison);
+                    let _ = js_sys::Reflect::set(&err, &"comparisonNotes".into(), &notes);
                     let _ = js_sys::Reflect::set(&err, &"series".into(), &series);
                 }
                 return Err(err);
@@ -549,6 +554,7 @@ impl Session {
         set(&out, "summary", &to_js(&summary)?);
         set(&out, "view", &plan_arrays(&plan).into());
         set(&out, "comparison", &comparison);
+        set(&out, "comparisonNotes", &notes);
         set(&out, "series", &series);
         if with_report.unwrap_or(true) {
             set_array(&out, "report", &report_bytes(&report)?);

@@ -5,7 +5,9 @@
 // G-code file checked against the loaded scan; the demo parts' menu.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import {
+  existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync,
+} from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
@@ -478,6 +480,52 @@ test('a drawing mostly beside the scan is refused, and written only once the ris
     /written only because the risk was accepted: only \d+\.\d of the drawing's \d+\.\d mm \(\d+ %\) lie over the scan and are printed/);
   // Planned: the plan's paths are the view's again.
   assert.equal(await page.evaluate(() => window.pcpp.state.refused), null);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
+// A 42.6 degree ramp (20 x 20 mm, two facets) and a line drawn up it, with
+// QA round 12 H1's nozzle and tol: every height that keeps tol floats, so
+// even floats all along while the paper's pcpp sits lower with its nozzle
+// within tol of the ramp. The page says so under the table, in the words
+// `pcpp compare` prints (job::comparison_notes).
+test('the comparison notes a planner whose fewer defects come from moves closer than tol, as the CLI does', async () => {
+  const k = Math.tan((42.6 * Math.PI) / 180);
+  const P = [[0, 0, 0], [20, 0, 20 * k], [20, 20, 20 * k], [0, 20, 0]];
+  const facets = [[0, 1, 2], [0, 2, 3]].map((t) => ` facet normal 0 0 0\n  outer loop\n${
+    t.map((i) => `   vertex ${P[i].join(' ')}\n`).join('')}  endloop\n endfacet\n`).join('');
+  const stl = `solid ramp\n${facets}endsolid ramp\n`;
+  const svg = '<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20">'
+    + '<path d="M 4 10 L 16 10" fill="none" stroke="black"/></svg>';
+  const scanPath = join(dir, 'ramp.stl');
+  const svgPath = join(dir, 'up-the-ramp.svg');
+  writeFileSync(scanPath, stl);
+  writeFileSync(svgPath, svg);
+  const cli = execFileSync(CLI, ['compare', '-q', '--place', 'centre', '--nozzle-id', '0.26', '--nozzle-od', '0.51',
+    '--tol', '0.05', '--scan', scanPath, '--path', svgPath], { encoding: 'utf8' });
+  const cliNotes = cli.split('\n').filter((l) => l.startsWith('note: ')).map((l) => l.slice('note: '.length));
+  assert.ok(cliNotes.some((n) => /^pcpp shows fewer defects than even/.test(n)), cli);
+
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // The demo part's comparison has nothing to note.
+  assert.equal(await page.locator('#compare-notes li').count(), 0);
+  await page.setInputFiles('#scan-input', scanPath);
+  await page.setInputFiles('#svg-input', svgPath);
+  await waitSettled(page);
+  for (const [id, v] of [['#nz-id', '0.26'], ['#nz-od', '0.51'], ['#pr-tol', '0.05']]) {
+    await page.fill(id, v);
+    await page.dispatchEvent(id, 'change');
+  }
+  await page.waitForFunction((n) => document.querySelectorAll('#compare-notes li').length === n,
+    cliNotes.length, { timeout: 120_000 });
+  await waitSettled(page);
+  assert.match(await page.textContent('#compare-of'), /^up-the-ramp\.svg on ramp\.stl$/);
+  const notes = await page.$$eval('#compare-notes li', (lis) => lis.map((li) => li.textContent));
+  assert.deepEqual(notes, cliNotes);
+  const { rows } = await compareTable(page);
+  assert.equal(rows.pcpp.clearanceBad, true);
+  assert.equal(rows.even.clearanceBad, false);
   assert.deepEqual(problems, []);
   await context.close();
 });
