@@ -1089,14 +1089,38 @@ pub fn refuse_whole_object_cloud(scan: &PreparedScan, accept_risk: bool) -> Resu
 /// Giving the units, mm included, is the user's word on its size.
 pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
     match scan.units_doubt {
-        Some(d) if !d.given && !accept_risk => Err(Error::UnitsDoubt {
-            message: d.message(&scan.file.name),
-            units: d.units,
-            size: if d.too_large { "large" } else { "small" },
-            stray: d.stray.is_some(),
-        }),
+        Some(d) if !d.given && !accept_risk => Err(unit_doubt_error(scan, d)),
         _ => Ok(()),
     }
+}
+
+/// The refusal of a scan whose size is in doubt (`d`).
+fn unit_doubt_error(scan: &PreparedScan, d: crate::mesh::UnitsDoubt) -> Error {
+    Error::UnitsDoubt {
+        message: d.message(&scan.file.name),
+        units: d.units,
+        size: if d.too_large { "large" } else { "small" },
+        stray: d.stray.is_some(),
+    }
+}
+
+/// Why no G-code can be written over a scan whose stray vertices
+/// ([`crate::mesh::StrayVertices`]) lie outside the build volume, accepted
+/// or not: the travel height and the check of every move clear them too.
+/// QA round 13 F2, with the risk accepted: a vertex at z = 1e30 then
+/// stopped the G-code at "safe travel height 1000000015047466219876688855040.000
+/// mm ... check the scan's units", the units blamed again.
+fn stray_blocks(scan: &PreparedScan, profile: &MachineProfile) -> Option<String> {
+    let st = scan.units_doubt?.stray?;
+    let fit =
+        crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+    (!fit.inside).then(|| {
+        format!(
+            "the travel height and the check of every move must clear the {} stray vertex(es) \
+             too, and they lie outside the build volume of profile {}",
+            st.count, profile.name
+        )
+    })
 }
 
 /// The plan's highest dispensing point above the surface, if it is past
@@ -1247,15 +1271,20 @@ pub fn write_outputs(
         ));
     }
     if let Some(d) = scan.units_doubt.filter(|d| !d.given) {
-        risks.push((
-            Risk::Units,
-            format!(
+        let text = match d.stray {
+            Some(st) => format!(
+                "the scan has {} stray vertex(es) far from the rest, which is {:.1} x {:.1} x \
+                 {:.1} mm",
+                st.count, st.rest_mm.x, st.rest_mm.y, st.rest_mm.z
+            ),
+            None => format!(
                 "the scan is {}{:.3} mm across, read in {} without its units given",
                 if d.too_large { "" } else { "only " },
                 d.size_mm.max_element(),
                 d.units
             ),
-        ));
+        };
+        risks.push((Risk::Units, text));
     }
     if let Some((height, at)) = far_above(plan, settings) {
         risks.push((
@@ -1314,9 +1343,11 @@ pub fn write_outputs(
     // asked of the refusals made before the G-code is written (those after
     // it were written).
     let unwritable = || {
-        crate::gcode::checked_safe_height(&job(&[]), profile)
-            .err()
-            .map(|g| g.to_string())
+        stray_blocks(scan, profile).or_else(|| {
+            crate::gcode::checked_safe_height(&job(&[]), profile)
+                .err()
+                .map(|g| g.to_string())
+        })
     };
     let refused = |e: Error, risk: Option<Risk>, blocked: Option<String>| -> Error {
         let others: Vec<String> = risks
@@ -1360,6 +1391,20 @@ pub fn write_outputs(
     // line numbers from this first writing hold for the final one.
     let draft = provenance(&report);
     let first = write_program(&job(&draft), profile).map_err(|e| {
+        // Stray vertices out of the volume (the risk of the units accepted):
+        // they are the cause, not the units nor the placement.
+        if let (Some(blocked), Some(d)) = (stray_blocks(scan, profile), scan.units_doubt) {
+            if matches!(
+                e,
+                GcodeError::OutOfVolume { .. } | GcodeError::SafeHeightOutOfVolume { .. }
+            ) {
+                return Error::AlsoRisks {
+                    first: Box::new(unit_doubt_error(scan, d)),
+                    others: Vec::new(),
+                    blocked: Some(blocked),
+                };
+            }
+        }
         let fit =
             crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
         match e {
@@ -2833,6 +2878,94 @@ mod tests {
         assert!(header.contains("rms 0.0000 mm"), "{header}");
         assert!(header.contains("mean e- 0.0000 mm"), "{header}");
         assert!(!header.contains("-0.0"), "{header}");
+    }
+
+    /// QA round 13 F2 with the risk accepted: a scan made huge by one
+    /// stray vertex (z = 1e30) stopped at "safe travel height
+    /// 1000000015047466219876688855040.000 mm ... check the scan's units".
+    /// The stray vertex is named as the cause, and accepting the risk is
+    /// said to write no G-code either; without it, the same refusal says
+    /// so too, and the units risk is not put as a size.
+    #[test]
+    fn stray_vertices_out_of_the_volume_block_the_g_code_by_name() {
+        // A 40 x 40 mm plate on a 12 x 12 grid (144 vertices) inside the
+        // build volume, and one triangle from its far edge up to the stray
+        // vertex.
+        let mut obj = String::new();
+        for j in 0..12 {
+            for i in 0..12 {
+                obj += &format!(
+                    "v {} {} 0\n",
+                    10.0 + i as f64 * 40.0 / 11.0,
+                    10.0 + j as f64 * 40.0 / 11.0
+                );
+            }
+        }
+        for j in 0..11 {
+            for i in 0..11 {
+                let v = j * 12 + i + 1;
+                obj += &format!(
+                    "f {} {} {}\nf {} {} {}\n",
+                    v,
+                    v + 1,
+                    v + 13,
+                    v,
+                    v + 13,
+                    v + 12
+                );
+            }
+        }
+        obj += "v 50 50 1e30\nf 143 144 145\n";
+        let scan = prepare_scan(
+            obj.as_bytes(),
+            "plate.obj",
+            &ImportOptions::DEFAULT,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        assert!(scan.units_doubt.and_then(|d| d.stray).is_some());
+        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="M 10 20 H 30" stroke="black"/></svg>"#;
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        // The line at y 30 mm, over the plate's middle (the drawing's y
+        // points down).
+        let settings = PlanSettings {
+            placement: crate::svg::Placement {
+                offset_mm: glam::DVec2::new(0.0, 50.0),
+                ..crate::svg::Placement::IDENTITY
+            },
+            ..Default::default()
+        };
+        for accept in [true, false] {
+            let e = run_on(&scan, svg, "line.svg", &settings, &profile, accept)
+                .map(|_| ())
+                .unwrap_err();
+            let text = e.to_string();
+            if accept {
+                assert!(
+                    matches!(&e, Error::AlsoRisks { first, blocked: Some(_), .. }
+                        if matches!(**first, Error::UnitsDoubt { stray: true, .. })),
+                    "{e:?}"
+                );
+                assert!(
+                    text.ends_with(
+                        "but accepting the risk would write no G-code either: the travel height \
+                         and the check of every move must clear the 1 stray vertex(es) too, and \
+                         they lie outside the build volume of profile marlin"
+                    ),
+                    "{text}"
+                );
+            } else {
+                assert!(matches!(e, Error::UnitsDoubt { stray: true, .. }), "{e:?}");
+            }
+            assert!(
+                text.contains(
+                    "1 vertex(es) lie far from the rest (the first at (50.0, 50.0, 1.000e30) mm)"
+                ),
+                "{text}"
+            );
+            assert!(!text.contains("check the scan's units"), "{text}");
+            assert!(!text.contains("000000000"), "{text}");
+        }
     }
 
     #[test]
