@@ -621,6 +621,7 @@ impl Move {
     /// that share them. The smallest value is the same (to the last bits:
     /// an edge is tried from its owner's side); where two candidates tie
     /// exactly, the one reported may be another.
+    #[inline(always)]
     fn triangle(
         &self,
         t: [DVec3; 3],
