@@ -2884,8 +2884,9 @@ mod tests {
     /// stray vertex (z = 1e30) stopped at "safe travel height
     /// 1000000015047466219876688855040.000 mm ... check the scan's units".
     /// The stray vertex is named as the cause, and accepting the risk is
-    /// said to write no G-code either; without it, the same refusal says
-    /// so too, and the units risk is not put as a size.
+    /// said to write no G-code either; without the risk accepted, the
+    /// refusal is the units doubt's, naming the stray vertex; neither
+    /// blames the units nor prints the 1e30 mm in full.
     #[test]
     fn stray_vertices_out_of_the_volume_block_the_g_code_by_name() {
         // A 40 x 40 mm plate on a 12 x 12 grid (144 vertices) inside the

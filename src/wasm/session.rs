@@ -436,15 +436,16 @@ impl Session {
     /// [`plan_arrays`]), `comparison` (`[job::ComparisonRow]`, every
     /// planner, or null), `comparisonNotes` (`job::comparison_notes` of
     /// those rows, the notes `pcpp compare` prints under its table, or
-    /// null) and `series` (per planner, see [`plan_series`], or null). With `with_report` false, `report` is left out and `reportId`
+    /// null) and `series` (per planner, see [`plan_series`], or null).
+    /// With `with_report` false, `report` is left out and `reportId`
     /// names the report kept for [`Session::report_json`]: its JSON is
     /// written only if asked for (a page re-planning as the user drags
     /// would write tens of MB per plan of a large drawing for nothing).
     ///
     /// G-code whose moves come closer to the surface than tol is refused
     /// unless `accept_risk` (an `Error` of kind `touching`, see
-    /// [`core_err`]); that error also carries the `comparison`, its notes and `series`
-    /// when they were asked for, so the page can compare the planners on the
+    /// [`core_err`]); that error also carries the `comparison`, its notes
+    /// and `series` when they were asked for, so the page can compare the planners on the
     /// settings that failed. Every refusal of a plan made (touching, far
     /// above, mostly beside the scan, out of the volume, ...) carries its
     /// `view` (as a plan's) and the `placement` it was planned at.
