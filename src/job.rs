@@ -1104,23 +1104,20 @@ fn unit_doubt_error(scan: &PreparedScan, d: crate::mesh::UnitsDoubt) -> Error {
     }
 }
 
-/// Why no G-code can be written over a scan whose stray vertices
-/// ([`crate::mesh::StrayVertices`]) lie outside the build volume, accepted
-/// or not: the travel height and the check of every move clear them too.
-/// QA round 13 F2, with the risk accepted: a vertex at z = 1e30 then
-/// stopped the G-code at "safe travel height 1000000015047466219876688855040.000
-/// mm ... check the scan's units", the units blamed again.
-fn stray_blocks(scan: &PreparedScan, profile: &MachineProfile) -> Option<String> {
+/// Why no G-code can be written over a scan with stray vertices
+/// ([`crate::mesh::StrayVertices`]), said where its travel height or its
+/// extent has failed the build volume: the travel height and the check of
+/// every move clear them too. QA round 13 F2, with the risk accepted: a
+/// vertex at z = 1e30 stopped the G-code at "safe travel height
+/// 1000000015047466219876688855040.000 mm ... check the scan's units", the
+/// units blamed again.
+fn stray_reason(scan: &PreparedScan, profile: &MachineProfile) -> Option<String> {
     let st = scan.units_doubt?.stray?;
-    let fit =
-        crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
-    (!fit.inside).then(|| {
-        format!(
-            "the travel height and the check of every move must clear the {} stray vertex(es) \
-             too, and they lie outside the build volume of profile {}",
-            st.count, profile.name
-        )
-    })
+    Some(format!(
+        "the travel height and the check of every move must clear the {} stray vertex(es) too, \
+         and they lie outside the build volume of profile {}",
+        st.count, profile.name
+    ))
 }
 
 /// The plan's highest dispensing point above the surface, if it is past
@@ -1343,11 +1340,9 @@ pub fn write_outputs(
     // asked of the refusals made before the G-code is written (those after
     // it were written).
     let unwritable = || {
-        stray_blocks(scan, profile).or_else(|| {
-            crate::gcode::checked_safe_height(&job(&[]), profile)
-                .err()
-                .map(|g| g.to_string())
-        })
+        crate::gcode::checked_safe_height(&job(&[]), profile)
+            .err()
+            .map(|g| stray_reason(scan, profile).unwrap_or_else(|| g.to_string()))
     };
     let refused = |e: Error, risk: Option<Risk>, blocked: Option<String>| -> Error {
         let others: Vec<String> = risks
@@ -1391,9 +1386,13 @@ pub fn write_outputs(
     // line numbers from this first writing hold for the final one.
     let draft = provenance(&report);
     let first = write_program(&job(&draft), profile).map_err(|e| {
+        let fit =
+            crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
         // Stray vertices out of the volume (the risk of the units accepted):
         // they are the cause, not the units nor the placement.
-        if let (Some(blocked), Some(d)) = (stray_blocks(scan, profile), scan.units_doubt) {
+        if let (false, Some(blocked), Some(d)) =
+            (fit.inside, stray_reason(scan, profile), scan.units_doubt)
+        {
             if matches!(
                 e,
                 GcodeError::OutOfVolume { .. } | GcodeError::SafeHeightOutOfVolume { .. }
@@ -1405,8 +1404,6 @@ pub fn write_outputs(
                 };
             }
         }
-        let fit =
-            crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
         match e {
             GcodeError::OutOfVolume { .. } | GcodeError::SafeHeightOutOfVolume { .. }
                 if !fit.inside =>
@@ -2892,31 +2889,11 @@ mod tests {
         // A 40 x 40 mm plate on a 12 x 12 grid (144 vertices) inside the
         // build volume, and one triangle from its far edge up to the stray
         // vertex.
-        let mut obj = String::new();
-        for j in 0..12 {
-            for i in 0..12 {
-                obj += &format!(
-                    "v {} {} 0\n",
-                    10.0 + i as f64 * 40.0 / 11.0,
-                    10.0 + j as f64 * 40.0 / 11.0
-                );
-            }
-        }
-        for j in 0..11 {
-            for i in 0..11 {
-                let v = j * 12 + i + 1;
-                obj += &format!(
-                    "f {} {} {}\nf {} {} {}\n",
-                    v,
-                    v + 1,
-                    v + 13,
-                    v,
-                    v + 13,
-                    v + 12
-                );
-            }
-        }
-        obj += "v 50 50 1e30\nf 143 144 145\n";
+        let axis: Vec<f64> = (0..12).map(|i| 10.0 + i as f64 * 40.0 / 11.0).collect();
+        let mut plate = crate::mesh::TriMesh::height_field(&axis, &axis, |_, _| 0.0);
+        plate.vertices.push(DVec3::new(50.0, 50.0, 1e30));
+        plate.triangles.push([142, 143, 144]);
+        let obj = crate::demo::workloads::to_obj(&plate);
         let scan = prepare_scan(
             obj.as_bytes(),
             "plate.obj",

@@ -187,7 +187,7 @@ function fmtClearance(c, tol) {
   return c === null || c === undefined ? `>${fmt(tol + clearanceCapAboveTolMm())}` : fmt(c);
 }
 
-export function showComparison(rows, selected, tol, notes = []) {
+export function showComparison(rows, selected, tol, notes) {
   $('compare-table').classList.remove('stale');
   $('compare-notes').classList.remove('stale');
   // The core's notes on the table, as `pcpp compare` prints them under it:
