@@ -210,10 +210,22 @@ fn outside_volume(source: &GcodeError, fit: &str) -> String {
     }
 }
 
+/// A length (mm) in an error's text: `digits` decimals, or three
+/// significant ones in scientific notation from 1e7 mm on (a fuzzed file's
+/// 1e299 mm written out in 300 digits said nothing more; QA round 14: a
+/// scan "1000000000000000052504760255204420248704...000 mm tall").
+pub fn mm_text(v: f64, digits: usize) -> String {
+    if v.abs() < 1e7 {
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
 /// What [`Error::UnitsDoubt`] asks of the user.
 fn units_advice(units: crate::mesh::ScanUnits, size: &str, stray: bool) -> String {
     if stray {
-        "no units flag mends a stray vertex; mend the file first".into()
+        "no choice of units mends a stray vertex; mend the file first".into()
     } else {
         format!("give the scan's units (--scan-units {units} if it really is this {size})")
     }

@@ -1004,6 +1004,7 @@ pub fn run_on(
     // reason that hides this one (the drawing misses it: "no part of the
     // path lies over the scan's surface" for a 5 mm RMS registration).
     refuse_unit_doubt(scan, accept_risk)?;
+    refuse_blocking_strays(scan, profile)?;
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
@@ -1091,6 +1092,35 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
     match scan.units_doubt {
         Some(d) if !d.given && !accept_risk => Err(unit_doubt_error(scan, d)),
         _ => Ok(()),
+    }
+}
+
+/// The refusal, before planning, of a scan whose stray vertices
+/// ([`crate::mesh::StrayVertices`]) put its top so high that no travel
+/// height over it lies in the build volume: no plan on it can be written,
+/// its units given or its risk accepted. QA round 14: with "It is in mm"
+/// chosen for a 0.9 x 1.5 mm model with one vertex at z = 1e300, the plan
+/// failed for the path ("points 0 and 1 of the path coincide") or for the
+/// scan being "seen edge-on from above", 1e300 mm tall in 300 digits.
+/// The refusal is the one writing the G-code gives (see [`write_outputs`]).
+pub fn refuse_blocking_strays(scan: &PreparedScan, profile: &MachineProfile) -> Result<()> {
+    let (Some(d), Some(blocked)) = (scan.units_doubt, stray_reason(scan, profile)) else {
+        return Ok(());
+    };
+    let travel_only = GcodeJob {
+        toolpaths: &[],
+        speed_mm_s: 1.0,
+        dwell_s: 0.0,
+        header: &[],
+        scan_top_z_mm: scan.surface.top_z(),
+    };
+    match crate::gcode::checked_safe_height(&travel_only, profile) {
+        Ok(_) => Ok(()),
+        Err(_) => Err(Error::AlsoRisks {
+            first: Box::new(unit_doubt_error(scan, d)),
+            others: Vec::new(),
+            blocked: Some(blocked),
+        }),
     }
 }
 
@@ -2943,6 +2973,73 @@ mod tests {
             );
             assert!(!text.contains("check the scan's units"), "{text}");
             assert!(!text.contains("000000000"), "{text}");
+        }
+    }
+
+    /// QA round 14: a scan with one vertex at z = 1e300 among the rest, its
+    /// units given ("It is in mm") or its risk accepted. The drawing runs
+    /// over the spike, and the plan failed for the path ("points 0 and 1
+    /// of the path coincide") or for the scan seen "edge-on from above",
+    /// 1e300 mm tall in 300 digits. The stray vertex is refused before
+    /// planning, as writing the G-code refuses it.
+    #[test]
+    fn a_stray_vertex_above_the_volume_is_refused_before_planning() {
+        // A 40 x 40 mm plate, its middle vertex (30, 30) a spike.
+        let axis: Vec<f64> = (0..11).map(|i| 10.0 + i as f64 * 4.0).collect();
+        let plate = crate::mesh::TriMesh::height_field(&axis, &axis, |x, y| {
+            if x == 30.0 && y == 30.0 {
+                1e300
+            } else {
+                0.0
+            }
+        });
+        let obj = crate::demo::workloads::to_obj(&plate);
+        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="M 5 20 H 35" stroke="black"/></svg>"#;
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        // The line at y 30 mm, through the spike (the drawing's y points
+        // down).
+        let settings = PlanSettings {
+            placement: crate::svg::Placement {
+                offset_mm: glam::DVec2::new(0.0, 50.0),
+                ..crate::svg::Placement::IDENTITY
+            },
+            ..Default::default()
+        };
+        for (units, accept) in [(Some(ScanUnits::Mm), false), (None, true)] {
+            let options = ImportOptions {
+                units,
+                ..ImportOptions::DEFAULT
+            };
+            let scan = prepare_scan(
+                obj.as_bytes(),
+                "plate.obj",
+                &options,
+                &RegistrationSettings::default(),
+            )
+            .unwrap();
+            let e = run_on(&scan, svg, "line.svg", &settings, &profile, accept)
+                .map(|_| ())
+                .unwrap_err();
+            let text = e.to_string();
+            assert!(
+                matches!(&e, Error::AlsoRisks { first, blocked: Some(_), .. }
+                    if matches!(**first, Error::UnitsDoubt { stray: true, .. })),
+                "{units:?} {accept}: {e:?}"
+            );
+            assert!(
+                text.starts_with(
+                    "plate.obj: the scan is 40.0 x 40.0 x 1.000e300 mm because 1 vertex(es) lie \
+                     far from the rest (the first at (30.0, 30.0, 1.000e300) mm); the rest is \
+                     40.0 x 40.0 x 0.0 mm, so the units are not the problem"
+                ),
+                "{text}"
+            );
+            // Made before planning, by this check.
+            assert!(refuse_blocking_strays(&scan, &profile).is_err());
+            assert!(
+                !text.contains("coincide") && !text.contains("edge-on"),
+                "{text}"
+            );
         }
     }
 

@@ -301,9 +301,11 @@ pub fn surface_path(
     let (foot, tall) = ((shi - slo).truncate(), shi.z - slo.z);
     let seen_edge_on = || {
         format!(
-            "the scan is seen edge-on from above, {:.3} x {:.3} mm wide and {:.3} mm tall \
+            "the scan is seen edge-on from above, {} x {} mm wide and {} mm tall \
              (printer frame)",
-            foot.x, foot.y, tall
+            crate::error::mm_text(foot.x, 3),
+            crate::error::mm_text(foot.y, 3),
+            crate::error::mm_text(tall, 3)
         )
     };
     const CHOOSE_UP_AXIS: &str = "if the scan lies on its side in the file, choose its up axis \

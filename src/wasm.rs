@@ -121,6 +121,10 @@ fn core_err(e: crate::Error) -> JsValue {
         "other"
     };
     let err = kind_err(kind, &message);
+    if let Error::UnitsDoubt { stray: true, .. } = &e {
+        // No units mend it: the page offers none.
+        let _ = js_sys::Reflect::set(&err, &"stray".into(), &true.into());
+    }
     if let Error::Touching(t) = &e {
         // Without it the message alone still names the first moves.
         if let Ok(summary) = to_js(&t.summary) {
@@ -688,6 +692,9 @@ struct UnitsDoubtView {
     too_large: bool,
     /// The core's warning, naming the file.
     message: String,
+    /// A few stray vertices make it large ([`crate::mesh::StrayVertices`]):
+    /// no units mend it, and none are offered.
+    stray: bool,
     /// The units it may be in, each with the size it would have.
     offers: Vec<UnitsOffer>,
 }
@@ -706,6 +713,7 @@ impl UnitsDoubtView {
             given: d.given,
             too_large: d.too_large,
             message: d.message(file),
+            stray: d.stray.is_some(),
             offers: d
                 .offers()
                 .into_iter()

@@ -599,6 +599,11 @@ function onPlanError(m, busy) {
       travel: 'The travel height over the scan would leave the printer\'s build volume: no G-code',
       'tool-path': 'The tool path would leave the printer\'s build volume: no G-code',
     }[volumeCause(m.message)];
+  } else if (m.kind === 'units' && m.stray) {
+    // (QA round 14: a vertex at z = 1e300 in a 1.5 mm model was offered
+    // "It is in mm", which planned into "points 0 and 1 coincide".)
+    title = 'The scan has stray vertices far from the rest: no G-code';
+    message = ended(message) + '\nMend the file (remove the stray vertices and their triangles), then open it again.';
   } else if (m.kind === 'units') {
     title = 'The scan is too small for its units: no G-code';
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';
@@ -626,7 +631,8 @@ function onPlanError(m, busy) {
   // file) is the scan's to mend, whatever the refusal: said under it, and
   // never the demo drawing's notice below (QA round 5 N4).
   const info = state.info;
-  const sideways = m.stage === 'plan' && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
+  // (Not one made tall by stray vertices: they are the cause.)
+  const sideways = m.stage === 'plan' && !m.stray && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
   if (sideways && !/edge-on/.test(message)) {
     const [lo, hi] = info.bbox_mm;
     message = `${ended(message)}\nThe scan is seen edge-on from above (${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} mm, `
@@ -700,7 +706,7 @@ function onPlanError(m, busy) {
   if (demoTried) {
     setStatus(`${busy.scan.name} open: the demo drawing does not print on it; open your drawing (SVG)`, false);
   } else if (unitsOffered) {
-    setStatus(`no G-code: choose the scan's units (see above)${showing}`, true);
+    setStatus(`no G-code: ${m.stray ? 'the scan has stray vertices' : "choose the scan's units"} (see above)${showing}`, true);
   } else if (offered) {
     setStatus(`no G-code: the ${toolPathOutside(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
       showing}`, true);

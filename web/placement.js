@@ -380,6 +380,12 @@ function showUnitsBanner(info) {
     $('units-banner-text').textContent = '';
     return;
   }
+  // A few stray vertices make it large: the core's words, and no units
+  // to choose, none mend it (QA round 14: "It is in mm" was offered).
+  if (d.stray) {
+    $('units-banner-text').textContent = `${d.message}. No units mend this: no G-code until the file is mended.`;
+    return;
+  }
   $('units-banner-text').textContent = d.too_large
     ? `${info.name} is ${sizeText(d.size_mm, 1)} mm read in ${UNIT_NAMES[d.units]}, larger than any `
       + 'printer: it was most likely saved in other units. No G-code until you choose them.'

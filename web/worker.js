@@ -54,6 +54,8 @@ function errorOf(err) {
   if (err && err.touching) out.touching = err.touching;
   // A refusal that accepting the risk would not lift either.
   if (err && err.blocked) out.blocked = true;
+  // A scan made huge by stray vertices: no units mend it.
+  if (err && err.stray) out.stray = true;
   if (err && err.comparison) {
     out.comparison = err.comparison;
     out.comparisonNotes = err.comparisonNotes || [];

@@ -626,7 +626,7 @@ pub struct UnitsDoubt {
     /// Too large rather than too small.
     pub too_large: bool,
     /// Set when a few vertices far from the rest make it too large, the
-    /// rest being of a printable size: the units are not the problem.
+    /// rest no larger than a printer's stage: no units mend it.
     pub stray: Option<StrayVertices>,
 }
 
@@ -650,7 +650,7 @@ const STRAY_SPREADS: f64 = 10.0;
 const STRAY_SHARE: f64 = 0.01;
 
 /// The stray vertices of a mesh whose size is in doubt (those its
-/// triangles use), if the rest is of a printable size (see
+/// triangles use), if the rest is no larger than a printer's stage (see
 /// [`StrayVertices`]). Runs only for a doubtful scan: it sorts a copy of
 /// each coordinate.
 fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
@@ -683,13 +683,11 @@ fn stray_vertices(mesh: &TriMesh) -> Option<StrayVertices> {
             (lo.min(*v), hi.max(*v))
         });
     let rest_mm = hi - lo;
-    (SMALL_SCAN_MM..=LARGE_SCAN_MM)
-        .contains(&rest_mm.max_element())
-        .then_some(StrayVertices {
-            count: stray.len(),
-            first: stray[0],
-            rest_mm,
-        })
+    (rest_mm.max_element() <= LARGE_SCAN_MM).then_some(StrayVertices {
+        count: stray.len(),
+        first: stray[0],
+        rest_mm,
+    })
 }
 
 impl UnitsDoubt {
@@ -778,21 +776,34 @@ impl UnitsDoubt {
         } else {
             ("only ", 3, "")
         };
-        // (A fuzzed file's 1e299 mm in 300 digits said nothing more.)
-        let mm = |v: f64| {
-            if v.abs() < 1e7 {
-                format!("{v:.digits$}")
-            } else {
-                format!("{v:.3e}")
-            }
-        };
+        let mm = |v: f64| crate::error::mm_text(v, digits);
         if let Some(st) = self.stray {
             let f = st.first;
+            let r = st.rest_mm;
+            // The rest of a printable size: its units are right. Smaller
+            // (QA round 14: a 0.9 x 1.5 mm model with one vertex at
+            // z = 1e300), they may be wrong too, once the file is mended.
+            let (rest, then) = if r.max_element() < SMALL_SCAN_MM {
+                (
+                    format!(
+                        "the rest is only {:.3} x {:.3} x {:.3} mm read in {}",
+                        r.x, r.y, r.z, self.units
+                    ),
+                    ", then check its units",
+                )
+            } else {
+                (
+                    format!(
+                        "the rest is {:.1} x {:.1} x {:.1} mm, so the units are not the problem",
+                        r.x, r.y, r.z
+                    ),
+                    "",
+                )
+            };
             return format!(
                 "{file}: the scan is {} x {} x {} mm because {} vertex(es) lie far from the rest \
-                 (the first at ({}, {}, {}) mm); the rest is {:.1} x {:.1} x {:.1} mm, \
-                 so the units are not the problem: remove the stray vertices (and the \
-                 triangles that use them) from the file",
+                 (the first at ({}, {}, {}) mm); {rest}: remove the stray vertices (and the \
+                 triangles that use them) from the file{then}",
                 mm(s.x),
                 mm(s.y),
                 mm(s.z),
@@ -800,9 +811,6 @@ impl UnitsDoubt {
                 mm(f.x),
                 mm(f.y),
                 mm(f.z),
-                st.rest_mm.x,
-                st.rest_mm.y,
-                st.rest_mm.z
             );
         }
         format!(
@@ -1509,6 +1517,32 @@ mod tests {
         let d = m.units_doubt.expect("too large");
         assert_eq!(d.stray, None);
         assert_eq!(d.offers()[0].0, ScanUnits::Mm);
+        // QA round 14: the grid a thousandth of its size (a model in
+        // metres, 0.09 m across, read in mm) with the stray vertex was a
+        // units doubt with no units offered but the ones it was read in,
+        // and choosing them planned into "points 0 and 1 of the path
+        // coincide". Its stray vertex is named, and its units doubted too.
+        let tiny: String = wild
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) if !v.ends_with("1e30") => {
+                    let c: Vec<f64> = v.split(' ').map(|c| c.parse().unwrap()).collect();
+                    format!("v {} {} {}\n", c[0] / 1e3, c[1] / 1e3, c[2] / 1e3)
+                }
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        let m = import_mesh(tiny.as_bytes(), "tiny.obj", &ImportOptions::DEFAULT).unwrap();
+        let d = m.units_doubt.expect("too large");
+        assert_eq!(d.stray.map(|s| s.count), Some(1));
+        assert!(d.offers().is_empty());
+        assert_eq!(
+            d.message("tiny.obj"),
+            "tiny.obj: the scan is 0.1 x 0.1 x 1.000e30 mm because 1 vertex(es) lie far from \
+             the rest (the first at (0.0, 0.0, 1.000e30) mm); the rest is only 0.090 x 0.054 x \
+             0.002 mm read in mm: remove the stray vertices (and the triangles that use them) \
+             from the file, then check its units"
+        );
     }
 
     #[test]

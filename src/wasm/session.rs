@@ -464,9 +464,10 @@ impl Session {
         // As job::run_on: bad settings and profiles fail before any work.
         settings.validate().map_err(core_err)?;
         job::refuse_unit_doubt(&self.scan, accept_risk).map_err(core_err)?;
+        let profile = profile(dialect, profile_file.as_deref())?;
+        job::refuse_blocking_strays(&self.scan, &profile).map_err(core_err)?;
         job::refuse_bad_registration(&self.scan.registration, &settings.nozzle, accept_risk)
             .map_err(core_err)?;
-        let profile = profile(dialect, profile_file.as_deref())?;
         self.ensure_surface_path(&settings)?;
         let Some(cache) = &self.cache else {
             return Err(JsError::new("the surface path was not kept").into());

@@ -416,3 +416,45 @@ test('a depth camera scan gets a note naming -Z, gone once read -Z up', async ()
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 14: a model with one vertex at z = 1e300 got the units banner,
+// "larger than any printer: it was most likely saved in other units",
+// offering "It is in mm"; chosen, the plan failed with "points 0 and 1 of
+// the path coincide". The banner names the stray vertex and offers no
+// units; given units, the plan is refused before planning, by name.
+test('a scan made huge by a stray vertex names it and offers no units', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // The 80 mm film in mm, its middle vertex (40, 40) sent up to 1e300.
+  const lines = filmInMetres(false, 0, 1).split('\n');
+  const centre = 20 * 41 + 20;
+  assert.match(lines[centre], /^v 40\.000000 40\.000000 /);
+  lines[centre] = 'v 40 40 1e300';
+  await page.setInputFiles('#scan-input', { name: 'film-spike.obj', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n')) });
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'film-spike.obj',
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
+  assert.match(await page.textContent('#units-banner-text'),
+    /^film-spike\.obj: the scan is 80\.0 x 80\.0 x 1\.000e300 mm because 1 vertex\(es\) lie far from the rest \(the first at \(40\.0, 40\.0, 1\.000e300\) mm\); the rest is 80\.0 x 80\.0 x 0\.8 mm, so the units are not the problem: remove the stray vertices .*No units mend this: no G-code until the file is mended\.$/);
+  assert.deepEqual(await page.$$eval('#units-banner-btns button', (bs) => bs.length), 0);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.match(await status(page), /^no G-code: the scan has stray vertices \(see above\)/);
+  // Its units given anyway: refused before planning, the stray vertex
+  // named, not the path nor an edge-on scan 1e300 mm tall.
+  await page.selectOption('#scan-units', 'mm');
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units_doubt
+    && window.pcpp.state.info.units_doubt.given, null, { timeout: 120_000 });
+  await waitIdle(page);
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden);
+  assert.equal(await page.isHidden('#units-banner'), true);
+  assert.equal(await page.textContent('#error-title'), 'The scan has stray vertices far from the rest: no G-code');
+  const message = await page.textContent('#error-message');
+  assert.match(message, /because 1 vertex\(es\) lie far from the rest/);
+  assert.match(message, /accepting the risk would write no G-code either: the travel height and the check of every move must clear the 1 stray vertex\(es\) too/);
+  assert.match(message, /Mend the file \(remove the stray vertices and their triangles\), then open it again\.$/);
+  assert.doesNotMatch(message, /coincide|edge-on|0000000000/);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});

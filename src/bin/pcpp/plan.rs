@@ -250,6 +250,7 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
     // Before the drawing is centred and scaled on a scan whose size is in
     // doubt (its warning about scaling came first, and misled).
     job::refuse_unit_doubt(&inputs.prepared, a.accept_risk)
+        .and_then(|()| job::refuse_blocking_strays(&inputs.prepared, &profile))
         .and_then(|()| {
             let nozzle = &settings.plan.nozzle;
             job::refuse_bad_registration(&inputs.prepared.registration, nozzle, a.accept_risk)
