@@ -631,8 +631,11 @@ function onPlanError(m, busy) {
   // file) is the scan's to mend, whatever the refusal: said under it, and
   // never the demo drawing's notice below (QA round 5 N4).
   const info = state.info;
-  // (Not one made tall by stray vertices: they are the cause.)
-  const sideways = m.stage === 'plan' && !m.stray && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
+  // (Not one made tall by stray vertices: they are the cause; nor for a
+  // drawing that could not be read, the drawing's to mend: QA round 14
+  // had both.)
+  const strayScan = m.stray || !!(info && info.units_doubt && info.units_doubt.stray);
+  const sideways = m.stage === 'plan' && m.kind !== 'svg' && !strayScan && !!info && edgeOn([...info.bbox_mm[0], ...info.bbox_mm[1]]);
   if (sideways && !/edge-on/.test(message)) {
     const [lo, hi] = info.bbox_mm;
     message = `${ended(message)}\nThe scan is seen edge-on from above (${fmt(hi[0] - lo[0], 1)} × ${fmt(hi[1] - lo[1], 1)} mm, `

@@ -455,6 +455,13 @@ test('a scan made huge by a stray vertex names it and offers no units', async ()
   assert.match(message, /Mend the file \(remove the stray vertices and their triangles\), then open it again\.$/);
   assert.doesNotMatch(message, /coincide|edge-on|0000000000/);
   assert.equal(await page.isHidden('#dl-gcode'), true);
+  // A drawing that cannot be read: its own error, with no word of the
+  // scan seen edge-on (it had one).
+  await page.setInputFiles('#svg-input', { name: 'empty-box.svg', mimeType: 'image/svg+xml',
+    buffer: Buffer.from('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 0 0"><path d="M 1 1 H 5" stroke="black"/></svg>') });
+  await page.waitForFunction(() => /empty-box\.svg/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  assert.doesNotMatch(await page.textContent('#error-message'), /edge-on/);
   assert.deepEqual(problems, []);
   await context.close();
 });
