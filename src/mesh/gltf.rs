@@ -20,7 +20,7 @@ use gltf::scene::Transform;
 use gltf::{Accessor, Document, Mesh, Node};
 
 use super::external::{relative_path, ExternalFiles, ExternalRef};
-use super::import::{Parsed, Welder};
+use super::import::{Parsed, Rounding, Welder};
 use super::{meshopt, MeshError, MAX_SCAN_BYTES, MAX_TRIANGLES};
 
 /// Data URIs from some exporters omit the base64 padding.
@@ -160,6 +160,8 @@ pub(super) fn parse(
         warnings: Vec::new(),
         skipped_primitives: 0,
         points: Vec::new(),
+        step: 0.0,
+        step_unknown: false,
     };
     match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(root) => {
@@ -234,17 +236,11 @@ pub(super) fn parse(
         }
     }
     let mut warnings = scene.warnings;
-    // QA round 13 F4: a scan Draco-compressed to upload it was planned on
-    // without a word; its positions were rounded by 0.056 mm, over half of
-    // tol, and the G-code came within tol of the uncompressed part.
-    if !rounding.is_empty() {
-        warnings.push(format!(
-            "{file}: its geometry is compressed ({}), which rounds vertex positions (commonly to \
-             the part's size over 2^11 to 2^14): the plan keeps tol from the rounded surface; \
-             where tol matters, plan on the scan as it was before compression",
-            rounding.join(", ")
-        ));
-    }
+    // Said once the units are known (import::Rounding).
+    let rounding = (!rounding.is_empty()).then(|| Rounding {
+        names: rounding,
+        step: (!scene.step_unknown && scene.step > 0.0).then_some(scene.step),
+    });
     let skipped = scene.skipped_primitives + scene.points.len();
     if skipped > 0 {
         warnings.push(format!(
@@ -256,6 +252,7 @@ pub(super) fn parse(
         vertices: scene.welder.vertices,
         triangles: scene.triangles,
         warnings,
+        rounding,
     };
     Ok((parsed, read))
 }
@@ -311,6 +308,25 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
             Ok(ExternalRef { buffer, uri, path })
         })
         .collect()
+}
+
+/// The grid Draco-decoded positions lie on, at most: the smallest gap
+/// between two of their distinct coordinates along an axis (each a whole
+/// number of the quantization step apart); `None` for a single position.
+fn grid_step(points: &[DVec3]) -> Option<f64> {
+    let mut step = f64::INFINITY;
+    let mut c = Vec::with_capacity(points.len());
+    for k in 0..3 {
+        c.clear();
+        c.extend(points.iter().map(|p| p[k]));
+        c.sort_unstable_by(f64::total_cmp);
+        for w in c.windows(2) {
+            if w[1] > w[0] {
+                step = step.min(w[1] - w[0]);
+            }
+        }
+    }
+    step.is_finite().then_some(step)
 }
 
 /// Draco's extension, which compresses a primitive's geometry (its
@@ -797,6 +813,11 @@ struct SceneReader<'f, 'b> {
     /// drawn, and how to name them): read as a point cloud when the scene
     /// has no triangles.
     points: Vec<(usize, DMat4, String)>,
+    /// The coarsest grid the positions read are rounded to (file units,
+    /// as the nodes place them; [`super::import::Rounding`]), and whether
+    /// some compressed positions' grid is not known.
+    step: f64,
+    step_unknown: bool,
 }
 
 impl SceneReader<'_, '_> {
@@ -1103,6 +1124,7 @@ impl SceneReader<'_, '_> {
                     None => self.decode_draco(&d, &at)?,
                 };
                 let corners = self.place(&points, world, &at)?;
+                self.note_step(grid_step(&points), world);
                 let out = (corners, indices.clone());
                 self.decoded.insert(key, (points, indices));
                 out
@@ -1114,6 +1136,8 @@ impl SceneReader<'_, '_> {
                     ));
                     continue;
                 };
+                let step = self.accessor_step(&accessor);
+                self.note_step(step, world);
                 let corners = match morphed(weights, &primitive) {
                     // The shape the file shows at rest (glTF 3.7.2.2: the
                     // base plus each target's offsets times its default
@@ -1181,6 +1205,47 @@ impl SceneReader<'_, '_> {
             }));
         }
         Ok(())
+    }
+
+    /// Notes the grid positions drawn with `world` are rounded to (`step`
+    /// in the file's frame; `None`: not known).
+    fn note_step(&mut self, step: Option<f64>, world: &DMat4) {
+        match step {
+            Some(s) => {
+                // The longest a unit vector of the file's frame becomes.
+                let scale = [world.x_axis, world.y_axis, world.z_axis]
+                    .iter()
+                    .map(|c| c.truncate().length())
+                    .fold(0.0, f64::max);
+                self.step = self.step.max(s * scale);
+            }
+            None => self.step_unknown = true,
+        }
+    }
+
+    /// The grid an accessor's positions are rounded to in the file's frame:
+    /// none for floats read as stored, one integer step for quantized ones
+    /// (KHR_mesh_quantization: normalized, one over the type's largest
+    /// value), not known for floats a meshopt filter decoded.
+    fn accessor_step(&self, accessor: &Accessor) -> Option<f64> {
+        let largest = match accessor.data_type() {
+            DataType::F32 => {
+                let filtered = accessor
+                    .view()
+                    .is_some_and(|v| self.views.contains_key(&v.index()));
+                return if filtered { None } else { Some(0.0) };
+            }
+            DataType::I8 => 127.0,
+            DataType::U8 => 255.0,
+            DataType::I16 => 32767.0,
+            DataType::U16 => 65535.0,
+            DataType::U32 => 4294967295.0,
+        };
+        Some(if accessor.normalized() {
+            1.0 / largest
+        } else {
+            1.0
+        })
     }
 
     /// POSITION values placed in the scene and welded; element `i` becomes

@@ -14,6 +14,53 @@ pub(super) struct Parsed {
     pub vertices: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
     pub warnings: Vec<String>,
+    /// Set for a file whose geometry is compressed ([`Rounding`]).
+    pub rounding: Option<Rounding>,
+}
+
+/// Compression that rounds a file's vertex positions (a glTF's Draco,
+/// meshopt or quantized positions), said once its units are known.
+#[derive(Debug, Default)]
+pub(super) struct Rounding {
+    /// The compressions, as the file names them.
+    pub names: Vec<&'static str>,
+    /// The coarsest the grid the positions are rounded to can be, in the
+    /// file's units as its nodes place them, where it is known for every
+    /// primitive (a Draco primitive's is the smallest gap between its
+    /// coordinates: a whole number of its quantization steps).
+    pub step: Option<f64>,
+}
+
+impl Rounding {
+    /// The warning, the step in mm (`scale`: the file's units to mm). QA
+    /// round 13 F4: a scan Draco-compressed to upload it was planned on
+    /// without a word; its positions were rounded by 0.056 mm, over half
+    /// of tol, and the G-code came within tol of the uncompressed part.
+    /// Round 14: the warning gave no step, only "commonly the part's size
+    /// over 2^11 to 2^14".
+    fn message(&self, file: &str, scale: f64) -> String {
+        let rounds = match self.step.map(|s| s * scale).filter(|s| *s > 0.0) {
+            Some(mm) => format!(
+                "which rounds vertex positions to a grid no coarser than {} mm (each moved by \
+                 up to half of it)",
+                significant(mm)
+            ),
+            None => "which rounds vertex positions (commonly to the part's size over 2^11 to \
+                     2^14)"
+                .to_string(),
+        };
+        format!(
+            "{file}: its geometry is compressed ({}), {rounds}: the plan keeps tol from the \
+             rounded surface; where tol matters, plan on the scan as it was before compression",
+            self.names.join(", ")
+        )
+    }
+}
+
+/// `v` with two significant digits (0.92, 0.056, 0.00012).
+fn significant(v: f64) -> String {
+    let digits = (1.0 - v.abs().log10().floor()).clamp(0.0, 12.0) as usize;
+    format!("{v:.digits$}")
 }
 
 /// Guesses the format: the file name's extension first, then the content.
@@ -524,8 +571,10 @@ fn import_cloud(
     let Parsed {
         mut vertices,
         mut warnings,
+        rounding,
         ..
     } = parsed;
+    warnings.extend(rounding.map(|r| r.message(file, units.to_mm())));
     to_printer_frame(&mut vertices, units.to_mm(), up_axis);
     // In mm, as a mesh's (`finish`).
     check_finite(&vertices, file)?;
@@ -911,7 +960,9 @@ fn finish(
         mut vertices,
         triangles,
         mut warnings,
+        rounding,
     } = parsed;
+    warnings.extend(rounding.map(|r| r.message(file, scale)));
     to_printer_frame(&mut vertices, scale, up_axis);
     // Checked in mm: a coordinate finite in the file's units may overflow
     // (1e306 m), and the surface relies on finite vertices and takes these
@@ -1341,6 +1392,7 @@ mod tests {
             vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(2.0, 0.0, 0.0)],
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
             warnings: vec![],
+            rounding: None,
         };
         let (mesh, warnings, _) = finish(parsed(), "t", 1.0, UpAxis::Z).unwrap();
         assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]]);
@@ -1585,6 +1637,7 @@ mod tests {
             vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
             triangles: vec![[0, 1, 2]],
             warnings: vec![],
+            rounding: None,
         };
         let (mesh, ..) = finish(parsed, "t", 2.0, UpAxis::Y).unwrap();
         assert_eq!(mesh.vertices[2], DVec3::new(0.0, 0.0, 2.0));

@@ -89,6 +89,7 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         vertices: p.vertices,
         triangles: p.triangles,
         warnings: Vec::new(),
+        rounding: None,
     })
 }
 

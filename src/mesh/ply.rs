@@ -119,6 +119,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         vertices: out.vertices,
         triangles: out.triangles,
         warnings,
+        rounding: None,
     })
 }
 

@@ -135,6 +135,7 @@ fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         vertices: welder.vertices,
         triangles,
         warnings,
+        rounding: None,
     })
 }
 
@@ -299,6 +300,7 @@ fn parse_ascii(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         vertices: welder.vertices,
         triangles,
         warnings,
+        rounding: None,
     })
 }
 
