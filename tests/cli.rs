@@ -387,6 +387,69 @@ fn plan_report_has_every_field() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// QA round 14: a scan with one vertex at z = 1e300, its units given,
+/// was planned and compared into "no part of the path lies over the scan's
+/// surface: the scan is seen edge-on from above, ... 1e300 mm tall". Both
+/// commands name the stray vertex, before planning, and plan writes
+/// nothing.
+#[test]
+fn plan_and_compare_name_a_stray_vertex_given_units() {
+    let dir = temp_dir("stray");
+    // A 40 x 40 mm plate at z 1, its middle vertex sent up to 1e300.
+    let mut obj = String::new();
+    for j in 0..11 {
+        for i in 0..11 {
+            let z = if (i, j) == (5, 5) { "1e300" } else { "1" };
+            obj.push_str(&format!("v {} {} {z}\n", 10 + 4 * i, 10 + 4 * j));
+        }
+    }
+    for j in 0..10 {
+        for i in 0..10 {
+            let a = 11 * j + i + 1;
+            obj.push_str(&format!(
+                "f {a} {} {}\nf {a} {} {}\n",
+                a + 1,
+                a + 12,
+                a + 12,
+                a + 11
+            ));
+        }
+    }
+    let scan = dir.join("spike.obj");
+    std::fs::write(&scan, obj).unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="30mm" height="2mm" viewBox="0 0 30 2"><path d="M 0 1 H 30" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let plan = plan_on(&scan, &svg, &["--scan-units", "mm", "-o", s(&out)]);
+    let compare = pcpp(&[
+        "compare",
+        "--scan",
+        s(&scan),
+        "--path",
+        s(&svg),
+        "--scan-units",
+        "mm",
+    ]);
+    for o in [&plan, &compare] {
+        let e = stderr(o);
+        assert_ne!(code(o), 0, "{e}");
+        assert!(
+            e.contains(
+                "error: spike.obj: the scan is 40.0 x 40.0 x 1.000e300 mm because 1 vertex(es) lie \
+                 far from the rest (the first at (30.0, 30.0, 1.000e300) mm)"
+            ),
+            "{e}"
+        );
+        assert!(!e.contains("edge-on") && !e.contains("coincide"), "{e}");
+    }
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn compare_prints_five_rows_and_writes_json() {
     let dir = temp_dir("compare");

@@ -347,8 +347,12 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
     let report = a.report.as_deref().map(|r| Flagged::new("--report", r));
     let outputs = Outputs::check("compare", report, job_inputs(&a.job, &a.machine))?;
     // The planner flag is plan's; compare plans with all of them.
-    let (mut settings, _profile) = job_settings("compare", &a.job, Default::default(), &a.machine)?;
+    let (mut settings, profile) = job_settings("compare", &a.job, Default::default(), &a.machine)?;
     let inputs = load_inputs(&a.job, &settings, &outputs, progress)?;
+    // As plan's: a spike of stray vertices out of the volume fails every
+    // planner for reasons that hide it ("seen edge-on from above").
+    job::refuse_blocking_strays(&inputs.prepared, &profile)
+        .map_err(|e| plan_failure(&inputs, e, progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step("planning with all five planners...");
     let comparison = job::compare_on(
