@@ -1097,12 +1097,15 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
 
 /// The refusal, before planning, of a scan whose stray vertices
 /// ([`crate::mesh::StrayVertices`]) put its top so high that no travel
-/// height over it lies in the build volume: no plan on it can be written,
-/// its units given or its risk accepted. QA round 14: with "It is in mm"
-/// chosen for a 0.9 x 1.5 mm model with one vertex at z = 1e300, the plan
-/// failed for the path ("points 0 and 1 of the path coincide") or for the
-/// scan being "seen edge-on from above", 1e300 mm tall in 300 digits.
-/// The refusal is the one writing the G-code gives (see [`write_outputs`]).
+/// height over it lies in the build volume, or make it taller than any
+/// printer's stage (a spike or a pit under the drawing, which the surface
+/// follows): no plan on it can be written, its units given or its risk
+/// accepted. QA round 14: with "It is in mm" chosen for a 0.9 x 1.5 mm
+/// model with one vertex at z = 1e300, the plan failed for the path
+/// ("points 0 and 1 of the path coincide") or for the scan being "seen
+/// edge-on from above", 1e300 mm tall in 300 digits; a vertex at z =
+/// -1e300 failed the same way. The refusal is the one writing the G-code
+/// gives (see [`write_outputs`]).
 pub fn refuse_blocking_strays(scan: &PreparedScan, profile: &MachineProfile) -> Result<()> {
     let (Some(d), Some(blocked)) = (scan.units_doubt, stray_reason(scan, profile)) else {
         return Ok(());
@@ -1114,14 +1117,15 @@ pub fn refuse_blocking_strays(scan: &PreparedScan, profile: &MachineProfile) -> 
         header: &[],
         scan_top_z_mm: scan.surface.top_z(),
     };
-    match crate::gcode::checked_safe_height(&travel_only, profile) {
-        Ok(_) => Ok(()),
-        Err(_) => Err(Error::AlsoRisks {
-            first: Box::new(unit_doubt_error(scan, d)),
-            others: Vec::new(),
-            blocked: Some(blocked),
-        }),
+    let tall = d.size_mm.z > crate::mesh::LARGE_SCAN_MM;
+    if !tall && crate::gcode::checked_safe_height(&travel_only, profile).is_ok() {
+        return Ok(());
     }
+    Err(Error::AlsoRisks {
+        first: Box::new(unit_doubt_error(scan, d)),
+        others: Vec::new(),
+        blocked: Some(blocked),
+    })
 }
 
 /// The refusal of a scan whose size is in doubt (`d`).
@@ -2976,19 +2980,25 @@ mod tests {
         }
     }
 
-    /// QA round 14: a scan with one vertex at z = 1e300 among the rest, its
-    /// units given ("It is in mm") or its risk accepted. The drawing runs
+    /// QA round 14: a scan with one vertex at z = 1e300 (or -1e300) among
+    /// the rest, its units given ("It is in mm") or its risk accepted. The drawing runs
     /// over the spike, and the plan failed for the path ("points 0 and 1
     /// of the path coincide") or for the scan seen "edge-on from above",
     /// 1e300 mm tall in 300 digits. The stray vertex is refused before
     /// planning, as writing the G-code refuses it.
     #[test]
     fn a_stray_vertex_above_the_volume_is_refused_before_planning() {
-        // A 40 x 40 mm plate, its middle vertex (30, 30) a spike.
+        for spike in [1e300, -1e300] {
+            a_stray_vertex_is_refused_before_planning(spike);
+        }
+    }
+
+    /// A 40 x 40 mm plate, its middle vertex (30, 30) at z = `spike`.
+    fn a_stray_vertex_is_refused_before_planning(spike: f64) {
         let axis: Vec<f64> = (0..11).map(|i| 10.0 + i as f64 * 4.0).collect();
         let plate = crate::mesh::TriMesh::height_field(&axis, &axis, |x, y| {
             if x == 30.0 && y == 30.0 {
-                1e300
+                spike
             } else {
                 0.0
             }
@@ -3027,11 +3037,12 @@ mod tests {
                 "{units:?} {accept}: {e:?}"
             );
             assert!(
-                text.starts_with(
+                text.starts_with(&format!(
                     "plate.obj: the scan is 40.0 x 40.0 x 1.000e300 mm because 1 vertex(es) lie \
-                     far from the rest (the first at (30.0, 30.0, 1.000e300) mm); the rest is \
-                     40.0 x 40.0 x 0.0 mm, so the units are not the problem"
-                ),
+                     far from the rest (the first at (30.0, 30.0, {}) mm); the rest is 40.0 x \
+                     40.0 x 0.0 mm, so the units are not the problem",
+                    crate::error::mm_text(spike, 1)
+                )),
                 "{text}"
             );
             // Made before planning, by this check.

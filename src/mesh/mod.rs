@@ -36,7 +36,7 @@ pub use external::{ExternalFiles, ExternalRef};
 pub(crate) use import::other_file_kind;
 pub use import::{
     detect_format, external_files_needed, import_mesh, import_mesh_unwelded, import_mesh_with,
-    StrayVertices, UnitsDoubt, Unwelded, WeldMap, SMALL_SCAN_MM,
+    StrayVertices, UnitsDoubt, Unwelded, WeldMap, LARGE_SCAN_MM, SMALL_SCAN_MM,
 };
 pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
