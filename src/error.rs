@@ -222,6 +222,19 @@ pub fn mm_text(v: f64, digits: usize) -> String {
     }
 }
 
+/// `x` (positive) in a message with `digits` significant digits and at
+/// least `min_decimals` decimals, at most 12 (0.92, 0.056 and 0.00012 with
+/// 2 and 0; 0.953 and 0.000272 with 3 and 3); `min_decimals` for zero or
+/// less.
+pub fn significant(x: f64, digits: i32, min_decimals: usize) -> String {
+    let decimals = if x > 0.0 {
+        ((digits - 1) as f64 - x.log10().floor()).clamp(min_decimals as f64, 12.0) as usize
+    } else {
+        min_decimals
+    };
+    format!("{x:.decimals$}")
+}
+
 /// What [`Error::UnitsDoubt`] asks of the user.
 fn units_advice(units: crate::mesh::ScanUnits, size: &str, stray: bool) -> String {
     if stray {

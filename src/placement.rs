@@ -309,7 +309,7 @@ pub fn centre_drawing(
             FIT_SHARE * 100.0,
             fhi.x - flo.x,
             fhi.y - flo.y,
-            three_digits(scale)
+            crate::error::significant(scale, 3, 3)
         ));
         lo *= scale;
         hi *= scale;
@@ -483,17 +483,6 @@ fn along_lines(drawn: &[Subpath2], n: usize) -> Vec<DVec2> {
         }
     }
     out
-}
-
-/// A factor below 1 with three significant digits (0.953, 0.000272): a
-/// drawing scaled down ten thousand times was "scaled by 0.000".
-fn three_digits(x: f64) -> String {
-    let decimals = if x > 0.0 && x < 1.0 {
-        (2 - x.log10().floor() as i32).clamp(3, 12) as usize
-    } else {
-        3
-    };
-    format!("{x:.decimals$}")
 }
 
 /// The drawing's placement after its scan moves from `from` to `to` (both
@@ -1032,11 +1021,14 @@ mod tests {
         assert_eq!(p.scale, 1.0);
     }
 
+    /// A factor below 1 with three significant digits (0.953, 0.000272): a
+    /// drawing scaled down ten thousand times was "scaled by 0.000".
     #[test]
     fn scale_factors_keep_three_significant_digits() {
-        assert_eq!(super::three_digits(0.953), "0.953");
-        assert_eq!(super::three_digits(0.0542), "0.0542");
-        assert_eq!(super::three_digits(0.000272), "0.000272");
-        assert_eq!(super::three_digits(0.5), "0.500");
+        let three_digits = |x| crate::error::significant(x, 3, 3);
+        assert_eq!(three_digits(0.953), "0.953");
+        assert_eq!(three_digits(0.0542), "0.0542");
+        assert_eq!(three_digits(0.000272), "0.000272");
+        assert_eq!(three_digits(0.5), "0.500");
     }
 }

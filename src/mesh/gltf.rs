@@ -160,8 +160,7 @@ pub(super) fn parse(
         warnings: Vec::new(),
         skipped_primitives: 0,
         points: Vec::new(),
-        step: 0.0,
-        step_unknown: false,
+        step: Some(0.0),
     };
     match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(root) => {
@@ -239,7 +238,7 @@ pub(super) fn parse(
     // Said once the units are known (import::Rounding).
     let rounding = (!rounding.is_empty()).then(|| Rounding {
         names: rounding,
-        step: (!scene.step_unknown && scene.step > 0.0).then_some(scene.step),
+        step: scene.step.filter(|s| *s > 0.0),
     });
     let skipped = scene.skipped_primitives + scene.points.len();
     if skipped > 0 {
@@ -347,9 +346,9 @@ const DRACO_FACES_ANYWAY: u64 = 65_536;
 /// normals, colours and texture coordinates besides.
 const DRACO_BYTES_PER_POINT: u64 = 64;
 
-/// A decoded Draco primitive: its points in the file's frame and its
-/// triangles' indices.
-type DecodedDraco = (Vec<DVec3>, Vec<usize>);
+/// A decoded Draco primitive: its points in the file's frame, its
+/// triangles' indices and the grid its points lie on ([`grid_step`]).
+type DecodedDraco = (Vec<DVec3>, Vec<usize>, Option<f64>);
 
 /// Where a Draco-compressed primitive's data lies, and which of its
 /// attributes is POSITION (KHR_draco_mesh_compression).
@@ -814,10 +813,9 @@ struct SceneReader<'f, 'b> {
     /// has no triangles.
     points: Vec<(usize, DMat4, String)>,
     /// The coarsest grid the positions read are rounded to (file units,
-    /// as the nodes place them; [`super::import::Rounding`]), and whether
+    /// as the nodes place them; [`super::import::Rounding`]); `None` once
     /// some compressed positions' grid is not known.
-    step: f64,
-    step_unknown: bool,
+    step: Option<f64>,
 }
 
 impl SceneReader<'_, '_> {
@@ -1119,14 +1117,14 @@ impl SceneReader<'_, '_> {
                 }
                 // Decoded once however many nodes draw the mesh.
                 let key = (mesh.index(), primitive.index());
-                let (points, indices) = match self.decoded.remove(&key) {
+                let (points, indices, step) = match self.decoded.remove(&key) {
                     Some(found) => found,
                     None => self.decode_draco(&d, &at)?,
                 };
                 let corners = self.place(&points, world, &at)?;
-                self.note_step(grid_step(&points), world);
+                self.note_step(step, world);
                 let out = (corners, indices.clone());
-                self.decoded.insert(key, (points, indices));
+                self.decoded.insert(key, (points, indices, step));
                 out
             } else {
                 let Some(accessor) = primitive.get(&Semantic::Positions) else {
@@ -1210,17 +1208,12 @@ impl SceneReader<'_, '_> {
     /// Notes the grid positions drawn with `world` are rounded to (`step`
     /// in the file's frame; `None`: not known).
     fn note_step(&mut self, step: Option<f64>, world: &DMat4) {
-        match step {
-            Some(s) => {
-                // The longest a unit vector of the file's frame becomes.
-                let scale = [world.x_axis, world.y_axis, world.z_axis]
-                    .iter()
-                    .map(|c| c.truncate().length())
-                    .fold(0.0, f64::max);
-                self.step = self.step.max(s * scale);
-            }
-            None => self.step_unknown = true,
-        }
+        // The longest a unit vector of the file's frame becomes.
+        let scale = [world.x_axis, world.y_axis, world.z_axis]
+            .iter()
+            .map(|c| c.truncate().length())
+            .fold(0.0, f64::max);
+        self.step = self.step.zip(step).map(|(a, s)| a.max(s * scale));
     }
 
     /// The grid an accessor's positions are rounded to in the file's frame:
@@ -1353,7 +1346,8 @@ impl SceneReader<'_, '_> {
                 indices.push(i);
             }
         }
-        Ok((points, indices))
+        let step = grid_step(&points);
+        Ok((points, indices, step))
     }
 
     /// `points` placed in the scene by `world` and welded; point `i`

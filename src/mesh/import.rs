@@ -20,7 +20,7 @@ pub(super) struct Parsed {
 
 /// Compression that rounds a file's vertex positions (a glTF's Draco,
 /// meshopt or quantized positions), said once its units are known.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub(super) struct Rounding {
     /// The compressions, as the file names them.
     pub names: Vec<&'static str>,
@@ -43,7 +43,7 @@ impl Rounding {
             Some(mm) => format!(
                 "which rounds vertex positions to a grid no coarser than {} mm (each moved by \
                  up to half of it)",
-                significant(mm)
+                crate::error::significant(mm, 2, 0)
             ),
             None => "which rounds vertex positions (commonly to the part's size over 2^11 to \
                      2^14)"
@@ -55,12 +55,6 @@ impl Rounding {
             self.names.join(", ")
         )
     }
-}
-
-/// `v` with two significant digits (0.92, 0.056, 0.00012).
-fn significant(v: f64) -> String {
-    let digits = (1.0 - v.abs().log10().floor()).clamp(0.0, 12.0) as usize;
-    format!("{v:.digits$}")
 }
 
 /// Guesses the format: the file name's extension first, then the content.
