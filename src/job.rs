@@ -1107,7 +1107,7 @@ pub fn refuse_unit_doubt(scan: &PreparedScan, accept_risk: bool) -> Result<()> {
 /// -1e300 failed the same way. The refusal is the one writing the G-code
 /// gives (see [`write_outputs`]).
 pub fn refuse_blocking_strays(scan: &PreparedScan, profile: &MachineProfile) -> Result<()> {
-    let (Some(d), Some(blocked)) = (scan.units_doubt, stray_reason(scan, profile)) else {
+    let Some(d) = scan.units_doubt.filter(|d| d.stray.is_some()) else {
         return Ok(());
     };
     let travel_only = GcodeJob {
@@ -1124,7 +1124,7 @@ pub fn refuse_blocking_strays(scan: &PreparedScan, profile: &MachineProfile) -> 
     Err(Error::AlsoRisks {
         first: Box::new(unit_doubt_error(scan, d)),
         others: Vec::new(),
-        blocked: Some(blocked),
+        blocked: stray_reason(scan, profile),
     })
 }
 
@@ -2927,30 +2927,10 @@ mod tests {
         let mut plate = crate::mesh::TriMesh::height_field(&axis, &axis, |_, _| 0.0);
         plate.vertices.push(DVec3::new(50.0, 50.0, 1e30));
         plate.triangles.push([142, 143, 144]);
-        let obj = crate::demo::workloads::to_obj(&plate);
-        let scan = prepare_scan(
-            obj.as_bytes(),
-            "plate.obj",
-            &ImportOptions::DEFAULT,
-            &RegistrationSettings::default(),
-        )
-        .unwrap();
-        assert!(scan.units_doubt.and_then(|d| d.stray).is_some());
-        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="M 10 20 H 30" stroke="black"/></svg>"#;
-        let profile = MachineProfile::builtin("marlin").unwrap();
-        // The line at y 30 mm, over the plate's middle (the drawing's y
-        // points down).
-        let settings = PlanSettings {
-            placement: crate::svg::Placement {
-                offset_mm: glam::DVec2::new(0.0, 50.0),
-                ..crate::svg::Placement::IDENTITY
-            },
-            ..Default::default()
-        };
         for accept in [true, false] {
-            let e = run_on(&scan, svg, "line.svg", &settings, &profile, accept)
-                .map(|_| ())
-                .unwrap_err();
+            // The line over the plate's middle.
+            let (scan, e) = refused_on_plate(&plate, None, "M 10 20 H 30", accept);
+            assert!(scan.units_doubt.and_then(|d| d.stray).is_some());
             let text = e.to_string();
             if accept {
                 assert!(
@@ -2980,6 +2960,51 @@ mod tests {
         }
     }
 
+    /// The scan `plate` read as plate.obj in `units`, and what `run_on`
+    /// refuses (profile marlin) for the path `d` of a 40 x 40 mm drawing
+    /// placed with its y 20 at y 30 mm (the drawing's y points down).
+    fn refused_on_plate(
+        plate: &crate::mesh::TriMesh,
+        units: Option<ScanUnits>,
+        d: &str,
+        accept: bool,
+    ) -> (PreparedScan, Error) {
+        let obj = crate::demo::workloads::to_obj(plate);
+        let options = ImportOptions {
+            units,
+            ..ImportOptions::DEFAULT
+        };
+        let scan = prepare_scan(
+            obj.as_bytes(),
+            "plate.obj",
+            &options,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        let svg = format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="{d}" stroke="black"/></svg>"#
+        );
+        let settings = PlanSettings {
+            placement: crate::svg::Placement {
+                offset_mm: glam::DVec2::new(0.0, 50.0),
+                ..crate::svg::Placement::IDENTITY
+            },
+            ..Default::default()
+        };
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let e = run_on(
+            &scan,
+            svg.as_bytes(),
+            "line.svg",
+            &settings,
+            &profile,
+            accept,
+        )
+        .map(|_| ())
+        .unwrap_err();
+        (scan, e)
+    }
+
     /// QA round 14: a scan with one vertex at z = 1e300 (or -1e300) among
     /// the rest, its units given ("It is in mm") or its risk accepted. The drawing runs
     /// over the spike, and the plan failed for the path ("points 0 and 1
@@ -3003,33 +3028,9 @@ mod tests {
                 0.0
             }
         });
-        let obj = crate::demo::workloads::to_obj(&plate);
-        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40"><path d="M 5 20 H 35" stroke="black"/></svg>"#;
-        let profile = MachineProfile::builtin("marlin").unwrap();
-        // The line at y 30 mm, through the spike (the drawing's y points
-        // down).
-        let settings = PlanSettings {
-            placement: crate::svg::Placement {
-                offset_mm: glam::DVec2::new(0.0, 50.0),
-                ..crate::svg::Placement::IDENTITY
-            },
-            ..Default::default()
-        };
         for (units, accept) in [(Some(ScanUnits::Mm), false), (None, true)] {
-            let options = ImportOptions {
-                units,
-                ..ImportOptions::DEFAULT
-            };
-            let scan = prepare_scan(
-                obj.as_bytes(),
-                "plate.obj",
-                &options,
-                &RegistrationSettings::default(),
-            )
-            .unwrap();
-            let e = run_on(&scan, svg, "line.svg", &settings, &profile, accept)
-                .map(|_| ())
-                .unwrap_err();
+            // The line through the spike.
+            let (scan, e) = refused_on_plate(&plate, units, "M 5 20 H 35", accept);
             let text = e.to_string();
             assert!(
                 matches!(&e, Error::AlsoRisks { first, blocked: Some(_), .. }
@@ -3046,6 +3047,7 @@ mod tests {
                 "{text}"
             );
             // Made before planning, by this check.
+            let profile = MachineProfile::builtin("marlin").unwrap();
             assert!(refuse_blocking_strays(&scan, &profile).is_err());
             assert!(
                 !text.contains("coincide") && !text.contains("edge-on"),

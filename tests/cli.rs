@@ -396,27 +396,16 @@ fn plan_report_has_every_field() {
 fn plan_and_compare_name_a_stray_vertex_given_units() {
     let dir = temp_dir("stray");
     // A 40 x 40 mm plate at z 1, its middle vertex sent up to 1e300.
-    let mut obj = String::new();
-    for j in 0..11 {
-        for i in 0..11 {
-            let z = if (i, j) == (5, 5) { "1e300" } else { "1" };
-            obj.push_str(&format!("v {} {} {z}\n", 10 + 4 * i, 10 + 4 * j));
+    let axis: Vec<f64> = (0..11).map(|i| 10.0 + 4.0 * i as f64).collect();
+    let plate = pcpp::mesh::TriMesh::height_field(&axis, &axis, |x, y| {
+        if (x, y) == (30.0, 30.0) {
+            1e300
+        } else {
+            1.0
         }
-    }
-    for j in 0..10 {
-        for i in 0..10 {
-            let a = 11 * j + i + 1;
-            obj.push_str(&format!(
-                "f {a} {} {}\nf {a} {} {}\n",
-                a + 1,
-                a + 12,
-                a + 12,
-                a + 11
-            ));
-        }
-    }
+    });
     let scan = dir.join("spike.obj");
-    std::fs::write(&scan, obj).unwrap();
+    std::fs::write(&scan, pcpp::demo::workloads::to_obj(&plate)).unwrap();
     let svg = dir.join("line.svg");
     std::fs::write(
         &svg,
