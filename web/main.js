@@ -434,6 +434,7 @@ function onWorkerMessage(e) {
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
       clearError();
       planOutcome(null, busy.gen);
+      state.lastRefusal = null;
       // Planned: the worker's scan is registered by the settings now (a
       // failed registration leaves the one before, which these are again).
       if (state.regFailed) {
@@ -519,6 +520,10 @@ function onPlanError(m, busy) {
   let file; // the file the title names
   let topic = null; // what the error is about (status.js)
   let notRead = false; // a scan file not read: the previous scan's state stands
+  // The refusal on screen before the file came, if the inputs are again
+  // the ones it was planned from.
+  const r = state.lastRefusal;
+  const kept = r && r.inputs === currentInputs() ? r : null;
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -549,6 +554,7 @@ function onPlanError(m, busy) {
     dropCentre();
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
+    if (kept) message += `\nIts plan stays refused: ${kept.title}.`;
     // A file of no kind the page reads (a dropped picture): the next file
     // accepted supersedes it.
     if (m.kind === 'mesh' && !isScanName(file)) topic = 'file';
@@ -669,7 +675,10 @@ function onPlanError(m, busy) {
   if (state.lastPlan) labelPlan(state.lastPlan, true);
   // Without a comparison of its own, the one on screen is the previous
   // plan's; one of an earlier failed plan says nothing of this one.
-  if (!m.comparison && state.lastComparison && state.lastComparison.failed) {
+  // (A scan file not read changes nothing the comparison was made from.)
+  if (notRead) {
+    if (!kept && state.lastComparison && state.lastComparison.failed) labelComparison('previous');
+  } else if (!m.comparison && state.lastComparison && state.lastComparison.failed) {
     state.lastComparison = null;
     clearComparison();
   } else if (!m.comparison) labelComparison('previous');
@@ -715,11 +724,17 @@ function onPlanError(m, busy) {
       showing}`, true);
   } else if (notRead) {
     // The scan still used, and its status, stand (it said "plan failed"
-    // where nothing had been planned).
-    setStatus(...busy.was);
+    // where nothing had been planned), a refusal's too (its status was
+    // replaced by "re-planning" when the file was picked).
+    setStatus(...(kept ? kept.status : busy.was));
   } else if (refusedOnScreen) {
     setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
+  if (m.stage === 'plan' && busy.gen === state.gen) {
+    state.lastRefusal = {
+      inputs: currentInputs(), title, status: [$('plan-status').textContent, $('plan-status').classList.contains('stale')],
+    };
+  } else if (!notRead) state.lastRefusal = null;
 }
 
 function cancelPlan() {

@@ -124,6 +124,11 @@ export const state = {
   // inputs}), shown instead of the last plan's (QA round 7 F3; see
   // view.js showRefused, dropRefused).
   refused: null,
+  // The last plan refused for the inputs as they were then ({inputs,
+  // title, status}): a scan file that then cannot be read changes none of
+  // them, and the refusal stands (QA round 15 F1: the status said
+  // "re-planning" for good and the failed comparison went).
+  lastRefusal: null,
   // Workers started so far: a plan's report is asked of the worker that
   // made it (a restarted one holds none).
   workerGen: 0,

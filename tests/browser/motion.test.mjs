@@ -529,3 +529,36 @@ test('the comparison notes a planner whose fewer defects come from moves closer 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 15 F1: after a refused plan, a scan file that cannot be read
+// left "settings changed: re-planning…" on screen while nothing planned,
+// emptied the planners' table and said nothing of the refusal. Nothing the
+// refusal was planned from changed: it stands, and says so.
+test('a broken scan after a refused plan keeps the refusal, its status and its comparison', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.selectOption('#demo-part', 'stepped-block');
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
+  await waitSettled(page);
+  await page.selectOption('#planner', 'slope');
+  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
+    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+  const status = await page.textContent('#plan-status');
+  assert.equal(status, 'no G-code: the refused tool path is shown where the drawing lies (see above)');
+  const table = await compareTable(page);
+  assert.equal(table.rows.slope.clearanceBad, true);
+
+  await page.setInputFiles('#scan-input', { name: 'broken.stl', mimeType: 'application/octet-stream',
+    buffer: Buffer.from('solid broken\nfacet normal 0 0 1\n outer loop\n  vertex 1 2\n') });
+  await page.waitForFunction(() => /broken\.stl/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  const message = await page.textContent('#error-message');
+  assert.match(message, /Still using the previous scan, demo-stepped-block\.ply\./);
+  assert.match(message, /Its plan stays refused: The nozzle would touch the part with slope: no G-code\./);
+  assert.equal(await page.textContent('#plan-status'), status);
+  assert.deepEqual(await compareTable(page), table);
+  assert.equal(await page.isHidden('#dl-gcode'), true);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
