@@ -998,6 +998,31 @@ pub fn run_on(
     profile: &MachineProfile,
     accept_risk: bool,
 ) -> Result<JobOutput> {
+    run_on_noting(
+        scan,
+        svg,
+        svg_name,
+        settings,
+        profile,
+        accept_risk,
+        &mut Vec::new(),
+    )
+}
+
+/// [`run_on`], pushing onto `noted` what the report would warn of about
+/// the drawing and the plan as soon as it is known (the drawing's notes,
+/// then the plan's warnings), so that a refusal can say them too (QA
+/// round 15 F2: a refused plan said nothing of the drawing's skipped text
+/// and the fifth of it off the scan; see [`refused_plan_warnings`]).
+pub fn run_on_noting(
+    scan: &PreparedScan,
+    svg: &[u8],
+    svg_name: &str,
+    settings: &PlanSettings,
+    profile: &MachineProfile,
+    accept_risk: bool,
+    noted: &mut Vec<String>,
+) -> Result<JobOutput> {
     settings.validate()?;
     // Before planning: a plan on a scan read in the wrong units, or
     // registered far off its printer points, fails, if it fails, for a
@@ -1007,7 +1032,9 @@ pub fn run_on(
     refuse_blocking_strays(scan, profile)?;
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
+    noted.extend(drawn.notes.iter().cloned());
     let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
+    noted.extend(plan.warnings.iter().cloned());
     refuse_uncleared(&plan, accept_risk)?;
     let path_file = InputFile::new(svg_name, svg);
     let (report, gcode) = write_outputs(
@@ -1024,6 +1051,19 @@ pub fn run_on(
         report,
         gcode,
     })
+}
+
+/// The warnings of a plan refused with `e` ([`run_on_noting`]'s), less
+/// those the refusal says itself: a warning that begins as the refusal
+/// does (its first 40 characters), as the share of the drawing over the
+/// scan does when that is the refusal.
+pub fn refused_plan_warnings(e: &Error, warnings: &[String]) -> Vec<String> {
+    let said = e.to_string();
+    let repeats = |w: &str| {
+        let head = w.char_indices().nth(40).map_or(w, |(i, _)| &w[..i]);
+        head.chars().count() == 40 && said.starts_with(head)
+    };
+    warnings.iter().filter(|w| !repeats(w)).cloned().collect()
 }
 
 /// The refusal of G-code on a registration whose fiducials miss their

@@ -1633,6 +1633,42 @@ fn a_tool_path_beside_a_scan_in_the_beds_corner_says_what_to_move() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// QA round 15 F2: a refused plan printed only the scan's warnings and the
+/// refusal; the drawing's (text skipped) and the plan's (parts off the
+/// scan) were said by `compare` only. They come before the refusal, less
+/// the one it repeats (the share of the drawing over the scan).
+#[test]
+fn a_refused_plan_says_the_drawings_and_the_plans_warnings() {
+    let dir = temp_dir("refused-warnings");
+    let scan = dir.join("part.ply");
+    std::fs::write(&scan, demo::to_binary_ply(&test_part::test_part())).unwrap();
+    let svg = dir.join("edge.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="80mm" height="80mm" viewBox="0 0 80 80"><path d="M 0 0 L 80 0 L 80 80 L 0 80 Z" stroke="black" fill="none"/><text x="10" y="10">label</text></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let place = ["--place", "0,80", "--place-scan", "bed", "-o", s(&out)];
+    let o = plan_on(&scan, &svg, &place);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    let (warned, refusal) = err.split_once("error: ").expect(&err);
+    assert!(
+        warned.contains("warning: 1 text element(s) skipped")
+            && warned.contains("lies off the scan")
+            && refusal.contains("only 19.8 of the drawing's 320.0 mm (6 %) lie over the scan"),
+        "{err}"
+    );
+    // Said once, by the refusal.
+    assert!(
+        !warned.contains("lie over the scan and are printed"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Issue 13: a scan still in its scanner's frame (the demo part turned and
 /// moved 800 mm down) with a spiral: the plan fails naming the placement
 /// flag; placed on the bed with the drawing centred, it succeeds, the

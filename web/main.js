@@ -669,6 +669,12 @@ function onPlanError(m, busy) {
       + 'open your drawing (SVG) to plan it on this scan.';
     title = `${busy.scan.name} is open; the demo drawing does not print on it`;
   }
+  // What the plan would have warned of (the drawing's skipped text, the
+  // parts off the scan...), said with its refusal: the figures on screen
+  // are the previous plan's (QA round 15 F2). Not the demo drawing's.
+  if (m.warnings && m.warnings.length && !demoTried) {
+    message = `${ended(message)}\nThis plan also warned:${m.warnings.map((w) => `\n• ${w}`).join('')}`;
+  }
   if (offered) clearError();
   else showError(title, message, file, topic, demoTried);
   if (busy.gen === state.gen && restorePlan()) return;

@@ -60,6 +60,8 @@ function errorOf(err) {
     out.comparison = err.comparison;
     out.comparisonNotes = err.comparisonNotes || [];
   }
+  // What the refused plan warned of (the drawing's notes, the plan's).
+  if (err && err.warnings) out.warnings = err.warnings;
   // A refused plan's paths and placement: the page shows them.
   if (err && err.view) out.view = err.view;
   if (err && err.placement) out.placement = err.placement;

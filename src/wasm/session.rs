@@ -523,7 +523,17 @@ impl Session {
         let (report, gcode) = match written {
             Ok(w) => w,
             Err(e) => {
+                // What the report would have warned of about the drawing
+                // and the plan, less what the refusal says (QA round 15 F2).
+                let noted: Vec<String> = (path.drawn.notes.iter())
+                    .chain(&plan.warnings)
+                    .cloned()
+                    .collect();
+                let warnings = job::refused_plan_warnings(&e, &noted);
                 let err = core_err(e);
+                if let Ok(w) = to_js(&warnings) {
+                    let _ = js_sys::Reflect::set(&err, &"warnings".into(), &w);
+                }
                 // The refused tool path, and where the drawing was placed,
                 // so that the page shows what was refused where it lies
                 // (QA round 7 F3: "move the drawing off that feature" was

@@ -473,6 +473,11 @@ test('a drawing mostly beside the scan is refused, and written only once the ris
   assert.match(text, /'Centre on scan' puts the drawing on the scan's footprint/);
   assert.match(text, /tick "write G-code even where it is refused \(at my risk\)"/);
   assert.doesNotMatch(text, /--/);
+  // What the plan warned of is said with its refusal (QA round 15 F2:
+  // only the previous plan's warnings were on screen), less the share
+  // over the scan, which the refusal says.
+  assert.match(text, /This plan also warned:\n• [^\n]*(lies off the scan|misses the scan)/);
+  assert.doesNotMatch(text, /and are printed/);
   await page.check('#accept-risk');
   await waitSettled(page);
   assert.equal(await page.isHidden('#error-panel'), true);

@@ -147,7 +147,9 @@ fn centre_on_scan(
 /// Errors of planning on a prepared scan: the drawn path's file is named.
 /// What the scan's import and registration noticed is said first: it may
 /// be the cause (a scan read in the wrong units leaves nothing to print).
-fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
+/// `noted`: the drawing's and the plan's warnings when the plan was made
+/// and then refused (said after the scan's, before the refusal).
+fn plan_failure(inputs: &Inputs, e: Error, noted: &[String], progress: &Progress) -> Failure {
     // The other risks the flag would accept, said after the refusal.
     if let Error::AlsoRisks {
         first,
@@ -155,7 +157,7 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
         blocked,
     } = e
     {
-        return match plan_failure(inputs, *first, progress) {
+        return match plan_failure(inputs, *first, noted, progress) {
             Failure::Input(mut m) => {
                 if !others.is_empty() {
                     m = format!(
@@ -183,6 +185,7 @@ fn plan_failure(inputs: &Inputs, e: Error, progress: &Progress) -> Failure {
         .collect();
     progress.warn(&warnings);
     progress.warn(&inputs.prepared.registration.notes);
+    progress.warn(&job::refused_plan_warnings(&e, noted));
     match e {
         Error::Gcode(g) => Failure::Input(format!("writing G-code: {g}")),
         e @ Error::OutsideVolume { .. } => Failure::Input(format!(
@@ -255,18 +258,20 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
             let nozzle = &settings.plan.nozzle;
             job::refuse_bad_registration(&inputs.prepared.registration, nozzle, a.accept_risk)
         })
-        .map_err(|e| plan_failure(&inputs, e, progress))?;
+        .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step(format!("planning ({})...", settings.plan.planner));
-    let output = job::run_on(
+    let mut noted = Vec::new();
+    let output = job::run_on_noting(
         &inputs.prepared,
         &inputs.svg,
         &inputs.svg_name,
         &settings.plan,
         &profile,
         a.accept_risk,
+        &mut noted,
     )
-    .map_err(|e| plan_failure(&inputs, e, progress))?;
+    .map_err(|e| plan_failure(&inputs, e, &noted, progress))?;
 
     progress.step("writing...");
     let mut staged = Staged::default();
@@ -352,7 +357,7 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
     // As plan's: a spike of stray vertices out of the volume fails every
     // planner for reasons that hide it ("seen edge-on from above").
     job::refuse_blocking_strays(&inputs.prepared, &profile)
-        .map_err(|e| plan_failure(&inputs, e, progress))?;
+        .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
     progress.step("planning with all five planners...");
     let comparison = job::compare_on(
@@ -361,7 +366,7 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
         &inputs.svg_name,
         &settings.plan,
     )
-    .map_err(|e| plan_failure(&inputs, e, progress))?;
+    .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     let rows = comparison.rows;
     if let Some(r) = &a.report {
         let files = [
