@@ -144,11 +144,10 @@ pub enum Error {
         "only {printed_mm:.1} of the drawing's {drawn_mm:.1} mm ({percent:.0} %) lie over the \
          scan; the rest lies beside it or over its holes and would not be printed; no G-code \
          written. The drawing as placed spans x {:.3}..{:.3}, y {:.3}..{:.3} mm and the scan x \
-         {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame): check the placement (--place centre \
-         puts the drawing on the scan's footprint), or accept the risk to print only the part \
-         over the scan",
+         {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame): {}, or accept the risk to print only \
+         the part over the scan",
         .drawing_xy[0], .drawing_xy[2], .drawing_xy[1], .drawing_xy[3],
-        .scan_xy[0], .scan_xy[2], .scan_xy[1], .scan_xy[3]
+        .scan_xy[0], .scan_xy[2], .scan_xy[1], .scan_xy[3], off_scan_advice(*.best_percent)
     )]
     MostlyOffScan {
         printed_mm: f64,
@@ -157,10 +156,29 @@ pub enum Error {
         /// lo x, lo y, hi x, hi y (mm, printer frame).
         drawing_xy: [f64; 4],
         scan_xy: [f64; 4],
+        /// The largest share in percent over the scan of the places tried
+        /// for the drawing at this size, when under a half: no move helps.
+        best_percent: Option<f64>,
     },
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// What [`Error::MostlyOffScan`] advises: the placement, or where no
+/// place tried puts half of the drawing over the scan (`best_percent`), a
+/// smaller drawing.
+fn off_scan_advice(best_percent: Option<f64>) -> String {
+    match best_percent {
+        Some(p) => format!(
+            "no place of the drawing at this size puts half of it over the scan (the best of \
+             those tried, {p:.0} %): the scanned surface is smaller than the drawing; scale the \
+             drawing down (a smaller SCALE in --place centre,ROT,SCALE)"
+        ),
+        None => {
+            "check the placement (--place centre puts the drawing on the scan's footprint)".into()
+        }
+    }
+}
 
 /// [`Error::AlsoRisks`]' other risks.
 fn also_accepts(others: &[String]) -> String {

@@ -1546,6 +1546,9 @@ pub fn write_outputs(
             percent: c.printed_percent(),
             drawing_xy: c.drawing_xy,
             scan_xy: [lo.x, lo.y, hi.x, hi.y],
+            best_percent: c
+                .best_percent
+                .filter(|p| *p < 100.0 * pipeline::MIN_PRINTED_SHARE),
         };
         return Err(refused(e, Some(Risk::MostlyOff), None));
     }

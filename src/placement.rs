@@ -409,14 +409,7 @@ fn centre_on_surface_exact(
             (lo.min(p), hi.max(p))
         });
     let size = (dhi - dlo).max_element();
-    let mut shifts: Vec<DVec2> = (0..9)
-        .flat_map(|i| (0..9).map(move |j| DVec2::new(i as f64, j as f64) / 8.0))
-        .map(|f| flo + f * (fhi - flo) - middle)
-        .collect();
-    if let Some(nearest) = surface.nearest_in_xy(middle) {
-        let away = (nearest - middle).normalize_or_zero();
-        shifts.extend((0..=4).map(|k| nearest - middle + away * (0.25 * k as f64 * size)));
-    }
+    let shifts = tried_middles(surface, size).into_iter().map(|c| c - middle);
     let centred = over(DVec2::ZERO);
     let (mut best, mut best_over) = (DVec2::ZERO, centred);
     for shift in shifts {
@@ -450,6 +443,55 @@ fn centre_on_surface_exact(
         None => moved,
     });
     Some((placed, note))
+}
+
+/// Where [`centre_on_surface`] tries the middle of a drawing `size` mm
+/// across when the middle of the scan's footprint is a gap: at 9 x 9
+/// points over the footprint, then from the surface nearest the
+/// footprint's middle outwards, a quarter of `size` at a time.
+fn tried_middles(surface: &Surface, size: f64) -> Vec<DVec2> {
+    let (lo, hi) = surface.bbox();
+    let (flo, fhi) = (lo.truncate(), hi.truncate());
+    let middle = 0.5 * (flo + fhi);
+    let mut at: Vec<DVec2> = (0..9)
+        .flat_map(|i| (0..9).map(move |j| DVec2::new(i as f64, j as f64) / 8.0))
+        .map(|f| flo + f * (fhi - flo))
+        .collect();
+    if let Some(nearest) = surface.nearest_in_xy(middle) {
+        let away = (nearest - middle).normalize_or_zero();
+        at.extend((0..=4).map(|k| nearest + away * (0.25 * k as f64 * size)));
+    }
+    at
+}
+
+/// The largest share (0 to 1) of the points along the drawing's lines,
+/// placed by `placement`, that lie over the scan's surface, where it is
+/// and with its middle at each place [`centre_on_surface`] tries
+/// ([`tried_middles`]), at the same size and turn. Under a half, no move
+/// of the drawing is likely to print half of it: the scanned surface is
+/// smaller than the drawing (QA round 15 F3: a drawing refused as mostly
+/// beside a scan was told to use `--place centre`, which it had).
+pub fn best_cover(drawn: &[Subpath2], surface: &Surface, placement: &Placement) -> f64 {
+    let samples: Vec<DVec2> = (along_lines(drawn, COVER_SAMPLES).into_iter())
+        .map(|p| placement.apply(p))
+        .collect();
+    if samples.is_empty() {
+        return 0.0;
+    }
+    let (dlo, dhi) = (samples.iter())
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let middle = 0.5 * (dlo + dhi);
+    let over = |shift: DVec2| {
+        (samples.iter())
+            .filter(|p| surface.highest_hit(**p + shift).is_some())
+            .count()
+    };
+    let best = (tried_middles(surface, (dhi - dlo).max_element()).into_iter())
+        .map(|c| over(c - middle))
+        .fold(over(DVec2::ZERO), usize::max);
+    best as f64 / samples.len() as f64
 }
 
 /// How many points along the drawing's lines [`centre_on_surface`] scores

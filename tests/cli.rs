@@ -1617,7 +1617,35 @@ fn a_tool_path_beside_a_scan_in_the_beds_corner_says_what_to_move() {
             && err.contains("only 19.8 of the drawing's 320.0 mm (6 %) lie over the scan")
             && err.contains("no G-code written")
             && err.contains("the scan x 70.000..150.000, y 70.000..150.000 mm")
+            && err.contains("check the placement (--place centre puts the drawing on the scan")
             && err.ends_with("(--accept-risk)\n"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // QA round 15 F3: a drawing larger than the scan, centred on it, was
+    // told to use --place centre. Lines 200 mm long across the 80 mm part:
+    // no place puts half of them over it.
+    let wide = dir.join("wide.svg");
+    std::fs::write(
+        &wide,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="60mm" viewBox="0 0 200 60"><path d="M 0 10 L 200 10 M 0 30 L 200 30 M 0 50 L 200 50" stroke="black" fill="none"/></svg>"#,
+    )
+    .unwrap();
+    let centred = [
+        "--place",
+        "centre,0,1",
+        "--place-scan",
+        "bed",
+        "-o",
+        s(&out),
+    ];
+    let o = plan_on(&scan, &wide, &centred);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("no place of the drawing at this size puts half of it over the scan")
+            && err.contains("scale the drawing down (a smaller SCALE in --place centre,ROT,SCALE)")
+            && !err.contains("check the placement (--place centre"),
         "{err}"
     );
     assert!(!out.exists());

@@ -351,3 +351,28 @@ test('fiducials: candidates ranked for the dot diameter, chosen by a click, prin
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 15 F3: a drawing larger than the scan is told to scale down,
+// not to centre it (which it is); the page says it with its own field.
+test('a drawing too large for the scan is told in the page\'s words to scale down', (t) => {
+  if (!existsSync(CLI)) {
+    t.skip(`${CLI} not built`);
+    return;
+  }
+  const plate = join(dir, 'plate80.obj');
+  writeFileSync(plate, 'v 0 0 0\nv 80 0 0\nv 80 80 0\nv 0 80 0\nf 1 2 3\nf 1 3 4\n');
+  const wide = join(dir, 'wide.svg');
+  writeFileSync(wide, '<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="60mm" viewBox="0 0 200 60">'
+    + '<path d="M 0 10 L 200 10 M 0 30 L 200 30 M 0 50 L 200 50" stroke="black" fill="none"/></svg>');
+  let err = '';
+  try {
+    execFileSync(CLI, ['plan', '--scan', plate, '--path', wide, '--place-scan', 'bed', '--place', 'centre,0,1',
+      '-o', join(dir, 'wide.gcode')], { stdio: ['ignore', 'ignore', 'pipe'] });
+  } catch (e) {
+    err = String(e.stderr);
+  }
+  assert.match(err, /the scanned surface is smaller than the drawing/);
+  const shown = pageText(err);
+  assert.match(shown, /scale the drawing down \(a smaller Scale\)/);
+  assert.doesNotMatch(shown, /--place centre/);
+});
