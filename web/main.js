@@ -736,7 +736,9 @@ function onPlanError(m, busy) {
   } else if (refusedOnScreen) {
     setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
-  if (m.stage === 'plan' && busy.gen === state.gen) {
+  // (Not a drawing that could not be read: the page went back to the
+  // one before, whose plan this is not; nor a crash.)
+  if (m.stage === 'plan' && busy.gen === state.gen && m.kind !== 'svg' && m.kind !== 'crash') {
     state.lastRefusal = {
       inputs: currentInputs(), title, status: [$('plan-status').textContent, $('plan-status').classList.contains('stale')],
     };
