@@ -169,10 +169,13 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// smaller drawing.
 fn off_scan_advice(best_percent: Option<f64>) -> String {
     match best_percent {
+        // (Rounded down: 49.6 % is not "half".)
         Some(p) => format!(
-            "no place of the drawing at this size puts half of it over the scan (the best of \
-             those tried, {p:.0} %): the scanned surface is smaller than the drawing; scale the \
-             drawing down (a smaller SCALE in --place centre,ROT,SCALE)"
+            "no place of the drawing at this size and turn puts half of it over the scan (the \
+             best of those tried, {} %): the scanned surface is smaller than the drawing, or has \
+             gaps or holes under it; scale the drawing down or turn it (a smaller SCALE or \
+             another ROT in --place centre,ROT,SCALE)",
+            p.floor()
         ),
         None => {
             "check the placement (--place centre puts the drawing on the scan's footprint)".into()

@@ -27,6 +27,7 @@ use crate::quality::QualitySummary;
 use crate::registration::{register, Registration, RegistrationError, RegistrationMethod};
 use crate::stats::PathStats;
 use crate::surface::{Indexed, SpatialIndex, Surface};
+use crate::svg::{Placement, Subpath2};
 
 /// Where the scan's fiducials come from.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -1045,7 +1046,8 @@ pub fn run_on_noting(
         settings,
         profile,
         accept_risk,
-    )?;
+    )
+    .map_err(|e| advise_off_scan(e, &drawn.subpaths, &scan.surface, &settings.placement))?;
     Ok(JobOutput {
         plan,
         report,
@@ -1053,15 +1055,48 @@ pub fn run_on_noting(
     })
 }
 
+/// [`Error::MostlyOffScan`] (alone or first of the risks) with its
+/// advice: where no place tried for the drawing at its size and turn
+/// ([`crate::placement::best_cover`]) puts half of it over the scan, to
+/// scale or turn it rather than move it (QA round 15 F3: a drawing
+/// centred on a scan smaller than it was told to centre it). Found only
+/// for a refusal (the page re-plans as the drawing is dragged); other
+/// errors are returned as they are.
+pub fn advise_off_scan(
+    mut e: Error,
+    drawn: &[Subpath2],
+    surface: &Surface,
+    placement: &Placement,
+) -> Error {
+    let target = match &mut e {
+        Error::AlsoRisks { first, .. } => first.as_mut(),
+        e => e,
+    };
+    if let Error::MostlyOffScan {
+        percent,
+        best_percent,
+        ..
+    } = target
+    {
+        // (Samples, not length: never said to be less than the share as
+        // placed.)
+        let best = (100.0 * crate::placement::best_cover(drawn, surface, placement)).max(*percent);
+        if best < 100.0 * pipeline::MIN_PRINTED_SHARE {
+            *best_percent = Some(best);
+        }
+    }
+    e
+}
+
 /// The warnings of a plan refused with `e` ([`run_on_noting`]'s), less
-/// those the refusal says itself: a warning that begins as the refusal
-/// does (its first 40 characters), as the share of the drawing over the
-/// scan does when that is the refusal.
+/// those the refusal says itself: a warning whose first 40 characters
+/// the refusal says (its own, or one of the other risks it lists), as the
+/// share of the drawing over the scan is when that is refused.
 pub fn refused_plan_warnings(e: &Error, warnings: &[String]) -> Vec<String> {
     let said = e.to_string();
     let repeats = |w: &str| {
         let head = w.char_indices().nth(40).map_or(w, |(i, _)| &w[..i]);
-        head.chars().count() == 40 && said.starts_with(head)
+        head.chars().count() == 40 && said.contains(head)
     };
     warnings.iter().filter(|w| !repeats(w)).cloned().collect()
 }
@@ -1546,9 +1581,7 @@ pub fn write_outputs(
             percent: c.printed_percent(),
             drawing_xy: c.drawing_xy,
             scan_xy: [lo.x, lo.y, hi.x, hi.y],
-            best_percent: c
-                .best_percent
-                .filter(|p| *p < 100.0 * pipeline::MIN_PRINTED_SHARE),
+            best_percent: None,
         };
         return Err(refused(e, Some(Risk::MostlyOff), None));
     }

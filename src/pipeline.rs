@@ -129,11 +129,6 @@ pub struct Coverage {
     /// The drawing's XY extent as placed: lo x, lo y, hi x, hi y (mm,
     /// printer frame).
     pub drawing_xy: [f64; 4],
-    /// Where less than [`MIN_PRINTED_SHARE`] of it is printed: the largest
-    /// share in percent over the scan of the places tried for it at this
-    /// size ([`crate::placement::best_cover`]); `None` otherwise.
-    #[serde(skip)]
-    pub best_percent: Option<f64>,
 }
 
 /// Below this share of the drawing's length printed, the G-code is refused
@@ -424,16 +419,11 @@ pub fn surface_path(
             ),
         );
     }
-    let mut coverage = Coverage {
+    let coverage = Coverage {
         drawn_mm,
         printed_mm: on_scan_mm,
         drawing_xy: [lo.x, lo.y, hi.x, hi.y],
-        best_percent: None,
     };
-    if coverage.mostly_off_scan() {
-        coverage.best_percent =
-            Some(100.0 * crate::placement::best_cover(drawn, surface, placement));
-    }
     Ok(SurfacePath {
         pieces,
         warnings,

@@ -1643,8 +1643,11 @@ fn a_tool_path_beside_a_scan_in_the_beds_corner_says_what_to_move() {
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
-        err.contains("no place of the drawing at this size puts half of it over the scan")
-            && err.contains("scale the drawing down (a smaller SCALE in --place centre,ROT,SCALE)")
+        err.contains("no place of the drawing at this size and turn puts half of it over the scan")
+            && err.contains(
+                "scale the drawing down or turn it (a smaller SCALE or another ROT in --place \
+                 centre,ROT,SCALE)"
+            )
             && !err.contains("check the placement (--place centre"),
         "{err}"
     );

@@ -523,7 +523,7 @@ function onPlanError(m, busy) {
   // The refusal on screen before the file came, if the inputs are again
   // the ones it was planned from.
   const r = state.lastRefusal;
-  const kept = r && r.inputs === currentInputs() ? r : null;
+  const kept = r && r.inputs && r.inputs === currentInputs() ? r : null;
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -554,7 +554,7 @@ function onPlanError(m, busy) {
     dropCentre();
     $('scan-name').textContent = state.scan.name;
     message += `\nStill using the previous scan, ${state.scan.name}.`;
-    if (kept) message += `\nIts plan stays refused: ${kept.title}.`;
+    if (kept) message += `\nIts plan ${kept.refused ? 'stays refused' : 'still fails'}: ${kept.title}.`;
     // A file of no kind the page reads (a dropped picture): the next file
     // accepted supersedes it.
     if (m.kind === 'mesh' && !isScanName(file)) topic = 'file';
@@ -737,13 +737,18 @@ function onPlanError(m, busy) {
     setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
   // (Not a drawing that could not be read: the page went back to the
-  // one before, whose plan this is not; nor a crash.)
+  // one before, whose plan this is not; nor a crash. Neither clears one
+  // kept: the inputs say whether it is still theirs.)
   if (m.stage === 'plan' && busy.gen === state.gen && m.kind !== 'svg' && m.kind !== 'crash') {
     state.lastRefusal = {
-      inputs: currentInputs(), title, status: [$('plan-status').textContent, $('plan-status').classList.contains('stale')],
+      inputs: currentInputs(), title, refused: REFUSALS.has(m.kind),
+      status: [$('plan-status').textContent, $('plan-status').classList.contains('stale')],
     };
-  } else if (!notRead) state.lastRefusal = null;
+  }
 }
+
+// The kinds of plan failure that are refusals of G-code (the others fail).
+const REFUSALS = new Set(['touching', 'volume', 'units', 'registration', ...Object.keys(RISKS)]);
 
 function cancelPlan() {
   const busy = state.busy;

@@ -65,7 +65,7 @@ const PAGE_WORDS = [
   [/Give a DZ of 0 or more/g, 'Give a Move Z of 0 or more'],
   [/give it with the placement \(--place centre,ROT,SCALE\), which is kept as given/g,
     'type it in Scale, which is planned as typed'],
-  [/\(a smaller SCALE in --place centre,ROT,SCALE\)/g, '(a smaller Scale)'],
+  [/\(a smaller SCALE or another ROT in --place centre,ROT,SCALE\)/g, '(a smaller Scale, or another Rotation)'],
   [/\(--place centre puts the drawing on the scan's footprint\)/g,
     "('Centre on scan' puts the drawing on the scan's footprint)"],
   [/\(--up-axis y, z or -z; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],

@@ -529,6 +529,7 @@ impl Session {
                     .chain(&plan.warnings)
                     .cloned()
                     .collect();
+                let e = job::advise_off_scan(e, &path.drawn.subpaths, surface, &settings.placement);
                 let warnings = job::refused_plan_warnings(&e, &noted);
                 let err = core_err(e);
                 if let Ok(w) = to_js(&warnings) {

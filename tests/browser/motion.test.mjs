@@ -564,6 +564,17 @@ test('a broken scan after a refused plan keeps the refusal, its status and its c
   assert.equal(await page.textContent('#plan-status'), status);
   assert.deepEqual(await compareTable(page), table);
   assert.equal(await page.isHidden('#dl-gcode'), true);
+  // A drawing that cannot be read goes back to the refused one; a broken
+  // scan after it still finds the refusal standing.
+  await page.setInputFiles('#svg-input', { name: 'broken.svg', mimeType: 'image/svg+xml', buffer: Buffer.from('<svg><path d="M 0 0 L') });
+  await page.waitForFunction(() => /broken\.svg/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  await page.setInputFiles('#scan-input', { name: 'broken2.stl', mimeType: 'application/octet-stream',
+    buffer: Buffer.from('solid broken\nfacet normal 0 0 1\n outer loop\n  vertex 1 2\n') });
+  await page.waitForFunction(() => /broken2\.stl/.test(document.getElementById('error-title').textContent));
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Its plan stays refused: The nozzle would touch the part with slope/);
+  assert.equal(await page.textContent('#plan-status'), status);
   assert.deepEqual(problems, []);
   await context.close();
 });

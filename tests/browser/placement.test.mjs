@@ -373,6 +373,6 @@ test('a drawing too large for the scan is told in the page\'s words to scale dow
   }
   assert.match(err, /the scanned surface is smaller than the drawing/);
   const shown = pageText(err);
-  assert.match(shown, /scale the drawing down \(a smaller Scale\)/);
+  assert.match(shown, /scale the drawing down or turn it \(a smaller Scale, or another Rotation\)/);
   assert.doesNotMatch(shown, /--place centre/);
 });

@@ -150,14 +150,17 @@ fn centre_on_scan(
 /// `noted`: the drawing's and the plan's warnings when the plan was made
 /// and then refused (said after the scan's, before the refusal).
 fn plan_failure(inputs: &Inputs, e: Error, noted: &[String], progress: &Progress) -> Failure {
-    // The other risks the flag would accept, said after the refusal.
+    // The other risks the flag would accept, said after the refusal (the
+    // plan's warnings that one of them says are left out: filtered here).
+    let kept = matches!(e, Error::AlsoRisks { .. }).then(|| job::refused_plan_warnings(&e, noted));
     if let Error::AlsoRisks {
         first,
         others,
         blocked,
     } = e
     {
-        return match plan_failure(inputs, *first, noted, progress) {
+        let noted = kept.unwrap_or_default();
+        return match plan_failure(inputs, *first, &noted, progress) {
             Failure::Input(mut m) => {
                 if !others.is_empty() {
                     m = format!(
