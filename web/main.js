@@ -672,11 +672,11 @@ function onPlanError(m, busy) {
   // What the plan would have warned of (the drawing's skipped text, the
   // parts off the scan...), said with its refusal: the figures on screen
   // are the previous plan's (QA round 15 F2). Not the demo drawing's.
-  if (m.warnings && m.warnings.length && !demoTried) {
-    message = `${ended(message)}\nThis plan also warned:${m.warnings.map((w) => `\n• ${w}`).join('')}`;
-  }
+  // (Shown only: the tests of the message below read the core's words.)
+  const shown = m.warnings && m.warnings.length && !demoTried
+    ? `${ended(message)}\nThis plan also warned:${m.warnings.map((w) => `\n• ${w}`).join('')}` : message;
   if (offered) clearError();
-  else showError(title, message, file, topic, demoTried);
+  else showError(title, shown, file, topic, demoTried);
   if (busy.gen === state.gen && restorePlan()) return;
   if (state.lastPlan) labelPlan(state.lastPlan, true);
   // Without a comparison of its own, the one on screen is the previous
