@@ -42,6 +42,19 @@ const compareTable = (page) => page.evaluate(() => {
   return { heads, rows };
 });
 
+// The demo's stepped block planned with the paper's slope planner, which
+// runs the nozzle into the steps' walls: refused for touching.
+async function refusedOnSteppedBlock(page) {
+  await waitSettled(page);
+  await page.selectOption('#demo-part', 'stepped-block');
+  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
+  await waitSettled(page);
+  await page.selectOption('#planner', 'slope');
+  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
+    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  await waitIdle(page);
+}
+
 test('every planner is compared with its defects, backward moves, clearance and waypoints; the plot shows each', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
@@ -200,14 +213,7 @@ test('a plan whose G-code touches the part names its lines and offers nothing; a
 // "showing the previous plan".
 test('a failure with no tool path of its own takes a refused one out of the view', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
-  await waitSettled(page);
-  await page.selectOption('#demo-part', 'stepped-block');
-  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
-  await waitSettled(page);
-  await page.selectOption('#planner', 'slope');
-  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
-    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
-  await waitIdle(page);
+  await refusedOnSteppedBlock(page);
   assert.equal(await page.evaluate(() => window.pcpp.state.refused !== null), true);
   // A drawing that cannot be read changes nothing the refusal was planned
   // from (the drawing before it is kept): the refused path stays, and the
@@ -541,14 +547,7 @@ test('the comparison notes a planner whose fewer defects come from moves closer 
 // refusal was planned from changed: it stands, and says so.
 test('a broken scan after a refused plan keeps the refusal, its status and its comparison', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
-  await waitSettled(page);
-  await page.selectOption('#demo-part', 'stepped-block');
-  await page.waitForFunction(() => document.getElementById('scan-name').textContent === 'demo-stepped-block.ply');
-  await waitSettled(page);
-  await page.selectOption('#planner', 'slope');
-  await page.waitForFunction(() => /touch/.test(document.getElementById('error-title').textContent)
-    && !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
-  await waitIdle(page);
+  await refusedOnSteppedBlock(page);
   const status = await page.textContent('#plan-status');
   assert.equal(status, 'no G-code: the refused tool path is shown where the drawing lies (see above)');
   const table = await compareTable(page);
