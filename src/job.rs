@@ -1093,7 +1093,13 @@ pub fn advise_off_scan(
 /// the refusal says (its own, or one of the other risks it lists), as the
 /// share of the drawing over the scan is when that is refused.
 pub fn refused_plan_warnings(e: &Error, warnings: &[String]) -> Vec<String> {
-    let said = e.to_string();
+    warnings_not_said(&e.to_string(), warnings)
+}
+
+/// `warnings` less those whose first 40 characters `said` contains (see
+/// [`refused_plan_warnings`]; the page's adapter has only the error's
+/// words for a failure it has already turned into a JS error).
+pub fn warnings_not_said(said: &str, warnings: &[String]) -> Vec<String> {
     let repeats = |w: &str| {
         let head = w.char_indices().nth(40).map_or(w, |(i, _)| &w[..i]);
         head.chars().count() == 40 && said.contains(head)

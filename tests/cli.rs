@@ -1697,6 +1697,37 @@ fn a_refused_plan_says_the_drawings_and_the_plans_warnings() {
         "{err}"
     );
     assert!(!out.exists());
+    // The same drawing on the scan moved 1 mm below the bed: refused for
+    // that first, the share over the scan listed among the other risks
+    // accepting it would accept, and so not said a second time as a
+    // warning (the filter against the other risks, QA round 15 F2's
+    // review).
+    let below = [
+        "--place",
+        "0,80",
+        "--place-scan",
+        "bed,0,0,-1",
+        "-o",
+        s(&out),
+    ];
+    let o = plan_on(&scan, &svg, &below);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    let (warned, refusal) = err.split_once("error: ").expect(&err);
+    assert!(
+        refusal.contains("below the bed")
+            && refusal.contains(
+                "--accept-risk would also accept: only 19.8 of the drawing's 320.0 mm (6 %) lie \
+                 over the scan and are printed"
+            ),
+        "{err}"
+    );
+    assert!(
+        warned.contains("warning: 1 text element(s) skipped")
+            && !warned.contains("lie over the scan and are printed"),
+        "{err}"
+    );
+    assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -468,7 +468,22 @@ impl Session {
         job::refuse_blocking_strays(&self.scan, &profile).map_err(core_err)?;
         job::refuse_bad_registration(&self.scan.registration, &settings.nozzle, accept_risk)
             .map_err(core_err)?;
-        self.ensure_surface_path(&settings)?;
+        if let Err(err) = self.ensure_surface_path(&settings) {
+            // The drawing's notes go with a failure of its surface path
+            // as with a refusal, and as `pcpp plan` prints them (a
+            // drawing read at 90 px per inch may be why it misses the
+            // scan), less what the failure says itself.
+            if let Some(path) = &self.path {
+                let said = js_sys::Reflect::get(&err, &"message".into())
+                    .ok()
+                    .and_then(|m| m.as_string())
+                    .unwrap_or_default();
+                if let Ok(w) = to_js(&job::warnings_not_said(&said, &path.drawn.notes)) {
+                    let _ = js_sys::Reflect::set(&err, &"warnings".into(), &w);
+                }
+            }
+            return Err(err);
+        }
         let Some(cache) = &self.cache else {
             return Err(JsError::new("the surface path was not kept").into());
         };

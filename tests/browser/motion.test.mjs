@@ -234,6 +234,42 @@ test('a failure with no tool path of its own takes a refused one out of the view
   await context.close();
 });
 
+// The review of QA round 15 F2's fix: a plan that failed in its surface
+// path (the drawing moved off the scan) said nothing of the drawing's own
+// notes in the page, which `pcpp plan` prints with the same failure.
+test('a drawing moved off the scan fails with its own notes said, as the CLI says them', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const svg = '<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="20mm" viewBox="0 0 20 20">'
+    + '<path d="M2 10 L18 10" stroke="black" fill="none"/><text x="2" y="5">ANT</text></svg>';
+  await page.setInputFiles('#svg-input', { name: 'labelled.svg', mimeType: 'image/svg+xml', buffer: Buffer.from(svg) });
+  await page.waitForFunction(() => document.getElementById('svg-name').textContent === 'labelled.svg',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  await page.fill('#pl-x', '500');
+  await page.waitForFunction(() => /misses the scan/.test(document.getElementById('error-message').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  const text = await page.textContent('#error-message');
+  assert.match(text, /This plan also warned:\n• 1 text element\(s\) skipped: text is not converted to paths/);
+  // The CLI's failure on the same drawing says the same note.
+  const scan = join(dir, 'demo-test-part.ply');
+  const drawing = join(dir, 'labelled.svg');
+  writeFileSync(drawing, svg);
+  execFileSync(CLI, ['demo', '--out', dir], { stdio: 'ignore' });
+  let stderr = '';
+  try {
+    execFileSync(CLI, ['plan', '--scan', scan, '--path', drawing, '--place', '500,0', '-o', join(dir, 'off.gcode')],
+      { stdio: ['ignore', 'ignore', 'pipe'] });
+  } catch (e) {
+    stderr = e.stderr.toString();
+  }
+  assert.match(stderr, /1 text element\(s\) skipped: text is not converted to paths/);
+  assert.match(stderr, /misses the scan/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('a G-code file is checked against the scan: the demo\'s own is clear, a cutting move and an arc are named by line', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
