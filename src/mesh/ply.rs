@@ -103,6 +103,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         vertices: Vec::new(),
         triangles: Vec::new(),
         short_faces: 0,
+        ignored_tail: 0,
     };
     match header.encoding {
         Encoding::Ascii => out.read_ascii(&header, body)?,
@@ -113,6 +114,12 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         warnings.push(format!(
             "{file}: skipped {} face(s) with fewer than 3 vertices",
             out.short_faces
+        ));
+    }
+    if out.ignored_tail > 0 {
+        warnings.push(format!(
+            "{file}: ignored {} byte(s) after the last element the PLY header declares",
+            out.ignored_tail
         ));
     }
     Ok(Parsed {
@@ -304,6 +311,9 @@ struct Body<'f> {
     vertices: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     short_faces: usize,
+    /// Bytes after the last element too few to hold one more of its
+    /// records (a writer's padding): ignored, with a warning.
+    ignored_tail: usize,
 }
 
 impl Body<'_> {
@@ -520,10 +530,16 @@ impl Body<'_> {
         };
         let split = ahead.as_ref().map_or(header.elements.len(), |a| a.element);
         let limit = ahead.as_ref().map_or(0, |a| self.index_limit(a.item));
+        // The last element with records, and where they start.
+        let mut last = None;
         let (head, mut early) = crate::parallel::join(
             || -> Result<(), MeshError> {
                 for element in &header.elements[..split] {
+                    let start = r.pos;
                     self.read_element(element, &mut r, &mut polygon, None)?;
+                    if element.count > 0 && !element.props.is_empty() {
+                        last = Some((element, start));
+                    }
                 }
                 Ok(())
             },
@@ -541,8 +557,50 @@ impl Body<'_> {
             // Read ahead where this element starts, as it must after
             // fixed-size records: else it is read here.
             let pre = early.take().filter(|(start, _)| *start == r.pos);
+            let start = r.pos;
             self.read_element(element, &mut r, &mut polygon, pre.map(|(_, t)| t))?;
+            if element.count > 0 && !element.props.is_empty() {
+                last = Some((element, start));
+            }
         }
+        self.check_binary_tail(&r, last)
+    }
+
+    /// The bytes after the last element (QA round 16 F1: a face count
+    /// halved in the header read half the scan without a word, and the
+    /// G-code drove the nozzle 30 mm into the real part): whitespace and
+    /// NULs are a writer's padding; fewer bytes than one more record of
+    /// the last element are ignored with a warning; room for a record or
+    /// more is an error, since the scan read would lack part of its
+    /// surface (the same count wrong the other way is already one).
+    fn check_binary_tail(
+        &mut self,
+        r: &BinReader,
+        last: Option<(&Element, usize)>,
+    ) -> Result<(), MeshError> {
+        let tail = r.bytes.get(r.pos..).unwrap_or_default();
+        if tail.iter().all(|&b| b == 0 || b.is_ascii_whitespace()) {
+            return Ok(());
+        }
+        if let Some((element, start)) = last {
+            // Records of lists vary in size: their mean in this file.
+            let record = (r.pos - start) as f64 / element.count as f64;
+            if tail.len() as f64 >= record {
+                return Err(MeshError::invalid(
+                    self.file,
+                    format!(
+                        "{} bytes of data follow the {} '{}' elements the PLY header declares, \
+                         room for about {} more (a wrong count in the header, or a damaged \
+                         file); not read, since the scan would lack part of its surface",
+                        tail.len(),
+                        element.count,
+                        element.name,
+                        (tail.len() as f64 / record).floor()
+                    ),
+                ));
+            }
+        }
+        self.ignored_tail = tail.len();
         Ok(())
     }
 
@@ -726,6 +784,27 @@ impl Body<'_> {
                     self.push_vertex(xyz, Some(line))?;
                 }
             }
+        }
+        // Values after the last element: its count in the header is too
+        // small, or the file is damaged (QA round 16 F1, as in binary).
+        t.skip_space();
+        if t.remaining() > 0 {
+            let last = header
+                .elements
+                .iter()
+                .rfind(|e| e.count > 0 && !e.props.is_empty());
+            return Err(MeshError::syntax(
+                file,
+                t.line,
+                format!(
+                    "data after the {}: a wrong count in the PLY header, or a damaged file; not \
+                     read, since the scan would lack part of its surface",
+                    last.map_or_else(
+                        || "header".to_string(),
+                        |e| format!("{} '{}' elements the header declares", e.count, e.name)
+                    )
+                ),
+            ));
         }
         Ok(())
     }
@@ -985,6 +1064,58 @@ mod tests {
         assert_eq!(p.vertices.len(), 4);
         assert_eq!(p.vertices[2], DVec3::new(1.0, 1.0, 0.0));
         assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    /// QA round 16 F1: a face count lowered in the header (a real scan's
+    /// 1610 faces declared as 805) read half the scan without a word, and
+    /// the G-code drove the nozzle 30 mm into the real part. Data after
+    /// the last element is an error naming the element and its count;
+    /// a writer's trailing blank line or padding is not.
+    #[test]
+    fn data_after_the_declared_elements_is_an_error() {
+        let e = parse(format!("{ASCII}0 2\n").as_bytes(), "t.ply")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.ply:24:") && e.contains("data after the 1 'edge' elements"),
+            "{e}"
+        );
+        assert!(parse(format!("{ASCII}\n  \n").as_bytes(), "t.ply").is_ok());
+        let verts = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let faces = [vec![0, 1, 2], vec![0, 2, 3], vec![1, 2, 3]];
+        for big in [false, true] {
+            let b = binary(&verts, &faces, big, "int");
+            let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+            let header = std::str::from_utf8(&b[..header_end]).unwrap();
+            let mut lowered = header
+                .replace("element face 3", "element face 1")
+                .into_bytes();
+            lowered.extend(&b[header_end..]);
+            let e = parse(&lowered, "b.ply").unwrap_err().to_string();
+            assert!(
+                e.contains("26 bytes of data follow the 1 'face' elements")
+                    && e.contains("room for about 2 more"),
+                "{e}"
+            );
+            // Fewer bytes than a record: a warning; NULs and newlines: nothing.
+            let mut padded = b.clone();
+            padded.extend([7u8, 7]);
+            let p = parse(&padded, "b.ply").unwrap();
+            assert_eq!(p.triangles.len(), 3);
+            assert!(
+                p.warnings[0].contains("ignored 2 byte(s)"),
+                "{:?}",
+                p.warnings
+            );
+            let mut blank = b.clone();
+            blank.extend([0u8, b'\n']);
+            assert!(parse(&blank, "b.ply").unwrap().warnings.is_empty());
+        }
     }
 
     #[test]

@@ -74,20 +74,7 @@ fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         )
     })?;
     let mut warnings = Vec::new();
-    // A writer that streams facets and never goes back to fill in the
-    // count leaves 0 there (QA: a file of 1800 facets was "the mesh has no
-    // triangles"): whole facets after it are read, with a note.
-    let body = bytes.len().saturating_sub(PREAMBLE);
-    let n = if n == 0 && body >= FACET && body.is_multiple_of(FACET) {
-        let found = u32::try_from(body / FACET).unwrap_or(u32::MAX);
-        warnings.push(format!(
-            "{file}: the binary STL header declares 0 triangles, but {found} whole facets \
-             ({body} bytes) follow it (a writer that never filled in the count): read them"
-        ));
-        found
-    } else {
-        n
-    };
+    let body = bytes.len().saturating_sub(PREAMBLE) as u64;
     let needed = binary_size(n);
     if (bytes.len() as u64) < needed {
         return Err(MeshError::invalid(
@@ -99,12 +86,54 @@ fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
             ),
         ));
     }
-    if (bytes.len() as u64) > needed {
-        warnings.push(format!(
-            "{file}: ignored {} bytes after the {n} triangles the binary STL header declares",
-            bytes.len() as u64 - needed
+    // Bytes after the declared facets: fewer than a facet's are ignored
+    // (a writer's padding); whole facets mean the count is wrong, and are
+    // read (a streaming writer that never went back to fill it in leaves
+    // 0: QA, "the mesh has no triangles"; QA round 16 F1: a count halved
+    // read half the scan with only a warning that bytes were ignored, and
+    // its G-code drove the nozzle 3.7 mm into the real part), since
+    // triangles left out could be under the nozzle while any read in
+    // excess only make the plan more careful (stray or broken ones are
+    // refused downstream as ever); more than a facet that are not whole
+    // facets are not guessed at.
+    let extra = bytes.len() as u64 - needed;
+    let n = if extra < FACET as u64 {
+        if extra > 0 {
+            warnings.push(format!(
+                "{file}: ignored {extra} bytes after the {n} triangles the binary STL header \
+                 declares"
+            ));
+        }
+        n
+    } else if extra.is_multiple_of(FACET as u64) {
+        let whole = u32::try_from(body / FACET as u64).map_err(|_| {
+            MeshError::invalid(
+                file,
+                format!("{body} bytes of facets: more than 2^32 of them"),
+            )
+        })?;
+        warnings.push(if n == 0 {
+            format!(
+                "{file}: the binary STL header declares 0 triangles, but {whole} whole facets \
+                 ({body} bytes) follow it (a writer that never filled in the count): read them"
+            )
+        } else {
+            format!(
+                "{file}: the binary STL header declares {n} triangles, but {whole} whole facets \
+                 follow it (a wrong count, or a damaged file): all {whole} read; check the scan"
+            )
+        });
+        whole
+    } else {
+        return Err(MeshError::invalid(
+            file,
+            format!(
+                "{extra} bytes follow the {n} triangles the binary STL header declares: more \
+                 than a facet ({FACET} bytes), but not whole facets (a wrong count, or a damaged \
+                 file); not read, since the scan would lack part of its surface"
+            ),
         ));
-    }
+    };
     // The size check above bounds `n` by the bytes present, so these
     // allocations are proportional to the input.
     let n = n as usize;
@@ -456,8 +485,53 @@ mod tests {
             "{:?}",
             p.warnings
         );
+        // Not whole facets, and more than one: not guessed at.
         b.push(0);
-        assert!(parse(&b, "s.stl").unwrap().triangles.is_empty());
+        let e = parse(&b, "s.stl").unwrap_err().to_string();
+        assert!(e.contains("101 bytes follow the 0 triangles"), "{e}");
+    }
+
+    /// QA round 16 F1: a count halved in the header read half of a real
+    /// scan, with only a warning that bytes were ignored. Whole facets
+    /// past the count are read; more than a facet's bytes that are not
+    /// whole facets are an error; fewer, a warning.
+    #[test]
+    fn whole_facets_past_the_declared_count_are_read() {
+        let facet = |tri: [[f32; 3]; 3]| {
+            let mut f = vec![0u8; 12];
+            for c in tri {
+                f.extend(c.iter().flat_map(|v| v.to_le_bytes()));
+            }
+            f.extend([0u8; 2]);
+            f
+        };
+        let mut b = vec![0u8; 84];
+        b[80..84].copy_from_slice(&1u32.to_le_bytes());
+        b.extend(facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]));
+        b.extend(facet([[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]));
+        let p = parse(&b, "s.stl").unwrap();
+        assert_eq!(p.triangles.len(), 2);
+        assert!(
+            p.warnings[0].contains("declares 1 triangles, but 2 whole facets follow it"),
+            "{:?}",
+            p.warnings
+        );
+        let mut odd = b.clone();
+        odd.extend([1u8; 10]);
+        let e = parse(&odd, "s.stl").unwrap_err().to_string();
+        assert!(
+            e.contains("60 bytes follow the 1 triangles") && e.contains("not whole facets"),
+            "{e}"
+        );
+        let mut pad = b[..134].to_vec();
+        pad.extend([1u8; 3]);
+        let p = parse(&pad, "s.stl").unwrap();
+        assert_eq!(p.triangles.len(), 1);
+        assert!(
+            p.warnings[0].contains("ignored 3 bytes"),
+            "{:?}",
+            p.warnings
+        );
     }
 
     #[test]
