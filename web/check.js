@@ -23,7 +23,11 @@ export function checkGcodeFile(file) {
   const id = ++state.checkId;
   const nozzle = { inner_diameter_mm: num(s.nozzle.id), outer_diameter_mm: num(s.nozzle.od) };
   const tol = num(s.process.tol);
-  state.checking = { id, name: file.name, file, nozzle, tol };
+  // What it is checked against: the scan as the worker will hold it, after
+  // any plan in flight (see `checkAgainstSettled`).
+  const frame = state.busy ? state.busy.checkFrame : state.workerFrame;
+  state.checking = { id, name: file.name, file, nozzle, tol, frame };
+  state.checkSource = { file, name: file.name, frame };
   state.checkMoves = null;
   $('check-draw').hidden = true;
   $('check-panel').hidden = false;
@@ -44,8 +48,38 @@ function showCheckError(name, message) {
   $('check-panel').hidden = false;
   $('check-verdict').textContent = `could not check ${name}`;
   $('check-verdict').className = 'verdict bad';
-  $('check-details').replaceChildren();
+  // Why, under the verdict too: the error panel is shared, and the next
+  // plan's outcome replaces it (QA round 16 F5: a program dropped with its
+  // scan said only "could not check").
+  $('check-details').replaceChildren(el('p', pageText(message), 'bad', 'check-why'));
+  $('check-details').classList.remove('stale');
   showError(`Could not check ${name}`, message, name, 'check');
+}
+
+// A plan sent to the worker (`frame`: its scan, how the scan is read and
+// placed, nozzle, tol and profile): a verdict of another frame is no
+// longer the scan's as it will be, and says so until checked again (QA
+// round 16 F4: a green "clear" stayed after the scan was moved 5 mm, and
+// the program cut 3.3 mm into the part as now placed).
+export function checkFrameLeaving(frame) {
+  const src = state.checkSource;
+  if (!src || src.frame === frame || state.checking) return;
+  $('check-verdict').textContent = `${src.name}: to be checked again against the scan as now read and placed, `
+    + 'with the nozzle and tol now set…';
+  $('check-verdict').className = 'verdict';
+  $('check-details').classList.add('stale');
+}
+
+// A plan settled, leaving the worker's scan in `frame` (the one before
+// for a scan file it could not read, null after a restart): the program
+// last checked is checked again where the frame it was checked in is
+// not this one (a scan moved, re-read, placed or registered otherwise,
+// another nozzle, tol or profile), its file being still at hand.
+export function checkAgainstSettled(frame) {
+  state.workerFrame = frame;
+  const src = state.checkSource;
+  // (A restarted worker is checked against once it holds a scan again.)
+  if (src && frame !== null && src.frame !== frame) checkGcodeFile(src.file);
 }
 
 export function onCheck(m) {
@@ -59,6 +93,7 @@ export function onCheck(m) {
   // A new file read and checked: the error of the check before it (or of
   // a file the page could not read at all) no longer stands beside it.
   clearError(['check', 'file']);
+  $('check-details').classList.remove('stale');
   // The file checked, for the preview.
   state.checked = req ? { file: req.file, name: m.name, nozzle: req.nozzle, tol: req.tol } : null;
   if (hooks.checkShown) hooks.checkShown();
@@ -131,6 +166,8 @@ export function onCheck(m) {
   state.checkMoves = c.moves ? { moves: c.moves, kinds: c.kinds } : null;
   $('check-draw').hidden = !state.checkMoves;
   if (state.viewShows === 'check') drawCheckedMoves(!!state.checkMoves);
+  // A plan sent since will leave the scan in another frame.
+  if (req && state.busy) checkFrameLeaving(state.busy.checkFrame);
 }
 
 // The view draws the checked program's moves (on) or the plan's paths.

@@ -9,7 +9,9 @@
 // preview), placement.js, fiducials.js, status.js; page.js holds what they
 // share. Text from files and errors is set with textContent.
 import { edgeOn, pageLimits, version } from '../pkg/pcpp.js';
-import { onCheck, syncCheckButton } from './check.js';
+import {
+  checkAgainstSettled, checkFrameLeaving, onCheck, syncCheckButton,
+} from './check.js';
 import {
   bindDownloads, downloadFollows, dropPress, hideDownloads, offerDownloads, pressReplans,
 } from './downloads.js';
@@ -124,13 +126,18 @@ function runPlan() {
   // The status it replaces, for a request that ends with nothing new (a
   // scan file not read).
   const was = [$('plan-status').textContent, $('plan-status').classList.contains('stale')];
+  const { dialect, file: profileFile } = profile();
   state.busy = {
     id, gen: state.gen, scan, svg, job, planner: job.plan.planner, compare, centre, t0: performance.now(), was,
+    // What a G-code check made after this plan is made against.
+    checkFrame: JSON.stringify([scan.key, job.scan, job.registration, job.plan.nozzle,
+      job.plan.process.tolerance_mm, dialect, profileFile || null]),
     // The demo drawing on a user's scan, not placed by the user since the
     // scan's first plan (see `onPlanError`).
     demoOnUserScan: demoOnUserScan(scan),
   };
   state.queued = false;
+  checkFrameLeaving(state.busy.checkFrame);
   laterProgress('starting');
   if (!state.interacting) setStatus('planning…');
   // The worker keeps the last drawing it was sent: its bytes go only when
@@ -142,7 +149,6 @@ function runPlan() {
     transfer.push(msgSvg.bytes.buffer);
     state.sentSvgKey = svg.key;
   }
-  const { dialect, file: profileFile } = profile();
   // A user's file is hashed by a second worker beside its import.
   const hashBeside = !!scan.blob;
   if (hashBeside) hashScan(scan);
@@ -265,9 +271,12 @@ function dropPlan(busy) {
   if (state.viewShows === 'plan') drawPlanPaths();
 }
 
-function finish() {
+// The plan in flight ended, leaving the worker's scan in `frame` (see
+// `checkAgainstSettled`).
+function finish(frame) {
   state.busy = null;
   endProgress();
+  checkAgainstSettled(frame);
   if (state.queued) runPlan();
 }
 
@@ -465,11 +474,13 @@ function onWorkerMessage(e) {
       break;
     }
     case 'done':
-      finish();
+      finish(busy.checkFrame);
       break;
     case 'error':
       onPlanError(m, busy);
-      finish();
+      // A scan file not read leaves the worker's scan as it was; a
+      // restarted worker holds none.
+      finish(busy.notRead ? state.workerFrame : m.kind === 'crash' ? null : busy.checkFrame);
       break;
     default:
       break;
@@ -520,10 +531,15 @@ function onPlanError(m, busy) {
   let file; // the file the title names
   let topic = null; // what the error is about (status.js)
   let notRead = false; // a scan file not read: the previous scan's state stands
+  // A drawing not read: the page went back to the one before, whose
+  // plan's state stands as well (QA round 16 F2: the status of a units
+  // refusal became "plan failed" and a refusal's comparison was emptied).
+  let svgNotRead = false;
   // The refusal on screen before the file came, if the inputs are again
   // the ones it was planned from.
   const r = state.lastRefusal;
-  const kept = r && r.inputs && r.inputs === currentInputs() ? r : null;
+  const keptRefusal = () => (r && r.inputs && r.inputs === currentInputs() ? r : null);
+  let kept = keptRefusal();
   if (m.kind === 'crash') {
     // The wasm instance trapped (most likely out of memory): a new worker.
     restartWorker();
@@ -544,6 +560,7 @@ function onPlanError(m, busy) {
     && state.pendingScan && busy.scan === state.pendingScan) {
     // The file could not be read: keep working with the previous scan.
     notRead = true;
+    busy.notRead = true;
     file = state.pendingScan.name;
     title = `Could not read the scan ${file}`;
     if (state.pendingScan.restored) {
@@ -586,6 +603,10 @@ function onPlanError(m, busy) {
     message += settings.pathSource === 'file'
       ? `\nStill using the previous SVG, ${state.svgFile.name}.`
       : `\nStill using ${$('path-source').selectedOptions[0].textContent}.`;
+    svgNotRead = true;
+    // (The inputs are the drawing before's again.)
+    kept = keptRefusal();
+    if (kept) message += `\nIts plan ${kept.refused ? 'stays refused' : 'still fails'}: ${kept.title}.`;
   } else if (m.kind === 'limit') {
     title = 'The path is too long for the page';
   } else if (m.kind === 'touching') {
@@ -611,7 +632,8 @@ function onPlanError(m, busy) {
     title = 'The scan has stray vertices far from the rest: no G-code';
     message = ended(message) + '\nMend the file (remove the stray vertices and their triangles), then open it again.';
   } else if (m.kind === 'units') {
-    title = 'The scan is too small for its units: no G-code';
+    // (QA round 16 F2: a scan read in metres, 3.3 m tall, was "too small".)
+    title = `The scan is too ${/larger than any printer/.test(message) ? 'large' : 'small'} for its units: no G-code`;
     message = ended(message) + '\nChoose its units in the Scan panel (Units).';
   } else if (m.kind === 'registration') {
     // Refused at planning: fiducials far off their printer points, or the
@@ -682,7 +704,7 @@ function onPlanError(m, busy) {
   // Without a comparison of its own, the one on screen is the previous
   // plan's; one of an earlier failed plan says nothing of this one.
   // (A scan file not read changes nothing the comparison was made from.)
-  if (notRead) {
+  if (notRead || svgNotRead) {
     if (!kept && state.lastComparison && state.lastComparison.failed) labelComparison('previous');
   } else if (!m.comparison && state.lastComparison && state.lastComparison.failed) {
     state.lastComparison = null;
@@ -728,8 +750,8 @@ function onPlanError(m, busy) {
   } else if (offered) {
     setStatus(`no G-code: the ${toolPathOutside(message) ? 'tool path' : 'scan'} lies outside the build volume (see above)${
       showing}`, true);
-  } else if (notRead) {
-    // The scan still used, and its status, stand (it said "plan failed"
+  } else if (notRead || svgNotRead) {
+    // The scan (or drawing) still used, and its status, stand (it said "plan failed"
     // where nothing had been planned), a refusal's too (its status was
     // replaced by "re-planning" when the file was picked).
     setStatus(...(kept ? kept.status : busy.was));

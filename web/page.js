@@ -66,6 +66,7 @@ const PAGE_WORDS = [
   [/give it with the placement \(--place centre,ROT,SCALE\), which is kept as given/g,
     'type it in Scale, which is planned as typed'],
   [/\(a smaller SCALE or another ROT in --place centre,ROT,SCALE\)/g, '(a smaller Scale, or another Rotation)'],
+  [/\(a smaller SCALE in --place centre,ROT,SCALE\)/g, '(a smaller Scale)'],
   [/\(--place centre puts the drawing on the scan's footprint\)/g,
     "('Centre on scan' puts the drawing on the scan's footprint)"],
   [/\(--up-axis y, z or -z; glTF files are \+Y up\)/g, '(Up axis; glTF files are +Y up)'],
@@ -148,6 +149,11 @@ export const state = {
   checking: null, // {id, name} of the check in flight
   checkMoves: null, // the last checked program's {moves, kinds} for the view
   checked: null, // the last file checked clear or not {file, name, nozzle, tol} (the preview reads it)
+  // The G-code file last asked to be checked {file, name, frame}, checked
+  // again when a plan leaves the worker's scan in another frame; the
+  // frame the worker's scan is in (`busy.checkFrame` of the last plan).
+  checkSource: null,
+  workerFrame: null,
   // What the view draws as its lines: 'plan' (Ta and T*), 'check' (a
   // checked program's moves) or 'preview' (the previewed program, with
   // the nozzle).

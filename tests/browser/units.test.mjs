@@ -258,6 +258,23 @@ test('a scan far too large for its units gets the units banner, offering mm', as
   assert.deepEqual(buttons, ['mm', 'cm', 'm']);
   assert.equal(await page.isHidden('#dl-gcode'), true);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
+  // A scan file, then a drawing, that cannot be read in between (QA round
+  // 16 F2): the refusal is said as too large, not "too small", and its
+  // status stands (the drawing's error made it "plan failed").
+  const status = await page.textContent('#plan-status');
+  assert.match(status, /choose the scan's units/);
+  await page.setInputFiles('#scan-input', { name: 'broken.stl', mimeType: 'model/stl', buffer: Buffer.alloc(100, 1) });
+  await page.waitForFunction(() => /Could not read the scan broken\.stl/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Its plan stays refused: The scan is too large for its units: no G-code\./);
+  assert.equal(await page.textContent('#plan-status'), status);
+  await page.setInputFiles('#svg-input', { name: 'broken.svg', mimeType: 'image/svg+xml', buffer: Buffer.from('<svg><path d="M 0 0 L') });
+  await page.waitForFunction(() => /Could not read the SVG broken\.svg/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#error-message'), /Its plan stays refused: The scan is too large for its units/);
+  assert.equal(await page.textContent('#plan-status'), status);
   await page.click('#units-banner-btns button[data-units="mm"]');
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.units === 'mm');
   await waitIdle(page);
