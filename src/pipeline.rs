@@ -368,6 +368,18 @@ pub fn surface_path(
                     ""
                 }
             )
+        } else if any_sample && lo.x <= slo.x && hi.x >= shi.x && lo.y <= slo.y && hi.y >= shi.y {
+            // Around the whole scan: larger than it, which no offset
+            // mends (QA round 16 F3: a 20 mm outline scaled x3 around a
+            // 4.2 mm plate was told to move onto the surface, 0 mm away).
+            format!(
+                "no part of the path lies over the scan's surface: the path spans x \
+                 {:.3}..{:.3}, y {:.3}..{:.3} mm, around the whole scan (x {:.3}..{:.3}, y \
+                 {:.3}..{:.3} mm, printer frame): the drawing as placed is larger than the scan, \
+                 and its lines pass beside it; scale the drawing down (a smaller SCALE in \
+                 --place centre,ROT,SCALE)",
+                lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
+            )
         } else if any_sample && inside {
             // Where the surface is (QA: a ring-shaped cloud's footprint
             // centre lay 68 mm from its nearest point, and a larger

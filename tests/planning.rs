@@ -517,6 +517,24 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         ),
         "{e}"
     );
+    // A square around both plates: larger than the scan, which no offset
+    // mends (QA round 16 F3: told to move the drawing onto the surface).
+    let (a, b) = (DVec2::new(-5.0, -5.0), DVec2::new(45.0, 45.0));
+    let around = [
+        line(a, DVec2::new(b.x, a.y)),
+        line(DVec2::new(b.x, a.y), b),
+        line(b, DVec2::new(a.x, b.y)),
+        line(DVec2::new(a.x, b.y), a),
+    ];
+    let e = pipeline::plan(&plates, &around, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("around the whole scan")
+            && e.contains("scale the drawing down (a smaller SCALE in --place centre,ROT,SCALE)")
+            && !e.contains("move the drawing onto the surface"),
+        "{e}"
+    );
     // Off the scan altogether: the placement is what to check.
     let off = [line(DVec2::new(50.0, 20.0), DVec2::new(60.0, 20.0))];
     let e = pipeline::plan(&plates, &off, &settings)

@@ -375,4 +375,20 @@ test('a drawing too large for the scan is told in the page\'s words to scale dow
   const shown = pageText(err);
   assert.match(shown, /scale the drawing down or turn it \(a smaller Scale, or another Rotation\)/);
   assert.doesNotMatch(shown, /--place centre/);
+  // QA round 16 F3: a square scaled up around the whole scan (no part of
+  // it over the surface) is told to scale down, not to move.
+  const square = join(dir, 'square.svg');
+  writeFileSync(square, '<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">'
+    + '<path d="M 1 1 L 39 1 L 39 39 L 1 39 Z" stroke="black" fill="none"/></svg>');
+  err = '';
+  try {
+    execFileSync(CLI, ['plan', '--scan', plate, '--path', square, '--place-scan', 'bed', '--place', 'centre,0,3',
+      '-o', join(dir, 'square.gcode')], { stdio: ['ignore', 'ignore', 'pipe'] });
+  } catch (e) {
+    err = String(e.stderr);
+  }
+  assert.match(err, /around the whole scan/);
+  const around = pageText(err);
+  assert.match(around, /scale the drawing down \(a smaller Scale\)/);
+  assert.doesNotMatch(around, /--place centre/);
 });
