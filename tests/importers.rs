@@ -1206,6 +1206,80 @@ fn regression_a_misnamed_scan_was_diagnosed_as_its_names_format() {
     assert!(e.starts_with("junk.stl: ") && !e.contains("rename"), "{e}");
 }
 
+/// A ZIP archive of entries `names` (stored, empty), as a phone scanning
+/// app exports an OBJ with its .mtl and texture.
+fn zip_of(names: &[&str]) -> Vec<u8> {
+    let (mut b, mut central) = (Vec::new(), Vec::new());
+    for n in names {
+        let offset = b.len() as u32;
+        b.extend(b"PK\x03\x04");
+        b.extend([0u8; 22]);
+        b.extend((n.len() as u16).to_le_bytes());
+        b.extend([0u8; 2]);
+        b.extend(n.as_bytes());
+        central.extend(b"PK\x01\x02");
+        central.extend([0u8; 24]);
+        central.extend((n.len() as u16).to_le_bytes());
+        central.extend([0u8; 12]);
+        central.extend(offset.to_le_bytes());
+        central.extend(n.as_bytes());
+    }
+    let at = b.len() as u32;
+    let size = central.len() as u32;
+    b.extend(central);
+    b.extend(b"PK\x05\x06");
+    b.extend([0u8; 4]);
+    b.extend((names.len() as u16).to_le_bytes());
+    b.extend((names.len() as u16).to_le_bytes());
+    b.extend(size.to_le_bytes());
+    b.extend(at.to_le_bytes());
+    b.extend([0u8; 2]);
+    b
+}
+
+/// QA round 16 F7: a phone scan's ZIP (fuze.obj, its .mtl and texture,
+/// trimesh's fuze.zip) was "not a scan this program reads". It is named
+/// as an archive, with the scan inside to open.
+#[test]
+fn a_zip_archive_is_told_to_be_unpacked_naming_the_scan_inside() {
+    let e = import_mesh(
+        &zip_of(&["fuze.obj", "fuze.obj.mtl", "fuze_uv.jpg"]),
+        "fuze.zip",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with(
+            "fuze.zip: the file is a ZIP archive holding fuze.obj, fuze.obj.mtl, fuze_uv.jpg, \
+             not a scan: unpack it and open the scan inside it, fuze.obj"
+        ),
+        "{e}"
+    );
+    let e = import_mesh(
+        &zip_of(&["scan/", "scan/a.ply", "scan/b.glb", "notes.md"]),
+        "scans.obj",
+        &ImportOptions::DEFAULT,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("open the scan inside it (one of scan/a.ply, scan/b.glb)"),
+        "{e}"
+    );
+    // Cut short (no directory): still an archive, its entries unnamed.
+    let cut = zip_of(&["fuze.obj"]);
+    let e = import_mesh(&cut[..40], "fuze.zip", &ImportOptions::DEFAULT)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(
+            "the file is a ZIP archive, not a scan: unpack it and open the scan inside it (an OBJ"
+        ),
+        "{e}"
+    );
+}
+
 /// A web page saved under a scan's name (GitHub's page for a .glb, saved
 /// from the browser) read "not a valid glTF 2.0 file: expected value at
 /// line 7 column 1" (a QA run); as .obj it would have been "no triangles".

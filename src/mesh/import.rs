@@ -250,6 +250,9 @@ pub fn import_mesh_unwelded(
              to the file; download the file itself (on GitHub, its \"raw\" or download link)",
         ));
     }
+    if is_zip(bytes) && !file.to_ascii_lowercase().ends_with(".3mf") {
+        return Err(MeshError::invalid(file, zip_message(bytes)));
+    }
     if is_svg(bytes) {
         // The drawing given as the scan (QA: an SVG named .ply was "line 1:
         // not a PLY file").
@@ -266,6 +269,86 @@ pub fn import_mesh_unwelded(
     let (parsed, external_files) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
     finish_import(parsed, format, file, options, external_files)
+}
+
+/// Whether the bytes are a ZIP archive (a local file header, or the end
+/// record of an empty one).
+fn is_zip(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"PK\x03\x04") || bytes.starts_with(b"PK\x05\x06")
+}
+
+/// What to do with a ZIP archive given as the scan (QA round 16 F7:
+/// phone and photogrammetry apps export an OBJ with its .mtl and
+/// textures zipped, and it was "not a scan this program reads"): unpack
+/// it and open the scan inside, named where its directory lists one.
+fn zip_message(bytes: &[u8]) -> String {
+    let names = zip_entry_names(bytes, 64);
+    let scans: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| !n.ends_with('/') && from_extension(n).is_some())
+        .collect();
+    let held = match names.len() {
+        0 => String::new(),
+        n => format!(
+            " holding {}{}",
+            names.iter().take(8).cloned().collect::<Vec<_>>().join(", "),
+            if n > 8 { ", ..." } else { "" }
+        ),
+    };
+    let open = match scans.as_slice() {
+        [] => "the scan inside it (an OBJ, PLY, STL, glTF or GLB file)".to_string(),
+        [one] => format!("the scan inside it, {one}"),
+        many => format!("the scan inside it (one of {})", many.join(", ")),
+    };
+    format!(
+        "the file is a ZIP archive{held}, not a scan: unpack it and open {open} (an OBJ's .mtl \
+         and textures are not needed)"
+    )
+}
+
+/// The names in a ZIP archive's central directory (at most `max`), or
+/// none where it cannot be found (a truncated archive).
+fn zip_entry_names(bytes: &[u8], max: usize) -> Vec<String> {
+    let u16_at = |at: usize| {
+        bytes
+            .get(at..at + 2)
+            .map(|b| usize::from(u16::from_le_bytes([b[0], b[1]])))
+    };
+    let u32_at = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    // The end record, within the last 64 KiB and its own 22 bytes.
+    let from = bytes.len().saturating_sub(22 + 65_535);
+    let Some(end) = bytes
+        .get(from..)
+        .and_then(|tail| tail.windows(4).rposition(|w| w == b"PK\x05\x06"))
+        .map(|i| from + i)
+    else {
+        return Vec::new();
+    };
+    let (Some(count), Some(mut at)) = (u16_at(end + 10), u32_at(end + 16)) else {
+        return Vec::new();
+    };
+    let mut names = Vec::new();
+    for _ in 0..count.min(max) {
+        if bytes.get(at..at + 4) != Some(b"PK\x01\x02".as_slice()) {
+            break;
+        }
+        let (Some(n), Some(extra), Some(comment)) =
+            (u16_at(at + 28), u16_at(at + 30), u16_at(at + 32))
+        else {
+            break;
+        };
+        let Some(name) = bytes.get(at + 46..at + 46 + n) else {
+            break;
+        };
+        names.push(String::from_utf8_lossy(name).into_owned());
+        at += 46 + n + extra + comment;
+    }
+    names
 }
 
 /// Whether the bytes are an SVG document: `<svg` first, or an XML
