@@ -1306,8 +1306,12 @@ pub fn write_outputs(
     // (QA: 2 mm of a scan below the bed, taken as it is: the page showed
     // a banner, the command line said nothing). If the part stands on the
     // bed, the scan is not in the printer's frame.
-    let fit =
-        crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+    let fit = crate::placement::volume_fit(
+        scan.surface.bbox(),
+        &profile.build_volume,
+        &profile.name,
+        scan.units,
+    );
     let placed = matches!(
         scan.registration.status,
         RegistrationStatus::PlacedOnBed { .. }
@@ -1501,8 +1505,12 @@ pub fn write_outputs(
     // line numbers from this first writing hold for the final one.
     let draft = provenance(&report);
     let first = write_program(&job(&draft), profile).map_err(|e| {
-        let fit =
-            crate::placement::volume_fit(scan.surface.bbox(), &profile.build_volume, &profile.name);
+        let fit = crate::placement::volume_fit(
+            scan.surface.bbox(),
+            &profile.build_volume,
+            &profile.name,
+            scan.units,
+        );
         // Stray vertices out of the volume (the risk of the units accepted):
         // they are the cause, not the units nor the placement.
         if let (false, Some(blocked), Some(d)) =

@@ -20,6 +20,7 @@ use glam::{DMat4, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::gcode::{BuildVolume, MachineProfile};
+use crate::mesh::ScanUnits;
 use crate::surface::Surface;
 use crate::svg::{Placement, Subpath2};
 
@@ -186,9 +187,14 @@ pub struct VolumeFit {
     pub placed_message: String,
 }
 
-/// Where a scan with bounds `bbox` (printer frame) lies against `volume` of
-/// profile `profile`.
-pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> VolumeFit {
+/// Where a scan with bounds `bbox` (printer frame), read in `read_in`,
+/// lies against `volume` of profile `profile`.
+pub fn volume_fit(
+    bbox: (DVec3, DVec3),
+    volume: &BuildVolume,
+    profile: &str,
+    read_in: ScanUnits,
+) -> VolumeFit {
     let (lo, hi) = bbox;
     let outside = (volume.min_mm - lo)
         .max(hi - volume.max_mm)
@@ -228,13 +234,51 @@ pub fn volume_fit(bbox: (DVec3, DVec3), volume: &BuildVolume, profile: &str) -> 
             let (axis, k) = [("x", 0), ("y", 1), ("z", 2)]
                 .into_iter()
                 .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
-            format!(
-                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm): \
-                 check the scan's units and up axis, or use a profile whose build volume holds \
-                 it (pcpp does not scale a scan: one too large even read in mm, the smallest \
-                 unit it reads, must be scaled down in the program that exported it)",
+            let larger = format!(
+                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm)",
                 size[k], room[k]
-            )
+            );
+            // Read in larger units than mm: the smaller ones it fits in
+            // (QA round 16 F10: a 2-unit glTF cube read in its metres was
+            // told it was too large "even read in mm").
+            let smaller: Vec<String> = [ScanUnits::Cm, ScanUnits::In, ScanUnits::Mm]
+                .into_iter()
+                .filter(|u| u.to_mm() < read_in.to_mm())
+                .map(|u| (u, size * (u.to_mm() / read_in.to_mm())))
+                .filter(|(_, s)| s.cmple(room).all())
+                .map(|(u, s)| {
+                    format!(
+                        "in {} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
+                        u.words(),
+                        s.x,
+                        s.y,
+                        s.z
+                    )
+                })
+                .collect();
+            if read_in == ScanUnits::Mm {
+                format!(
+                    "{larger}: check the scan's units and up axis, or use a profile whose build \
+                     volume holds it (pcpp does not scale a scan: one too large even read in mm, \
+                     the smallest unit it reads, must be scaled down in the program that exported \
+                     it)"
+                )
+            } else if smaller.is_empty() {
+                format!(
+                    "{larger}, read in {}, and in any smaller units too: check the scan's up \
+                     axis, or use a profile whose build volume holds it (pcpp does not scale a \
+                     scan: one too large even read in mm must be scaled down in the program that \
+                     exported it)",
+                    read_in.words()
+                )
+            } else {
+                format!(
+                    "{larger}, read in {}: {}; check the scan's units and up axis, or use a \
+                     profile whose build volume holds it",
+                    read_in.words(),
+                    smaller.join(", ")
+                )
+            }
         }
     };
     if placed_message.is_empty() {
@@ -665,7 +709,7 @@ mod tests {
     #[test]
     fn a_scan_larger_than_the_volume_is_told_which_axis_not_to_place_it() {
         let bbox = (DVec3::new(30.0, 30.0, 0.0), DVec3::new(90.0, 90.0, 260.4));
-        let fit = volume_fit(bbox, &volume(), "marlin");
+        let fit = volume_fit(bbox, &volume(), "marlin", ScanUnits::Mm);
         assert!(!fit.inside && !fit.fits_on_bed);
         assert!(
             fit.message
@@ -682,16 +726,45 @@ mod tests {
         // Placed on the bed, the same: moving it cannot help (QA: a scan
         // read in metres, placed on the bed, was told to move back inside).
         assert_eq!(fit.placed_message, fit.message);
+        // Read in metres, a 2 m cube (a glTF's 2 units): the smaller units
+        // it fits in, not "even read in mm" (QA round 16 F10).
+        let cube = (DVec3::ZERO, DVec3::splat(2000.0));
+        let fit = volume_fit(cube, &volume(), "marlin", ScanUnits::M);
+        assert!(
+            fit.message.contains(
+                "the volume 220.0 mm), read in metres: in centimetres it would be 20.0 x 20.0 x \
+                 20.0 mm (--scan-units cm), in inches it would be 50.8 x 50.8 x 50.8 mm \
+                 (--scan-units in), in millimetres it would be 2.0 x 2.0 x 2.0 mm (--scan-units \
+                 mm); check the scan's units"
+            ) && !fit.message.contains("even read in mm"),
+            "{}",
+            fit.message
+        );
+        // In centimetres, 5 m: too large in millimetres too.
+        let fit = volume_fit(
+            (DVec3::ZERO, DVec3::splat(5000.0)),
+            &volume(),
+            "marlin",
+            ScanUnits::Cm,
+        );
+        assert!(
+            fit.message
+                .contains("read in centimetres, and in any smaller units too"),
+            "{}",
+            fit.message
+        );
         let fit = volume_fit(
             (DVec3::new(0.0, 0.0, 0.0), DVec3::new(30.0, 30.0, 10.0)),
             &volume(),
             "marlin",
+            ScanUnits::Mm,
         );
         assert!(fit.inside);
         let fit = volume_fit(
             (DVec3::new(-10.0, 0.0, 0.0), DVec3::new(30.0, 30.0, 10.0)),
             &volume(),
             "marlin",
+            ScanUnits::Mm,
         );
         assert!(
             fit.placed_message
@@ -704,9 +777,19 @@ mod tests {
     #[test]
     fn a_scan_a_hair_past_a_face_is_inside() {
         let hi = DVec3::new(80.0, 80.0, 8.0);
-        let fit = volume_fit((DVec3::new(-1e-13, 0.0, 3.5), hi), &volume(), "marlin");
+        let fit = volume_fit(
+            (DVec3::new(-1e-13, 0.0, 3.5), hi),
+            &volume(),
+            "marlin",
+            ScanUnits::Mm,
+        );
         assert!(fit.inside, "{}", fit.message);
-        let fit = volume_fit((DVec3::new(-0.01, 0.0, 3.5), hi), &volume(), "marlin");
+        let fit = volume_fit(
+            (DVec3::new(-0.01, 0.0, 3.5), hi),
+            &volume(),
+            "marlin",
+            ScanUnits::Mm,
+        );
         assert!(!fit.inside);
     }
 
@@ -716,7 +799,7 @@ mod tests {
             DVec3::new(-60.0, 30.0, -820.0),
             DVec3::new(40.0, 90.0, -790.0),
         );
-        let fit = volume_fit(bbox, &volume(), "marlin");
+        let fit = volume_fit(bbox, &volume(), "marlin", ScanUnits::Mm);
         assert!(!fit.inside && fit.fits_on_bed);
         assert!(fit.message.contains("--place-scan bed"), "{}", fit.message);
         let p = ScanPlacement::OnBed {
@@ -729,7 +812,7 @@ mod tests {
         assert!((lo.z - 0.0).abs() < 1e-9 && (hi.z - 30.0).abs() < 1e-9);
         let mid = 0.5 * (lo + hi);
         assert!((mid.truncate() - DVec2::new(110.0, 110.0)).length() < 1e-9);
-        assert!(volume_fit((lo.min(hi), lo.max(hi)), &volume(), "marlin").inside);
+        assert!(volume_fit((lo.min(hi), lo.max(hi)), &volume(), "marlin", ScanUnits::Mm).inside);
         // Turned a quarter and raised: the footprint turns about its
         // middle, the lowest point stays on the bed plus the offset.
         let p = ScanPlacement::OnBed {

@@ -513,20 +513,28 @@ fn bounds(what: &str, v: &[f64]) -> Result<(DVec3, DVec3), JsError> {
 
 /// Where a scan with bounds `bbox` (`[min x, y, z, max x, y, z]`, printer
 /// frame) lies against the build volume of the machine profile `dialect`
-/// (as in [`Session::plan`]): `placement::VolumeFit` with the sentence the
+/// (as in [`Session::plan`]), read in `units` (`mm`, `cm`, `m`, `in` or
+/// `ft`; mm if not given): `placement::VolumeFit` with the sentence the
 /// page shows in its banner.
 #[wasm_bindgen(js_name = volumeFit)]
 pub fn volume_fit(
     bbox: &[f64],
     dialect: &str,
     profile_file: Option<String>,
+    units: Option<String>,
 ) -> Result<JsValue, JsValue> {
     let bbox = bounds("the scan's bounds", bbox)?;
     let p = profile(dialect, profile_file.as_deref())?;
+    // The units the scan was read in (`info.units`); mm where not given.
+    let read_in = match units.as_deref() {
+        Some(u) => u.parse().map_err(|e: String| JsError::new(&e))?,
+        None => crate::mesh::ScanUnits::Mm,
+    };
     Ok(to_js(&placement::volume_fit(
         bbox,
         &p.build_volume,
         &p.name,
+        read_in,
     ))?)
 }
 

@@ -3292,3 +3292,49 @@ fn check_reads_a_grbl_program_as_grbl_does() {
     assert!(stderr(&o).contains("as Grbl makes it"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 16 F10: a cube 2 units across read in metres (a glTF's default)
+/// was refused as "too large even read in mm, ... scaled down in the
+/// program that exported it", where reading it in smaller units is the
+/// fix. The refusal names the units it was read in and those it fits in.
+#[test]
+fn a_scan_too_large_in_its_units_is_told_the_units_it_fits_in() {
+    let dir = temp_dir("too-large-units");
+    let cube = dir.join("cube.obj");
+    let mut obj = String::new();
+    for z in [0.0, 2.0] {
+        for (x, y) in [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)] {
+            obj.push_str(&format!("v {x} {y} {z}\n"));
+        }
+    }
+    obj.push_str("f 5 6 7\nf 5 7 8\nf 1 3 2\nf 1 4 3\n");
+    std::fs::write(&cube, obj).unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M 2 5 L 8 5" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    let args = [
+        "--scan-units",
+        "m",
+        "--place-scan",
+        "bed",
+        "--place",
+        "centre",
+        "-o",
+        s(&out),
+    ];
+    let o = plan_on(&cube, &svg, &args);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(
+            "read in metres: in centimetres it would be 20.0 x 20.0 x 20.0 mm (--scan-units cm)"
+        ) && !err.contains("even read in mm"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -326,7 +326,7 @@ export function showScanPlacement() {
     const [lo, hi] = info.bbox_mm;
     const { dialect, file } = profile();
     try {
-      fit = volumeFit([...lo, ...hi], dialect, file);
+      fit = volumeFit([...lo, ...hi], dialect, file, info.units);
     } catch {
       fit = null; // a bad profile: its own error is shown when planning
     }
