@@ -1151,7 +1151,7 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
         .iter()
         .flat_map(|p| p.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
         .collect();
-    let fit = json(pcpp::wasm::volume_fit(&b, "marlin", None).unwrap());
+    let fit = json(pcpp::wasm::volume_fit(&b, "marlin", None, None).unwrap());
     assert_eq!(fit["inside"], false);
     let message = fit["message"].as_str().unwrap();
     assert!(
@@ -1159,7 +1159,17 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
             && message.contains("(--place-scan bed)"),
         "{message}"
     );
-    assert!(pcpp::wasm::volume_fit(&b[..5], "marlin", None).is_err());
+    assert!(pcpp::wasm::volume_fit(&b[..5], "marlin", None, None).is_err());
+    // Read in metres, a 2 m cube is told the units it fits in (QA round
+    // 16 F10); units the page never sends are an error.
+    let cube = [0.0, 0.0, 0.0, 2000.0, 2000.0, 2000.0];
+    let fit = json(pcpp::wasm::volume_fit(&cube, "marlin", None, Some("m".into())).unwrap());
+    let message = fit["message"].as_str().unwrap();
+    assert!(
+        message.contains("read in metres: in centimetres it would be 20.0 x 20.0 x 20.0 mm"),
+        "{message}"
+    );
+    assert!(pcpp::wasm::volume_fit(&cube, "marlin", None, Some("furlong".into())).is_err());
 
     // Placed on the bed of the profile: lowest point at z 0, the scan's
     // own frame unchanged, the status says so.
