@@ -1842,7 +1842,7 @@ pub fn check_gcode_as(
              nothing to check; is it the G-code file the printer runs?"
         )));
     }
-    let (frame_notes, planned_otherwise) = header_mismatch(text, scan);
+    let (frame_notes, planned_otherwise, placed_alike) = header_mismatch(text, scan);
     let clearance = Clearance::new(nozzle, tol_mm);
     let summary = check_moves(
         &scan.surface,
@@ -1861,12 +1861,20 @@ pub fn check_gcode_as(
                 (lo.min(p), hi.max(p))
             });
         let (slo, shi) = scan.surface.bbox();
+        // Written for another profile, with the scan placed as here (both
+        // on the bed): that profile's bed is the other frame, and placing
+        // the scan again cannot help (QA round 16 F9: told to place it on
+        // the bed, which it was, "placed on the bed" against "placed on
+        // the bed").
+        let by_profile = other_profile.is_some() && placed_alike.is_some();
+        let frame_notes: Vec<&String> = frame_notes
+            .iter()
+            .filter(|n| !by_profile || Some(*n) != placed_alike.as_ref())
+            .collect();
         return Err(Error::Plan(format!(
             "none of the {} moves of the program passes over the scan, so none could be checked: \
              the moves span x {:.3}..{:.3}, y {:.3}..{:.3} mm, the scan x {:.3}..{:.3}, y \
-             {:.3}..{:.3} mm; the program and the scan are not in one frame: place or register \
-             the scan as it was when the program was planned (a pcpp program's header says how, \
-             e.g. placed on the bed: --place-scan bed){}",
+             {:.3}..{:.3} mm; the program and the scan are not in one frame{}{}",
             program.moves.len(),
             lo.x,
             hi.x,
@@ -1876,12 +1884,18 @@ pub fn check_gcode_as(
             shi.x,
             slo.y,
             shi.y,
+            if by_profile {
+                ""
+            } else {
+                ": place or register the scan as it was when the program was planned (a pcpp \
+                 program's header says how, e.g. placed on the bed: --place-scan bed)"
+            },
             // The header's profile first: its bed places the scan (QA
             // round 12 L1: said only as another frame, with the flag
             // that checks it as planned left out).
             other_profile
                 .iter()
-                .chain(&frame_notes)
+                .chain(frame_notes.iter().copied())
                 .map(|n| format!("; {n}"))
                 .collect::<String>()
         )));
@@ -2198,7 +2212,12 @@ fn smaller_nozzle(
 /// The second list holds those of them that say the scan was read or
 /// placed another way (units, up axis, frame): then this check's scan is
 /// not where the program's part was.
-fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>) {
+///
+/// Also the note of a registration whose header says the scan was placed
+/// as this check's is (e.g. both on the bed) though G differs: on another
+/// profile's bed, where the header names another profile.
+fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>, Option<String>) {
+    let mut placed_alike = None;
     let mut notes = Vec::new();
     let mut otherwise = Vec::new();
     // Another scan file than the program's (its header's first line):
@@ -2291,12 +2310,15 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
                      register the scan as it was then (this check's scan is {})",
                     scan.registration.status
                 );
+                if status == scan.registration.status.to_string() {
+                    placed_alike = Some(note.clone());
+                }
                 otherwise.push(note.clone());
                 notes.push(note);
             }
         }
     }
-    (notes, otherwise)
+    (notes, otherwise, placed_alike)
 }
 
 /// Plans from bytes: the CLI's `plan` and the page's Plan button.

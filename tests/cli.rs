@@ -1383,6 +1383,14 @@ fn regression_a_check_that_placed_the_scan_on_another_profiles_bed_did_not_name_
             && err.contains("(--dialect grbl)"),
         "{err}"
     );
+    // The scan placed on the bed as the header says: only the profile's
+    // bed differs, so the refusal does not send the user to place it on
+    // the bed again (QA round 16 F9: "placed on the bed" against "placed
+    // on the bed").
+    assert!(
+        !err.contains("--place-scan bed") && !err.contains("in another frame: its header says"),
+        "{err}"
+    );
     let o = check_on(&scan, &g, &["--place-scan", "bed", "--dialect", "grbl"]);
     assert_eq!(code(&o), 0, "{}{}", stdout(&o), stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
