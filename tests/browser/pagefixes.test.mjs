@@ -406,3 +406,30 @@ test('a drawing partly off the scan is said in the status line, not only in the 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 16 F5: a program dropped together with the scan it was made
+// for was checked against the scan open before ("could not check", the
+// reason soon replaced by the plan's outcome), and never again. It is
+// checked again once the new scan is read, and the reason of a check
+// that could not be made stays in the check panel.
+test('a G-code dropped together with its scan is checked against that scan', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A plate beside the demo part, and a program over it only.
+  const plate = 'v 100 100 1\nv 140 100 1\nv 140 140 1\nv 100 140 1\nf 1 2 3\nf 1 3 4\n';
+  const program = 'G21 G90\nG0 X110 Y120 Z10\nG1 X130 Y120 Z5 F300\nG0 Z20\n';
+  // Alone, against the demo part: not checked, and why, in the panel.
+  await drop(page, [['beside.gcode', program]]);
+  await page.waitForFunction(() => /^could not check beside\.gcode/.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 120_000 });
+  assert.match(await page.textContent('#check-details'), /none of the 2 moves of the program passes over the scan/);
+  await drop(page, [['plate.obj', plate], ['plate.gcode', program]]);
+  await scanRead(page, 'plate.obj');
+  await page.waitForFunction(() => {
+    const v = document.getElementById('check-verdict').textContent;
+    return /plate\.gcode against plate\.obj/.test(v) && !/^checking |to be checked again/.test(v);
+  }, null, { timeout: 120_000 });
+  assert.match(await page.textContent('#check-verdict'), /^clear: none of the \d+ moves comes closer than tol; plate\.gcode against plate\.obj/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
