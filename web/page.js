@@ -153,6 +153,9 @@ export const state = {
   // again when a plan leaves the worker's scan in another frame; the
   // frame the worker's scan is in (`busy.checkFrame` of the last plan).
   checkSource: null,
+  // The offset {x, y} the page last centred the drawing at (the core's
+  // centring, or kept centred by a typed Rotation or Scale since).
+  centredAt: null,
   workerFrame: null,
   // What the view draws as its lines: 'plan' (Ta and T*), 'check' (a
   // checked program's moves) or 'preview' (the previewed program, with

@@ -247,6 +247,9 @@ export function onCentred(m, busy) {
   // sent is the page's choice, not the user's.
   const from = busy.centre.scale;
   s.fit = m.placement.scale !== from ? { userScale: from, note: m.note || '' } : null;
+  // Where the page centred it: a Rotation or Scale typed while it is still
+  // there keeps it centred (settings.js, `centredStill`).
+  state.centredAt = { x: s.placement.x, y: s.placement.y };
   // What was sent is what the worker plans: the request matches again.
   busy.job.plan.placement = m.placement;
   setNote(m.note || '');

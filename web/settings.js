@@ -362,8 +362,10 @@ export function bindForm() {
       // 20 mm one).
       const refit = antennaField && !!settings.fit;
       const before = antennaField && !refit ? pathCentre() : null;
-      // Turned or sized here, the drawing keeps its middle where it is.
-      const pivot = PIVOTED.has(id) ? pivotNow() : null;
+      // Turned or sized here, the drawing keeps its middle where it is;
+      // typed, too, while it lies where the page centred it.
+      const centred = TYPED.has(id) && centredStill();
+      const pivot = PIVOTED.has(id) || centred ? pivotNow() : null;
       const value = el.type === 'checkbox' ? el.checked : el.value;
       const reread = id === 'scan-units' || id === 'scan-up';
       if (reread) leaveReading();
@@ -375,6 +377,7 @@ export function bindForm() {
       if (/^pl-/.test(id)) userPlaced();
       if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
       if (pivot) keepCentre(pivot);
+      if (centred) state.centredAt = { x: settings.placement.x, y: settings.placement.y };
       const after = before ? pathCentre() : null;
       if (before && after) {
         const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);
@@ -499,6 +502,15 @@ function pathCentre() {
 // The typed Rotation and Scale fields stay the numbers of --place, as
 // typed beside a typed offset (the CLI's placement, tests/browser/upload).
 const PIVOTED = new Set(['pl-rot-range', 'pl-scale-range']);
+
+// The typed Rotation and Scale keep the middle too while the drawing lies
+// where the page centred it (QA round 16 F8: a Scale typed after the
+// page centred a drawing grew it from its SVG origin, off the scan, where
+// the CLI's --place centre,ROT,SCALE centres it at that scale). Once its
+// offset is moved or typed, they are the numbers of --place again.
+const TYPED = new Set(['pl-rot', 'pl-scale']);
+const centredStill = () => !!state.centredAt && num(settings.placement.x) === num(state.centredAt.x)
+  && num(settings.placement.y) === num(state.centredAt.y);
 
 // The middle kept over a run of turns and sizes: {svg, centre (the box's,
 // drawing frame), world (where it is on the printer), origin (the

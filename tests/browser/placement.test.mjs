@@ -8,7 +8,9 @@
 // chosen by a click, printer points pasted, residuals per fiducial.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import {
+  existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync,
+} from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
@@ -391,4 +393,59 @@ test('a drawing too large for the scan is told in the page\'s words to scale dow
   const around = pageText(err);
   assert.match(around, /scale the drawing down \(a smaller Scale\)/);
   assert.doesNotMatch(around, /--place centre/);
+});
+
+// QA round 16 F8: a Scale typed after the page centred the drawing grew it
+// from its SVG origin, off the scan ("only 60 % ... lie over the scan"),
+// where `pcpp plan --place centre,ROT,SCALE` centres it at that scale.
+// Typed while the drawing lies where the page centred it, Rotation and
+// Scale keep it centred, as the CLI's centre does; once its offset is
+// typed, they are --place's numbers again.
+test('a Scale typed after the page centred the drawing keeps it centred, as the CLI\'s centre does', async (t) => {
+  const plate = join(dir, 'plate40.obj');
+  writeFileSync(plate, 'v 0 0 1\nv 40 0 1\nv 40 40 1\nv 0 40 1\nf 1 2 3\nf 1 3 4\n');
+  const svg = join(dir, 'offcorner.svg');
+  // Its line far from the SVG origin, so scaling about the origin moves it.
+  writeFileSync(svg, '<svg xmlns="http://www.w3.org/2000/svg" width="30mm" height="30mm" viewBox="0 0 30 30">'
+    + '<path d="M 14 20 L 26 20 L 26 26" stroke="black" fill="none"/></svg>');
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', plate);
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'plate40.obj',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  await page.setInputFiles('#svg-input', svg);
+  await page.waitForFunction(() => document.getElementById('svg-name').textContent === 'offcorner.svg',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  const placement = () => page.evaluate(() => Object.fromEntries(
+    Object.entries(window.pcpp.settings.placement).map(([k, v]) => [k, Number(v)]),
+  ));
+  const centred = await placement();
+  await page.fill('#pl-scale', '1.5');
+  await waitSettled(page);
+  const scaled = await placement();
+  assert.equal(scaled.scale, 1.5);
+  assert.notDeepEqual([scaled.x, scaled.y], [centred.x, centred.y]);
+  assert.doesNotMatch(await page.textContent('#plan-status'), /lie over the scan|beside/);
+  if (existsSync(CLI)) {
+    const report = join(dir, 'centred.json');
+    execFileSync(CLI, ['plan', '--scan', plate, '--path', svg, '--place', `centre,${centred.rot},1.5`,
+      '-o', join(dir, 'centred.gcode'), '--report', report], { stdio: 'ignore' });
+    const cli = JSON.parse(readFileSync(report, 'utf8')).settings.placement;
+    assert.ok(Math.abs(cli.offset_mm[0] - scaled.x) <= 0.011 && Math.abs(cli.offset_mm[1] - scaled.y) <= 0.011,
+      `${JSON.stringify(cli)} vs ${JSON.stringify(scaled)}`);
+  } else {
+    t.diagnostic(`${CLI} not built: the placement is not compared with the CLI's`);
+  }
+  // Its offset typed: the typed Scale is --place's number again, about
+  // the SVG origin.
+  await page.fill('#pl-x', String(scaled.x + 1));
+  await waitSettled(page);
+  await page.fill('#pl-scale', '1.2');
+  await waitSettled(page);
+  const typed = await placement();
+  assert.deepEqual([typed.x, typed.y, typed.scale], [scaled.x + 1, scaled.y, 1.2]);
+  assert.deepEqual(problems, []);
+  await context.close();
 });
