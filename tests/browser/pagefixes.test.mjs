@@ -89,8 +89,13 @@ test('a dropped .txt is a point cloud or a G-code program by its content', async
   assert.equal(await page.textContent('#scan-name'), 'cloud.txt');
   assert.match(await page.textContent('#scan-info'), /^XYZ, .*point cloud: 1681 points meshed/);
   assert.match(await page.textContent('#plan-status'), /^planned .* on cloud\.txt/);
-  // The program was checked once, the cloud never.
-  assert.equal(await page.evaluate(() => window.pcpp.state.checkId), 1);
+  // The cloud was never checked as a program; the program was checked
+  // again, against the cloud now the scan (QA round 16 F4: a verdict
+  // stayed that of the scan before).
+  await page.waitForFunction(() => /program\.txt against cloud\.txt/.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 60_000 });
+  assert.equal(await page.evaluate(() => window.pcpp.state.checkSource.name), 'program.txt');
+  assert.ok(await page.evaluate(() => window.pcpp.state.checkId) >= 2);
   assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
   assert.deepEqual(problems, []);
   await context.close();
