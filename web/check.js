@@ -26,7 +26,7 @@ export function checkGcodeFile(file) {
   // What it is checked against: the scan as the worker will hold it, after
   // any plan in flight (see `checkAgainstSettled`).
   const frame = state.busy ? state.busy.checkFrame : state.workerFrame;
-  state.checking = { id, name: file.name, file, nozzle, tol, frame };
+  state.checking = { id, name: file.name, file, nozzle, tol };
   state.checkSource = { file, name: file.name, frame };
   state.checkMoves = null;
   $('check-draw').hidden = true;

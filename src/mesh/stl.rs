@@ -464,6 +464,16 @@ mod tests {
     /// Two facets after a header whose count was left at 0 (found by QA: a
     /// streaming writer's file was "the mesh has no triangles"); a body
     /// that is not whole facets is not guessed at.
+    /// One binary facet: a zero normal, the corners, no attribute.
+    fn facet(tri: [[f32; 3]; 3]) -> Vec<u8> {
+        let mut f = vec![0u8; 12];
+        for c in tri {
+            f.extend(c.iter().flat_map(|v| v.to_le_bytes()));
+        }
+        f.extend([0u8; 2]);
+        f
+    }
+
     #[test]
     fn a_binary_count_left_at_zero_reads_the_whole_facets_after_it() {
         let mut b = vec![0u8; 84];
@@ -471,11 +481,7 @@ mod tests {
             [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
             [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
         ] {
-            b.extend([0u8; 12]);
-            for c in tri {
-                b.extend(c.iter().flat_map(|v| v.to_le_bytes()));
-            }
-            b.extend([0u8; 2]);
+            b.extend(facet(tri));
         }
         let p = parse(&b, "s.stl").unwrap();
         assert_eq!(p.triangles.len(), 2);
@@ -497,14 +503,6 @@ mod tests {
     /// whole facets are an error; fewer, a warning.
     #[test]
     fn whole_facets_past_the_declared_count_are_read() {
-        let facet = |tri: [[f32; 3]; 3]| {
-            let mut f = vec![0u8; 12];
-            for c in tri {
-                f.extend(c.iter().flat_map(|v| v.to_le_bytes()));
-            }
-            f.extend([0u8; 2]);
-            f
-        };
         let mut b = vec![0u8; 84];
         b[80..84].copy_from_slice(&1u32.to_le_bytes());
         b.extend(facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]));
