@@ -107,7 +107,9 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     };
     match header.encoding {
         Encoding::Ascii => out.read_ascii(&header, body)?,
-        Encoding::Binary { big_endian } => out.read_binary(&header, body, big_endian)?,
+        Encoding::Binary { big_endian } => out
+            .read_binary(&header, body, big_endian)
+            .map_err(|e| with_count_hint(e, &header, body, big_endian, file))?,
     }
     let mut warnings = Vec::new();
     if out.short_faces > 0 {
@@ -128,6 +130,106 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         warnings,
         rounding: None,
     })
+}
+
+/// A binary body's error (a NaN coordinate, an index out of range, data
+/// ending inside an element) with the vertex count its size fits, when
+/// that is not the header's (QA round 16: `element vertex 502` raised to
+/// 602 blamed a NaN in what were face bytes read as vertices).
+fn with_count_hint(
+    e: MeshError,
+    header: &Header,
+    body: &[u8],
+    big_endian: bool,
+    file: &str,
+) -> MeshError {
+    let Some((element, fits)) = vertex_count_fitting(header, body, big_endian) else {
+        return e;
+    };
+    let said = e.to_string();
+    let said = said.strip_prefix(&format!("{file}: ")).unwrap_or(&said);
+    MeshError::invalid(
+        file,
+        format!(
+            "{said}. The file's data fits {fits} vertices, not the {} its header \
+             declares on line {}: is that count wrong?",
+            element.count, element.line
+        ),
+    )
+}
+
+/// The vertex count other than the header's with which the body reads to
+/// its last byte: the elements up to the first with lists have fixed-size
+/// records, the first record after them starts with a polygon of indices
+/// below that count, and walking every record from there (each list as
+/// long as its count says) ends where the body does. Candidates failing
+/// the polygon test cost a few reads; at most a few dozen are walked.
+fn vertex_count_fitting<'h>(
+    header: &'h Header,
+    body: &[u8],
+    big_endian: bool,
+) -> Option<(&'h Element, u64)> {
+    let fixed_size = |e: &Element| {
+        e.props.iter().try_fold(0u64, |n, p| match p.kind {
+            Kind::Scalar(s) => Some(n + s.size() as u64),
+            Kind::List { .. } => None,
+        })
+    };
+    let first_list = header
+        .elements
+        .iter()
+        .position(|e| e.count > 0 && fixed_size(e).is_none())?;
+    let (head, rest) = header.elements.split_at(first_list);
+    let vertex = head.iter().find(|e| e.name == "vertex")?;
+    let stride = fixed_size(vertex)?;
+    let others = head
+        .iter()
+        .filter(|e| e.name != "vertex")
+        .try_fold(0u64, |n, e| {
+            n.checked_add(e.count.checked_mul(fixed_size(e)?)?)
+        })?;
+    let Kind::List { count, item } = rest[0].props.first()?.kind else {
+        return None;
+    };
+    if stride == 0 {
+        return None;
+    }
+    let len = body.len() as u64;
+    let most = len.checked_sub(others)? / stride;
+    let mut walked = 0;
+    for fits in 1..=most {
+        let start = usize::try_from(fits * stride + others).ok()?;
+        let mut r = BinReader {
+            bytes: body,
+            pos: start,
+            big_endian,
+        };
+        let polygon = r.int(count).filter(|n| (3..=16).contains(n));
+        let Some(n) = polygon else { continue };
+        if !(0..n).all(|_| r.index(item).is_some_and(|i| (0..fits as i64).contains(&i))) {
+            continue;
+        }
+        walked += 1;
+        if walked > 32 {
+            return None;
+        }
+        r.pos = start;
+        let end = rest.iter().try_fold((), |(), e| {
+            (0..e.count).try_for_each(|_| {
+                e.props.iter().try_for_each(|p| match p.kind {
+                    Kind::Scalar(s) => r.skip(s.size()),
+                    Kind::List { count, item } => {
+                        let n = usize::try_from(r.int(count)?).ok()?;
+                        r.skip(n.checked_mul(item.size())?)
+                    }
+                })
+            })
+        });
+        if end.is_some() && r.pos == body.len() {
+            return (fits != vertex.count).then_some((vertex, fits));
+        }
+    }
+    None
 }
 
 fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
@@ -1116,6 +1218,50 @@ mod tests {
             blank.extend([0u8, b'\n']);
             assert!(parse(&blank, "b.ply").unwrap().warnings.is_empty());
         }
+    }
+
+    #[test]
+    fn a_wrong_vertex_count_is_named_from_the_files_size() {
+        let verts = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let faces = [vec![0, 1, 2], vec![0, 2, 3], vec![1, 2, 3]];
+        for big in [false, true] {
+            let b = binary(&verts, &faces, big, "int");
+            let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+            let header = std::str::from_utf8(&b[..header_end]).unwrap();
+            for (declared, shown) in [("element vertex 5", 5), ("element vertex 3", 3)] {
+                let mut wrong = header.replace("element vertex 4", declared).into_bytes();
+                wrong.extend(&b[header_end..]);
+                let e = parse(&wrong, "b.ply").unwrap_err().to_string();
+                assert!(
+                    e.starts_with("b.ply: ")
+                        && e.contains(&format!(
+                            "fits 4 vertices, not the {shown} its header declares on line 3"
+                        )),
+                    "{e}"
+                );
+            }
+        }
+        // Lists walk as long as their counts say: a quad and a triangle.
+        let b = binary(&verts, &[vec![0, 1, 2, 3], vec![0, 1, 2]], false, "int");
+        let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let header = std::str::from_utf8(&b[..header_end]).unwrap();
+        let mut wrong = header
+            .replace("element vertex 4", "element vertex 5")
+            .into_bytes();
+        wrong.extend(&b[header_end..]);
+        let e = parse(&wrong, "b.ply").unwrap_err().to_string();
+        assert!(e.contains("fits 4 vertices, not the 5"), "{e}");
+        // A NaN in a file whose counts are right blames the NaN alone.
+        let nan = [[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let e = parse(&binary(&nan, &[vec![0, 1, 2]], false, "int"), "b.ply")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "b.ply: vertex 1 has a non-finite coordinate (NaN)");
     }
 
     #[test]
