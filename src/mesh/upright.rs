@@ -47,7 +47,19 @@ pub(crate) fn note(
 ) -> Option<String> {
     let stride = vertices.len().div_ceil(SAMPLES).max(1);
     let sample: Vec<DVec3> = vertices.iter().step_by(stride).copied().collect();
-    let spread = side_spreads(&sample)?;
+    resting_note(&sample, vertices, triangles, up, file).or_else(|| edge_note(&sample, up, file))
+}
+
+/// The note for a scan resting clearly on a side that says the other axis
+/// was up.
+fn resting_note(
+    sample: &[DVec3],
+    vertices: &[DVec3],
+    triangles: &[[u32; 3]],
+    up: UpAxis,
+    file: &str,
+) -> Option<String> {
+    let spread = side_spreads(sample)?;
     // [-X, +X, -Y, +Y, -Z, +Z], the side it rests on: the widest, by the
     // margin.
     let side = (0..6).max_by(|&a, &b| spread[a].total_cmp(&spread[b]))?;
@@ -78,6 +90,42 @@ pub(crate) fn note(
         "{file}: read {read}, it rests on its {name} side (its outermost points spread far \
          wider there than on any other side): it was likely saved with {other} up; if the \
          part is {shown} as read, read it {other} up (--up-axis {flag})"
+    ))
+}
+
+/// How much thinner along Y than along X and Z a scan standing on an edge
+/// is.
+const EDGE: f64 = 0.3;
+
+/// The note for a plate standing on an edge as read: thin along Y, wide
+/// along X and tall along Z (QA round 16: a flange ring, a wing and a case
+/// lid, each saved +Y up and read +Z up, were planned on their 10 mm rims
+/// with no word, their two broad faces spreading alike so that neither is
+/// the side they rest on). A substrate lies on the bed; standing on an
+/// edge it offers the nozzle its rim only.
+fn edge_note(sample: &[DVec3], up: UpAxis, file: &str) -> Option<String> {
+    let (other, flag, read) = match up {
+        UpAxis::Z => ("+Y", "y", "+Z up"),
+        UpAxis::Y => ("+Z", "z", "+Y up (glTF's convention)"),
+        UpAxis::NegZ => return None,
+    };
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for &p in sample {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let size = hi - lo;
+    let broad = size.x.min(size.z);
+    if !(size.is_finite() && broad > 0.0 && size.y <= EDGE * broad) {
+        return None;
+    }
+    Some(format!(
+        "{file}: read {read}, it stands on an edge, {} x {} x {} mm and thinnest along Y: \
+         it was likely saved with {other} up; if the part lies flat, read it {other} up \
+         (--up-axis {flag})",
+        crate::error::mm_text(size.x, 1),
+        crate::error::mm_text(size.y, 1),
+        crate::error::mm_text(size.z, 1),
     ))
 }
 
@@ -289,6 +337,41 @@ mod tests {
             note(&sliver.vertices, &sliver.triangles, UpAxis::Z, "s"),
             None
         );
+    }
+
+    /// A ring 120 mm across and 10 mm thick, its faces at y = 0 and 10:
+    /// standing on its rim as read.
+    fn ring() -> Vec<DVec3> {
+        (0..72)
+            .flat_map(|i| {
+                let a = f64::from(i) * 5f64.to_radians();
+                [40.0, 60.0].into_iter().flat_map(move |r| {
+                    [0.0, 10.0].map(|y| DVec3::new(60.0 + r * a.cos(), y, 60.0 + r * a.sin()))
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_plate_standing_on_an_edge_gets_the_other_axis_note() {
+        let n = note(&ring(), &[], UpAxis::Z, "ring.ply").unwrap();
+        assert_eq!(
+            n,
+            "ring.ply: read +Z up, it stands on an edge, 120.0 x 10.0 x 120.0 mm and thinnest \
+             along Y: it was likely saved with +Y up; if the part lies flat, read it +Y up \
+             (--up-axis y)"
+        );
+        let n = note(&ring(), &[], UpAxis::Y, "ring.glb").unwrap();
+        assert!(n.ends_with("read it +Z up (--up-axis z)"), "{n}");
+        assert_eq!(note(&ring(), &[], UpAxis::NegZ, "ring.xyz"), None);
+        // Lying flat, or thicker than the rule: no note.
+        let flat: Vec<DVec3> = ring().iter().map(|p| DVec3::new(p.x, p.z, p.y)).collect();
+        assert_eq!(note(&flat, &[], UpAxis::Z, "flat.ply"), None);
+        let thick: Vec<DVec3> = ring()
+            .iter()
+            .map(|p| DVec3::new(p.x, 4.0 * p.y, p.z))
+            .collect();
+        assert_eq!(note(&thick, &[], UpAxis::Z, "thick.ply"), None);
     }
 
     #[test]
