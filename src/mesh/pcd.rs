@@ -145,6 +145,18 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                     ));
                 }
                 let points = match (points, width, height) {
+                    // QA round 17: a POINTS count changed by hand read the
+                    // data to the end without a word; PCL requires both.
+                    (Some(p), Some(w), Some(h)) if w.checked_mul(h) != Some(p) => {
+                        return Err(MeshError::invalid(
+                            file,
+                            format!(
+                                "the PCD header declares POINTS {p}, but WIDTH x HEIGHT is \
+                                 {w} x {h} = {}: one of them is wrong (a damaged file?)",
+                                w.saturating_mul(h)
+                            ),
+                        ))
+                    }
                     (Some(p), _, _) => p,
                     (None, Some(w), Some(h)) => w.saturating_mul(h),
                     _ => {
@@ -229,6 +241,7 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
     let body = &bytes[h.body..];
     let mut points = Vec::new();
     let mut missing = 0usize;
+    let mut ignored_tail = 0usize;
     let mut push = |p: [f64; 3], points: &mut Vec<DVec3>| {
         if p.iter().any(|v| v.is_nan()) {
             missing += 1;
@@ -249,12 +262,31 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
             let cols = xyz.map(|(k, _, _)| first[k]);
             // One buffer for every line's values.
             let mut toks: Vec<&[u8]> = Vec::with_capacity(tokens_per_point);
+            // Records read, NaN ones included (QA round 17: a cloud cut
+            // short at a line's end, its last rows lost, read without a
+            // word): checked against the header's count both ways.
+            let mut records = 0usize;
+            let mut last_line = h.lines;
             for (k, raw) in body.split(|&c| c == b'\n').enumerate() {
                 let line = raw.trim_ascii();
                 if line.is_empty() || line.starts_with(b"#") {
                     continue;
                 }
                 let line_no = h.lines + k + 1;
+                if records == h.points {
+                    return Err(syntax(
+                        file,
+                        line_no,
+                        format!(
+                            "data after the {} points the PCD header declares: a wrong count \
+                             in the header (POINTS, WIDTH x HEIGHT), or a damaged file; not \
+                             read, since the scan would lack part of its surface",
+                            h.points
+                        ),
+                    ));
+                }
+                records += 1;
+                last_line = line_no;
                 toks.clear();
                 toks.extend(
                     line.split(|c| c.is_ascii_whitespace())
@@ -296,6 +328,16 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
                 }
                 push(p, &mut points);
             }
+            if records < h.points {
+                return Err(MeshError::invalid(
+                    file,
+                    format!(
+                        "the PCD header declares {} points, but its data ends after {records} \
+                         (line {last_line}): the file is cut short, or the count is wrong",
+                        h.points
+                    ),
+                ));
+            }
         }
         Data::Binary => {
             let need = h.points.checked_mul(step).filter(|&n| n <= body.len());
@@ -310,6 +352,26 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
                     ),
                 ));
             };
+            // Bytes past the declared points: a writer's padding (NULs,
+            // white space, less than a point) is ignored, a point's worth
+            // or more is a wrong count (QA round 17, as PLY's since 16).
+            let tail = &body[need..];
+            if !tail.iter().all(|&b| b == 0 || b.is_ascii_whitespace()) {
+                if tail.len() >= step {
+                    return Err(MeshError::invalid(
+                        file,
+                        format!(
+                            "{} bytes of data follow the {} points the PCD header declares, \
+                             room for {} more (a wrong count in the header, or a damaged \
+                             file); not read, since the scan would lack part of its surface",
+                            tail.len(),
+                            h.points,
+                            tail.len() / step.max(1)
+                        ),
+                    ));
+                }
+                ignored_tail = tail.len();
+            }
             points.reserve(h.points);
             for row in body[..need].chunks_exact(step.max(1)) {
                 let p = xyz.map(|(_, off, size)| float(&row[off..], size));
@@ -339,6 +401,11 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
     if missing > 0 {
         warnings.push(format!(
             "{file}: skipped {missing} point(s) with NaN coordinates (missing points of the scan)"
+        ));
+    }
+    if ignored_tail > 0 {
+        warnings.push(format!(
+            "{file}: ignored {ignored_tail} byte(s) after the points the PCD header declares"
         ));
     }
     if points.is_empty() {
@@ -479,6 +546,33 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn binary_data_past_the_declared_points() {
+        let mut binary = format!("{HEAD}DATA binary\n").into_bytes();
+        for p in pts() {
+            for v in p {
+                binary.extend_from_slice(&v.to_le_bytes());
+            }
+            binary.extend_from_slice(&7u32.to_le_bytes());
+        }
+        // A point's worth or more: an error; less: a warning; padding: nothing.
+        let mut more = binary.clone();
+        more.extend_from_slice(&[1u8; 33]);
+        let e = parse(&more, "c.pcd").unwrap_err().to_string();
+        assert!(
+            e.contains("33 bytes of data follow the 3 points") && e.contains("room for 2 more"),
+            "{e}"
+        );
+        let mut odd = binary.clone();
+        odd.extend_from_slice(&[1u8; 5]);
+        let (_, w) = parse(&odd, "c.pcd").unwrap();
+        assert!(w.iter().any(|w| w.contains("ignored 5 byte(s)")), "{w:?}");
+        let mut padded = binary;
+        padded.extend_from_slice(&[0u8; 40]);
+        let (_, w) = parse(&padded, "c.pcd").unwrap();
+        assert_eq!(w.len(), 1, "{w:?}");
+    }
+
+    #[test]
     fn lzf_back_references_are_followed() {
         // "abcabcabc": literal "abc", then a back reference of 6 bytes at
         // distance 3 (len - 2 = 4 in the top bits, offset 2).
@@ -530,6 +624,20 @@ pub(crate) mod tests {
                 "no DATA",
             ),
             ("FIELDS x y z\nBOGUS 1\n", "'BOGUS'"),
+            // QA round 17: counts checked against the data both ways.
+            (
+                "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n",
+                "declares 3 points, but its data ends after 2 (line 7): the file is cut short",
+            ),
+            (
+                "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n\n4 5 6\n",
+                "h.pcd:8: data after the 1 points the PCD header declares",
+            ),
+            (
+                "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 5\nHEIGHT 2\nPOINTS 9\n\
+                 DATA ascii\n1 2 3\n",
+                "POINTS 9, but WIDTH x HEIGHT is 5 x 2 = 10",
+            ),
         ] {
             let e = match parse(text.as_bytes(), "h.pcd") {
                 Err(e) => e.to_string(),
