@@ -2140,7 +2140,7 @@ pub fn planned_profile(text: &str) -> Option<String> {
 /// program checked as Marlin's was refused as "not in one frame" with no
 /// word of its header): the flag or control that checks it as planned.
 pub fn other_profile_note(text: &str, profile: &str) -> Option<String> {
-    let p = planned_profile(text).filter(|p| p != profile)?;
+    let p = planned_profile(text).filter(|p| !p.eq_ignore_ascii_case(profile))?;
     let how = if crate::gcode::MachineProfile::builtin(&p).is_some() {
         format!("(--dialect {p})")
     } else {
@@ -2257,17 +2257,21 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
             let ours = scan_reading(scan.units, scan.up_axis);
             let (units, up) = v.split_once(", ").unwrap_or((v, ""));
             let up = up.trim_end_matches(" up");
-            if v != ours && another_file {
+            // Compared whatever the case (QA round 17 F3: a program a
+            // sender lower-cased read "+y up" as another up axis than +Y).
+            let differs = !v.eq_ignore_ascii_case(&ours);
+            if differs && another_file {
                 notes.push(format!(
                     "the program's scan was read in {v}, this check reads {} in {ours}; as \
                      they are different files, check this file's own units and up axis rather \
                      than copying the program's",
                     scan.file.name
                 ));
-            } else if v != ours {
+            } else if differs {
                 let flags: Vec<String> = [
-                    (units != scan.units.to_string()).then(|| format!("--scan-units {units}")),
-                    (up != scan.up_axis.to_string()).then(|| {
+                    (!units.eq_ignore_ascii_case(&scan.units.to_string()))
+                        .then(|| format!("--scan-units {units}")),
+                    (!up.eq_ignore_ascii_case(&scan.up_axis.to_string())).then(|| {
                         format!("--up-axis {}", up.trim_start_matches('+').to_lowercase())
                     }),
                 ]
@@ -2283,9 +2287,10 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
                 notes.push(note);
             }
         } else if let Some(v) = line.strip_prefix("registration: ") {
-            let Some((status, g)) = v.rsplit_once("; G [") else {
+            let Some(at) = v.to_ascii_lowercase().rfind("; g [") else {
                 continue;
             };
+            let (status, g) = (&v[..at], &v[at + 5..]);
             let numbers: Vec<f64> = g
                 .trim_end_matches(']')
                 .split([';', ' '])
@@ -2310,7 +2315,7 @@ fn header_mismatch(text: &str, scan: &PreparedScan) -> (Vec<String>, Vec<String>
                      register the scan as it was then (this check's scan is {})",
                     scan.registration.status
                 );
-                if status == scan.registration.status.to_string() {
+                if status.eq_ignore_ascii_case(&scan.registration.status.to_string()) {
                     placed_alike = Some(note.clone());
                 }
                 otherwise.push(note.clone());

@@ -3079,6 +3079,19 @@ fn check_names_the_units_the_program_was_planned_with() {
     assert!(err.contains("read in mm: check its units"), "{err}");
     let o = check_on(&scan, &gcode, &["--scan-units", "m"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
+    // QA round 17 F3: the program lower-cased whole (as some senders do)
+    // read "+z up" as another up axis than +Z, and advised the flag given.
+    let lower = dir.join("lower.gcode");
+    std::fs::write(&lower, text.to_lowercase()).unwrap();
+    let o = check_on(&scan, &lower, &["--scan-units", "m"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = check_on(&scan, &lower, &[]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("this check reads it in mm, +Z up: read it as it was then (--scan-units m)"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
