@@ -28,6 +28,7 @@ export function checkGcodeFile(file) {
   const frame = state.busy ? state.busy.checkFrame : state.workerFrame;
   state.checking = { id, name: file.name, file, nozzle, tol };
   state.checkSource = { file, name: file.name, frame };
+  state.checkVerdictKept = null;
   state.checkMoves = null;
   $('check-draw').hidden = true;
   $('check-panel').hidden = false;
@@ -64,6 +65,12 @@ function showCheckError(name, message) {
 export function checkFrameLeaving(frame) {
   const src = state.checkSource;
   if (!src || src.frame === frame || state.checking) return;
+  // The verdict as it stood, back if the plan leaves the scan where it was
+  // (QA round 17 F6: a scan file not read left "to be checked again" for
+  // good, though nothing had moved and no check followed).
+  if (!state.checkVerdictKept) {
+    state.checkVerdictKept = { text: $('check-verdict').textContent, className: $('check-verdict').className };
+  }
   $('check-verdict').textContent = `${src.name}: to be checked again against the scan as now read and placed, `
     + 'with the nozzle and tol now set…';
   $('check-verdict').className = 'verdict';
@@ -78,8 +85,16 @@ export function checkFrameLeaving(frame) {
 export function checkAgainstSettled(frame) {
   state.workerFrame = frame;
   const src = state.checkSource;
+  const kept = state.checkVerdictKept;
+  state.checkVerdictKept = null;
   // (A restarted worker is checked against once it holds a scan again.)
-  if (src && frame !== null && src.frame !== frame) checkGcodeFile(src.file);
+  if (src && frame !== null && src.frame !== frame) {
+    checkGcodeFile(src.file);
+  } else if (src && kept && src.frame === frame && !state.checking) {
+    $('check-verdict').textContent = kept.text;
+    $('check-verdict').className = kept.className;
+    $('check-details').classList.remove('stale');
+  }
 }
 
 export function onCheck(m) {

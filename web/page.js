@@ -153,6 +153,9 @@ export const state = {
   // again when a plan leaves the worker's scan in another frame; the
   // frame the worker's scan is in (`busy.checkFrame` of the last plan).
   checkSource: null,
+  // The check's verdict while a plan in flight may move the scan
+  // (`checkFrameLeaving`).
+  checkVerdictKept: null,
   // The offset {x, y} the page last centred the drawing at (the core's
   // centring, or kept centred by a typed Rotation or Scale since).
   centredAt: null,

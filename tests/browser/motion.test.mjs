@@ -320,6 +320,32 @@ test('a checked G-code is checked again when the scan moves, and clear again whe
   await context.close();
 });
 
+// QA round 17 F6: a scan file that could not be read left the verdict at
+// "to be checked again" for good, though the scan had not moved and no
+// check followed.
+test('a scan file not read leaves the checked G-code\'s verdict as it was', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const own = await download(page, 'dl-gcode');
+  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 120_000 });
+  const before = await page.textContent('#check-verdict');
+  const checks = await page.evaluate(() => window.pcpp.state.checkId);
+  await page.setInputFiles('#scan-input', { name: 'broken.stl', mimeType: 'model/stl',
+    buffer: Buffer.from('solid broken\nfacet normal 0 0 1\n outer loop\n  vertex 1 2\n') });
+  await page.waitForFunction(() => /^Could not read the scan broken\.stl/.test(document.getElementById('error-title').textContent),
+    null, { timeout: 120_000 });
+  await waitIdle(page);
+  assert.equal(await page.textContent('#check-verdict'), before);
+  assert.equal(await page.$eval('#check-verdict', (e) => e.classList.contains('good')), true);
+  assert.equal(await page.$eval('#check-details', (e) => e.classList.contains('stale')), false);
+  // Nothing moved: no check was needed, and none was made.
+  assert.equal(await page.evaluate(() => window.pcpp.state.checkId), checks);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('a G-code file is checked against the scan: the demo\'s own is clear, a cutting move and an arc are named by line', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
