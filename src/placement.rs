@@ -241,11 +241,23 @@ pub fn volume_fit(
             // Read in larger units than mm: the smaller ones it fits in
             // (QA round 16 F10: a 2-unit glTF cube read in its metres was
             // told it was too large "even read in mm").
-            let smaller: Vec<String> = [ScanUnits::Cm, ScanUnits::In, ScanUnits::Mm]
+            let fitting: Vec<(ScanUnits, DVec3)> = [ScanUnits::Cm, ScanUnits::In, ScanUnits::Mm]
                 .into_iter()
                 .filter(|u| u.to_mm() < read_in.to_mm())
                 .map(|u| (u, size * (u.to_mm() / read_in.to_mm())))
                 .filter(|(_, s)| s.cmple(room).all())
+                .collect();
+            // Only units in which it is a part to print on (QA round 17
+            // F8: a 155 mm bunny given in metres, too tall for a 100 mm
+            // volume, was offered 1.6 mm in cm and 0.2 mm in mm, each of
+            // which the units check itself calls too small).
+            let tiny = !fitting.is_empty()
+                && fitting
+                    .iter()
+                    .all(|(_, s)| s.max_element() < crate::mesh::SMALL_SCAN_MM);
+            let smaller: Vec<String> = fitting
+                .into_iter()
+                .filter(|(_, s)| s.max_element() >= crate::mesh::SMALL_SCAN_MM)
                 .map(|(u, s)| {
                     format!(
                         "in {} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
@@ -262,6 +274,14 @@ pub fn volume_fit(
                      volume holds it (pcpp does not scale a scan: one too large even read in mm, \
                      the smallest unit it reads, must be scaled down in the program that exported \
                      it)"
+                )
+            } else if tiny {
+                format!(
+                    "{larger}, read in {}; in smaller units it would fit only as a part under \
+                     {} mm across: check the scan's up axis, or use a profile whose build volume \
+                     holds it",
+                    read_in.words(),
+                    crate::mesh::SMALL_SCAN_MM
                 )
             } else if smaller.is_empty() {
                 format!(
@@ -734,9 +754,30 @@ mod tests {
             fit.message.contains(
                 "the volume 220.0 mm), read in metres: in centimetres it would be 20.0 x 20.0 x \
                  20.0 mm (--scan-units cm), in inches it would be 50.8 x 50.8 x 50.8 mm \
-                 (--scan-units in), in millimetres it would be 2.0 x 2.0 x 2.0 mm (--scan-units \
-                 mm); check the scan's units"
+                 (--scan-units in); check the scan's units"
             ) && !fit.message.contains("even read in mm"),
+            "{}",
+            fit.message
+        );
+        // QA round 17 F8: a 155 mm bunny in metres, too tall for a 100 mm
+        // volume: no units in which it would be a speck.
+        let tall = DVec3::new(300.0, 300.0, 100.0);
+        let bunny = (DVec3::ZERO, DVec3::new(155.7, 120.7, 154.3));
+        let fit = volume_fit(
+            bunny,
+            &BuildVolume {
+                min_mm: DVec3::ZERO,
+                max_mm: tall,
+            },
+            "lab",
+            ScanUnits::M,
+        );
+        assert!(
+            fit.message.contains(
+                "(z 154.3 mm, the volume 100.0 mm), read in metres; in smaller units it would \
+                 fit only as a part under 5 mm across: check the scan's up axis, or use a \
+                 profile whose build volume holds it"
+            ) && !fit.message.contains("--scan-units"),
             "{}",
             fit.message
         );
