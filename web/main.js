@@ -757,6 +757,11 @@ function onPlanError(m, busy) {
     setStatus(...(kept ? kept.status : busy.was));
   } else if (refusedOnScreen) {
     setStatus('no G-code: the refused tool path is shown where the drawing lies (see above)', true);
+  } else if (RISKS[m.kind]) {
+    // A refusal, not a failure (QA round 17 F11: a whole object's cloud
+    // read "plan failed", as if something broke).
+    const why = RISKS[m.kind].replace(/: no G-code$/, '');
+    setStatus(`no G-code: ${why.charAt(0).toLowerCase()}${why.slice(1)} (see above)${showing}`, true);
   } else setStatus(state.lastPlan ? 'plan failed: showing the previous plan, no download' : 'plan failed', true);
   // (Not a drawing that could not be read: the page went back to the
   // one before, whose plan this is not; nor a crash. Neither clears one

@@ -294,6 +294,9 @@ test('the page\'s advice after a refusal follows a finished sentence', async () 
   // ball's side until the spline's direction at a piece's end was mended,
   // QA round 9 M1).
   assert.match(message, /or accept the risk(; accepting the risk would also accept: the tool path dispenses \d+\.\d{3} mm above the surface at \([-\d., ]+\))?\.\nTo write it anyway, tick /);
+  // A refusal, not a failure (QA round 17 F11: the status read "plan failed").
+  assert.match(await page.textContent('#plan-status'),
+    /^no G-code: the scan is a point cloud of a whole object \(see above\)(; showing the previous plan)?$/);
   assert.deepEqual(problems, []);
   await context.close();
 });
