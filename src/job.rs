@@ -775,6 +775,20 @@ pub fn report(
     let (lo, hi) = scan.surface.bbox();
     let mut warnings = scan.warnings.clone();
     warnings.extend(scan.registration.notes.iter().cloned());
+    // The clearance is the scan's as registered: where the fiducials fit
+    // worse than tol, the part may be further off than tol (QA round 17
+    // F5: residuals up to 0.70 mm beside "min clearance 0.204 mm (tol 0.1
+    // mm)" with no word relating them).
+    let worst = scan.registration.max_residual_mm();
+    let tol = settings.process.tolerance_mm;
+    if worst > tol {
+        warnings.push(format!(
+            "the registration's residuals (up to {worst:.3} mm, rms {:.3} mm) exceed tol {tol} \
+             mm: the nozzle keeps tol from the scan as registered, but the part may lie up to \
+             about {worst:.3} mm from there; measure the printer points again, or raise tol",
+            scan.registration.rms_mm
+        ));
+    }
     warnings.extend(plan.warnings.iter().cloned());
     Report {
         program: "pcpp".into(),

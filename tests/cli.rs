@@ -3359,3 +3359,38 @@ fn a_scan_too_large_in_its_units_is_told_the_units_it_fits_in() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 17 F5: a registration whose fiducials fit 0.7 mm apart (one
+/// printer point mistyped) was planned with "min clearance 0.204 mm (tol
+/// 0.1 mm)" and no word that the part may be further off than that. The
+/// demo part's holes at 4,4 / 76,4 / 4,76 fit to 0 mm: no such word; one
+/// point 0.9 mm off: the residuals are named against tol.
+#[test]
+fn a_registration_fitting_worse_than_tol_is_said_to() {
+    let dir = temp_dir("reg-residuals");
+    let out = dir.join("p.gcode");
+    let warned = |points: &str| {
+        let o = plan_demo(&[
+            "--place=0,80",
+            "-o",
+            s(&out),
+            "--fiducials",
+            "auto",
+            "--printer-points",
+            points,
+        ]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        stderr(&o)
+    };
+    let exact = warned("4,4,5; 76,4,5; 4,76,5");
+    assert!(!exact.contains("residuals"), "{exact}");
+    let off = warned("4,4,5; 76.9,4,5; 4,76,5");
+    assert!(
+        off.contains("the registration's residuals (up to 0.")
+            && off.contains(
+                "mm) exceed tol 0.1 mm: the nozzle keeps tol from the scan as registered"
+            ),
+        "{off}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
