@@ -63,7 +63,34 @@ fn looks_binary(bytes: &[u8]) -> bool {
     bytes.iter().take(4096).any(|&b| b == 0)
 }
 
+/// U+FFFD in UTF-8 (EF BF BD): what a text-mode copy (an editor, a
+/// paste, a tool reading the file as UTF-8) writes for each byte of a
+/// binary file it cannot decode.
+const REPLACEMENT: [u8; 3] = [0xEF, 0xBF, 0xBD];
+
+/// A binary STL whose bytes hold U+FFFD far more often than chance would
+/// put it there (about once in 16 M bytes): damaged by a text-mode copy
+/// (QA round 17 F10: one read as 4 garbage triangles 1e29 mm across and
+/// asked for its units). `None` for a sound file.
+fn text_mode_damage(bytes: &[u8], file: &str) -> Option<MeshError> {
+    let found = bytes.windows(3).filter(|w| *w == REPLACEMENT).count();
+    // Three or more, and one in 1000 bytes: chance gives neither.
+    (found >= 3 && found * 1000 >= bytes.len()).then(|| {
+        MeshError::invalid(
+            file,
+            format!(
+                "the binary STL looks damaged by a text-mode copy: {found} of its byte runs \
+                 are U+FFFD, the replacement character written for bytes a text tool could not \
+                 read; copy or download it again as a binary file (or export it again)"
+            ),
+        )
+    })
+}
+
 fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    if let Some(e) = text_mode_damage(bytes.get(PREAMBLE..).unwrap_or_default(), file) {
+        return Err(e);
+    }
     let n = declared_triangles(bytes).ok_or_else(|| {
         MeshError::invalid(
             file,
@@ -529,6 +556,33 @@ mod tests {
             p.warnings[0].contains("ignored 3 bytes"),
             "{:?}",
             p.warnings
+        );
+    }
+
+    #[test]
+    fn a_text_mode_copy_is_named() {
+        let mut b = vec![0u8; 84];
+        b[80..84].copy_from_slice(&4u32.to_le_bytes());
+        let sound: Vec<u8> = (0..4)
+            .flat_map(|k| facet([[k as f32, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, -2.5]]))
+            .collect();
+        let mut good = b.clone();
+        good.extend(&sound);
+        assert!(parse(&good, "t.stl").is_ok());
+        // Each byte from 0x80 up written as EF BF BD, as a UTF-8 round
+        // trip does.
+        let mut mangled = b;
+        for &byte in &sound {
+            if byte >= 0x80 {
+                mangled.extend(REPLACEMENT);
+            } else {
+                mangled.push(byte);
+            }
+        }
+        let e = parse(&mangled, "t.stl").unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.stl: the binary STL looks damaged by a text-mode copy"),
+            "{e}"
         );
     }
 
