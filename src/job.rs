@@ -1885,6 +1885,20 @@ pub fn check_gcode_as(
             .iter()
             .filter(|n| !by_profile || Some(*n) != placed_alike.as_ref())
             .collect();
+        // In inches, where the same numbers in mm would pass over the scan
+        // (QA round 17 F4: a pcpp program with G21 changed to G20 was told
+        // to place the scan as planned, which it was).
+        let inches = inch_line(text).filter(|_| {
+            let (a, b) = (lo / 25.4, hi / 25.4);
+            a.x <= shi.x && b.x >= slo.x && a.y <= shi.y && b.y >= slo.y
+        });
+        let inch_note = inches.map(|line| {
+            format!(
+                "; the program switches to inches (G20, line {line}): its numbers read in mm \
+                 would pass over the scan; if it was written in mm, its G20 is wrong"
+            )
+        });
+        let by_profile = by_profile || (inch_note.is_some() && frame_notes.is_empty());
         return Err(Error::Plan(format!(
             "none of the {} moves of the program passes over the scan, so none could be checked: \
              the moves span x {:.3}..{:.3}, y {:.3}..{:.3} mm, the scan x {:.3}..{:.3}, y \
@@ -1907,11 +1921,12 @@ pub fn check_gcode_as(
             // The header's profile first: its bed places the scan (QA
             // round 12 L1: said only as another frame, with the flag
             // that checks it as planned left out).
-            other_profile
-                .iter()
-                .chain(frame_notes.iter().copied())
-                .map(|n| format!("; {n}"))
-                .collect::<String>()
+            inch_note.unwrap_or_default()
+                + &other_profile
+                    .iter()
+                    .chain(frame_notes.iter().copied())
+                    .map(|n| format!("; {n}"))
+                    .collect::<String>()
         )));
     }
     // Above the highest point by tol the nozzle clears everything, wherever
@@ -2214,6 +2229,18 @@ fn smaller_nozzle(
          {outer_diameter_mm} mm, tol {tol_mm} mm): check it with the program's (--nozzle-od \
          {od} --tol {tol})"
     ))
+}
+
+/// The first line (1-based) whose words, outside comments, switch the
+/// program to inches: `G20` (or `G70`).
+fn inch_line(text: &str) -> Option<usize> {
+    text.lines().enumerate().find_map(|(k, line)| {
+        let code = line.split(';').next().unwrap_or_default();
+        let code = code.split('(').next().unwrap_or_default();
+        code.split_whitespace()
+            .any(|w| w.eq_ignore_ascii_case("G20") || w.eq_ignore_ascii_case("G70"))
+            .then_some(k + 1)
+    })
 }
 
 /// What a pcpp program's own header says it was planned on, against the

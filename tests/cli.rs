@@ -3394,3 +3394,29 @@ fn a_registration_fitting_worse_than_tol_is_said_to() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 17 F4: a program in inches (G21 changed to G20) checked
+/// against its own scan was told to place or register the scan as it was
+/// planned, which it was; the G20 was not named.
+#[test]
+fn a_program_switched_to_inches_is_told_so() {
+    let dir = temp_dir("check-inches");
+    let gcode = dir.join("p.gcode");
+    let o = plan_demo(&["--place=0,80", "-o", s(&gcode)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    let line = text.lines().position(|l| l.trim() == "G21").unwrap() + 1;
+    let inches = dir.join("inches.gcode");
+    std::fs::write(&inches, text.replacen("\nG21\n", "\nG20\n", 1)).unwrap();
+    let o = check_on(&demo_file(demo::DEMO_SCAN_NAME), &inches, &[]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(&format!(
+            "not in one frame; the program switches to inches (G20, line {line}): its numbers \
+             read in mm would pass over the scan"
+        )) && !err.contains("place or register"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
