@@ -600,9 +600,9 @@ fn run_piece(
     nozzle: &Nozzle,
     process: &Process,
     safe_motion: bool,
-    cap: f64,
+    clearance: &Clearance,
 ) -> PieceRun {
-    let clearance = Clearance::new(nozzle, process.tolerance_mm);
+    let cap = process.tolerance_mm + CLEARANCE_CAP_ABOVE_TOL_MM;
     let mut planned = plan_points(
         planner,
         surface,
@@ -719,7 +719,15 @@ fn plan_stage(
     let mut fell_back: (usize, Option<DVec3>) = (0, None);
     let mut print_moves: Vec<(DVec3, DVec3, Option<usize>)> = Vec::new();
     for (k, piece) in sp.pieces.iter().enumerate() {
-        let mut run = run_piece(planner, surface, piece, nozzle, process, safe_motion, cap);
+        let mut run = run_piece(
+            planner,
+            surface,
+            piece,
+            nozzle,
+            process,
+            safe_motion,
+            &clearance,
+        );
         // Spec 6(e), promise 2: `even` has no more defects than the paper's
         // planner made safe on any part (QA round 17 F9: 2 of 750 real
         // scan and drawing pairs, small drawings with detail near the
@@ -736,7 +744,7 @@ fn plan_stage(
                 nozzle,
                 process,
                 safe_motion,
-                cap,
+                &clearance,
             );
             if alt.defects() < run.defects()
                 && alt.unresolved.len() <= run.unresolved.len()

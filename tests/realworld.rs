@@ -1265,22 +1265,32 @@ fn even_prints_real_logos_on_the_bunny_no_worse_than_a_safe_paper_planner() {
                 p.quality.defect_pct()
             );
         }
-        // Every print move of `even` (waypoints included), followed by the
-        // oracle that shares no code with the planner.
-        for piece in &even.pieces {
-            let gcode: String = piece
-                .moves
-                .iter()
-                .map(|m| format!("G1 X{:.6} Y{:.6} Z{:.6}\n", m.x, m.y, m.z))
-                .collect();
-            let oracle = crate::bruteforce::check_gcode(
-                &gcode,
-                &mesh,
-                settings.nozzle.outer_diameter_mm,
-                settings.process.tolerance_mm,
-            );
-            assert_eq!(oracle.too_close, 0, "{name}: {oracle:?}");
-        }
+        oracle_clears_every_move(even, &mesh, &settings, name);
+    }
+}
+
+/// Every print move of `plan` (waypoints included), piece by piece,
+/// followed by the oracle that shares no code with the planner: none
+/// comes closer than tol to `mesh`.
+fn oracle_clears_every_move(
+    plan: &pcpp::pipeline::Plan,
+    mesh: &pcpp::mesh::TriMesh,
+    settings: &PlanSettings,
+    case: &str,
+) {
+    for piece in &plan.pieces {
+        let gcode: String = piece
+            .moves
+            .iter()
+            .map(|m| format!("G1 X{:.6} Y{:.6} Z{:.6}\n", m.x, m.y, m.z))
+            .collect();
+        let oracle = crate::bruteforce::check_gcode(
+            &gcode,
+            mesh,
+            settings.nozzle.outer_diameter_mm,
+            settings.process.tolerance_mm,
+        );
+        assert_eq!(oracle.too_close, 0, "{case}: {oracle:?}");
     }
 }
 
@@ -1379,20 +1389,7 @@ fn even_is_no_worse_than_a_safe_paper_planner_with_the_large_nozzle() {
                         .iter()
                         .any(|w| w.contains("(pcpp-guarded) predicts fewer defects")),
                 );
-                for piece in &even.pieces {
-                    let gcode: String = piece
-                        .moves
-                        .iter()
-                        .map(|m| format!("G1 X{:.6} Y{:.6} Z{:.6}\n", m.x, m.y, m.z))
-                        .collect();
-                    let oracle = crate::bruteforce::check_gcode(
-                        &gcode,
-                        &mesh,
-                        settings.nozzle.outer_diameter_mm,
-                        settings.process.tolerance_mm,
-                    );
-                    assert_eq!(oracle.too_close, 0, "{case}: {oracle:?}");
-                }
+                oracle_clears_every_move(even, &mesh, &settings, &case);
             }
         }
     }

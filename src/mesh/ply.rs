@@ -1183,21 +1183,9 @@ mod tests {
             "{e}"
         );
         assert!(parse(format!("{ASCII}\n  \n").as_bytes(), "t.ply").is_ok());
-        let verts = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-        ];
-        let faces = [vec![0, 1, 2], vec![0, 2, 3], vec![1, 2, 3]];
         for big in [false, true] {
-            let b = binary(&verts, &faces, big, "int");
-            let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
-            let header = std::str::from_utf8(&b[..header_end]).unwrap();
-            let mut lowered = header
-                .replace("element face 3", "element face 1")
-                .into_bytes();
-            lowered.extend(&b[header_end..]);
+            let b = binary(&SQUARE, &square_faces(), big, "int");
+            let lowered = header_changed(&b, "element face 3", "element face 1");
             let e = parse(&lowered, "b.ply").unwrap_err().to_string();
             assert!(
                 e.contains("26 bytes of data follow the 1 'face' elements")
@@ -1222,20 +1210,10 @@ mod tests {
 
     #[test]
     fn a_wrong_vertex_count_is_named_from_the_files_size() {
-        let verts = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-        ];
-        let faces = [vec![0, 1, 2], vec![0, 2, 3], vec![1, 2, 3]];
         for big in [false, true] {
-            let b = binary(&verts, &faces, big, "int");
-            let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
-            let header = std::str::from_utf8(&b[..header_end]).unwrap();
+            let b = binary(&SQUARE, &square_faces(), big, "int");
             for (declared, shown) in [("element vertex 5", 5), ("element vertex 3", 3)] {
-                let mut wrong = header.replace("element vertex 4", declared).into_bytes();
-                wrong.extend(&b[header_end..]);
+                let wrong = header_changed(&b, "element vertex 4", declared);
                 let e = parse(&wrong, "b.ply").unwrap_err().to_string();
                 assert!(
                     e.starts_with("b.ply: ")
@@ -1247,13 +1225,8 @@ mod tests {
             }
         }
         // Lists walk as long as their counts say: a quad and a triangle.
-        let b = binary(&verts, &[vec![0, 1, 2, 3], vec![0, 1, 2]], false, "int");
-        let header_end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
-        let header = std::str::from_utf8(&b[..header_end]).unwrap();
-        let mut wrong = header
-            .replace("element vertex 4", "element vertex 5")
-            .into_bytes();
-        wrong.extend(&b[header_end..]);
+        let b = binary(&SQUARE, &[vec![0, 1, 2, 3], vec![0, 1, 2]], false, "int");
+        let wrong = header_changed(&b, "element vertex 4", "element vertex 5");
         let e = parse(&wrong, "b.ply").unwrap_err().to_string();
         assert!(e.contains("fits 4 vertices, not the 5"), "{e}");
         // A NaN in a file whose counts are right blames the NaN alone.
@@ -1354,6 +1327,29 @@ mod tests {
             }
         }
         b
+    }
+
+    /// The unit square's corners and three triangles over them.
+    const SQUARE: [[f32; 3]; 4] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+
+    fn square_faces() -> [Vec<i64>; 3] {
+        [vec![0, 1, 2], vec![0, 2, 3], vec![1, 2, 3]]
+    }
+
+    /// `b` with the header line `from` written as `to` (a count changed by
+    /// hand), its body as it was.
+    fn header_changed(b: &[u8], from: &str, to: &str) -> Vec<u8> {
+        let end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let header = std::str::from_utf8(&b[..end]).unwrap();
+        assert!(header.contains(from), "{header}");
+        let mut out = header.replace(from, to).into_bytes();
+        out.extend(&b[end..]);
+        out
     }
 
     #[test]

@@ -88,8 +88,12 @@ fn text_mode_damage(bytes: &[u8], file: &str) -> Option<MeshError> {
 }
 
 fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
-    if let Some(e) = text_mode_damage(bytes.get(PREAMBLE..).unwrap_or_default(), file) {
-        return Err(e);
+    // A text-mode copy writes three bytes for each it cannot decode, so
+    // the size no longer fits the count: a file that fits is not scanned.
+    if !is_binary_size(bytes) {
+        if let Some(e) = text_mode_damage(bytes.get(PREAMBLE..).unwrap_or_default(), file) {
+            return Err(e);
+        }
     }
     let n = declared_triangles(bytes).ok_or_else(|| {
         MeshError::invalid(

@@ -109,11 +109,7 @@ fn edge_note(sample: &[DVec3], up: UpAxis, file: &str) -> Option<String> {
         UpAxis::Y => ("+Z", "z", "+Y up (glTF's convention)"),
         UpAxis::NegZ => return None,
     };
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for &p in sample {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
+    let (lo, hi) = bounds(sample);
     let size = hi - lo;
     let broad = size.x.min(size.z);
     if !(size.is_finite() && broad > 0.0 && size.y <= EDGE * broad) {
@@ -145,15 +141,19 @@ fn faces_down(vertices: &[DVec3], triangles: &[[u32; 3]]) -> bool {
     area > 0.0 && sum.z < -0.5 * area
 }
 
+/// The box of `points` (infinite, inside out, for none).
+fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
+    points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    )
+}
+
 /// For each side of the box of `points` (-X, +X, -Y, +Y, -Z, +Z): the area
 /// of the convex hull of the points within `SLAB` of it, seen along its
 /// axis, over the largest extent squared. `None` for a degenerate box.
 fn side_spreads(points: &[DVec3]) -> Option<[f64; 6]> {
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for &p in points {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
+    let (lo, hi) = bounds(points);
     let size = (hi - lo).max_element();
     if !(size.is_finite() && size > 0.0) {
         return None;
