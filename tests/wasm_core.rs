@@ -1212,10 +1212,32 @@ fn a_scan_in_its_scanner_frame_is_placed_on_the_bed_by_the_page() {
         .unwrap_or_else(|e| panic!("{e:?}"));
     let centred = json(
         placed
-            .centre_drawing(js(&settings.plan.placement))
+            .centre_drawing(js(&settings.plan.placement), None)
             .unwrap_or_else(|e| panic!("{e:?}")),
     );
     assert!(centred["note"].is_null(), "{centred}");
+    // Far larger than the scan: scaled down to fit, unless the scale is to
+    // be kept (a Scale the user typed, `--place centre,ROT,SCALE`).
+    let mut huge = settings.plan.placement;
+    huge.scale = 50.0;
+    let fitted = json(
+        placed
+            .centre_drawing(js(&huge), None)
+            .unwrap_or_else(|e| panic!("{e:?}")),
+    );
+    assert!(
+        fitted["placement"]["scale"].as_f64().unwrap() < 50.0,
+        "{fitted}"
+    );
+    assert!(fitted["note"].is_string(), "{fitted}");
+    let kept = json(
+        placed
+            .centre_drawing(js(&huge), Some(false))
+            .unwrap_or_else(|e| panic!("{e:?}")),
+    );
+    assert_eq!(kept["placement"]["scale"], 50.0, "{kept}");
+    let note = kept["note"].as_str().unwrap_or_default();
+    assert!(note.contains("kept at its scale"), "{kept}");
     settings.plan.placement = serde_json::from_value(centred["placement"].clone()).unwrap();
     let out = placed
         .plan_live(js(&settings.plan), "marlin", false, None, false, None)

@@ -146,9 +146,12 @@ export function moveScan(change) {
 // request cannot be taken for it. A new drawing (`drawing`) starts at its
 // own size: the scale set for the previous one does not carry over; the
 // core scales it down if it does not fit.
-export function requestCentre(drawing = false) {
+// `keepScale`: centred again at the user's own scale, not fitted to the
+// scan (a Scale or Rotation typed while the drawing lies where the page
+// centred it: `pcpp plan --place centre,ROT,SCALE`).
+export function requestCentre(drawing = false, keepScale = false) {
   const fresh = drawing || !!(state.centre && state.centre.fresh);
-  state.centre = { token: ++centreTokens, fresh };
+  state.centre = { token: ++centreTokens, fresh, keepScale: keepScale && !fresh };
 }
 
 // The drawing's placement in each reading of the scan (its units and up
@@ -222,11 +225,13 @@ function userScale() {
   return v > 0 && Number.isFinite(v) ? v : 1;
 }
 
-// What a plan request carries: {token, fresh, scale} (the scale to centre
-// from: 1 for a new drawing, else the user's), or null.
+// What a plan request carries: {token, fresh, scale, fit} (the scale to
+// centre from: 1 for a new drawing, else the user's; `fit`: scaled down
+// if it does not fit the scan), or null.
 export function centreRequest() {
   if (!state.centre) return null;
-  return { ...state.centre, scale: state.centre.fresh ? 1 : userScale() };
+  const { token, fresh, keepScale } = state.centre;
+  return { token, fresh, scale: fresh ? 1 : userScale(), fit: !keepScale };
 }
 
 // The worker centred the drawing for the request `busy` (its token): taken

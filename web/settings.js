@@ -377,7 +377,15 @@ export function bindForm() {
       if (/^pl-/.test(id)) userPlaced();
       if (id === 'fid-printer' || id === 'fid-scan') pointsEdited();
       if (pivot) keepCentre(pivot);
-      if (centred) state.centredAt = { x: settings.placement.x, y: settings.placement.y };
+      if (centred) {
+        state.centredAt = { x: settings.placement.x, y: settings.placement.y };
+        // The core centres it again at the new turn and size, as `--place
+        // centre,ROT,SCALE` does: off a gap under the footprint's middle
+        // too (QA round 17 F7: a Scale typed on a gear kept the drawing
+        // over its bore, 66 % printed, where the CLI's moved it off). The
+        // user's scale is kept; one the page fitted is fitted again.
+        requestCentre(false, !settings.fit);
+      }
       const after = before ? pathCentre() : null;
       if (before && after) {
         const [dx, dy] = placed([before[0] - after[0], before[1] - after[1]]);

@@ -300,7 +300,9 @@ async function plan(m) {
       // centre_drawing), told to the page before planning, so it keeps the
       // placement even if this plan fails. It starts from the user's scale
       // (1 for a new drawing), not from one fitted to another scan.
-      const c = session.centreDrawing({ ...m.plan.placement, scale: m.centre.scale });
+      // A Scale the user typed is kept (`fit` false), as --place
+      // centre,ROT,SCALE keeps it.
+      const c = session.centreDrawing({ ...m.plan.placement, scale: m.centre.scale }, m.centre.fit !== false);
       if (c) {
         // Already as the fields show it (the core's placement::as_shown).
         const { placement } = c;

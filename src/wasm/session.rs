@@ -401,11 +401,17 @@ impl Session {
     /// The drawing of [`Session::set_path`] centred on this scan's footprint
     /// (printer XY), or on its surface nearest the footprint's middle when
     /// that is a gap, keeping the rotation and scale of `placement` and
-    /// scaling it down when it does not fit ([`placement::centre_on_surface`]):
-    /// `{placement, note}` (`note` says how it was scaled, or is null), or
-    /// null for a drawing without points.
+    /// scaling it down when it does not fit ([`placement::centre_on_surface`]),
+    /// unless `fit` is false: then the scale is kept whatever the size, as
+    /// `pcpp plan --place centre,ROT,SCALE` keeps a scale given (QA round
+    /// 17 F7). `{placement, note}` (`note` says how it was scaled, or is
+    /// null), or null for a drawing without points.
     #[wasm_bindgen(js_name = centreDrawing)]
-    pub fn centre_drawing(&self, placement: JsValue) -> Result<JsValue, JsValue> {
+    pub fn centre_drawing(
+        &self,
+        placement: JsValue,
+        fit: Option<bool>,
+    ) -> Result<JsValue, JsValue> {
         #[derive(Serialize)]
         struct Centred {
             placement: Placement,
@@ -416,8 +422,12 @@ impl Session {
             .path
             .as_ref()
             .ok_or_else(|| JsError::new("no drawing to centre: set a path first"))?;
-        let centred =
-            placement::centre_on_surface(&path.drawn.subpaths, &self.scan.surface, &current, true);
+        let centred = placement::centre_on_surface(
+            &path.drawn.subpaths,
+            &self.scan.surface,
+            &current,
+            fit.unwrap_or(true),
+        );
         Ok(match centred {
             Some((placement, note)) => to_js(&Centred { placement, note })?,
             None => JsValue::NULL,

@@ -449,3 +449,57 @@ test('a Scale typed after the page centred the drawing keeps it centred, as the 
   assert.deepEqual(problems, []);
   await context.close();
 });
+
+// QA round 17 F7: on a scan with a gap under its footprint's middle (a
+// gear's bore), a Scale typed after the page centred the drawing kept it
+// over the gap, where `--place centre,ROT,SCALE` moves it off. Typed while
+// centred, the core centres it again, as the CLI does.
+test('a Scale typed while centred moves the drawing off a gap and stays the user\'s, as the CLI\'s centre does', async () => {
+  // A 60 mm frame around a 20 mm hole.
+  const frame = join(dir, 'frame60.obj');
+  const v = [[0, 0], [60, 0], [60, 60], [0, 60], [20, 20], [40, 20], [40, 40], [20, 40]];
+  const f = [[1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 4, 8], [3, 8, 7], [4, 1, 5], [4, 5, 8]];
+  writeFileSync(frame, v.map(([x, y]) => `v ${x} ${y} 1\n`).join('') + f.map((t) => `f ${t.join(' ')}\n`).join(''));
+  const svg = join(dir, 'square30.svg');
+  writeFileSync(svg, '<svg xmlns="http://www.w3.org/2000/svg" width="30mm" height="30mm" viewBox="0 0 30 30">'
+    + '<path d="M 1 1 H 29 V 29 H 1 Z" stroke="black" fill="none"/></svg>');
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  await page.setInputFiles('#scan-input', frame);
+  await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'frame60.obj',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  await page.setInputFiles('#svg-input', svg);
+  await page.waitForFunction(() => document.getElementById('svg-name').textContent === 'square30.svg',
+    null, { timeout: 120_000 });
+  await waitSettled(page);
+  await page.fill('#pl-scale', '0.5');
+  await waitSettled(page);
+  await waitIdle(page);
+  const scaled = await page.evaluate(() => Object.fromEntries(
+    Object.entries(window.pcpp.settings.placement).map(([k, n]) => [k, Number(n)]),
+  ));
+  assert.equal(scaled.scale, 0.5);
+  assert.match(await page.textContent('#plan-status'), /^planned square30\.svg on frame60\.obj/);
+  const report = join(dir, 'frame-centred.json');
+  execFileSync(CLI, ['plan', '--scan', frame, '--path', svg, '--place', `centre,${scaled.rot},0.5`,
+    '-o', join(dir, 'frame-centred.gcode'), '--report', report], { stdio: 'ignore' });
+  const cli = JSON.parse(readFileSync(report, 'utf8')).settings.placement;
+  assert.ok(Math.abs(cli.offset_mm[0] - scaled.x) <= 0.011 && Math.abs(cli.offset_mm[1] - scaled.y) <= 0.011,
+    `${JSON.stringify(cli)} vs ${JSON.stringify(scaled)}`);
+  // A Scale larger than the scan is the user's too: centred again, not
+  // fitted back down (as --place centre,ROT,SCALE keeps a scale given).
+  await page.fill('#pl-scale', '3');
+  // Planned, or refused (most of a 90 mm square lies off a 60 mm frame).
+  await page.waitForFunction(() => {
+    const s = window.pcpp.state;
+    const status = document.getElementById('plan-status').textContent;
+    return !s.busy && !s.queued && !/planning/.test(status)
+      && ((s.lastPlan && s.lastPlan.gen === s.gen) || /^no G-code: /.test(status));
+  }, null, { timeout: 120_000 });
+  assert.match(await page.textContent('#plan-status'), /^no G-code: /);
+  assert.equal(Number(await page.evaluate(() => window.pcpp.settings.placement.scale)), 3);
+  assert.equal(await page.inputValue('#pl-scale'), '3');
+  assert.deepEqual(problems, []);
+  await context.close();
+});
