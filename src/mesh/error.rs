@@ -70,9 +70,10 @@ pub enum MeshError {
     /// (remote, `file:`, absolute, a drive letter, a bad escape): only
     /// files given beside the scan are read.
     #[error(
-        "{file}: buffer {buffer} refers to '{uri}', {reason}; only files beside the .gltf are \
-         read (a relative reference such as \"scene.bin\"): re-export the scan with its \
-         buffers beside it, or as one .glb"
+        "{file}: buffer {buffer} refers to '{uri}', {reason}; only files named relative to the \
+         .gltf's folder are read (a relative reference such as \"scene.bin\" or \
+         \"../buffers/scene.bin\"): re-export the scan with its buffers beside it, or as one \
+         .glb"
     )]
     ExternalUri {
         file: String,

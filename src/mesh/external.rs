@@ -226,7 +226,9 @@ mod tests {
             assert!(
                 e.starts_with("part.gltf: buffer 2 ")
                     && e.contains(&format!("'{uri}'"))
-                    && e.contains(why),
+                    && e.contains(why)
+                    // `../up.bin` is read (above): not "beside" (QA round 18 F4).
+                    && e.contains("only files named relative to the .gltf's folder are read"),
                 "{uri}: {e}"
             );
         }

@@ -85,6 +85,7 @@ pub(super) fn parse(
             .any(|e| e == ext)
     };
     // Compression that rounds positions, said once the scene is read.
+    let quantized = uses("KHR_mesh_quantization");
     let rounding: Vec<&str> = [DRACO, meshopt::EXT, "KHR_mesh_quantization"]
         .into_iter()
         .filter(|e| uses(e))
@@ -145,7 +146,7 @@ pub(super) fn parse(
         ));
     }
     check_position_accessors(&root, file)?;
-    fill_position_bounds(&mut root);
+    let bounded = fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
     let (buffers, read) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
     let views = decode_views(&gltf, &compressed, &buffers, file)?;
@@ -161,6 +162,9 @@ pub(super) fn parse(
         skipped_primitives: 0,
         points: Vec::new(),
         step: Some(0.0),
+        quantized,
+        bounded,
+        meshes_drawn: 0,
     };
     match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(root) => {
@@ -185,6 +189,7 @@ pub(super) fn parse(
                 }
                 let world = parent * local_transform(&node);
                 if let Some(mesh) = node.mesh() {
+                    scene.meshes_drawn += 1;
                     match instanced.get(&node.index()) {
                         Some(inst) => {
                             for local in scene.instances(&gltf, node.index(), inst)? {
@@ -206,10 +211,12 @@ pub(super) fn parse(
         }
         None => {
             for mesh in gltf.meshes() {
+                scene.meshes_drawn += 1;
                 scene.draw(&mesh, &DMat4::IDENTITY, None)?;
             }
         }
     }
+    scene.nothing_drawn(&gltf)?;
     // A glTF of points alone (photogrammetry and lidar tools export point
     // clouds as POINTS primitives) is a point cloud, as a PLY or OBJ of
     // vertices alone is: its points are read and the importer meshes them
@@ -606,8 +613,11 @@ fn check_position_accessors(root: &gltf::json::Root, file: &str) -> Result<(), M
 /// glTF requires a POSITION accessor's `min` and `max`, but the bounds
 /// are found here from the data (and checked finite, naming the vertex):
 /// a file that leaves them out, or writes them as anything but three
-/// numbers, is read, not refused for them.
-fn fill_position_bounds(root: &mut gltf::json::Root) {
+/// numbers, is read, not refused for them. Returns the POSITION accessors
+/// whose bounds the file gave (the values read are checked against them,
+/// [`SceneReader::check_positions`]).
+fn fill_position_bounds(root: &mut gltf::json::Root) -> std::collections::HashSet<usize> {
+    let mut bounded = std::collections::HashSet::new();
     let positions: Vec<usize> = root
         .meshes
         .iter()
@@ -618,8 +628,14 @@ fn fill_position_bounds(root: &mut gltf::json::Root) {
         })
         .map(|a| a.value())
         .collect();
+    let mut positions = positions;
+    // An accessor drawn by several primitives is looked at once (a second
+    // look would take the bounds filled in here for the file's).
+    positions.sort_unstable();
+    positions.dedup();
     for i in positions {
         if let Some(a) = root.accessors.get_mut(i) {
+            let mut given = true;
             for bound in [&mut a.min, &mut a.max] {
                 let three = bound.as_ref().is_some_and(|v| {
                     v.as_array()
@@ -627,10 +643,15 @@ fn fill_position_bounds(root: &mut gltf::json::Root) {
                 });
                 if !three {
                     *bound = Some(serde_json::json!([0.0, 0.0, 0.0]));
+                    given = false;
                 }
+            }
+            if given {
+                bounded.insert(i);
             }
         }
     }
+    bounded
 }
 
 /// The bytes of each buffer.
@@ -696,7 +717,7 @@ fn load_buffers<'a>(
                     file,
                     format!(
                         "buffer {index}{from} holds {} bytes but declares byteLength {} \
-                         (truncated file?)",
+                         (a truncated file, or not the buffer the .gltf was written with?)",
                         data.len(),
                         buffer.length()
                     ),
@@ -816,6 +837,12 @@ struct SceneReader<'f, 'b> {
     /// as the nodes place them; [`super::import::Rounding`]); `None` once
     /// some compressed positions' grid is not known.
     step: Option<f64>,
+    /// The file uses KHR_mesh_quantization: positions may be integers.
+    quantized: bool,
+    /// The POSITION accessors whose `min` and `max` the file gave.
+    bounded: std::collections::HashSet<usize>,
+    /// How many meshes the scene's nodes draw.
+    meshes_drawn: usize,
 }
 
 impl SceneReader<'_, '_> {
@@ -1141,7 +1168,7 @@ impl SceneReader<'_, '_> {
                     // base plus each target's offsets times its default
                     // weight), not the base alone.
                     Some(targets) => {
-                        let mut points = self.vec3s(&accessor, "POSITION", &at)?;
+                        let mut points = self.position_values(&accessor, &at)?;
                         for (w, target) in targets {
                             let what = format!("morph target POSITION (weight {w})");
                             let offsets = self.vec3s(&target, &what, &at)?;
@@ -1249,8 +1276,112 @@ impl SceneReader<'_, '_> {
         world: &DMat4,
         at: &str,
     ) -> Result<Vec<u32>, MeshError> {
-        let points = self.vec3s(accessor, "POSITION", at)?;
+        let points = self.position_values(accessor, at)?;
         self.place(&points, world, at)
+    }
+
+    /// A POSITION accessor's values in the file's frame, checked
+    /// ([`Self::check_positions`]).
+    fn position_values(&self, accessor: &Accessor, at: &str) -> Result<Vec<DVec3>, MeshError> {
+        let points = self.vec3s(accessor, "POSITION", at)?;
+        self.check_positions(accessor, &points, at)?;
+        Ok(points)
+    }
+
+    /// glTF 2.0 stores positions as floats, integers only with
+    /// KHR_mesh_quantization, and requires each POSITION accessor's `min`
+    /// and `max`: an accessor of another type, or values well outside
+    /// the bounds it declares, is a damaged or mis-typed accessor (QA
+    /// round 18 F2: floats typed as bytes were read as a 2.5 m part of
+    /// noise, and planned once the units were changed as advised). The
+    /// bounds are checked with a slack of 1 % of their extent, so that
+    /// bounds rounded by an exporter are not refused.
+    fn check_positions(
+        &self,
+        accessor: &Accessor,
+        points: &[DVec3],
+        at: &str,
+    ) -> Result<(), MeshError> {
+        let index = accessor.index();
+        let ty = accessor.data_type();
+        if ty != DataType::F32 && !self.quantized {
+            return Err(self.err(format!(
+                "{at}: its POSITION accessor {index} holds {} values, which glTF allows only \
+                 with the extension KHR_mesh_quantization, and the file does not declare it: a \
+                 damaged or mis-typed accessor (export the scan again)",
+                type_name(ty)
+            )));
+        }
+        if ty != DataType::F32 || !self.bounded.contains(&index) {
+            return Ok(());
+        }
+        let bound = |v: Option<gltf::json::Value>| {
+            let n: Vec<f64> = v
+                .and_then(|v| v.as_array().cloned())
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|x| x.as_f64())
+                .collect();
+            (n.len() == 3).then(|| DVec3::new(n[0], n[1], n[2]))
+        };
+        let (Some(lo), Some(hi)) = (bound(accessor.min()), bound(accessor.max())) else {
+            return Ok(());
+        };
+        let slack = 0.01 * (hi - lo).max_element().max(0.0)
+            + 1e-6 * lo.abs().max(hi.abs()).max_element()
+            + 1e-9;
+        let outside = points.iter().position(|p| {
+            p.is_finite() && ((lo - *p).max_element() > slack || (*p - hi).max_element() > slack)
+        });
+        if let Some(i) = outside {
+            let v = |p: DVec3| {
+                let n = |x: f64| {
+                    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
+                        format!("{}", (x * 1e6).round() / 1e6)
+                    } else {
+                        format!("{x:.3e}")
+                    }
+                };
+                format!("{}, {}, {}", n(p.x), n(p.y), n(p.z))
+            };
+            return Err(self.err(format!(
+                "{at}: POSITION element {i} ({}) lies outside the bounds its accessor {index} \
+                 declares (min [{}], max [{}]): a damaged or mis-typed accessor (export the scan \
+                 again)",
+                v(points[i]),
+                v(lo),
+                v(hi)
+            )));
+        }
+        Ok(())
+    }
+
+    /// When the scene gave no triangle and no point: why, naming what the
+    /// file holds instead of the importer's "no triangles" (QA round 18
+    /// F5).
+    fn nothing_drawn(&self, gltf: &Document) -> Result<(), MeshError> {
+        if !self.triangles.is_empty() || !self.points.is_empty() {
+            return Ok(());
+        }
+        let scene = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+            Some(s) => format!("scene {}", s.index()),
+            None => "the file".to_string(),
+        };
+        if self.skipped_primitives > 0 {
+            return Err(self.err(format!(
+                "{scene} draws only lines ({} primitive(s) of mode LINES, LINE_LOOP or \
+                 LINE_STRIP), which describe no surface: a scan must be triangles, or points \
+                 for a point cloud",
+                self.skipped_primitives
+            )));
+        }
+        if self.meshes_drawn == 0 {
+            return Err(self.err(format!(
+                "{scene} draws no mesh (none of its nodes has one): nothing to read; was the \
+                 scene exported empty, or the mesh left out of it?"
+            )));
+        }
+        Ok(())
     }
 
     /// The values of a VEC3 accessor, in the file's frame.
@@ -1418,6 +1549,18 @@ fn morphed<'a>(
     (!targets.is_empty()).then_some(targets)
 }
 
+/// The glTF name of an accessor's component type.
+fn type_name(ty: DataType) -> &'static str {
+    match ty {
+        DataType::I8 => "BYTE",
+        DataType::U8 => "UNSIGNED_BYTE",
+        DataType::I16 => "SHORT",
+        DataType::U16 => "UNSIGNED_SHORT",
+        DataType::U32 => "UNSIGNED_INT",
+        DataType::F32 => "FLOAT",
+    }
+}
+
 /// One component at byte `at` of an element, as the value it stands for:
 /// KHR_mesh_quantization allows integer positions, normalized or not.
 fn component(element: &[u8], at: usize, ty: DataType, normalized: bool) -> f64 {
@@ -1475,6 +1618,92 @@ mod tests {
             "data:application/octet-stream;base64,{}",
             STANDARD.encode(bytes)
         )
+    }
+
+    /// QA round 18 F2: a POSITION accessor typed as bytes without
+    /// KHR_mesh_quantization (floats read as 0..255 integers: a part of
+    /// noise, offered other units) is refused naming it; with the
+    /// extension declared, its integers are read.
+    #[test]
+    fn integer_positions_need_the_quantization_extension() {
+        let bytes = STANDARD.encode([0u8, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]);
+        let file = |used: &str| {
+            format!(
+                r#"{{"asset":{{"version":"2.0"}},{used}"scene":0,"scenes":[{{"nodes":[0]}}],
+                "nodes":[{{"mesh":0}}],
+                "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+                "accessors":[{{"bufferView":0,"componentType":5121,"count":3,"type":"VEC3",
+                    "min":[0,0,0],"max":[1,1,0]}}],
+                "bufferViews":[{{"buffer":0,"byteLength":12,"byteStride":4}}],
+                "buffers":[{{"byteLength":12,"uri":"data:application/octet-stream;base64,{bytes}"}}]}}"#
+            )
+        };
+        let err = parse(file("").as_bytes(), "bytes.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("mesh 0 primitive 0: its POSITION accessor 0 holds UNSIGNED_BYTE values")
+                && err.contains("KHR_mesh_quantization"),
+            "{err}"
+        );
+        let quantized = file(r#""extensionsUsed":["KHR_mesh_quantization"],"#);
+        let parsed = parse(quantized.as_bytes(), "bytes.gltf").unwrap();
+        assert_eq!(parsed.triangles.len(), 1);
+    }
+
+    /// Values outside the bounds their accessor declares are a damaged
+    /// accessor, named; bounds an exporter rounded (within 1 % of their
+    /// extent) are not, and neither are missing ones, also where two
+    /// primitives draw one accessor.
+    #[test]
+    fn positions_outside_their_declared_bounds_are_refused() {
+        let with_bounds = |max: &str| {
+            triangle_gltf("", &triangle_uri())
+                .replace(r#""max":[1,1,0]"#, &format!(r#""max":{max}"#))
+        };
+        let err = parse(with_bounds("[1,0.5,0]").as_bytes(), "b.gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(
+                "mesh 0 primitive 0: POSITION element 2 (0, 1, 0) lies outside the bounds"
+            ) && err.contains("max [1, 0.5, 0]"),
+            "{err}"
+        );
+        parse(with_bounds("[1,0.995,0]").as_bytes(), "b.gltf").unwrap();
+        let unbounded = triangle_gltf("", &triangle_uri())
+            .replace(r#""min":[0,0,0],"max":[1,1,0]"#, r#""name":"unbounded""#)
+            .replace(
+                r#""primitives":[{"attributes":{"POSITION":0}}]"#,
+                r#""primitives":[{"attributes":{"POSITION":0}},{"attributes":{"POSITION":0}}]"#,
+            );
+        assert!(!unbounded.contains(r#""min""#), "{unbounded}");
+        assert_eq!(
+            parse(unbounded.as_bytes(), "b.gltf")
+                .unwrap()
+                .triangles
+                .len(),
+            2
+        );
+    }
+
+    /// QA round 18 F5: a scene of lines, or of no mesh, is told as such,
+    /// not as "no triangles".
+    #[test]
+    fn a_scene_without_triangles_says_what_it_holds() {
+        let lines = triangle_gltf("", &triangle_uri()).replace(
+            r#"{"attributes":{"POSITION":0}}"#,
+            r#"{"attributes":{"POSITION":0},"mode":1}"#,
+        );
+        let err = parse(lines.as_bytes(), "l.gltf").unwrap_err().to_string();
+        assert!(
+            err.contains("scene 0 draws only lines (1 primitive(s) of mode LINES"),
+            "{err}"
+        );
+        let empty = triangle_gltf("", &triangle_uri())
+            .replace(r#""scenes":[{"nodes":[0]}]"#, r#""scenes":[{"nodes":[]}]"#);
+        let err = parse(empty.as_bytes(), "e.gltf").unwrap_err().to_string();
+        assert!(err.contains("scene 0 draws no mesh"), "{err}");
     }
 
     /// A triangle drawn by one node with EXT_mesh_gpu_instancing: two
@@ -1902,7 +2131,7 @@ mod tests {
         assert_eq!(
             e,
             "t.gltf: buffer 0 (file 'scan.bin') holds 10 bytes but declares byteLength 36 \
-             (truncated file?)"
+             (a truncated file, or not the buffer the .gltf was written with?)"
         );
     }
 
