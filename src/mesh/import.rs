@@ -735,6 +735,11 @@ pub const SMALL_SCAN_MM: f64 = 5.0;
 /// glTF, whose unit is the metre, written by a CAD tool in mm) or inches.
 pub const LARGE_SCAN_MM: f64 = 2000.0;
 
+/// The largest extent (mm) of a reading of a scan in other units that
+/// [`UnitsDoubt::offers`] offers: larger than a microextrusion stage (a
+/// few hundred mm) by a margin, far below [`LARGE_SCAN_MM`].
+pub const OFFER_MAX_MM: f64 = 1000.0;
+
 /// A scan so small or so large in the units it was read in (less than
 /// [`SMALL_SCAN_MM`] or more than [`LARGE_SCAN_MM`] across) that they are
 /// likely wrong: a file in metres or inches read as millimetres, or one
@@ -859,9 +864,11 @@ impl UnitsDoubt {
     }
 
     /// The units the scan may be in, each with the size it would have in
-    /// them (mm): larger ones (metres, inches) for a scan too small,
-    /// smaller ones (mm, cm, inches) for one too large; those in which it
-    /// would be neither.
+    /// them (mm): larger ones (metres, centimetres, inches) for a scan too
+    /// small, smaller ones (mm, cm, inches) for one too large; those in
+    /// which it would be neither, nor larger than [`OFFER_MAX_MM`] (QA
+    /// round 18 F3: a model 2 units across was offered metres, a 2 m part
+    /// no stage holds, and not centimetres).
     pub fn offers(&self) -> Vec<(ScanUnits, DVec3)> {
         if self.stray.is_some() {
             return Vec::new();
@@ -870,14 +877,14 @@ impl UnitsDoubt {
         let candidates: &[ScanUnits] = if self.too_large {
             &[ScanUnits::Mm, ScanUnits::Cm, ScanUnits::In]
         } else {
-            &[ScanUnits::M, ScanUnits::In]
+            &[ScanUnits::M, ScanUnits::Cm, ScanUnits::In]
         };
         candidates
             .iter()
             .copied()
             .filter(|&u| u != self.units && (u.to_mm() < as_read) == self.too_large)
             .map(|u| (u, self.size_mm * (u.to_mm() / as_read)))
-            .filter(|(_, size)| (SMALL_SCAN_MM..=LARGE_SCAN_MM).contains(&size.max_element()))
+            .filter(|(_, size)| (SMALL_SCAN_MM..=OFFER_MAX_MM).contains(&size.max_element()))
             .collect()
     }
 
@@ -1539,6 +1546,18 @@ mod tests {
         let d = m.units_doubt.unwrap();
         assert_eq!(d.size_mm, DVec3::new(0.08, 0.08, 0.004));
         assert!(d.message("film.obj").contains("0.080 x 0.080 x 0.004 mm"));
+        // A model 2 units across (QA round 18 F3): centimetres and inches,
+        // not metres (a 2 m part).
+        let two = b"v 0 0 0\nv 2 0 0\nv 0 2 1.5\nf 1 2 3\n";
+        let m = import_mesh(two, "bunny.obj", &ImportOptions::DEFAULT).unwrap();
+        let offers: Vec<ScanUnits> = m
+            .units_doubt
+            .unwrap()
+            .offers()
+            .into_iter()
+            .map(|(u, _)| u)
+            .collect();
+        assert_eq!(offers, [ScanUnits::Cm, ScanUnits::In]);
         // Large enough: no doubt.
         let big = b"v 0 0 0\nv 8 0 0\nv 0 8 0.4\nf 1 2 3\n";
         let m = import_mesh(big, "film.obj", &ImportOptions::DEFAULT).unwrap();
@@ -1559,7 +1578,8 @@ mod tests {
         let d = m.units_doubt.unwrap();
         assert!(d.too_large && d.given);
         let offers: Vec<ScanUnits> = d.offers().into_iter().map(|(u, _)| u).collect();
-        assert_eq!(offers, [ScanUnits::Mm, ScanUnits::Cm, ScanUnits::In]);
+        // Not inches: a 1.5 m part ([`OFFER_MAX_MM`]).
+        assert_eq!(offers, [ScanUnits::Mm, ScanUnits::Cm]);
         let message = d.message("dome.obj");
         assert!(
             message.starts_with(

@@ -86,10 +86,10 @@ test('a scan in metres gets the units banner, no G-code, and plans once read in 
   await context.close();
 });
 
-// A file 1.8 units across: read in metres it is larger than the printer,
-// in inches it fits. Inches come first and highlighted; metres last, said
-// to be larger than the printer (QA round 7 F3: metres came first, and
-// chosen gave a red error).
+// A file 1.8 units across: in centimetres and inches it fits the printer;
+// read in metres it would be 1.8 m, and is not offered (QA round 18 F3;
+// before, metres came last, said to be larger than the printer, and QA
+// round 7 F3: metres came first, and chosen gave a red error).
 test('the units banner puts first the readings that fit the printer', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
@@ -98,11 +98,10 @@ test('the units banner puts first the readings that fit the printer', async () =
   await waitIdle(page);
   await page.waitForFunction(() => !document.getElementById('units-banner').hidden);
   const buttons = await page.$$eval('#units-banner-btns button', (bs) => bs.map((b) => [b.dataset.units, b.textContent, b.className]));
-  assert.deepEqual(buttons.map((b) => b[0]), ['in', 'm', 'mm'], JSON.stringify(buttons));
-  assert.match(buttons[0][1], /^Read in inches \(45\.\d × 45\.\d × \d+\.\d mm\)$/);
+  assert.deepEqual(buttons.map((b) => b[0]), ['cm', 'in', 'mm'], JSON.stringify(buttons));
+  assert.match(buttons[0][1], /^Read in cm \(18\.\d × 18\.\d × \d+\.\d mm\)$/);
   assert.equal(buttons[0][2], 'primary');
-  assert.match(buttons[1][1], /^Read in metres \(1801\.\d × 1801\.\d × \d+\.\d mm, larger than the printer\)$/);
-  assert.equal(buttons[1][2], '');
+  assert.match(buttons[1][1], /^Read in inches \(45\.\d × 45\.\d × \d+\.\d mm\)$/);
   assert.deepEqual(problems, []);
   await context.close();
 });
