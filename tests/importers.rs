@@ -707,7 +707,7 @@ fn empty_and_garbage_files() {
     assert_error(
         br#"{"asset":{"version":"2.0"}}"#,
         "g.gltf",
-        &["no triangles"],
+        &["the file draws no mesh"],
     );
 }
 
