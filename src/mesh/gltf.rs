@@ -550,6 +550,13 @@ fn split_glb<'b>(bytes: &'b [u8], file: &str) -> Result<(&'b [u8], Option<&'b [u
     if version != 2 {
         return Err(bad(format!("version {version}, only glTF 2.0 is read")));
     }
+    // A text-mode copy grows the file and garbles its lengths: said as
+    // such, not as truncation.
+    if length as usize != bytes.len() {
+        if let Some(e) = super::error::text_mode_damage(bytes, file, "GLB") {
+            return Err(e);
+        }
+    }
     if length as usize > bytes.len() {
         return Err(bad(format!(
             "the header declares {length} bytes, the file has {} (truncated file?)",
@@ -1618,6 +1625,35 @@ mod tests {
             "data:application/octet-stream;base64,{}",
             STANDARD.encode(bytes)
         )
+    }
+
+    /// QA round 18 F8: a GLB through a text-mode copy (each byte from 0x80
+    /// up written as U+FFFD's three bytes) is named as such, not as a
+    /// truncated file.
+    #[test]
+    fn a_text_mode_copy_of_a_glb_is_named() {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        let json = triangle_gltf("", "").replace(r#","uri":"""#, "");
+        let glb = crate::demo::glb_container(json.as_bytes(), &bin);
+        assert_eq!(parse(&glb, "t.glb").unwrap().triangles.len(), 1);
+        let mangled: Vec<u8> = glb
+            .iter()
+            .flat_map(|&b| {
+                if b >= 0x80 {
+                    vec![0xEF, 0xBF, 0xBD]
+                } else {
+                    vec![b]
+                }
+            })
+            .collect();
+        let e = parse(&mangled, "t.glb").unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.glb: the GLB looks damaged by a text-mode copy"),
+            "{e}"
+        );
     }
 
     /// QA round 18 F2: a POSITION accessor typed as bytes without

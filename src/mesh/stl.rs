@@ -63,35 +63,12 @@ fn looks_binary(bytes: &[u8]) -> bool {
     bytes.iter().take(4096).any(|&b| b == 0)
 }
 
-/// U+FFFD in UTF-8 (EF BF BD): what a text-mode copy (an editor, a
-/// paste, a tool reading the file as UTF-8) writes for each byte of a
-/// binary file it cannot decode.
-const REPLACEMENT: [u8; 3] = [0xEF, 0xBF, 0xBD];
-
-/// A binary STL whose bytes hold U+FFFD far more often than chance would
-/// put it there (about once in 16 M bytes): damaged by a text-mode copy
-/// (QA round 17 F10: one read as 4 garbage triangles 1e29 mm across and
-/// asked for its units). `None` for a sound file.
-fn text_mode_damage(bytes: &[u8], file: &str) -> Option<MeshError> {
-    let found = bytes.windows(3).filter(|w| *w == REPLACEMENT).count();
-    // Three or more, and one in 1000 bytes: chance gives neither.
-    (found >= 3 && found * 1000 >= bytes.len()).then(|| {
-        MeshError::invalid(
-            file,
-            format!(
-                "the binary STL looks damaged by a text-mode copy: {found} of its byte runs \
-                 are U+FFFD, the replacement character written for bytes a text tool could not \
-                 read; copy or download it again as a binary file (or export it again)"
-            ),
-        )
-    })
-}
-
 fn parse_binary(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     // A text-mode copy writes three bytes for each it cannot decode, so
     // the size no longer fits the count: a file that fits is not scanned.
     if !is_binary_size(bytes) {
-        if let Some(e) = text_mode_damage(bytes.get(PREAMBLE..).unwrap_or_default(), file) {
+        let rest = bytes.get(PREAMBLE..).unwrap_or_default();
+        if let Some(e) = super::error::text_mode_damage(rest, file, "binary STL") {
             return Err(e);
         }
     }
@@ -578,7 +555,7 @@ mod tests {
         let mut mangled = b;
         for &byte in &sound {
             if byte >= 0x80 {
-                mangled.extend(REPLACEMENT);
+                mangled.extend([0xEF, 0xBF, 0xBD]);
             } else {
                 mangled.push(byte);
             }
