@@ -804,7 +804,15 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             }
         }
         let unused = &prepared.unused;
-        let reason = if unused.shapes > 0 {
+        let reason = if let Some(how) = root_hidden(text) {
+            // QA round 18 F10: an icon sprite sheet hides its root; told to
+            // add a <use>, the user did, and was told "none does" again.
+            format!(
+                "the root <svg> is hidden ({how}), as an icon sprite sheet's is: nothing in it \
+                 is drawn, not even what a <use> refers to; remove that from the root <svg>, or \
+                 open the one icon's own SVG"
+            )
+        } else if unused.shapes > 0 {
             let first = unused.ids.first().map_or("its-id", String::as_str);
             let named: Vec<String> = unused
                 .ids
@@ -1650,6 +1658,25 @@ fn xml_options<'input>() -> roxmltree::ParsingOptions<'input> {
         allow_dtd: true,
         ..Default::default()
     }
+}
+
+/// How the root `<svg>` of `text` is hidden (`display="none"`, or
+/// `display:none` in its `style`: nothing inside can undo it), as written;
+/// `None` when it is not.
+fn root_hidden(text: &str) -> Option<String> {
+    let doc = roxmltree::Document::parse_with_options(text, xml_options()).ok()?;
+    let root = doc.root_element();
+    let squeezed = |v: &str| {
+        v.split_whitespace()
+            .collect::<String>()
+            .to_ascii_lowercase()
+    };
+    if let Some(d) = root.attribute("display").filter(|d| squeezed(d) == "none") {
+        return Some(format!("display=\"{d}\""));
+    }
+    let style = root.attribute("style")?;
+    let hides = squeezed(style).split(';').any(|d| d == "display:none");
+    hides.then(|| format!("style=\"{style}\""))
 }
 
 /// What is wrong with the size of the drawing in `text`, whose root

@@ -1261,6 +1261,39 @@ fn icon_sprite_reported_as_containing_no_shapes() {
     assert_eq!(subs.len(), 1);
 }
 
+/// QA round 18 F10: ionicons' sprite sheet hides its root
+/// (`style="display:none"`); told to add a <use>, the user did, and was
+/// told "none does" again. The hidden root is named, and how to mend it.
+#[test]
+fn a_hidden_root_is_named_not_the_missing_use() {
+    let symbols =
+        r##"<defs><symbol id="dash"><path d="M0 0 H10" stroke="black"/></symbol></defs>"##;
+    for (root, how) in [
+        (r#"style="display:none""#, r#"style="display:none""#),
+        (
+            r#"style="fill: red; display : none""#,
+            r#"style="fill: red; display : none""#,
+        ),
+        (r#"display="none""#, r#"display="none""#),
+    ] {
+        for body in [
+            symbols.to_string(),
+            format!(r##"{symbols}<use href="#dash"/>"##),
+        ] {
+            let e = import_error(&doc(&format!("{MM} {root}"), &body));
+            assert!(
+                e.contains(&format!("the root <svg> is hidden ({how})"))
+                    && e.contains("remove that from the root <svg>")
+                    && !e.contains("none does"),
+                "{root} {body}: {e}"
+            );
+        }
+    }
+    // Shown, the used symbol prints.
+    let subs = import(&doc(MM, &format!(r##"{symbols}<use href="#dash"/>"##)));
+    assert_eq!(subs.len(), 1);
+}
+
 /// QA `vb0.svg`: `viewBox="0 0 0 0"` was ignored and user units taken as
 /// px, printing 9.5 mm where the page is 40 mm wide. SVG draws nothing for a
 /// zero-size viewBox (a viewer shows an empty page), and no scale can be
