@@ -38,8 +38,14 @@ impl Rounding {
     /// of tol, and the G-code came within tol of the uncompressed part.
     /// Round 14: the warning gave no step, only "commonly the part's size
     /// over 2^11 to 2^14".
+    /// QA round 18 F11: a user who has only the compressed file cannot plan
+    /// on the scan before compression; the message says by how much to
+    /// raise tol instead: every vertex lies within half the grid along each
+    /// axis of where it was, so within sqrt(3)/2 of the grid, and so does
+    /// every point of the surface between them.
     fn message(&self, file: &str, scale: f64) -> String {
-        let rounds = match self.step.map(|s| s * scale).filter(|s| *s > 0.0) {
+        let step = self.step.map(|s| s * scale).filter(|s| *s > 0.0);
+        let rounds = match step {
             Some(mm) => format!(
                 "which rounds vertex positions to a grid no coarser than {} mm (each moved by \
                  up to half of it)",
@@ -49,12 +55,30 @@ impl Rounding {
                      2^14)"
                 .to_string(),
         };
+        let or_raise = match step {
+            Some(mm) => format!(
+                ", or raise tol by {} mm (--tol; every point of the surface lies within that of \
+                 where it was)",
+                up_to_two_digits(mm * 3f64.sqrt() / 2.0)
+            ),
+            None => String::new(),
+        };
         format!(
             "{file}: its geometry is compressed ({}), {rounds}: the plan keeps tol from the \
-             rounded surface; where tol matters, plan on the scan as it was before compression",
+             rounded surface; where tol matters, plan on the scan as it was before \
+             compression{or_raise}",
             self.names.join(", ")
         )
     }
+}
+
+/// `v` (positive) rounded up to two significant digits, as text: a margin
+/// said is never less than the one needed.
+fn up_to_two_digits(v: f64) -> String {
+    let unit = 10f64.powf(v.log10().floor() - 1.0);
+    let up = (v / unit - 1e-9).ceil() * unit;
+    let decimals = (-(unit.log10().round())).max(0.0) as usize;
+    format!("{up:.decimals$}")
 }
 
 /// Guesses the format: the file name's extension first, then the content.
