@@ -12,11 +12,13 @@ import { drawPlanPaths, setViewShows } from './view.js';
 // A user's G-code (ours or another tool's) checked by the core against the
 // scan the worker holds, with the nozzle and tol of the settings: the
 // worker reads the File (as it reads a scan), after any plan in flight.
-export function checkGcodeFile(file) {
+// `again`: checked again by the page because the scan changed, not by the
+// user (see `checkAgainstSettled`).
+export function checkGcodeFile(file, again = false) {
   try {
     checkGcodeSize(file.name, file.size);
   } catch (e) {
-    showCheckError(file.name, e.message);
+    showCheckError(file.name, e.message, again);
     return;
   }
   const s = settings;
@@ -26,7 +28,7 @@ export function checkGcodeFile(file) {
   // What it is checked against: the scan as the worker will hold it, after
   // any plan in flight (see `checkAgainstSettled`).
   const frame = state.busy ? state.busy.checkFrame : state.workerFrame;
-  state.checking = { id, name: file.name, file, nozzle, tol };
+  state.checking = { id, name: file.name, file, nozzle, tol, again };
   state.checkSource = { file, name: file.name, frame };
   state.checkVerdictKept = null;
   state.checkMoves = null;
@@ -40,7 +42,11 @@ export function checkGcodeFile(file) {
   state.worker.postMessage({ type: 'check', id, file, name: file.name, nozzle, tol, dialect: profile().name });
 }
 
-function showCheckError(name, message) {
+// `again`: the page checked the file again after the scan changed: its
+// failure (most often: the program was planned on another scan) is said in
+// the check panel only, not in the red panel kept for what the user just
+// did (QA round 18 F7: it came back at the top on every scan opened).
+function showCheckError(name, message, again = false) {
   state.checkMoves = null;
   state.checked = null;
   if (hooks.checkShown) hooks.checkShown();
@@ -54,7 +60,8 @@ function showCheckError(name, message) {
   // scan said only "could not check").
   $('check-details').replaceChildren(el('p', pageText(message), 'bad', 'check-why'));
   $('check-details').classList.remove('stale');
-  showError(`Could not check ${name}`, message, name, 'check');
+  if (again) clearError(['check']);
+  else showError(`Could not check ${name}`, message, name, 'check');
 }
 
 // A plan sent to the worker (`frame`: its scan, how the scan is read and
@@ -89,7 +96,7 @@ export function checkAgainstSettled(frame) {
   state.checkVerdictKept = null;
   // (A restarted worker is checked against once it holds a scan again.)
   if (src && frame !== null && src.frame !== frame) {
-    checkGcodeFile(src.file);
+    checkGcodeFile(src.file, true);
   } else if (src && kept && src.frame === frame && !state.checking) {
     $('check-verdict').textContent = kept.text;
     $('check-verdict').className = kept.className;
@@ -102,7 +109,7 @@ export function onCheck(m) {
   const req = state.checking;
   state.checking = null;
   if (m.error) {
-    showCheckError(m.name, m.error);
+    showCheckError(m.name, m.error, !!(req && req.again));
     return;
   }
   // A new file read and checked: the error of the check before it (or of

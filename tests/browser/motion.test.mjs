@@ -320,6 +320,33 @@ test('a checked G-code is checked again when the scan moves, and clear again whe
   await context.close();
 });
 
+// QA round 18 F7: a G-code checked against one scan, checked again by the
+// page once another scan file was opened, put a red "Could not check" panel
+// at the top on every scan opened after it. Its reason is said in the check
+// panel; the red panel is for what the user just did.
+test('a checked G-code that cannot be checked against a newly opened scan says so in its panel only', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  const own = await download(page, 'dl-gcode');
+  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 120_000 });
+  const checks = await page.evaluate(() => window.pcpp.state.checkId);
+  // Another part: a 150 mm plate, far from where the demo's program runs.
+  const plate = 'v 300 300 2\nv 450 300 2\nv 450 450 2\nv 300 450 2\nf 1 2 3\nf 1 3 4\n';
+  await page.setInputFiles('#scan-input', { name: 'plate150.obj', mimeType: 'text/plain', buffer: Buffer.from(plate) });
+  await page.waitForFunction((id) => window.pcpp.state.checkId > id && !window.pcpp.state.checking
+    && !/^checking |to be checked again/.test(document.getElementById('check-verdict').textContent), checks,
+  { timeout: 120_000 });
+  await waitIdle(page);
+  assert.match(await page.textContent('#check-verdict'), /^could not check demo-test-part-lines-even\.gcode/);
+  assert.match(await page.textContent('#check-details'), /planned on another scan file|passes over the scan/);
+  const title = await page.$eval('#error-panel', (e) => (e.hidden ? '' : document.getElementById('error-title').textContent));
+  assert.doesNotMatch(title, /^Could not check/);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 // QA round 17 F6: a scan file that could not be read left the verdict at
 // "to be checked again" for good, though the scan had not moved and no
 // check followed.
