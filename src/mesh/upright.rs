@@ -71,16 +71,28 @@ fn resting_note(
         return None;
     }
     // Read +Z up, a +Y-up scan rests on -Y and a depth camera's (-Z up) on
-    // +Z; read +Y up, a +Z-up one rests on +Y (its -Z turned to +Y).
+    // +Z; read +Y up, a +Z-up one rests on +Y, its -Z turned to +Y: named
+    // in the file's own axes, as its up axis is (QA round 18 F12: "read
+    // +Y up, it rests on its +Y side").
     let (name, other, flag, shown) = match (up, side) {
         (UpAxis::Z, 2) => ("-Y", "+Y", "y", "lying on its side"),
         // Only a mesh whose surface faces down as read: a depth camera sees
         // the faces turned to it, at -Z. A scan seen from above with a flat
         // top over a tilted base spreads widest at its top too (review).
         (UpAxis::Z, 5) if faces_down(vertices, triangles) => ("+Z", "-Z", "-z", "upside down"),
-        (UpAxis::Y, 3) => ("+Y", "+Z", "z", "lying on its side"),
+        (UpAxis::Y, 3) => ("-Z (in the file's axes)", "+Z", "z", "lying on its side"),
         _ => return None,
     };
+    // Turned onto that side, a part much taller than as read stands on an
+    // end (QA round 18 F12: a VR controller lying flat, 82 mm high, would
+    // stand 181 mm tall): a substrate lies on the bed, so no note.
+    if side == 2 || side == 3 {
+        let (lo, hi) = bounds(sample);
+        let size = hi - lo;
+        if size.y > TALLER * size.z {
+            return None;
+        }
+    }
     let read = match up {
         UpAxis::Z => "+Z up",
         UpAxis::Y => "+Y up (glTF's convention)",
@@ -92,6 +104,10 @@ fn resting_note(
          part is {shown} as read, read it {other} up (--up-axis {flag})"
     ))
 }
+
+/// How much taller than as read a part turned onto the side it rests on
+/// may be for the note to suggest it.
+const TALLER: f64 = 1.5;
 
 /// How much thinner along Y than along X and Z a scan standing on an edge
 /// is.
@@ -305,8 +321,22 @@ mod tests {
         // -Z in the file rests on +Y.
         let turned = stand(|p| DVec3::new(p.x, -p.z, p.y));
         let note = note(&turned.vertices, &turned.triangles, UpAxis::Y, "cad.glb").expect("a note");
-        assert!(note.contains("rests on its +Y side"), "{note}");
+        assert!(
+            note.contains(
+                "read +Y up (glTF's convention), it rests on its -Z (in the file's axes) side"
+            ),
+            "{note}"
+        );
         assert!(note.ends_with("read it +Z up (--up-axis z)"), "{note}");
+        // Lying flat as read (40 x 75 mm on the bed, 20 mm high, as QA's VR
+        // controller lay, 124 x 181 x 82 mm) though it spreads widest on
+        // that side: turned, it would stand on an end, 75 mm tall; no note
+        // (QA round 18 F12).
+        let flat = stand(|p| DVec3::new(p.x, -p.z * 3.0, p.y));
+        assert_eq!(
+            super::note(&flat.vertices, &flat.triangles, UpAxis::Y, "c.glb"),
+            None
+        );
     }
 
     #[test]
