@@ -441,6 +441,16 @@ fn gltf_compressed_geometry_is_said_to_be_rounded() {
 /// axis, of its uncompressed self; the grid of the dense bunny is a fine
 /// one (under a thousandth of its size). Floats through meshopt's
 /// exponential filter have no one step: the warning says none.
+/// The number `text` writes between `before` and `after`.
+fn number_between(text: &str, before: &str, after: &str) -> f64 {
+    text.split_once(before)
+        .and_then(|(_, rest)| rest.split_once(after))
+        .unwrap_or_else(|| panic!("{text}"))
+        .0
+        .parse()
+        .unwrap_or_else(|e| panic!("{text}: {e}"))
+}
+
 #[test]
 fn gltf_compressed_geometry_states_its_grid() {
     let original = import(data!("mesh/bunny.glb"), "bunny.glb");
@@ -456,26 +466,18 @@ fn gltf_compressed_geometry_states_its_grid() {
             .iter()
             .find(|w| w.contains("its geometry is compressed"))
             .unwrap_or_else(|| panic!("{name}: not said"));
-        let grid: f64 = w
-            .split_once("to a grid no coarser than ")
-            .and_then(|(_, rest)| rest.split_once(" mm (each moved by up to half of it)"))
-            .unwrap_or_else(|| panic!("{w}"))
-            .0
-            .parse()
-            .unwrap_or_else(|e| panic!("{w}: {e}"));
+        let grid = number_between(
+            w,
+            "to a grid no coarser than ",
+            " mm (each moved by up to half of it)",
+        );
         assert!(
             grid > 0.0 && grid < size / 1000.0,
             "{name}: {grid} mm of {size}"
         );
         // The margin to add to tol (QA round 18 F11): half the grid's
         // diagonal, rounded up, and no surface point moved more.
-        let raise: f64 = w
-            .split_once("or raise tol by ")
-            .and_then(|(_, rest)| rest.split_once(" mm (--tol"))
-            .unwrap_or_else(|| panic!("{w}"))
-            .0
-            .parse()
-            .unwrap_or_else(|e| panic!("{w}: {e}"));
+        let raise = number_between(w, "or raise tol by ", " mm (--tol");
         assert!(
             raise >= grid * 3f64.sqrt() / 2.0 * 0.95 && raise <= grid * 3f64.sqrt() / 2.0 * 1.2,
             "{name}: raise {raise} for a grid of {grid} mm"

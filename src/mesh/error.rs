@@ -26,6 +26,22 @@ pub(super) fn text_mode_damage(bytes: &[u8], file: &str, what: &str) -> Option<M
     })
 }
 
+/// `bytes` as a text-mode copy leaves them: each byte from 0x80 up written
+/// as U+FFFD, as a UTF-8 round trip does.
+#[cfg(test)]
+pub(super) fn text_mode_copy(bytes: &[u8]) -> Vec<u8> {
+    bytes
+        .iter()
+        .flat_map(|&b| {
+            if b >= 0x80 {
+                REPLACEMENT.to_vec()
+            } else {
+                vec![b]
+            }
+        })
+        .collect()
+}
+
 /// A scan that cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {

@@ -1639,16 +1639,7 @@ mod tests {
         let json = triangle_gltf("", "").replace(r#","uri":"""#, "");
         let glb = crate::demo::glb_container(json.as_bytes(), &bin);
         assert_eq!(parse(&glb, "t.glb").unwrap().triangles.len(), 1);
-        let mangled: Vec<u8> = glb
-            .iter()
-            .flat_map(|&b| {
-                if b >= 0x80 {
-                    vec![0xEF, 0xBF, 0xBD]
-                } else {
-                    vec![b]
-                }
-            })
-            .collect();
+        let mangled = super::super::error::text_mode_copy(&glb);
         let e = parse(&mangled, "t.glb").unwrap_err().to_string();
         assert!(
             e.starts_with("t.glb: the GLB looks damaged by a text-mode copy"),

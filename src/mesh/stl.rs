@@ -553,13 +553,7 @@ mod tests {
         // Each byte from 0x80 up written as EF BF BD, as a UTF-8 round
         // trip does.
         let mut mangled = b;
-        for &byte in &sound {
-            if byte >= 0x80 {
-                mangled.extend([0xEF, 0xBF, 0xBD]);
-            } else {
-                mangled.push(byte);
-            }
-        }
+        mangled.extend(super::super::error::text_mode_copy(&sound));
         let e = parse(&mangled, "t.stl").unwrap_err().to_string();
         assert!(
             e.starts_with("t.stl: the binary STL looks damaged by a text-mode copy"),

@@ -320,6 +320,14 @@ test('a checked G-code is checked again when the scan moves, and clear again whe
   await context.close();
 });
 
+// The demo's own G-code downloaded and checked: clear.
+async function checkOwnGcode(page) {
+  const own = await download(page, 'dl-gcode');
+  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
+  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
+    null, { timeout: 120_000 });
+}
+
 // QA round 18 F7: a G-code checked against one scan, checked again by the
 // page once another scan file was opened, put a red "Could not check" panel
 // at the top on every scan opened after it. Its reason is said in the check
@@ -327,10 +335,7 @@ test('a checked G-code is checked again when the scan moves, and clear again whe
 test('a checked G-code that cannot be checked against a newly opened scan says so in its panel only', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  const own = await download(page, 'dl-gcode');
-  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
-  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
-    null, { timeout: 120_000 });
+  await checkOwnGcode(page);
   const checks = await page.evaluate(() => window.pcpp.state.checkId);
   // Another part: a 150 mm plate, far from where the demo's program runs.
   const plate = 'v 300 300 2\nv 450 300 2\nv 450 450 2\nv 300 450 2\nf 1 2 3\nf 1 3 4\n';
@@ -353,10 +358,7 @@ test('a checked G-code that cannot be checked against a newly opened scan says s
 test('a scan file not read leaves the checked G-code\'s verdict as it was', async () => {
   const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
   await waitSettled(page);
-  const own = await download(page, 'dl-gcode');
-  await page.setInputFiles('#gcode-input', gcodeFile(own.name, own.bytes));
-  await page.waitForFunction(() => /^clear: /.test(document.getElementById('check-verdict').textContent),
-    null, { timeout: 120_000 });
+  await checkOwnGcode(page);
   const before = await page.textContent('#check-verdict');
   const checks = await page.evaluate(() => window.pcpp.state.checkId);
   await page.setInputFiles('#scan-input', { name: 'broken.stl', mimeType: 'model/stl',
