@@ -1557,10 +1557,24 @@ pub fn write_outputs(
             // (QA round 8 F5: "Planning failed", with nothing to do).
             GcodeError::SafeHeightOutOfVolume { .. } => Error::OutsideVolume {
                 source: Box::new(e),
-                fit: "the scan lies inside the build volume, but the travel height over it does \
-                      not: lower the scan (placed on the bed, its Move Z: --place-scan \
-                      bed,DX,DY,DZ), or use a profile whose build volume is taller"
-                    .into(),
+                fit: format!(
+                    "the scan lies inside the build volume, but the travel height over it \
+                     does not: lower the scan (placed on the bed, its Move Z: --place-scan \
+                     bed,DX,DY,DZ), or use a profile whose build volume is taller{}",
+                    // QA round 19 F4: a clearance of a kilometre was
+                    // the cause, and not named.
+                    if profile.safe_travel_clearance_mm
+                        > 0.5 * (profile.build_volume.max_mm.z - profile.build_volume.min_mm.z)
+                    {
+                        format!(
+                            " or whose `safe_travel_clearance_mm` ({} mm in {}) is smaller",
+                            profile.safe_travel_clearance_mm,
+                            profile.label()
+                        )
+                    } else {
+                        String::new()
+                    }
+                ),
             },
             // The scan inside, the tool path beside it outside: a drawing
             // up to the edge of a scan that lies against the volume's side
@@ -1623,6 +1637,29 @@ pub fn write_outputs(
     }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
+    // A move of the profile's end block is the profile's doing, not the
+    // planner's (QA round 19 F4: "use even", which was in use).
+    let end_touch = checked.touching.iter().find(|t| {
+        t.line.is_some_and(|line| {
+            first
+                .moves
+                .iter()
+                .any(|m| m.line == line && m.kind == crate::gcode::MoveKind::End)
+        })
+    });
+    if let (Some(t), false) = (end_touch, accept_risk) {
+        let e = Error::Gcode(GcodeError::ProfileField {
+            file: profile.label(),
+            field: "end".into(),
+            message: format!(
+                "moves the nozzle closer to the part than tol = {} mm after the print: G-code \
+                 {t}; no G-code written. Park at the safe travel height ({{safe_z}}) before \
+                 any move down, or remove the move",
+                settings.process.tolerance_mm
+            ),
+        });
+        return Err(refused(e, None, None));
+    }
     if checked.touching_moves > 0 && !accept_risk {
         let e = Error::Touching(Box::new(TouchingMoves {
             planner: plan.planner.name().into(),

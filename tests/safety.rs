@@ -616,15 +616,28 @@ fn regression_profile_blocks_that_move_into_the_part_are_refused() {
             accept_risk,
         )
     };
-    let mut end = marlin();
+    // A user's file (QA round 19 F4: named "marlin" inside, it read as
+    // the built-in profile, and the refusal blamed the planner).
+    let text = marlin().to_json().unwrap();
+    let mut end = MachineProfile::from_json(&text, "lab-bench.json").unwrap();
     end.end = vec!["M107".into(), "G1 Z0".into(), "M84".into()];
     let e = run(&end, false)
         .err()
         .expect("an end block into the part written");
-    let Error::Touching(t) = &e else {
-        panic!("{e}")
-    };
-    let line = t.summary.touching[0].line.expect("the end block's line");
+    let said = e.to_string();
+    assert!(
+        matches!(e, Error::Gcode(_))
+            && said.contains("machine profile lab-bench.json, field `end`")
+            && said.contains("after the print")
+            && !said.contains("planner"),
+        "{said}"
+    );
+    let line: usize = said
+        .split("G-code line ")
+        .nth(1)
+        .and_then(|rest| rest.split(':').next())
+        .and_then(|n| n.parse().ok())
+        .expect("the end block's line");
     let out = run(&end, true).unwrap();
     assert_eq!(out.gcode.lines().nth(line - 1), Some("G1 Z0"));
     let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
@@ -640,6 +653,18 @@ fn regression_profile_blocks_that_move_into_the_part_are_refused() {
     let out = run(&end, false).unwrap();
     let oracle = check_gcode(&out.gcode, &mesh, DO, TOL);
     assert_eq!(oracle.too_close, 0, "{}", describe(&oracle));
+    // A travel clearance no build volume holds is named as the cause
+    // (QA round 19 F4: only "lower the scan" was said).
+    let mut high = MachineProfile::from_json(&text, "lab-bench.json").unwrap();
+    high.safe_travel_clearance_mm = 1e6;
+    let said = run(&high, false)
+        .err()
+        .expect("a travel height outside the volume")
+        .to_string();
+    assert!(
+        said.contains("`safe_travel_clearance_mm` (1000000 mm in lab-bench.json) is smaller"),
+        "{said}"
+    );
     let mut dispense = marlin();
     dispense.dispense_on = vec!["G1 Z-0.5".into(), "M106 S255".into()];
     let e = run(&dispense, true)

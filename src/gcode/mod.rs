@@ -45,8 +45,8 @@ mod writer;
 use glam::DVec3;
 
 pub use profile::{
-    BuildVolume, CommentStyle, FeedUnits, MachineProfile, BLOCK_TOKENS, DEFAULT_DECIMALS,
-    DWELL_TOKENS, VOLUME_HAIR_MM,
+    BuildVolume, CommentStyle, FeedUnits, MachineProfile, ProfileSource, BLOCK_TOKENS,
+    DEFAULT_DECIMALS, DWELL_TOKENS, VOLUME_HAIR_MM,
 };
 pub(crate) use read::numbered_lines;
 pub use read::{

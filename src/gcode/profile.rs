@@ -152,6 +152,35 @@ pub struct MachineProfile {
     pub build_volume: BuildVolume,
     /// Digits after the decimal point of coordinates, 3 to 6.
     pub decimals: u32,
+    /// Where the profile was read from, naming it in the errors found
+    /// when a program is written (QA round 19 F4: a user's file named
+    /// "marlin" read as the built-in). Not part of the JSON.
+    #[serde(skip)]
+    pub source: ProfileSource,
+}
+
+/// Where a profile was read from: a file's name, or empty for one made
+/// in code. Every source compares equal: two profiles with the same
+/// fields are the same profile.
+#[derive(Debug, Clone, Default)]
+pub struct ProfileSource(pub String);
+
+impl PartialEq for ProfileSource {
+    fn eq(&self, _: &ProfileSource) -> bool {
+        true
+    }
+}
+
+impl MachineProfile {
+    /// The label of the profile's errors: the file it was read from, or
+    /// its name.
+    pub fn label(&self) -> String {
+        if self.source.0.is_empty() {
+            format!("{} (in memory)", self.name)
+        } else {
+            self.source.0.clone()
+        }
+    }
 }
 
 impl MachineProfile {
@@ -165,7 +194,9 @@ impl MachineProfile {
         let (_, text) = BUILTINS.iter().find(|(n, _)| *n == name)?;
         // The files are compiled in and a unit test loads each one, so this
         // cannot fail in a released build.
-        MachineProfile::from_json(text, &format!("{name}.json")).ok()
+        let mut profile = MachineProfile::from_json(text, &format!("{name}.json")).ok()?;
+        profile.source = ProfileSource(format!("{name} (built in)"));
+        Some(profile)
     }
 
     /// Reads and validates a profile. `file_name` only labels errors.
@@ -175,6 +206,9 @@ impl MachineProfile {
     /// unknown fields are errors so that a misspelt field is not silently
     /// ignored.
     pub fn from_json(text: &str, file_name: &str) -> Result<MachineProfile, GcodeError> {
+        // QA round 19 F9: Windows editors save a byte-order mark, which
+        // the page's decoder drops and serde_json refuses.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let value: Value = serde_json::from_str(text).map_err(|e| GcodeError::ProfileSyntax {
             file: file_name.into(),
             message: e.to_string(),
@@ -206,6 +240,7 @@ impl MachineProfile {
             rapid_feed_word: fields.optional("rapid_feed_word")?.unwrap_or(false),
             build_volume: fields.required("build_volume")?,
             decimals: fields.optional("decimals")?.unwrap_or(DEFAULT_DECIMALS),
+            source: ProfileSource(file_name.into()),
         };
         fields.finish()?;
         profile.validate(file_name)?;
@@ -290,6 +325,22 @@ impl MachineProfile {
                 "prefix and suffix must not contain line breaks or control characters".into(),
             ));
         }
+        // QA round 19 F1, F10: the header's comments must stay comments
+        // (a prefix `G1 Z0 ;` made every one a plunge; a space, a letter
+        // or a `(` never closed sent the text to the controller).
+        for text in COMMENT_PROBES {
+            let line = super::format::comment_line(c, text);
+            if !super::read::is_comment_only(&line) {
+                return Err(bad(
+                    "comment",
+                    format!(
+                        "the comment line `{line}` would be read as a command, not a comment: \
+                         use the prefix `;` (Marlin, Grbl), `'` (Aerotech) or `(` with the \
+                         suffix `)`"
+                    ),
+                ));
+            }
+        }
         if self.dispense_on.is_empty() {
             return Err(bad("dispense_on", "needs at least one line".into()));
         }
@@ -311,8 +362,98 @@ impl MachineProfile {
         if self.dwell.trim().is_empty() {
             return Err(bad("dwell", "must not be empty".into()));
         }
-        check_template(source, "dwell", &self.dwell, DWELL_TOKENS)
+        check_template(source, "dwell", &self.dwell, DWELL_TOKENS)?;
+        // The commands the writer puts between checked moves must not
+        // move the head or change where the next move goes (QA round 19
+        // F1, F2: axis words on a valve's M-code, a dwell written `G1 Z0
+        // P{s}` or `G91 G4 P{s}`).
+        for (name, lines) in [
+            ("dispense_on", &self.dispense_on),
+            ("dispense_off", &self.dispense_off),
+        ] {
+            for (i, line) in lines.iter().enumerate() {
+                check_inert(source, &format!("{name}[{i}]"), line, BLOCK_TOKENS)?;
+            }
+        }
+        check_inert(source, "dwell", &self.dwell, DWELL_TOKENS)
     }
+}
+
+/// Header texts a comment line is tried with: what the writer writes
+/// (letters, digits, parentheses, a `;`), so a style that reads any of
+/// them as a command is refused.
+const COMMENT_PROBES: [&str; 4] = [
+    "pcpp 0.1.0",
+    "",
+    "G1 X10 Y10 Z0 F100",
+    "safe motion: min clearance 0.101 mm (tol 0.1 mm); a 'quote'",
+];
+
+/// Axis letters: on a line with no motion G-code, Grbl and LinuxCNC move
+/// them in the modal motion mode (G1 after a print move).
+const AXIS_LETTERS: [char; 9] = ['X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'];
+
+/// A command the writer puts between checked moves (a dispense line, the
+/// dwell): no axis word, no G-code but the dwell G4, and, followed by
+/// the G-code reader (both its readings of M-codes with axis words) from
+/// a known position, no move of its own and the next move where it was
+/// written to go. Tokens are filled with stand-in values.
+fn check_inert(source: &str, field: &str, line: &str, known: &[&str]) -> Result<(), GcodeError> {
+    let bad = |message: String| GcodeError::ProfileField {
+        file: source.into(),
+        field: field.into(),
+        message,
+    };
+    let filled = template::fill(line, |token| {
+        known.contains(&token).then(|| "1".to_string())
+    })
+    .map_err(|e| template_error(source, field, e, known))?;
+    let words = super::read::line_words(&filled)
+        .map_err(|p| bad(format!("`{}` cannot be read as G-code: {p}", line.trim())))?;
+    for (letter, value) in words.iter().flatten() {
+        if AXIS_LETTERS.contains(letter) {
+            return Err(bad(format!(
+                "`{}` has the axis word {letter}: a controller moves that axis (Grbl and \
+                 LinuxCNC in the modal motion mode, on a line with no G0/G1), between moves \
+                 pcpp checked against the part: remove it",
+                line.trim()
+            )));
+        }
+        if *letter == 'G' && value.is_none_or(|v| v != 4.0) {
+            return Err(bad(format!(
+                "`{}` has a G-code other than the dwell G4 (a move, or a change of units, \
+                 mode or frame) between moves pcpp checked against the part: remove it",
+                line.trim()
+            )));
+        }
+    }
+    let program = format!("G21\nG90\nG0 X1 Y2 Z3\n{filled}\nG0 X4 Y5 Z6\n");
+    for read in [super::read_gcode, super::read_gcode_grbl] {
+        let followed = read(&program, source).map_err(|e| {
+            bad(format!(
+                "`{}` cannot be followed by the G-code reader ({e}), so the moves after it \
+                 cannot be checked: remove it",
+                line.trim()
+            ))
+        })?;
+        let moved_itself = followed.unknown_moves.iter().any(|u| u.line > 3)
+            || followed.moves.iter().any(|m| m.line == 4);
+        let next: Vec<_> = followed.moves.iter().filter(|m| m.line > 4).collect();
+        let next_as_written = matches!(next[..], [m] if m.from == DVec3::new(1.0, 2.0, 3.0)
+            && m.to == DVec3::new(4.0, 5.0, 6.0));
+        if moved_itself || !next_as_written {
+            return Err(bad(format!(
+                "`{}` {} between moves pcpp checked against the part: remove it",
+                line.trim(),
+                if moved_itself {
+                    "moves the head"
+                } else {
+                    "changes where the moves after it go (units, relative moves or offsets)"
+                }
+            )));
+        }
+    }
+    Ok(())
 }
 
 impl MachineProfile {
@@ -331,6 +472,10 @@ impl MachineProfile {
             message,
         };
         let (mut inches, mut relative) = (None::<(String, u32)>, None::<(String, u32)>);
+        let mut feed_mode = None::<(String, u32)>;
+        // Offsets, scaling and rotation the start turns on: the G-code
+        // that cancels each, the line and the code.
+        let mut active: Vec<(u32, String, u32)> = Vec::new();
         let blocks = [
             ("start", &self.start),
             ("dispense_on", &self.dispense_on),
@@ -339,6 +484,26 @@ impl MachineProfile {
         for (name, lines) in blocks {
             for (i, line) in lines.iter().enumerate() {
                 let field = format!("{name}[{i}]");
+                let words = super::read::line_words(line)
+                    .ok()
+                    .flatten()
+                    .unwrap_or_default();
+                let has = |letter: char| words.iter().any(|&(l, _)| l == letter);
+                // QA round 19 F3: home offsets move the frame as G92 does.
+                if let Some(m) = words
+                    .iter()
+                    .filter(|&&(l, _)| l == 'M')
+                    .find_map(|&(_, v)| v.filter(|&v| v == 206.0 || v == 428.0))
+                {
+                    return Err(bad(
+                        field,
+                        format!(
+                            "M{m} sets home offsets, so the controller would not go where \
+                             pcpp's moves (millimetres, absolute, in the frame the scan was \
+                             placed in) were checked to go: remove it"
+                        ),
+                    ));
+                }
                 // (G codes times ten, as the G-code reader reads them.)
                 for g in super::read::g_codes(line) {
                     let what = match g {
@@ -352,6 +517,34 @@ impl MachineProfile {
                         }
                         910 if name == "start" => {
                             relative = Some((field.clone(), g));
+                            continue;
+                        }
+                        930 | 950 if name == "start" => {
+                            feed_mode = Some((field.clone(), g));
+                            continue;
+                        }
+                        940 if name == "start" => {
+                            feed_mode = None;
+                            continue;
+                        }
+                        // QA round 19 F3: offsets, scaling and rotation
+                        // the G-code reader cannot relate either; those
+                        // a later line of the start cancels are fine.
+                        100 if has('L') || has('P') => "sets work or tool offsets",
+                        520 => "sets a local coordinate offset",
+                        410..=429 | 430..=439 | 510..=519 | 680..=689 if name == "start" => {
+                            let cancel = match g {
+                                410..=429 => 400,
+                                430..=439 => 490,
+                                510..=519 => 500,
+                                _ => 690,
+                            };
+                            active.retain(|a| a.0 != cancel);
+                            active.push((cancel, field.clone(), g));
+                            continue;
+                        }
+                        400 | 490 | 500 | 690 if name == "start" => {
+                            active.retain(|a| a.0 != g);
                             continue;
                         }
                         900 if name == "start" => {
@@ -383,15 +576,46 @@ impl MachineProfile {
             Some((field, g)) => Err(bad(
                 field,
                 format!(
-                    "{} leaves the controller in {what} after the start, but pcpp writes its \
-                     moves in millimetres, absolute: remove it, or end the start with {back}",
+                    "{} leaves the controller in {what} after the start: remove it, or end \
+                     the start with {back}",
                     super::read::g_name(g)
                 ),
             )),
             None => Ok(()),
         };
-        left(inches, "inches", "G21")?;
-        left(relative, "relative moves", "G90")
+        left(
+            inches,
+            "inches, but pcpp writes its moves in millimetres",
+            "G21",
+        )?;
+        left(
+            relative,
+            "relative moves, but pcpp writes its moves absolute",
+            "G90",
+        )?;
+        if let Some((cancel, field, g)) = active.into_iter().next() {
+            let what = match g {
+                410..=429 => "offsets the path by the tool's radius",
+                430..=439 => "applies a tool length offset, which shifts every Z after it",
+                510..=519 => "scales the coordinates",
+                _ => "rotates the coordinates",
+            };
+            return Err(bad(
+                field,
+                format!(
+                    "{} {what}, so the controller would not go where pcpp's moves were checked \
+                     to go: remove it, or end the start with {}",
+                    super::read::g_name(g),
+                    super::read::g_name(cancel)
+                ),
+            ));
+        }
+        left(
+            feed_mode,
+            "another feed mode (inverse time or per revolution), so every F word pcpp writes \
+             would be read as another speed",
+            "G94",
+        )
     }
 }
 
@@ -628,6 +852,165 @@ mod tests {
         for name in MachineProfile::builtin_names() {
             MachineProfile::builtin(name).unwrap();
         }
+    }
+
+    /// QA round 19 F1-F3, F9, F10: what the writer puts between checked
+    /// moves (comments, dispense commands, the dwell) cannot move the
+    /// head or change where the next move goes, and a start cannot leave
+    /// offsets, scaling or another feed mode the checks do not know.
+    #[test]
+    fn lines_between_checked_moves_cannot_move_the_head() {
+        let with = |field: &str, value: Value| {
+            let mut v = marlin_json();
+            v.as_object_mut().unwrap().insert(field.into(), value);
+            load(&v).map(|_| ()).map_err(|e| e.to_string())
+        };
+        use serde_json::json;
+        for (field, value, named, says) in [
+            (
+                "comment",
+                json!({"prefix": "G1 Z0 ;"}),
+                "`comment`",
+                "`G1 Z0 ; pcpp",
+            ),
+            (
+                "comment",
+                json!({"prefix": " "}),
+                "`comment`",
+                "read as a command",
+            ),
+            (
+                "comment",
+                json!({"prefix": "X"}),
+                "`comment`",
+                "read as a command",
+            ),
+            ("comment", json!({"prefix": "("}), "`comment`", "suffix `)`"),
+            (
+                "comment",
+                json!({"prefix": "%"}),
+                "`comment`",
+                "read as a command",
+            ),
+            (
+                "dispense_on",
+                json!(["M3 S1000 Z-2"]),
+                "`dispense_on[0]`",
+                "axis word Z",
+            ),
+            (
+                "dispense_on",
+                json!(["M106", "X10 Y10 Z0"]),
+                "`dispense_on[1]`",
+                "axis word X",
+            ),
+            (
+                "dispense_off",
+                json!(["M5 Z0"]),
+                "`dispense_off[0]`",
+                "axis word Z",
+            ),
+            (
+                "dwell",
+                json!("G1 Z0 P{s}"),
+                "`dwell`",
+                "other than the dwell G4",
+            ),
+            ("dwell", json!("G4 P{s} Z0"), "`dwell`", "axis word Z"),
+            (
+                "dwell",
+                json!("G91 G4 P{s}"),
+                "`dwell`",
+                "other than the dwell G4",
+            ),
+            (
+                "dwell",
+                json!("G4 P{s} G20"),
+                "`dwell`",
+                "other than the dwell G4",
+            ),
+            (
+                "dwell",
+                json!("G92 Z0 G4 P{s}"),
+                "`dwell`",
+                "other than the dwell G4",
+            ),
+            ("dwell", json!("G4 P{s} M206 Z5"), "`dwell`", "axis word Z"),
+            (
+                "dwell",
+                json!("G4 P{s} M428"),
+                "`dwell`",
+                "cannot be followed",
+            ),
+            (
+                "dispense_on",
+                json!(["M106 S255 (open"]),
+                "`dispense_on[0]`",
+                "cannot be read",
+            ),
+            (
+                "start",
+                json!(["G21", "G10 L20 P1 X0 Y0 Z0"]),
+                "`start[1]`",
+                "offsets",
+            ),
+            (
+                "start",
+                json!(["G21", "G10 L2 P1 Z-5"]),
+                "`start[1]`",
+                "offsets",
+            ),
+            (
+                "start",
+                json!(["G21", "G43 H1"]),
+                "`start[1]`",
+                "tool length offset",
+            ),
+            (
+                "start",
+                json!(["G43.1 Z5"]),
+                "`start[0]`",
+                "tool length offset",
+            ),
+            (
+                "start",
+                json!(["G21", "M206 Z-5"]),
+                "`start[1]`",
+                "home offsets",
+            ),
+            ("start", json!(["G51 X2"]), "`start[0]`", "scales"),
+            ("start", json!(["G68 R30"]), "`start[0]`", "rotates"),
+            ("start", json!(["G21", "G93"]), "`start[1]`", "feed mode"),
+        ] {
+            let e = with(field, value.clone()).unwrap_err();
+            assert!(e.contains(named) && e.contains(says), "{value}: {e}");
+        }
+        // What controllers write and the built-in profiles use stays
+        // fine: comments of each form, a valve's M-codes with S and P
+        // words, a dwell alone, an output set, a cancelled offset or feed
+        // mode, Marlin's firmware retraction.
+        for (field, value) in [
+            ("comment", json!({"prefix": ";"})),
+            ("comment", json!({"prefix": "(", "suffix": ")"})),
+            ("comment", json!({"prefix": "'"})),
+            ("comment", json!({"prefix": "//"})),
+            ("dispense_on", json!(["M42 P4 S255", "G4 P{safe_z}"])),
+            ("dispense_on", json!(["$DO[0].X = 1"])),
+            ("dispense_on", json!(["SET_PIN PIN=valve VALUE=1"])),
+            ("dwell", json!("G4 S{s}")),
+            ("dwell", json!("DWELL {s}")),
+            ("dwell", json!("M400 G4 P{ms} ; wait")),
+            ("start", json!(["G21", "G93", "G94", "G90"])),
+            ("start", json!(["G21", "G43 H1", "G49", "G10"])),
+        ] {
+            assert_eq!(with(field, value.clone()), Ok(()), "{value}");
+        }
+        // A profile saved with a byte-order mark reads as without.
+        let text = format!("\u{feff}{}", marlin_json());
+        assert_eq!(
+            MachineProfile::from_json(&text, "bom.json").unwrap(),
+            MachineProfile::from_json(&marlin_json().to_string(), "plain.json").unwrap()
+        );
     }
 
     #[test]

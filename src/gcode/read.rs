@@ -875,6 +875,11 @@ fn classify(code: u32, has_l: bool, has_s: bool, tool_offsets: bool) -> G {
         (51, _) => G::Frame {
             what: "scales the coordinates (G51)",
         },
+        // QA round 19 F3: LinuxCNC's `G43 H1` and Grbl's `G43.1 Z5` shift
+        // every Z after them by a length this reader does not know.
+        (43, _) => G::Frame {
+            what: "applies a tool length offset (G43)",
+        },
         (52, 0) => G::Frame {
             what: "sets a local coordinate offset (G52)",
         },
@@ -928,6 +933,40 @@ pub(crate) fn g_codes(line: &str) -> Vec<u32> {
             .collect(),
         _ => Vec::new(),
     }
+}
+
+/// A word's upper-case letter and its number, if it has one.
+pub(crate) type LineWord = (char, Option<f64>);
+
+/// One line's words as the reader reads them (upper-case letter, number
+/// if any; comments dropped), for the profile's checks of its own lines:
+/// `Ok(None)` for a line of comments only or of another language (a
+/// statement such as `$DO[0].X = 1`), the reader's problem for one it
+/// refuses.
+pub(crate) fn line_words(line: &str) -> Result<Option<Vec<LineWord>>, String> {
+    let mut words = Vec::new();
+    match scan(line, &mut words).map_err(|p| p.to_string())? {
+        (Shape::Words, _) => Ok(Some(
+            words
+                .iter()
+                .map(|w| {
+                    let value = match w.value {
+                        Value::Number(v) => Some(v),
+                        Value::Flag | Value::Text => None,
+                    };
+                    (char::from(w.letter), value)
+                })
+                .collect(),
+        )),
+        (Shape::Blank | Shape::Statement(_), _) => Ok(None),
+    }
+}
+
+/// Whether a line reads as a comment alone (or nothing): for the
+/// profile's comment style, whose lines must never be executed.
+pub(crate) fn is_comment_only(line: &str) -> bool {
+    matches!(scan(line, &mut Vec::new()), Ok((Shape::Blank, false)))
+        && !line.trim_start().starts_with('%')
 }
 
 pub(crate) fn g_name(code: u32) -> String {
@@ -2141,6 +2180,9 @@ mod tests {
             ("G59.1\n", "line 1: `G59.1` at column 1 selects another"),
             ("G10 L2 P1 X0\n", "line 1: `G10` at column 1 sets work or tool offsets"),
             ("G52 X1\n", "line 1: `G52` at column 1 sets a local coordinate offset"),
+            // QA round 19 F3: was ignored, and the check said "clear".
+            ("G21\nG43 H1\n", "line 2: `G43` at column 1 applies a tool length offset"),
+            ("G43.1 Z5\n", "line 1: `G43.1` at column 1 applies a tool length offset"),
             ("G5 X1 Y1\n", "line 1: splines (`G5` at column 1)"),
             ("G12 P1\n", "line 1: circle and nozzle-cleaning patterns"),
             ("G81 X1 Y1 Z-1 R1\n", "line 1: canned cycles (`G81` at column 1)"),
@@ -2422,7 +2464,7 @@ mod tests {
 
     #[test]
     fn parameters_text_and_other_words_are_not_moves() {
-        let text = "M201 X1000 Y1000 Z200 E5000\nM117 Printing G2 X1 (50%\nM92 X80\nG28 X Y\nG92 E0\nG1 Z5 E-2 A1\nG43.1 Z0.5\nM291 P\"hello \"\"you\"\" (\" S1\nG10\nG11\nG90 G0 X0 Y0 Z0\n/G1 X1\n";
+        let text = "M201 X1000 Y1000 Z200 E5000\nM117 Printing G2 X1 (50%\nM92 X80\nG28 X Y\nG92 E0\nG1 Z5 E-2 A1\nG100 Z0.5\nM291 P\"hello \"\"you\"\" (\" S1\nG10\nG11\nG90 G0 X0 Y0 Z0\n/G1 X1\n";
         let p = read(text);
         assert_eq!(p.moves.len(), 1);
         assert_eq!(p.moves[0].line, 12);
@@ -2431,8 +2473,8 @@ mod tests {
             "lines 1, 3: X/Y/Z words read as parameters of M-codes (M201, M92), not as moves",
             "lines 1, 5-6: E words (extrusion) ignored",
             "line 6: A axis words ignored",
-            "line 7: G-codes this reader does not know (G43.1), ignored",
-            "line 7: X/Y/Z words read as parameters of G43.1, not as moves",
+            "line 7: G-codes this reader does not know (G100), ignored",
+            "line 7: X/Y/Z words read as parameters of G100, not as moves",
             "lines 9-10: G10, G11 read as firmware retraction",
             "line 11: several G/M commands on one line",
             "line 12: block-delete lines (`/`) read as executed",

@@ -115,7 +115,7 @@ pub fn write_program(
     job: &GcodeJob,
     profile: &MachineProfile,
 ) -> Result<WrittenProgram, GcodeError> {
-    let source = format!("{} (in memory)", profile.name);
+    let source = profile.label();
     profile.validate(&source)?;
     check_job(job)?;
     let safe_z = checked_safe_height(job, profile)?;
@@ -446,7 +446,7 @@ impl<'p> Program<'p> {
             at: None,
             moves: Vec::new(),
             profile,
-            source: format!("{} (in memory)", profile.name),
+            source: profile.label(),
             decimals: profile.decimals,
             safe_z: fixed(safe_z, profile.decimals),
             travel_f: feed_word(profile, profile.travel_feed_mm_s),
