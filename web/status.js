@@ -30,9 +30,12 @@ export function clearError(topics) {
   shownTopic = null;
 }
 
+// The status line keeps a fixed height (index.html): a text too long for
+// it scrolls there, and shows whole on hover.
 export function setStatus(text, stale) {
   const el = $('plan-status');
   el.textContent = text;
+  el.title = text;
   el.classList.toggle('stale', !!stale);
 }
 

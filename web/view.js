@@ -107,6 +107,18 @@ export function canvasPixel(canvas, e) {
     (e.clientY - rect.top) * (canvas.height / rect.height)];
 }
 
+// The device pixel of a pointer event during a drag, measured against the
+// canvas as it lay at the press (`rect`): the pointer's movement since the
+// press, not wherever the canvas is now. A layout change mid-drag (the
+// status line, a warning or an error appearing above the view) moves the
+// canvas under a still pointer; measured against the new rect, the drawing
+// jumped by as much (QA round 19 F5). Scaled by the canvas's size now, so a
+// resize mid-drag keeps the pointer at the same fraction of the view.
+function dragPixel(canvas, rect, e) {
+  return [(e.clientX - rect.left) * (canvas.width / rect.width),
+    (e.clientY - rect.top) * (canvas.height / rect.height)];
+}
+
 // Where the camera ray through a pixel meets the plane z = zPlane (printer
 // frame): the point of the scan the pointer holds during a drag. Null when
 // the ray runs parallel to the plane or away from it.
@@ -220,9 +232,11 @@ export function bindView() {
     const wantMove = e.button === 0 && !e.shiftKey && (state.moving || e.ctrlKey || e.altKey || e.metaKey);
     if (wantMove && state.info) {
       const z = dragPlaneZ();
-      const g = groundPoint(canvasPixel(canvas, e), z);
+      const r = canvas.getBoundingClientRect();
+      const rect = { left: r.left, top: r.top, width: r.width, height: r.height };
+      const g = rect.width > 0 && rect.height > 0 ? groundPoint(dragPixel(canvas, rect, e), z) : null;
       if (g) {
-        drag.move = { z, g0: g, px: num(settings.placement.x), py: num(settings.placement.y), moved: false };
+        drag.move = { z, g0: g, rect, px: num(settings.placement.x), py: num(settings.placement.y), moved: false };
       }
     }
     canvas.setPointerCapture(e.pointerId);
@@ -230,7 +244,7 @@ export function bindView() {
   canvas.addEventListener('pointermove', (e) => {
     if (!drag) return;
     if (drag.move) {
-      const g = groundPoint(canvasPixel(canvas, e), drag.move.z);
+      const g = groundPoint(dragPixel(canvas, drag.move.rect, e), drag.move.z);
       if (!g) return;
       drag.move.moved = true;
       movePlacementTo(drag.move.px + g[0] - drag.move.g0[0], drag.move.py + g[1] - drag.move.g0[1]);
