@@ -24,8 +24,11 @@ use crate::mesh::ScanUnits;
 use crate::surface::Surface;
 use crate::svg::{Placement, Subpath2};
 
-/// The bed of a machine: the middle of its build volume in XY, at its
-/// lowest z.
+/// The bed of a machine: the middle of its build volume in XY, at z = 0
+/// where the volume holds it (the work zero a user touches off on the
+/// bed; QA round 19 F13: on Grbl's volume, z -100 to 100, the scan went
+/// to z -100 and the nozzle 89 mm into a bed touched off at 0), else at
+/// its lowest z.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Bed {
     pub centre_mm: DVec2,
@@ -36,7 +39,11 @@ impl Bed {
     pub fn of(volume: &BuildVolume) -> Bed {
         Bed {
             centre_mm: 0.5 * (volume.min_mm + volume.max_mm).truncate(),
-            z_mm: volume.min_mm.z,
+            z_mm: if (volume.min_mm.z..=volume.max_mm.z).contains(&0.0) {
+                0.0
+            } else {
+                volume.min_mm.z
+            },
         }
     }
 
@@ -870,6 +877,19 @@ mod tests {
             "{x_end}"
         );
         assert!(ScanPlacement::AsScanned.transform(bbox).is_none());
+        // QA round 19 F13: the built-in Grbl and Aerotech volumes reach
+        // below z = 0 (work coordinates); their bed is z = 0, where a
+        // user touches off the nozzle, not the volume's floor.
+        for name in ["grbl", "aerotech"] {
+            let profile = MachineProfile::builtin(name).unwrap();
+            assert!(profile.build_volume.min_mm.z < 0.0, "{name}");
+            assert_eq!(Bed::of_profile(&profile).z_mm, 0.0, "{name}");
+        }
+        let above = BuildVolume {
+            min_mm: DVec3::new(0.0, 0.0, 10.0),
+            max_mm: DVec3::new(100.0, 100.0, 50.0),
+        };
+        assert_eq!(Bed::of(&above).z_mm, 10.0);
     }
 
     #[test]
