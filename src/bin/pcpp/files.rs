@@ -10,11 +10,48 @@ use pcpp::mesh::{ExternalFiles, MeshError};
 use crate::outputs::Outputs;
 use crate::{CliResult, Failure};
 
-pub fn read_bytes(path: &Path, what: &str) -> CliResult<Vec<u8>> {
+/// The most the CLI reads of a drawing (the page reads up to 64 MiB).
+pub const MAX_SVG_BYTES: usize = 256 << 20;
+/// The most the CLI reads of a machine profile or a settings file.
+pub const MAX_SETTINGS_BYTES: usize = 16 << 20;
+
+/// Reads an input of at most `max` bytes: a larger one is refused once
+/// `max` bytes are read, so a pipe or a device (`/dev/zero`, a stream
+/// that never ends) cannot fill the memory first (QA round 19 F14).
+pub fn read_bytes(path: &Path, what: &str, max: usize) -> CliResult<Vec<u8>> {
     if is_stdin(path) {
-        return read_stdin(what);
+        return read_stdin(what, max);
     }
-    std::fs::read(path).map_err(|e| cannot_read(path, what, e))
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
+    read_at_most(file, max, path, what)
+}
+
+fn read_at_most(
+    reader: impl std::io::Read,
+    max: usize,
+    path: &Path,
+    what: &str,
+) -> CliResult<Vec<u8>> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    reader
+        .take(max as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| {
+            Failure::Input(format!(
+                "cannot read {what} from {}: {e}",
+                input_shown(path)
+            ))
+        })?;
+    if bytes.len() > max {
+        return Err(Failure::Input(format!(
+            "{}: the {what} is more than {:.0} MB, the most pcpp reads of one (a file that \
+             large, or a stream or device that does not end?)",
+            input_shown(path),
+            max as f64 / 1e6
+        )));
+    }
+    Ok(bytes)
 }
 
 /// An input as messages name it: its path, or "standard input" for `-`.
@@ -32,14 +69,8 @@ pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
-fn read_stdin(what: &str) -> CliResult<Vec<u8>> {
-    use std::io::Read as _;
-    let mut bytes = Vec::new();
-    std::io::stdin()
-        .lock()
-        .read_to_end(&mut bytes)
-        .map_err(|e| Failure::Input(format!("cannot read {what} from standard input: {e}")))?;
-    Ok(bytes)
+fn read_stdin(what: &str, max: usize) -> CliResult<Vec<u8>> {
+    read_at_most(std::io::stdin().lock(), max, Path::new("-"), what)
 }
 
 fn cannot_read(path: &Path, what: &str, e: std::io::Error) -> Failure {
@@ -75,19 +106,17 @@ impl AsRef<[u8]> for ScanBytes {
 /// Maps `path` where it can, else reads it ([`ScanBytes`]): the file is
 /// opened once either way.
 pub fn read_scan(path: &Path, what: &str) -> CliResult<ScanBytes> {
-    use std::io::Read as _;
+    // A byte more than the importer takes, so that it names the size.
+    let max = pcpp::mesh::MAX_SCAN_BYTES + 1;
     if is_stdin(path) {
-        return read_stdin(what).map(ScanBytes::Read);
+        return read_stdin(what, max).map(ScanBytes::Read);
     }
-    let mut file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, what, e))?;
     #[cfg(target_os = "linux")]
     if let Some(m) = mapped::Mapped::of(&file) {
         return Ok(ScanBytes::Mapped(m));
     }
-    let mut bytes = Vec::new();
-    file.read_to_end(&mut bytes)
-        .map_err(|e| cannot_read(path, what, e))?;
-    Ok(ScanBytes::Read(bytes))
+    read_at_most(file, max, path, what).map(ScanBytes::Read)
 }
 
 /// The external files a scan names that are not in its folder: (the path
@@ -223,8 +252,8 @@ mod mapped {
     }
 }
 
-pub fn read_text(path: &Path, what: &str) -> CliResult<String> {
-    let bytes = read_bytes(path, what)?;
+pub fn read_text(path: &Path, what: &str, max: usize) -> CliResult<String> {
+    let bytes = read_bytes(path, what, max)?;
     String::from_utf8(bytes).map_err(|e| {
         Failure::Input(format!(
             "{}, {}: the {what} is not UTF-8 text",
@@ -253,7 +282,8 @@ fn not_utf8_at(bytes: &[u8], at: usize) -> String {
 /// with a warning naming the first; outside a comment the reader then
 /// names their line as not G-code. (The whole file was refused.)
 pub fn read_gcode_text(path: &Path) -> CliResult<(String, Option<String>)> {
-    let bytes = read_bytes(path, "G-code")?;
+    // A byte more than the reader takes, so that it names the size.
+    let bytes = read_bytes(path, "G-code", pcpp::gcode::MAX_GCODE_BYTES + 1)?;
     match String::from_utf8(bytes) {
         Ok(text) => Ok((text, None)),
         Err(e) => {
@@ -496,6 +526,31 @@ mod tests {
         let got = read_scan(&p, "scan").unwrap();
         assert!(matches!(got, ScanBytes::Read(_)) && got.as_ref().is_empty());
         std::fs::remove_file(&p).unwrap();
+    }
+
+    /// QA round 19 F14: `/dev/zero` or a pipe that never ends read until
+    /// the memory ran out; now the read stops a byte past the limit.
+    #[test]
+    fn an_endless_input_stops_at_its_limit() {
+        let e = read_at_most(std::io::repeat(0), 1000, Path::new("-"), "path").unwrap_err();
+        let Failure::Input(said) = e else {
+            panic!("not an input error")
+        };
+        assert!(
+            said.starts_with("standard input: the path is more than 0 MB"),
+            "{said}"
+        );
+        let e = read_at_most(
+            std::io::repeat(0),
+            5_000_000,
+            Path::new("/dev/zero"),
+            "scan",
+        );
+        assert!(
+            matches!(e, Err(Failure::Input(s)) if s.contains("/dev/zero: the scan is more than 5 MB"))
+        );
+        let exact = read_at_most(&[7u8; 1000][..], 1000, Path::new("a.svg"), "path").unwrap();
+        assert_eq!(exact.len(), 1000);
     }
 
     #[test]

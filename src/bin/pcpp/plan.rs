@@ -48,7 +48,7 @@ fn load_inputs(
     progress: &Progress,
 ) -> CliResult<Inputs> {
     let prepared = load_scan(&a.scan, settings, outputs, progress)?;
-    let svg = read_bytes(&a.path, "path")?;
+    let svg = read_bytes(&a.path, "path", crate::files::MAX_SVG_BYTES)?;
     Ok(Inputs {
         svg_name: file_name(&a.path),
         scan_path: a.scan.scan.clone(),

@@ -28,7 +28,7 @@ pub fn import_options(a: &ScanArgs) -> ImportOptions {
 pub fn profile(a: &MachineArgs) -> CliResult<MachineProfile> {
     match &a.profile {
         Some(path) => {
-            let text = read_text(path, "machine profile")?;
+            let text = read_text(path, "machine profile", crate::files::MAX_SETTINGS_BYTES)?;
             // The profile's name labels its errors: give the whole path.
             MachineProfile::from_json(&text, &path.display().to_string())
                 .map_err(|e| Failure::Input(e.to_string()))
