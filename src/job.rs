@@ -1637,6 +1637,34 @@ pub fn write_outputs(
     }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
+    // Where the start block puts the nozzle, where the G-code reader
+    // knows it (QA round 19 F6: `G0 X40 Y40 Z0.2`, inside the part, was
+    // written with a warning that the block moves the head).
+    let start = first.start_moves(profile.start.len());
+    let start_check = check_moves(
+        &scan.surface,
+        start
+            .iter()
+            .map(|&(from, to, line, _)| (from.unwrap_or(to), to, Some(line))),
+        &clearance,
+    );
+    if let (Some(t), false) = (start_check.touching.first(), accept_risk) {
+        let i = start
+            .iter()
+            .find(|m| Some(m.2) == t.line)
+            .map_or(0, |m| m.3);
+        let e = Error::Gcode(GcodeError::ProfileField {
+            file: profile.label(),
+            field: format!("start[{i}]"),
+            message: format!(
+                "puts the nozzle closer to the part than tol = {} mm before the print: G-code \
+                 {t}; no G-code written. Keep the start block's moves at or above the safe \
+                 travel height ({{safe_z}}), or remove them",
+                settings.process.tolerance_mm
+            ),
+        });
+        return Err(refused(e, None, None));
+    }
     // A move of the profile's end block is the profile's doing, not the
     // planner's (QA round 19 F4: "use even", which was in use).
     let end_touch = checked.touching.iter().find(|t| {

@@ -665,6 +665,31 @@ fn regression_profile_blocks_that_move_into_the_part_are_refused() {
         said.contains("`safe_travel_clearance_mm` (1000000 mm in lab-bench.json) is smaller"),
         "{said}"
     );
+    // A start that ends where the reader knows, inside the part (QA
+    // round 19 F6: written with a warning that the block moves the head);
+    // one that stays above it is written, with that warning.
+    let mut start = MachineProfile::from_json(&text, "lab-bench.json").unwrap();
+    start.start = ["G21", "G90", "G0 Z0.5", "G0 X40 Y40 Z0.2"]
+        .map(String::from)
+        .to_vec();
+    let said = run(&start, false)
+        .err()
+        .expect("a start into the part")
+        .to_string();
+    assert!(
+        said.contains("machine profile lab-bench.json, field `start[3]`: puts the nozzle closer"),
+        "{said}"
+    );
+    start.start[3] = "G0 X40 Y40 Z30".into();
+    let out = run(&start, false).unwrap();
+    assert!(
+        out.report
+            .warnings
+            .iter()
+            .any(|w| w.contains("its start block moves the head")),
+        "{:?}",
+        out.report.warnings
+    );
     let mut dispense = marlin();
     dispense.dispense_on = vec!["G1 Z-0.5".into(), "M106 S255".into()];
     let e = run(&dispense, true)

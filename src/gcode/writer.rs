@@ -73,6 +73,38 @@ pub struct WrittenProgram {
 }
 
 impl WrittenProgram {
+    /// The moves of the profile's `start` block (its `lines` lines after
+    /// the header) whose end the G-code reader knows, as it follows the
+    /// block from wherever the head stands: (from, where known; to;
+    /// program line; index in `start`). `start_block_motion` warns that
+    /// these run before any checked move; where a move ends is still
+    /// known, and a start that drives the nozzle into the part there is
+    /// refused (QA round 19 F6). Empty for a block the reader cannot
+    /// follow (the warning says so).
+    pub fn start_moves(&self, lines: usize) -> Vec<(Option<DVec3>, DVec3, usize, usize)> {
+        let text: String = self
+            .text
+            .lines()
+            .skip(self.header.1)
+            .take(lines)
+            .flat_map(|l| [l, "\n"])
+            .collect();
+        let Ok(read) = super::read_gcode(&text, "start") else {
+            return Vec::new();
+        };
+        let at = |line: usize| (self.header.1 + line, line - 1);
+        let known = read.moves.iter().map(|m| {
+            let (line, i) = at(m.line);
+            (Some(m.from), m.to, line, i)
+        });
+        let ends = read.unknown_moves.iter().filter_map(|u| {
+            let [x, y, z] = u.to;
+            let (line, i) = at(u.line);
+            Some((None, DVec3::new(x?, y?, z?), line, i))
+        });
+        known.chain(ends).collect()
+    }
+
     /// The text `write_program` writes for `job`, which differs from the
     /// job this program was written for only in its header values, when
     /// the new header takes as many lines (so that `moves` still hold):
