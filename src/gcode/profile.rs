@@ -389,9 +389,11 @@ const COMMENT_PROBES: [&str; 4] = [
     "safe motion: min clearance 0.101 mm (tol 0.1 mm); a 'quote'",
 ];
 
-/// Axis letters: on a line with no motion G-code, Grbl and LinuxCNC move
-/// them in the modal motion mode (G1 after a print move).
-const AXIS_LETTERS: [char; 9] = ['X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'];
+/// The stage's axis letters: on a line with no motion G-code, Grbl and
+/// LinuxCNC move them in the modal motion mode (G1 after a print move).
+/// (Other letters are parameters of M-codes the nozzle does not follow:
+/// Marlin's `M150 R255 U0 B0` sets a light, `M260 A66 B1` talks to I2C.)
+const AXIS_LETTERS: [char; 3] = ['X', 'Y', 'Z'];
 
 /// A command the writer puts between checked moves (a dispense line, the
 /// dwell): no axis word, no G-code but the dwell G4, and, followed by
@@ -552,6 +554,14 @@ impl MachineProfile {
                             continue;
                         }
                         40 => continue,
+                        // Slicers' start blocks reset the extruder with
+                        // `G92 E0`, which leaves X, Y and Z as they are.
+                        920 if name == "start"
+                            && has('E')
+                            && !(has('X') || has('Y') || has('Z')) =>
+                        {
+                            continue
+                        }
                         920..=923 => "sets the position to other coordinates",
                         530 => "moves in machine coordinates",
                         540..600 => "switches to another work offset",
@@ -981,6 +991,18 @@ mod tests {
             ("start", json!(["G51 X2"]), "`start[0]`", "scales"),
             ("start", json!(["G68 R30"]), "`start[0]`", "rotates"),
             ("start", json!(["G21", "G93"]), "`start[1]`", "feed mode"),
+            (
+                "start",
+                json!(["G21", "G92 E0 Z0"]),
+                "`start[1]`",
+                "other coordinates",
+            ),
+            (
+                "start",
+                json!(["G21", "G92"]),
+                "`start[1]`",
+                "other coordinates",
+            ),
         ] {
             let e = with(field, value.clone()).unwrap_err();
             assert!(e.contains(named) && e.contains(says), "{value}: {e}");
@@ -997,11 +1019,16 @@ mod tests {
             ("dispense_on", json!(["M42 P4 S255", "G4 P{safe_z}"])),
             ("dispense_on", json!(["$DO[0].X = 1"])),
             ("dispense_on", json!(["SET_PIN PIN=valve VALUE=1"])),
+            (
+                "dispense_on",
+                json!(["M150 R255 U0 B0", "M260 A66 B1 S1", "M106"]),
+            ),
             ("dwell", json!("G4 S{s}")),
             ("dwell", json!("DWELL {s}")),
             ("dwell", json!("M400 G4 P{ms} ; wait")),
             ("start", json!(["G21", "G93", "G94", "G90"])),
             ("start", json!(["G21", "G43 H1", "G49", "G10"])),
+            ("start", json!(["G21", "G90", "M82", "G92 E0"])),
         ] {
             assert_eq!(with(field, value.clone()), Ok(()), "{value}");
         }
