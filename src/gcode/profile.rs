@@ -213,6 +213,15 @@ impl MachineProfile {
             file: file_name.into(),
             message: e.to_string(),
         })?;
+        // QA round 19: a key written twice was taken at its last value,
+        // silently, where a misspelt one is refused.
+        if let Some(key) = repeated_key(text) {
+            return Err(GcodeError::ProfileField {
+                file: file_name.into(),
+                field: key,
+                message: "appears twice in the file, and only one can be meant: keep one".into(),
+            });
+        }
         let Value::Object(map) = value else {
             return Err(GcodeError::ProfileSyntax {
                 file: file_name.into(),
@@ -377,6 +386,74 @@ impl MachineProfile {
         }
         check_inert(source, "dwell", &self.dwell, DWELL_TOKENS)
     }
+}
+
+/// The first key an object of the JSON `text` repeats, as a path
+/// (`comment.prefix`, `start`), which `serde_json` reads as its last value
+/// without a word; `None` when there is none (or the text is not JSON,
+/// which the parse says).
+fn repeated_key(text: &str) -> Option<String> {
+    use serde::de::{DeserializeSeed, Deserializer, MapAccess, SeqAccess, Visitor};
+    struct Walk;
+    impl<'de> DeserializeSeed<'de> for Walk {
+        type Value = Option<String>;
+        fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+            d.deserialize_any(Walk)
+        }
+    }
+    impl<'de> Visitor<'de> for Walk {
+        type Value = Option<String>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("JSON")
+        }
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut seen = std::collections::HashSet::new();
+            let mut found = None;
+            while let Some(key) = map.next_key::<String>()? {
+                let inner = map.next_value_seed(Walk)?;
+                if found.is_none() {
+                    found = match inner {
+                        Some(path) => Some(format!("{key}.{path}")),
+                        None if !seen.insert(key.clone()) => Some(key),
+                        None => None,
+                    };
+                }
+            }
+            Ok(found)
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+            let mut found = None;
+            let mut i = 0;
+            while let Some(inner) = seq.next_element_seed(Walk)? {
+                if found.is_none() {
+                    found = inner.map(|path| format!("[{i}].{path}"));
+                }
+                i += 1;
+            }
+            Ok(found)
+        }
+        fn visit_bool<E>(self, _: bool) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_i64<E>(self, _: i64) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_u64<E>(self, _: u64) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_f64<E>(self, _: f64) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_str<E>(self, _: &str) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_unit<E>(self) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+    }
+    Walk.deserialize(&mut serde_json::Deserializer::from_str(text))
+        .ok()
+        .flatten()
 }
 
 /// Header texts a comment line is tried with: what the writer writes
@@ -1032,6 +1109,20 @@ mod tests {
         ] {
             assert_eq!(with(field, value.clone()), Ok(()), "{value}");
         }
+        // A key written twice is named, nested ones by their path.
+        let twice = |text: &str| {
+            MachineProfile::from_json(text, "dup.json")
+                .unwrap_err()
+                .to_string()
+        };
+        let text = marlin_json().to_string();
+        let e = twice(&text.replacen("\"decimals\"", "\"decimals\":4,\"decimals\"", 1));
+        assert!(
+            e.contains("dup.json, field `decimals`: appears twice"),
+            "{e}"
+        );
+        let e = twice(&text.replacen("\"prefix\"", "\"prefix\":\"(\",\"prefix\"", 1));
+        assert!(e.contains("field `comment.prefix`: appears twice"), "{e}");
         // A profile saved with a byte-order mark reads as without.
         let text = format!("\u{feff}{}", marlin_json());
         assert_eq!(
