@@ -19,7 +19,7 @@ use crate::mesh::{
     CloudInfo, ExternalFiles, ImportOptions, ImportedMesh, MeshFormat, ScanUnits, Topology,
     TriMesh, UnitsDoubt, UpAxis,
 };
-use crate::motion::{check_moves, check_program, Clearance, MotionSummary, TouchingMoves};
+use crate::motion::{check_moves, check_program, Clearance, MotionSummary, Touch, TouchingMoves};
 use crate::pipeline::{self, Plan, PlanMotion, PlanSettings};
 use crate::placement::{RegistrationStatus, ScanPlacement};
 use crate::planners::PlannerKind;
@@ -1637,6 +1637,20 @@ pub fn write_outputs(
     }
     let clearance = Clearance::new(&settings.nozzle, settings.process.tolerance_mm);
     let checked = check_program(&scan.surface, &first.moves, &clearance);
+    // A profile's block that brings the nozzle within tol: the profile's
+    // doing, not the planner's, refused naming its file and field.
+    let profile_touch = |field: String, does: &str, when: &str, t: &Touch, advice: &str| {
+        let e = Error::Gcode(GcodeError::ProfileField {
+            file: profile.label(),
+            field,
+            message: format!(
+                "{does} closer to the part than tol = {} mm {when}: G-code {t}; no G-code \
+                 written. {advice}",
+                settings.process.tolerance_mm
+            ),
+        });
+        refused(e, None, None)
+    };
     // Where the start block puts the nozzle, where the G-code reader
     // knows it (QA round 19 F6: `G0 X40 Y40 Z0.2`, inside the part, was
     // written with a warning that the block moves the head).
@@ -1653,17 +1667,14 @@ pub fn write_outputs(
             .iter()
             .find(|m| Some(m.2) == t.line)
             .map_or(0, |m| m.3);
-        let e = Error::Gcode(GcodeError::ProfileField {
-            file: profile.label(),
-            field: format!("start[{i}]"),
-            message: format!(
-                "puts the nozzle closer to the part than tol = {} mm before the print: G-code \
-                 {t}; no G-code written. Keep the start block's moves at or above the safe \
-                 travel height ({{safe_z}}), or remove them",
-                settings.process.tolerance_mm
-            ),
-        });
-        return Err(refused(e, None, None));
+        return Err(profile_touch(
+            format!("start[{i}]"),
+            "puts the nozzle",
+            "before the print",
+            t,
+            "Keep the start block's moves at or above the safe travel height ({safe_z}), or \
+             remove them",
+        ));
     }
     // A move of the profile's end block is the profile's doing, not the
     // planner's (QA round 19 F4: "use even", which was in use).
@@ -1676,17 +1687,13 @@ pub fn write_outputs(
         })
     });
     if let (Some(t), false) = (end_touch, accept_risk) {
-        let e = Error::Gcode(GcodeError::ProfileField {
-            file: profile.label(),
-            field: "end".into(),
-            message: format!(
-                "moves the nozzle closer to the part than tol = {} mm after the print: G-code \
-                 {t}; no G-code written. Park at the safe travel height ({{safe_z}}) before \
-                 any move down, or remove the move",
-                settings.process.tolerance_mm
-            ),
-        });
-        return Err(refused(e, None, None));
+        return Err(profile_touch(
+            "end".into(),
+            "moves the nozzle",
+            "after the print",
+            t,
+            "Park at the safe travel height ({safe_z}) before any move down, or remove the move",
+        ));
     }
     if checked.touching_moves > 0 && !accept_risk {
         let e = Error::Touching(Box::new(TouchingMoves {

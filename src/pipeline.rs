@@ -622,6 +622,22 @@ struct ToBeat {
     uncleared: usize,
 }
 
+impl ToBeat {
+    fn of(run: &PieceRun) -> ToBeat {
+        ToBeat {
+            defects: run.defects(),
+            unresolved: run.unresolved.len(),
+            uncleared: run.planned.uncleared.len(),
+        }
+    }
+
+    fn beaten_by(&self, run: &PieceRun) -> bool {
+        run.defects() < self.defects
+            && run.unresolved.len() <= self.unresolved
+            && run.planned.uncleared.len() <= self.uncleared
+    }
+}
+
 /// [`run_piece`], stopping with `None` as soon as the run cannot beat
 /// `bar`; what it returns is what [`run_piece`] returns. When the run to
 /// beat left no move unresolved, the safe-motion stage (most of a guarded
@@ -664,27 +680,28 @@ fn run_piece_to_beat(
     };
     let guarded_motion = safe_motion && planner.is_guarded();
     // The prediction with no unresolved move, asked before the
-    // safe-motion stage where the bar allows none.
+    // safe-motion stage where the bar allows none (`Ok`: the run's
+    // quality if no move is left unresolved; `Err`: the prediction still
+    // without the moves' contacts).
     let early = match bar {
         Some(b) if guarded_motion && b.unresolved == 0 => {
             let quality = with_nozzle_contacts(
                 surface,
+                piece,
                 &planned,
-                predicted.clone(),
+                predicted,
                 &[],
                 planner,
                 safe_motion,
                 nozzle,
                 process,
-                &piece.ta,
-                &piece.geometry,
             );
             if defects(&quality) >= b.defects {
                 return None;
             }
-            Some(quality)
+            Ok(quality)
         }
-        _ => None,
+        _ => Err(predicted),
     };
     // The planned moves the G-code makes as they are (see
     // `nozzle_contacts`): a guarded planner's get waypoints, but for
@@ -703,10 +720,11 @@ fn run_piece_to_beat(
     let quality = match early {
         // The bar allows no unresolved move: with one the run is not
         // taken; without, the early prediction is the run's.
-        Some(_) if !unresolved.is_empty() => return None,
-        Some(quality) => quality,
-        None => with_nozzle_contacts(
+        Ok(_) if !unresolved.is_empty() => return None,
+        Ok(quality) => quality,
+        Err(predicted) => with_nozzle_contacts(
             surface,
+            piece,
             &planned,
             predicted,
             &unresolved,
@@ -714,8 +732,6 @@ fn run_piece_to_beat(
             safe_motion,
             nozzle,
             process,
-            &piece.ta,
-            &piece.geometry,
         ),
     };
     Some(PieceRun {
@@ -740,6 +756,7 @@ fn defects(quality: &[PointQuality]) -> usize {
 #[allow(clippy::too_many_arguments)]
 fn with_nozzle_contacts(
     surface: &Surface,
+    piece: &SurfacePiece,
     planned: &crate::planners::PlannedPoints,
     quality: Vec<PointQuality>,
     unresolved: &[usize],
@@ -747,8 +764,6 @@ fn with_nozzle_contacts(
     safe_motion: bool,
     nozzle: &Nozzle,
     process: &Process,
-    ta: &[DVec3],
-    geometry: &[LocalGeometry],
 ) -> Vec<PointQuality> {
     // (As flags: a lookup per point, however many there are.)
     let flags = |all: bool, list: &[usize]| {
@@ -783,7 +798,14 @@ fn with_nozzle_contacts(
     for &j in &into {
         contact[j] = true;
     }
-    predict_given_contact(ta, geometry, &planned.toolpath, &contact, nozzle, process)
+    predict_given_contact(
+        &piece.ta,
+        &piece.geometry,
+        &planned.toolpath,
+        &contact,
+        nozzle,
+        process,
+    )
 }
 
 fn plan_stage(
@@ -833,11 +855,7 @@ fn plan_stage(
         // prediction), so the plan's defects are at most `pcpp-guarded`'s.
         // (`pcpp-guarded`'s run stops as soon as it cannot be taken.)
         if planner == PlannerKind::Even && safe_motion && run.defects() > 0 {
-            let bar = ToBeat {
-                defects: run.defects(),
-                unresolved: run.unresolved.len(),
-                uncleared: run.planned.uncleared.len(),
-            };
+            let bar = ToBeat::of(&run);
             let alt = run_piece_to_beat(
                 PlannerKind::PcppGuarded,
                 surface,
@@ -848,11 +866,7 @@ fn plan_stage(
                 &clearance,
                 Some(bar),
             );
-            if let Some(alt) = alt.filter(|alt| {
-                alt.defects() < bar.defects
-                    && alt.unresolved.len() <= bar.unresolved
-                    && alt.planned.uncleared.len() <= bar.uncleared
-            }) {
+            if let Some(alt) = alt.filter(|alt| bar.beaten_by(alt)) {
                 run = alt;
                 fell_back.0 += 1;
                 fell_back.1.get_or_insert(piece.ta[0]);
@@ -1187,16 +1201,8 @@ mod tests {
                     if even.defects() == 0 {
                         continue;
                     }
-                    let bar = ToBeat {
-                        defects: even.defects(),
-                        unresolved: even.unresolved.len(),
-                        uncleared: even.planned.uncleared.len(),
-                    };
-                    let beats = |r: &PieceRun| {
-                        r.defects() < bar.defects
-                            && r.unresolved.len() <= bar.unresolved
-                            && r.planned.uncleared.len() <= bar.uncleared
-                    };
+                    let bar = ToBeat::of(&even);
+                    let beats = |r: &PieceRun| bar.beaten_by(r);
                     let full = run(PlannerKind::PcppGuarded, None).unwrap();
                     let early = run(PlannerKind::PcppGuarded, Some(bar));
                     let case = format!("{} piece {}", part.name(), piece.source);

@@ -194,9 +194,7 @@ impl MachineProfile {
         let (_, text) = BUILTINS.iter().find(|(n, _)| *n == name)?;
         // The files are compiled in and a unit test loads each one, so this
         // cannot fail in a released build.
-        let mut profile = MachineProfile::from_json(text, &format!("{name}.json")).ok()?;
-        profile.source = ProfileSource(format!("{name} (built in)"));
-        Some(profile)
+        MachineProfile::from_json(text, &format!("{name} (built in)")).ok()
     }
 
     /// Reads and validates a profile. `file_name` only labels errors.
@@ -456,6 +454,21 @@ fn repeated_key(text: &str) -> Option<String> {
         .flatten()
 }
 
+/// A frame a start may turn on if it turns it off again (G codes times
+/// ten): the code that cancels it, and what it does.
+fn modal_frame(g: u32) -> Option<(u32, &'static str)> {
+    match g {
+        410..=429 => Some((400, "offsets the path by the tool's radius")),
+        430..=439 => Some((
+            490,
+            "applies a tool length offset, which shifts every Z after it",
+        )),
+        510..=519 => Some((500, "scales the coordinates")),
+        680..=689 => Some((690, "rotates the coordinates")),
+        _ => None,
+    }
+}
+
 /// Header texts a comment line is tried with: what the writer writes
 /// (letters, digits, parentheses, a `;`), so a style that reads any of
 /// them as a command is refused.
@@ -569,17 +582,16 @@ impl MachineProfile {
                     .unwrap_or_default();
                 let has = |letter: char| words.iter().any(|&(l, _)| l == letter);
                 // QA round 19 F3: home offsets move the frame as G92 does.
-                if let Some(m) = words
-                    .iter()
-                    .filter(|&&(l, _)| l == 'M')
-                    .find_map(|&(_, v)| v.filter(|&v| v == 206.0 || v == 428.0))
-                {
+                if let Some((m, what)) = words.iter().find_map(|&(l, v)| {
+                    let m = v.filter(|v| l == 'M' && v.fract() == 0.0 && (0.0..1e5).contains(v))?;
+                    Some((m, super::read::m_frame(m as u32)?))
+                }) {
                     return Err(bad(
                         field,
                         format!(
-                            "M{m} sets home offsets, so the controller would not go where \
-                             pcpp's moves (millimetres, absolute, in the frame the scan was \
-                             placed in) were checked to go: remove it"
+                            "M{m} {what}, so the controller would not go where pcpp's moves \
+                             (millimetres, absolute, in the frame the scan was placed in) were \
+                             checked to go: remove it"
                         ),
                     ));
                 }
@@ -611,13 +623,8 @@ impl MachineProfile {
                         // a later line of the start cancels are fine.
                         100 if has('L') || has('P') => "sets work or tool offsets",
                         520 => "sets a local coordinate offset",
-                        410..=429 | 430..=439 | 510..=519 | 680..=689 if name == "start" => {
-                            let cancel = match g {
-                                410..=429 => 400,
-                                430..=439 => 490,
-                                510..=519 => 500,
-                                _ => 690,
-                            };
+                        _ if name == "start" && modal_frame(g).is_some() => {
+                            let cancel = modal_frame(g).map_or(0, |m| m.0);
                             active.retain(|a| a.0 != cancel);
                             active.push((cancel, field.clone(), g));
                             continue;
@@ -681,12 +688,7 @@ impl MachineProfile {
             "G90",
         )?;
         if let Some((cancel, field, g)) = active.into_iter().next() {
-            let what = match g {
-                410..=429 => "offsets the path by the tool's radius",
-                430..=439 => "applies a tool length offset, which shifts every Z after it",
-                510..=519 => "scales the coordinates",
-                _ => "rotates the coordinates",
-            };
+            let what = modal_frame(g).map_or("", |m| m.1);
             return Err(bad(
                 field,
                 format!(

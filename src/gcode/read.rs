@@ -1041,17 +1041,20 @@ fn m_code(line: &str, w: &Word) -> Result<Option<u32>, GcodeLineProblem> {
         98 => Err(flow("a subprogram or macro call")),
         99 => Err(flow("a subprogram return or program loop")),
         808 => Err(flow("a repeat marker")),
-        206 => Err(P::UnknownFrame {
-            word,
-            column,
-            what: "sets home offsets",
-        }),
-        428 => Err(P::UnknownFrame {
-            word,
-            column,
-            what: "sets home offsets (Marlin; elsewhere, as in LinuxCNC, a user's own code)",
-        }),
-        _ => Ok(Some(code)),
+        _ => match m_frame(code) {
+            Some(what) => Err(P::UnknownFrame { word, column, what }),
+            None => Ok(Some(code)),
+        },
+    }
+}
+
+/// What an M-code does to the frame the moves after it are in, for the
+/// reader and the profile's checks of its start block.
+pub(crate) fn m_frame(code: u32) -> Option<&'static str> {
+    match code {
+        206 => Some("sets home offsets"),
+        428 => Some("sets home offsets (Marlin; elsewhere, as in LinuxCNC, a user's own code)"),
+        _ => None,
     }
 }
 
