@@ -27,7 +27,7 @@ use crate::quality::{
     QualitySummary,
 };
 use crate::registration::Registration;
-use crate::sampling::try_sample_subpath;
+use crate::sampling::{try_sample_subpath, DrawingSize, MAX_SAMPLES};
 use crate::spacing::{blobs, close_lines, Line};
 use crate::spline::{local_geometry, LocalGeometry};
 use crate::stats::{path_stats, PathStats};
@@ -154,6 +154,30 @@ impl Coverage {
     }
 }
 
+/// The size of `drawn` as stage 4 samples it (d/2 after `placement`,
+/// spec section 3), refused past [`crate::sampling::MAX_DRAWING_SAMPLES`]
+/// before a sample is made. A subpath too long by itself is named by its
+/// own error ([`try_sample_subpath`]'s, which counts before it
+/// allocates).
+pub fn drawing_size(
+    drawn: &[Subpath2],
+    nozzle: &Nozzle,
+    placement: &Placement,
+) -> Result<DrawingSize> {
+    let spacing = 0.5 * nozzle.inner_diameter_mm;
+    let size = DrawingSize::of(drawn, placement.scale, spacing);
+    if size.check().is_err() {
+        for sub in drawn {
+            let one = DrawingSize::of(std::slice::from_ref(sub), placement.scale, spacing);
+            if one.samples > MAX_SAMPLES as f64 {
+                try_sample_subpath(&placement.apply_subpath(sub), spacing)?;
+            }
+        }
+        size.check()?;
+    }
+    Ok(size)
+}
+
 /// Stage 4: placement, sampling at d/2 (spec section 3), projection
 /// (section 4) and the spline's local geometry (section 5).
 pub fn surface_path(
@@ -167,6 +191,7 @@ pub fn surface_path(
     if drawn.is_empty() {
         return Err(Error::Plan("the drawing has no path to print".into()));
     }
+    drawing_size(drawn, nozzle, placement)?;
     let spacing = 0.5 * nozzle.inner_diameter_mm;
     let mut warnings = Vec::new();
     let mut pieces = Vec::new();

@@ -15,6 +15,21 @@ pub const MIN_SPACING_MM: f64 = 1e-3;
 /// Most samples per subpath: ten million at d/2 = 0.3 mm is 3 km of path.
 pub const MAX_SAMPLES: usize = 10_000_000;
 
+/// Most samples of one drawing, all its subpaths together (QA round 19
+/// F11: vpype's 500-polyline benchmark SVG, 500 subpaths each under the
+/// per-subpath limit, scaled to 9.7 M samples, ran 7.6 min, peaked at
+/// 5.3 GB and wrote a week of print with no word first).
+pub const MAX_DRAWING_SAMPLES: usize = MAX_SAMPLES;
+
+/// From this many samples a drawing is large: the command line says so
+/// before it plans (minutes, and gigabytes: [`BYTES_PER_SAMPLE`]); the
+/// page plans no more than about this many in one drawing.
+pub const LARGE_DRAWING_SAMPLES: usize = 1_000_000;
+
+/// Peak memory a planned sample costs natively, about (QA round 19 F11:
+/// 5.28 GB at 9.7 M samples on the demo part, 545 bytes a sample).
+pub const BYTES_PER_SAMPLE: f64 = 550.0;
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SamplingError {
     /// The spacing is NaN, infinite, zero or negative.
@@ -37,6 +52,114 @@ pub enum SamplingError {
         count: f64,
         spacing_mm: f64,
     },
+    /// The drawing as a whole would exceed [`MAX_DRAWING_SAMPLES`] (its
+    /// subpaths each within [`MAX_SAMPLES`]).
+    #[error(
+        "the drawing needs about {:.1} million samples ({:.1} m of path at {spacing_mm} mm \
+         spacing, d/2), more than the {} million planned in one drawing; check the drawing's \
+         units and scale, or split it into several drawings",
+        .count / 1e6,
+        .length_mm / 1e3,
+        MAX_DRAWING_SAMPLES / 1_000_000
+    )]
+    DrawingTooLarge {
+        count: f64,
+        length_mm: f64,
+        spacing_mm: f64,
+    },
+}
+
+/// How large a drawing is as the planner samples it: its length and
+/// samples estimated from its drawn length, before any is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrawingSize {
+    /// At most this many samples (each subpath's length over the spacing,
+    /// rounded up, plus one per drawn point: each corner adds at most one).
+    pub samples: f64,
+    /// The drawn length, scaled (mm).
+    pub length_mm: f64,
+    /// The spacing it was counted at (mm).
+    pub spacing_mm: f64,
+}
+
+impl DrawingSize {
+    /// The size of `subpaths` scaled by `scale` (the placement's, which
+    /// alone changes lengths) and sampled at `spacing_mm` (spec section 3:
+    /// d/2).
+    pub fn of(subpaths: &[Subpath2], scale: f64, spacing_mm: f64) -> DrawingSize {
+        let mut size = DrawingSize {
+            samples: 0.0,
+            length_mm: 0.0,
+            spacing_mm,
+        };
+        for sub in subpaths {
+            let length = sub.length_mm() * scale.abs();
+            size.length_mm += length;
+            size.samples += estimated_samples(length, sub.points.len(), spacing_mm);
+        }
+        size
+    }
+
+    /// Refuses a drawing past [`MAX_DRAWING_SAMPLES`] (or whose size is
+    /// NaN), before a sample is made.
+    pub fn check(&self) -> Result<(), SamplingError> {
+        if self.samples.is_nan() || self.samples > MAX_DRAWING_SAMPLES as f64 {
+            return Err(SamplingError::DrawingTooLarge {
+                count: self.samples,
+                length_mm: self.length_mm,
+                spacing_mm: self.spacing_mm,
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether the drawing is large enough to be told of before it is
+    /// planned ([`LARGE_DRAWING_SAMPLES`]).
+    pub fn is_large(&self) -> bool {
+        self.samples >= LARGE_DRAWING_SAMPLES as f64
+    }
+
+    /// What a user is told before a large drawing is planned (see
+    /// [`Self::is_large`]): its length, its samples, the memory they take
+    /// ([`BYTES_PER_SAMPLE`]) and how long it prints at `speed_mm_s`.
+    pub fn large_note(&self, speed_mm_s: f64) -> Option<String> {
+        if !self.is_large() {
+            return None;
+        }
+        let print = if speed_mm_s > 0.0 && speed_mm_s.is_finite() {
+            format!(
+                ", and it would print for about {} at {speed_mm_s} mm/s",
+                duration_text(self.length_mm / speed_mm_s)
+            )
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "a large drawing: {:.1} m of path, about {:.1} million samples at {} mm spacing \
+             (d/2): planning it may take minutes and about {:.1} GB of memory{print}; check the \
+             drawing's units and scale (Ctrl-C stops)",
+            self.length_mm / 1e3,
+            self.samples / 1e6,
+            self.spacing_mm,
+            self.samples * BYTES_PER_SAMPLE / 1e9,
+        ))
+    }
+}
+
+/// `s` seconds in hours, or in days from two days on.
+fn duration_text(s: f64) -> String {
+    let hours = s / 3600.0;
+    if hours >= 48.0 {
+        format!("{:.1} days", hours / 24.0)
+    } else {
+        format!("{hours:.1} h")
+    }
+}
+
+/// Samples a subpath of `length_mm` with `points` drawn points needs at
+/// `spacing_mm`, at most (see [`DrawingSize::samples`]).
+pub fn estimated_samples(length_mm: f64, points: usize, spacing_mm: f64) -> f64 {
+    (length_mm / spacing_mm).ceil() + points as f64
 }
 
 /// Samples of one subpath, with the drawn corners marked.
@@ -313,6 +436,105 @@ mod tests {
             closed,
             source: "test".into(),
         }
+    }
+
+    /// A small deterministic generator for the tests.
+    fn lcg(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn a_drawings_size_bounds_its_samples_from_above() {
+        // Random polylines, some with sharp corners, some curves with
+        // points closer than the spacing, scaled up and down: the size
+        // counted before sampling is never below what sampling makes.
+        let mut seed = 7u64;
+        for case in 0..200 {
+            let n = 2 + (lcg(&mut seed) * 40.0) as usize;
+            let step = [0.01, 0.2, 3.0][case % 3];
+            let mut p = (0.0, 0.0);
+            let pts: Vec<(f64, f64)> = (0..n)
+                .map(|_| {
+                    p.0 += (lcg(&mut seed) - 0.5) * step;
+                    p.1 += (lcg(&mut seed) - 0.5) * step;
+                    p
+                })
+                .collect();
+            let corner: Vec<bool> = (0..n)
+                .map(|i| i == 0 || i == n - 1 || lcg(&mut seed) < 0.3)
+                .collect();
+            let drawn = sub(&pts, &corner, false);
+            let scale = [0.5, 1.0, 2.5][case % 3];
+            let spacing = 0.3015;
+            let scaled = Subpath2 {
+                points: drawn.points.iter().map(|&q| q * scale).collect(),
+                ..drawn.clone()
+            };
+            let made = try_sample_subpath(&scaled, spacing).unwrap().len() as f64;
+            let size = DrawingSize::of(std::slice::from_ref(&drawn), -scale, spacing);
+            assert!(
+                made <= size.samples,
+                "case {case}: {made} > {}",
+                size.samples
+            );
+            assert!((size.length_mm - scaled.length_mm()).abs() < 1e-9 * size.length_mm.max(1.0));
+        }
+    }
+
+    #[test]
+    fn a_drawing_past_its_limit_is_refused_and_a_large_one_is_told_of() {
+        let spacing = 0.3;
+        // Subpaths each within the limit for one, together past the one
+        // for a drawing (QA round 19 F11: 500 of them made 9.7 M samples).
+        let line = sub(&[(0.0, 0.0), (1.8e6, 0.0)], &[true, true], false);
+        let one = DrawingSize::of(std::slice::from_ref(&line), 1.0, spacing);
+        assert!(one.samples < MAX_SAMPLES as f64 && one.check().is_ok());
+        let two = DrawingSize::of(&[line.clone(), line.clone()], 1.0, spacing);
+        match two.check() {
+            Err(e @ SamplingError::DrawingTooLarge { .. }) => {
+                let m = e.to_string();
+                assert!(
+                    m.contains("about 12.0 million samples (3600.0 m of path"),
+                    "{m}"
+                );
+                assert!(m.contains("more than the 10 million"), "{m}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // The placement's scale counts: halved, the two fit.
+        assert!(DrawingSize::of(&[line.clone(), line], 0.5, spacing)
+            .check()
+            .is_ok());
+
+        // Told of from LARGE_DRAWING_SAMPLES on, with its memory and print.
+        let short = sub(&[(0.0, 0.0), (299_000.0, 0.0)], &[true, true], false);
+        let size = DrawingSize::of(std::slice::from_ref(&short), 1.0, spacing);
+        assert!(!size.is_large() && size.large_note(5.0).is_none());
+        let long = sub(&[(0.0, 0.0), (3.0e6, 0.0)], &[true, true], false);
+        let size = DrawingSize::of(std::slice::from_ref(&long), 1.0, spacing);
+        assert!(size.is_large());
+        let note = size.large_note(5.0).unwrap();
+        assert!(
+            note.starts_with("a large drawing: 3000.0 m of path, about 10.0 million samples"),
+            "{note}"
+        );
+        assert!(note.contains("about 5.5 GB of memory"), "{note}");
+        assert!(
+            note.contains("print for about 6.9 days at 5 mm/s"),
+            "{note}"
+        );
+        let hours = DrawingSize::of(std::slice::from_ref(&short), 1.1, spacing);
+        let note = hours.large_note(5.0).unwrap();
+        assert!(note.contains("print for about 18.3 h at 5 mm/s"), "{note}");
+        // A NaN size (a NaN scale) is refused, not passed.
+        assert!(
+            DrawingSize::of(std::slice::from_ref(&short), f64::NAN, spacing)
+                .check()
+                .is_err()
+        );
     }
 
     #[test]

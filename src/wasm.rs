@@ -23,7 +23,7 @@ use crate::mesh::MAX_SCAN_BYTES;
 use crate::pipeline::{self, PlanSettings};
 use crate::placement::{self, Bed, ScanPlacement};
 use crate::planners::PlannerKind;
-use crate::sampling::{try_sample_subpath, MAX_SAMPLES};
+use crate::sampling::{DrawingSize, SamplingError, MAX_DRAWING_SAMPLES, MAX_SAMPLES};
 use crate::svg::Placement;
 
 mod scan;
@@ -47,7 +47,7 @@ const _: () = assert!(PAGE_MAX_SCAN_BYTES < MAX_SCAN_BYTES);
 
 /// Most samples the page plans for one drawing, all subpaths together: one
 /// million (300 m of path at the 20-gauge tip's d/2). The core allows
-/// [`MAX_SAMPLES`] per subpath, but a sample costs the page about 1.7 KB of
+/// [`MAX_DRAWING_SAMPLES`] in a drawing, but a sample costs the page about 1.7 KB of
 /// wasm memory at the peak of a plan (measured: a raster of 838 k points on
 /// the demo part took the worker from 25 to 1407 MiB; its JSON report alone
 /// is 281 MiB), so ten million would not fit a tab's 4 GiB.
@@ -181,7 +181,8 @@ const MIB: f64 = (1u64 << 20) as f64;
 
 /// The page's limits, for its messages and the README: `{scan_bytes,
 /// svg_bytes, samples, core_scan_bytes, core_samples_per_subpath,
-/// gcode_bytes}` (the last: the largest G-code file the reader checks).
+/// core_samples_per_drawing, gcode_bytes}` (the last: the largest G-code
+/// file the reader checks).
 #[wasm_bindgen(js_name = pageLimits)]
 pub fn page_limits() -> JsValue {
     let o = js_sys::Object::new();
@@ -190,6 +191,11 @@ pub fn page_limits() -> JsValue {
     set(&o, "samples", &(PAGE_MAX_SAMPLES as f64).into());
     set(&o, "core_scan_bytes", &(MAX_SCAN_BYTES as f64).into());
     set(&o, "core_samples_per_subpath", &(MAX_SAMPLES as f64).into());
+    set(
+        &o,
+        "core_samples_per_drawing",
+        &(MAX_DRAWING_SAMPLES as f64).into(),
+    );
     set(&o, "gcode_bytes", &(MAX_GCODE_BYTES as f64).into());
     o.into()
 }
@@ -747,42 +753,42 @@ struct RegistrationView<'a> {
     notes: &'a [String],
 }
 
-/// Samples a drawing would need at `spacing` after `placement`, estimated
-/// from its drawn length (each corner adds at most one).
-fn estimated_samples(sub: &crate::svg::Subpath2, placement: &Placement, spacing: f64) -> f64 {
-    (sub.length_mm() * placement.scale.abs() / spacing).ceil() + sub.points.len() as f64
-}
-
 /// The page's sample limit ([`PAGE_MAX_SAMPLES`]) over the whole drawing,
-/// after the core's own per-subpath limit, whose message (from
-/// [`try_sample_subpath`], which counts before it allocates) the page shows
-/// as the CLI would.
+/// after the core's own limit on a subpath, whose message (from
+/// [`crate::sampling::try_sample_subpath`], which counts before it
+/// allocates) the page shows as the CLI would.
 fn check_samples(path: &LoadedPath, settings: &PlanSettings) -> Result<(), JsValue> {
-    let spacing = 0.5 * settings.nozzle.inner_diameter_mm;
     let placement = &settings.placement;
-    let mut total = 0.0;
-    for sub in &path.drawn.subpaths {
-        let n = estimated_samples(sub, placement, spacing);
-        if n > MAX_SAMPLES as f64 {
-            try_sample_subpath(&placement.apply_subpath(sub), spacing)
-                .map_err(|e| core_err(e.into()))?;
-        }
-        total += n;
-    }
-    if total > PAGE_MAX_SAMPLES as f64 {
+    let size =
+        match crate::pipeline::drawing_size(&path.drawn.subpaths, &settings.nozzle, placement) {
+            Ok(size) => size,
+            // Past the core's limit for a drawing, the page's own (lower) one
+            // is the one to name.
+            Err(crate::Error::Sampling(SamplingError::DrawingTooLarge {
+                count,
+                length_mm,
+                spacing_mm,
+            })) => DrawingSize {
+                samples: count,
+                length_mm,
+                spacing_mm,
+            },
+            Err(e) => return Err(core_err(e)),
+        };
+    if size.samples > PAGE_MAX_SAMPLES as f64 {
         return Err(kind_err(
             "limit",
             &format!(
                 "{}: about {:.2} million samples at {} mm spacing (d/2) after scaling by {}, \
                  more than the {} million this page plans in one drawing; shorten the path or \
                  scale it down, use a wider nozzle, or plan it with the command line (pcpp plan \
-                 allows {} million per subpath)",
+                 allows {} million)",
                 path.file.name,
-                total / 1e6,
-                spacing,
+                size.samples / 1e6,
+                size.spacing_mm,
                 placement.scale,
                 PAGE_MAX_SAMPLES / 1_000_000,
-                MAX_SAMPLES / 1_000_000
+                MAX_DRAWING_SAMPLES / 1_000_000
             ),
         ));
     }

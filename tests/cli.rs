@@ -3420,3 +3420,61 @@ fn a_program_switched_to_inches_is_told_so() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// QA round 19 F11: a 2.8 MB drawing of 500 polylines planned for 7.6 min,
+/// peaked at 5.3 GB and wrote a week of print, and said nothing first.
+/// Now a large drawing is told of before it is planned, and one past the
+/// limit for a drawing is refused at once, naming the file.
+#[test]
+fn a_large_drawing_is_told_of_before_planning_and_a_huge_one_refused() {
+    let dir = temp_dir("large-drawing");
+    let lines = |n: usize, len: f64| -> String {
+        let paths: String = (0..n)
+            .map(|i| format!(r#"<path d="M0 {:.3} H{len}"/>"#, i as f64 * 0.001))
+            .collect();
+        format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{len}mm" height="10mm" viewBox="0 0 {len} 10"><g fill="none" stroke="black">{paths}</g></svg>"#
+        )
+    };
+    // 1000 lines of 310 mm: 310 m, 1.03 M samples at the default d/2;
+    // placed off the scan, so the plan fails fast after the warning.
+    let large = dir.join("large.svg");
+    std::fs::write(&large, lines(1000, 310.0)).unwrap();
+    let out = dir.join("out.gcode");
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &large,
+        &["--place", "1000,1000", "-q", "-o", s(&out)],
+    );
+    let err = stderr(&o);
+    assert_eq!(code(&o), 1, "{err}");
+    let warning = format!(
+        "warning: {}: a large drawing: 310.0 m of path, about 1.0 million samples",
+        s(&large)
+    );
+    let (at_warning, at_error) = (err.find(&warning), err.find("misses the scan"));
+    assert!(
+        at_warning.is_some() && at_warning < at_error,
+        "told of first: {err}"
+    );
+    assert!(
+        err.contains("about 0.6 GB of memory") && err.contains("print for about 17.2 h"),
+        "{err}"
+    );
+    // Two lines of 1.8 km: 6 M samples each, 12 M together, past the
+    // 10 M of a drawing: refused before planning, naming the file.
+    let huge = dir.join("huge.svg");
+    std::fs::write(&huge, lines(2, 1.8e6)).unwrap();
+    let o = plan_on(
+        &demo_file(demo::DEMO_SCAN_NAME),
+        &huge,
+        &["--place", "0,0", "-q", "-o", s(&out)],
+    );
+    let err = stderr(&o);
+    assert_eq!(code(&o), 1, "{err}");
+    assert!(
+        err.contains("huge.svg") && err.contains("the drawing needs about 11.9 million samples"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

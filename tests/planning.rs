@@ -457,6 +457,38 @@ fn regression_tiny_elements_of_a_real_drawing_stopped_the_whole_plan() {
 }
 
 #[test]
+fn a_drawing_too_large_as_a_whole_is_refused_before_it_is_sampled() {
+    // QA round 19 F11: 500 subpaths, each far within the limit for one,
+    // made 9.7 M samples together, and a run of 7.6 min and 5.3 GB.
+    // Here 1.8 km lines at d/2 = 0.3015 mm: 6 M samples each, 12 M both.
+    let settings = PlanSettings::default();
+    let flat = Surface::new(height_field(
+        &range(0.0, 40.0, 4),
+        &range(0.0, 40.0, 4),
+        |_, _| 0.0,
+    ))
+    .unwrap();
+    let long = line(DVec2::new(0.0, 5.0), DVec2::new(1.8e6, 5.0));
+    let e = pipeline::plan(&flat, &[long.clone(), long.clone()], &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the drawing needs about 11.9 million samples (3600.0 m of path at 0.3015 mm")
+            && e.contains("more than the 10 million planned in one drawing"),
+        "{e}"
+    );
+    // A subpath too long by itself is still named by its own error.
+    let longer = line(DVec2::new(0.0, 5.0), DVec2::new(4.0e6, 5.0));
+    let e = pipeline::plan(&flat, &[long, longer], &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("line: ") && e.contains("samples needed at 0.3015 mm spacing"),
+        "{e}"
+    );
+}
+
+#[test]
 fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
     let settings = PlanSettings::default();
     // Two pads of a footprint drawn as zero-length lines (their width is

@@ -804,7 +804,9 @@ fn too_long_paths_are_refused_with_the_page_and_the_core_messages() {
     let (message, kind) = message_and_kind(&err);
     assert_eq!(kind, "limit", "{message}");
     assert!(
-        message.contains(demo::DEMO_PATH_NAME) && message.contains("1 million"),
+        message.contains(demo::DEMO_PATH_NAME)
+            && message.contains("1 million")
+            && message.contains("(pcpp plan allows 10 million)"),
         "{message}"
     );
     // Scaled 50 000 times one line needs more samples than the core allows

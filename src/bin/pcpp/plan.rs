@@ -144,6 +144,23 @@ fn centre_on_scan(
     Ok(())
 }
 
+/// Before a large drawing is planned, how large it is (QA round 19 F11: a
+/// week of print took 7.6 min and 5.3 GB to plan, with no word until it
+/// was done). A drawing that cannot be read or is too large is left to
+/// the plan's own error.
+fn warn_large_drawing(inputs: &Inputs, plan: &pcpp::pipeline::PlanSettings, progress: &Progress) {
+    let Ok(drawn) = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name) else {
+        return;
+    };
+    let size = pcpp::pipeline::drawing_size(&drawn.subpaths, &plan.nozzle, &plan.placement);
+    if let Some(note) = size
+        .ok()
+        .and_then(|s| s.large_note(plan.process.speed_mm_s))
+    {
+        progress.warn(&[format!("{}: {note}", input_shown(&inputs.svg_path))]);
+    }
+}
+
 /// Errors of planning on a prepared scan: the drawn path's file is named.
 /// What the scan's import and registration noticed is said first: it may
 /// be the cause (a scan read in the wrong units leaves nothing to print).
@@ -263,6 +280,7 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
         })
         .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
+    warn_large_drawing(&inputs, &settings.plan, progress);
     progress.step(format!("planning ({})...", settings.plan.planner));
     let mut noted = Vec::new();
     let output = job::run_on_noting(
@@ -362,6 +380,7 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
     job::refuse_blocking_strays(&inputs.prepared, &profile)
         .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
+    warn_large_drawing(&inputs, &settings.plan, progress);
     progress.step("planning with all five planners...");
     let comparison = job::compare_on(
         &inputs.prepared,
