@@ -1655,6 +1655,38 @@ pub fn write_outputs(
     // knows it (QA round 19 F6: `G0 X40 Y40 Z0.2`, inside the part, was
     // written with a warning that the block moves the head).
     let start = first.start_moves(profile.start.len());
+    // A start or end block's move out of the build volume, where the
+    // program's own points are never written (QA round 19: not flagged):
+    // the block or the volume is wrong. Not the part's safety (a firmware
+    // stops at its limits, or alarms), so said, not refused.
+    let end_moves = first
+        .moves
+        .iter()
+        .filter(|m| m.kind == crate::gcode::MoveKind::End)
+        .map(|m| ("end".to_string(), m.to));
+    let out_of_volume = start
+        .iter()
+        .map(|&(_, to, _, i)| (format!("start[{i}]"), to))
+        .chain(end_moves)
+        .find(|(_, to)| !profile.build_volume.contains(*to));
+    if let Some((field, to)) = out_of_volume {
+        let (lo, hi) = (profile.build_volume.min_mm, profile.build_volume.max_mm);
+        report.warnings.push(format!(
+            "profile {}: its `{field}` moves the head to ({:.3}, {:.3}, {:.3}), outside its \
+             build volume (x {}..{}, y {}..{}, z {}..{}), where the program's own moves never \
+             go: keep the block's moves inside the volume, or correct `build_volume`",
+            profile.label(),
+            to.x,
+            to.y,
+            to.z,
+            lo.x,
+            hi.x,
+            lo.y,
+            hi.y,
+            lo.z,
+            hi.z
+        ));
+    }
     let start_check = check_moves(
         &scan.surface,
         start

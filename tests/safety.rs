@@ -690,6 +690,39 @@ fn regression_profile_blocks_that_move_into_the_part_are_refused() {
         "{:?}",
         out.report.warnings
     );
+    let outside = |w: &Vec<String>| -> Vec<String> {
+        w.iter()
+            .filter(|w| w.contains("outside its build volume"))
+            .cloned()
+            .collect()
+    };
+    assert_eq!(outside(&out.report.warnings), Vec::<String>::new());
+    // A start or end block's move out of the build volume is said, naming
+    // the field and where (QA round 19: not flagged); the part is not at
+    // risk (the firmware stops at its limits), so the G-code is written.
+    let (lo, hi) = (start.build_volume.min_mm, start.build_volume.max_mm);
+    start.start[3] = format!("G0 X{} Y40 Z30", hi.x + 5.0);
+    let out = run(&start, false).unwrap();
+    let said = outside(&out.report.warnings);
+    assert!(
+        said.len() == 1
+            && said[0].starts_with(&format!(
+                "profile lab-bench.json: its `start[3]` moves the head to ({:.3}, 40.000, \
+                 30.000), outside its build volume (x {}..{}",
+                hi.x + 5.0,
+                lo.x,
+                hi.x
+            )),
+        "{said:?}"
+    );
+    let mut park = MachineProfile::from_json(&text, "lab-bench.json").unwrap();
+    park.end = vec!["M107".into(), format!("G0 X0 Y{}", lo.y - 1.0)];
+    let out = run(&park, false).unwrap();
+    let said = outside(&out.report.warnings);
+    assert!(
+        said.len() == 1 && said[0].contains("its `end` moves the head to (0.000, "),
+        "{said:?}"
+    );
     let mut dispense = marlin();
     dispense.dispense_on = vec!["G1 Z-0.5".into(), "M106 S255".into()];
     let e = run(&dispense, true)
