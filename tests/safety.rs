@@ -680,7 +680,19 @@ fn regression_profile_blocks_that_move_into_the_part_are_refused() {
         said.contains("machine profile lab-bench.json, field `start[3]`: puts the nozzle closer"),
         "{said}"
     );
+    // A bare coordinate moves in the machine's motion mode (Grbl's `Z0`):
+    // followed there too (QA round 19: only warned about).
     start.start[3] = "G0 X40 Y40 Z30".into();
+    start.start.push("Z0.2".into());
+    let said = run(&start, false)
+        .err()
+        .expect("a bare Z into the part")
+        .to_string();
+    assert!(
+        said.contains("machine profile lab-bench.json, field `start[4]`: puts the nozzle closer"),
+        "{said}"
+    );
+    start.start.pop();
     let out = run(&start, false).unwrap();
     assert!(
         out.report

@@ -89,7 +89,7 @@ impl WrittenProgram {
             .take(lines)
             .flat_map(|l| [l, "\n"])
             .collect();
-        let Ok(read) = super::read_gcode(&text, "start") else {
+        let Ok(read) = read_start_block(&text, "start") else {
             return Vec::new();
         };
         let at = |line: usize| (self.header.1 + line, line - 1);
@@ -203,6 +203,35 @@ pub fn write_program(
     })
 }
 
+/// A start block's text as the G-code reader follows it, its lines
+/// numbered as in `text`. The block runs in whatever motion mode the
+/// machine is in, so a bare coordinate (Grbl's `Z0`) is a straight move
+/// there, G0 or G1 alike (Grbl starts in G0; Marlin ignores the line, so
+/// taking it as a move is the cautious reading): it is read after a `G0`
+/// that moves nothing, where the reader alone refuses it (QA round 19: a
+/// start's bare `Z0` into the part was only warned about).
+fn read_start_block(text: &str, name: &str) -> Result<super::GcodeProgram, super::GcodeReadError> {
+    let mut read = super::read_gcode(&format!("G0\n{text}"), name).map_err(|e| match e {
+        super::GcodeReadError::Line {
+            file,
+            line,
+            problem,
+        } => super::GcodeReadError::Line {
+            file,
+            line: line.saturating_sub(1),
+            problem,
+        },
+        e => e,
+    })?;
+    for m in &mut read.moves {
+        m.line -= 1;
+    }
+    for u in &mut read.unknown_moves {
+        u.line -= 1;
+    }
+    Ok(read)
+}
+
 /// The header's note on the program's first move, which no check covers.
 const FIRST_RISE_NOTE: &str = "first move: a rise to the safe travel height from wherever the \
      head stands, which pcpp cannot check (start with the nozzle above the part)";
@@ -234,7 +263,7 @@ pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
     if text.trim().is_empty() {
         return None;
     }
-    let read = match super::read_gcode(&text, &profile.name) {
+    let read = match read_start_block(&text, &profile.name) {
         Ok(read) => read,
         Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
     };
@@ -829,6 +858,9 @@ M84
             ),
             (vec!["G21", "M107 ; fan off", "T0", "M104 S0"], None),
             (vec!["G21", "G1Z5"], Some("start[1] `G1Z5`")),
+            // A bare coordinate moves in the machine's motion mode
+            // (QA round 19: "a line the reader cannot follow").
+            (vec!["G21", "M107", "Z0"], Some("start[2] `Z0`")),
             (vec![], None),
         ] {
             p.start = start.iter().map(|l| l.to_string()).collect();
