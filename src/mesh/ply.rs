@@ -115,6 +115,8 @@ struct ShortFace {
 
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     let header = parse_header(bytes, file)?;
+    no_vertex_element(&header, file)?;
+    faces_under_another_name(&header, file)?;
     let body = bytes.get(header.body_start..).unwrap_or_default();
     // An ascii body under a CR-only header has CR-only lines too: as LF,
     // its lines are numbered as the header's are.
@@ -172,6 +174,82 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         warnings,
         rounding: None,
     })
+}
+
+/// A header without a 'vertex' element whose vertices are elsewhere (an
+/// element of x, y and z under another name) or referred to (faces): read,
+/// it would be no vertices, an empty scan or faces out of range.
+fn no_vertex_element(header: &Header, file: &str) -> Result<(), MeshError> {
+    if header.elements.iter().any(|e| e.name == "vertex") {
+        return Ok(());
+    }
+    let scalar = |e: &Element, name: &str| {
+        e.props
+            .iter()
+            .any(|p| p.name == name && matches!(p.kind, Kind::Scalar(_)))
+    };
+    if let Some(e) = header
+        .elements
+        .iter()
+        .find(|e| ["x", "y", "z"].iter().all(|n| scalar(e, n)))
+    {
+        return Err(MeshError::syntax(
+            file,
+            e.line,
+            format!(
+                "element '{}' has x, y and z, but the header declares no element 'vertex', \
+                 the one PLY vertices are read from: is it the vertices (rename it 'vertex')?",
+                e.name
+            ),
+        ));
+    }
+    if let Some(e) = header
+        .elements
+        .iter()
+        .find(|e| e.count > 0 && (e.name == "face" || e.name == "tristrips"))
+    {
+        return Err(MeshError::syntax(
+            file,
+            e.line,
+            format!(
+                "element '{}' refers to vertices, but the header declares no element 'vertex'",
+                e.name
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A header without faces or strips whose surface is in an element of
+/// another name ('faces', 'polygon') holding a `vertex_indices` list: read,
+/// it would be skipped and the scan meshed as a point cloud. A range grid
+/// (the Stanford raw scans) holds such lists too, and is a point cloud.
+fn faces_under_another_name(header: &Header, file: &str) -> Result<(), MeshError> {
+    let surface = |e: &&Element| e.count > 0 && (e.name == "face" || e.name == "tristrips");
+    if header.elements.iter().any(|e| surface(&e)) {
+        return Ok(());
+    }
+    let listed = header.elements.iter().find_map(|e| {
+        let p = e.props.iter().find(|p| {
+            matches!(p.kind, Kind::List { .. })
+                && (p.name == "vertex_indices" || p.name == "vertex_index")
+        })?;
+        (e.count > 0 && e.name != "range_grid" && e.name != "vertex").then_some((e, p))
+    });
+    match listed {
+        Some((e, p)) => Err(MeshError::syntax(
+            file,
+            e.line,
+            format!(
+                "element '{}' has the list '{}' of a surface, but PLY faces are read from an \
+                 element named 'face' (or 'tristrips'), which the header does not declare: \
+                 are these the faces (rename it 'face')? Read as it is, the scan would be a \
+                 point cloud",
+                e.name, p.name
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// `e` with the sentence `more` after its message, its file and line kept.
@@ -419,7 +497,10 @@ fn vertex_count_fitting<'h>(
         };
         let polygon = r.int(count).filter(|n| (3..=16).contains(n));
         let Some(n) = polygon else { continue };
-        if !(0..n).all(|_| r.index(item).is_some_and(|i| (0..fits as i64).contains(&i))) {
+        if !(0..n).all(|_| {
+            r.index(item)
+                .is_some_and(|i| i.is_ok_and(|i| (0..fits as i64).contains(&i)))
+        }) {
             continue;
         }
         walked += 1;
@@ -612,8 +693,13 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                 let name = words.next().unwrap_or_default();
                 let count = words
                     .next()
-                    .and_then(|c| c.parse::<u64>().ok())
                     .ok_or_else(|| bad(format!("element '{name}' needs a count")))?;
+                let count = count.parse::<u64>().map_err(|_| {
+                    bad(format!(
+                        "element '{name}' has count '{count}', not a whole number from 0 to \
+                         2^64 - 1"
+                    ))
+                })?;
                 elements.push(Element {
                     name: name.into(),
                     count,
@@ -939,7 +1025,17 @@ impl Body<'_> {
                     if matches!(role, Role::FaceIndices | Role::StripIndices) {
                         polygon.clear();
                         for _ in 0..n {
-                            let v = r.index(item).ok_or_else(|| truncated(i))?;
+                            let v = r.index(item).ok_or_else(|| truncated(i))?.map_err(|f| {
+                                MeshError::invalid(
+                                    file,
+                                    format!(
+                                        "'{}' element {i}: list '{}' holds {f}, {}",
+                                        element.name,
+                                        prop.name,
+                                        not_an_index(f)
+                                    ),
+                                )
+                            })?;
                             self.push_index(*role, polygon, i, v, None)?;
                         }
                         self.end_list(*role, polygon, i, None);
@@ -1087,7 +1183,22 @@ impl Body<'_> {
         let count = check_count(file, element, min_bytes, r.remaining(), "binary data")?;
         match element.name.as_str() {
             "vertex" => self.vertices.reserve_exact(count),
-            "face" if early.is_none() => self.triangles.reserve(count),
+            // A face makes a triangle only with 3 indices or more: no more
+            // than the bytes left hold (not `count`, which needs 1 byte
+            // each and would reserve 12 per byte of the body).
+            "face" if early.is_none() => {
+                let item = element
+                    .props
+                    .iter()
+                    .zip(&roles)
+                    .find_map(|(p, role)| match (p.kind, role) {
+                        (Kind::List { item, .. }, Role::FaceIndices) => Some(item.size()),
+                        _ => None,
+                    })
+                    .unwrap_or(1);
+                let fit = r.remaining() / (min_bytes + 3 * item);
+                self.triangles.reserve(count.min(fit));
+            }
             _ => {}
         }
         let mut i = 0;
@@ -1217,7 +1328,20 @@ impl Body<'_> {
                                 for _ in 0..n {
                                     let token = t.next().ok_or_else(|| missing(&t))?;
                                     let v =
-                                        ascii_int(token).ok_or_else(|| not_number(&t, token))?;
+                                        ascii_int(token).ok_or_else(|| match parse_f64(token) {
+                                            Some(f) => MeshError::syntax(
+                                                file,
+                                                t.line,
+                                                format!(
+                                                    "'{}' element {i}: property '{}' is '{}', {}",
+                                                    element.name,
+                                                    prop.name,
+                                                    super::import::shown_token(token),
+                                                    not_an_index(f)
+                                                ),
+                                            ),
+                                            None => not_number(&t, token),
+                                        })?;
                                     self.push_index(*role, &mut polygon, i, v, Some(t.line))?;
                                 }
                                 self.end_list(*role, &polygon, i, Some(line));
@@ -1256,6 +1380,15 @@ impl Body<'_> {
             ));
         }
         Ok(())
+    }
+}
+
+/// What a number read for a vertex index is instead.
+fn not_an_index(f: f64) -> &'static str {
+    if f.is_finite() && f.fract() == 0.0 {
+        "too large for a vertex index"
+    } else {
+        "not a whole number"
     }
 }
 
@@ -1479,18 +1612,19 @@ impl BinReader<'_> {
         })
     }
 
-    /// An index of any declared type; float indices must be whole numbers.
-    fn index(&mut self, s: Scalar) -> Option<i64> {
+    /// An index of any declared type; `Err` with the value read for a
+    /// float index that is not a whole number (or too large for one), which
+    /// must not be taken for a value of the file's (as -1, a strip's end).
+    fn index(&mut self, s: Scalar) -> Option<Result<i64, f64>> {
         if s.is_float() {
             let f = self.f64(s)?;
-            // Non-integral or huge float indices map to -1: out of range.
             return Some(if f.fract() == 0.0 && f.abs() < 9.0e15 {
-                f as i64
+                Ok(f as i64)
             } else {
-                -1
+                Err(f)
             });
         }
-        self.int(s)
+        self.int(s).map(Ok)
     }
 }
 
@@ -1513,6 +1647,171 @@ mod tests {
         assert_eq!(p.vertices.len(), 4);
         assert_eq!(p.vertices[2], DVec3::new(1.0, 1.0, 0.0));
         assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    /// A float-typed index list: a value that is no whole number (2.5,
+    /// NaN, 1e30) was read as -1, which ends a strip in a `tristrips`
+    /// list, so the strip's triangles changed without a word, and in a
+    /// face was reported as "vertex index -1", a value not in the file.
+    #[test]
+    fn float_indices_that_are_not_whole_are_named_not_read_as_a_strip_end() {
+        for (bad, shown) in [
+            (2.5, "2.5, not a whole number"),
+            (f64::NAN, "NaN, not a whole number"),
+            (1e30, "too large for a vertex index"),
+        ] {
+            let indices = [0, 1, 2, 3, 99, 1, 4, 5];
+            for big in [false, true] {
+                let mut b = binary_strips(&indices, big, "int", "float");
+                // Index 4 (99) is the list's fifth value, 4 bytes each.
+                let at = b.len() - 4 * 4;
+                let mut v = (bad as f32).to_le_bytes();
+                if big {
+                    v.reverse();
+                }
+                b[at..at + 4].copy_from_slice(&v);
+                let e = parse(&b, "s.ply").unwrap_err().to_string();
+                assert!(
+                    e.starts_with("s.ply: 'tristrips' element 0: list 'vertex_indices' holds ")
+                        && e.contains(shown),
+                    "{bad} {big}: {e}"
+                );
+            }
+        }
+        let b = binary(&SQUARE, &[vec![0, 1, 2]], false, "int");
+        let mut b = header_changed(&b, "uchar int vertex_indices", "uchar float vertex_indices");
+        let at = b.len() - 12;
+        for (k, i) in [0f32, 1.0, 2.5].iter().enumerate() {
+            b[at + 4 * k..at + 4 * k + 4].copy_from_slice(&i.to_le_bytes());
+        }
+        let e = parse(&b, "f.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("f.ply: 'face' element 0: list 'vertex_indices' holds 2.5, not a whole"),
+            "{e}"
+        );
+        // Whole floats are indices, as before.
+        b[at + 8..].copy_from_slice(&2.0f32.to_le_bytes());
+        assert_eq!(parse(&b, "f.ply").unwrap().triangles, vec![[0, 1, 2]]);
+        // Ascii: the value is named as what it is, not "not a number".
+        let text = ascii_quad(4, "3 1 2 0.5\n", 1);
+        let e = parse(text.as_bytes(), "a.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("a.ply:14: 'face' element 0: property 'vertex_indices' is '0.5', not a whole number"),
+            "{e}"
+        );
+    }
+
+    /// A scan whose vertices are in an element not named 'vertex' (a
+    /// 'point' element) read as no vertices at all: "the mesh has no
+    /// triangles", or, with faces, "face 0 refers to vertex index 0, but
+    /// only 0 vertices are defined".
+    #[test]
+    fn vertices_in_an_element_not_named_vertex_are_named() {
+        let text = "ply\nformat ascii 1.0\nelement point 3\nproperty float x\n\
+            property float y\nproperty float z\nelement face 1\n\
+            property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        let e = parse(text.as_bytes(), "p.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "p.ply:3: element 'point' has x, y and z, but the header declares no \
+                 element 'vertex'"
+            ),
+            "{e}"
+        );
+        let cloud = text.replace(
+            "element face 1\nproperty list uchar int vertex_indices\n",
+            "",
+        );
+        let cloud = cloud.replace("3 0 1 2\n", "");
+        let e = parse(cloud.as_bytes(), "p.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("p.ply:3: element 'point' has x, y and z"),
+            "{e}"
+        );
+        let faces = "ply\nformat binary_little_endian 1.0\nelement face 1\n\
+            property list uchar int vertex_indices\nend_header\n\x03\0\0\0\0\x01\0\0\0\x02\0\0\0";
+        let e = parse(faces.as_bytes(), "f.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "f.ply:3: element 'face' refers to vertices, but the header declares \
+                 no element 'vertex'"
+            ),
+            "{e}"
+        );
+        // A header of no elements, or of others only, is no error here.
+        assert!(parse(b"ply\nformat ascii 1.0\nend_header\n", "e.ply").is_ok());
+    }
+
+    /// Faces in an element not named 'face' ('faces') were skipped as an
+    /// extra element without a word, and the import meshed the vertices as
+    /// a point cloud in place of the scan's surface.
+    #[test]
+    fn faces_in_an_element_not_named_face_are_named() {
+        let text = ascii_quad(4, "3 1 2 0\n", 1).replace("element face 1", "element faces 1");
+        let e = parse(text.as_bytes(), "f.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "f.ply:7: element 'faces' has the list 'vertex_indices' of a surface, but PLY \
+                 faces are read from an element named 'face'"
+            ),
+            "{e}"
+        );
+        // A range grid (Stanford raw scans) is a point cloud, and a mesh
+        // may carry such lists in other elements beside its faces.
+        let grid = ascii_quad(4, "1 0\n0\n", 2).replace("element face 2", "element range_grid 2");
+        let p = parse(grid.as_bytes(), "g.ply").unwrap();
+        assert_eq!((p.vertices.len(), p.triangles.len()), (4, 0));
+        let both = ascii_quad(4, "3 1 2 0\n2 0 1\n", 1).replace(
+            "end_header",
+            "element polyline 1\nproperty list uchar int vertex_indices\nend_header",
+        );
+        assert_eq!(
+            parse(both.as_bytes(), "b.ply").unwrap().triangles,
+            vec![[1, 2, 0]]
+        );
+    }
+
+    /// A face count far above the faces the data holds reserved room for
+    /// that many triangles, 12 bytes each, before the data could refute it
+    /// (a 1-byte minimum per face: a 12-fold allocation of the body's size).
+    #[test]
+    fn triangles_are_reserved_for_what_the_data_can_hold() {
+        // 1000 empty faces (a count byte of 0 each): valid, no triangle.
+        let mut b = b"ply\nformat binary_big_endian 1.0\nelement vertex 0\n\
+            property float x\nproperty float y\nproperty float z\nelement face 1000\n\
+            property list uchar int vertex_indices\nend_header\n"
+            .to_vec();
+        b.extend([0u8; 1000]);
+        let p = parse(&b, "r.ply").unwrap();
+        assert!(p.triangles.is_empty());
+        assert!(
+            p.triangles.capacity() <= 1000 / 13,
+            "{}",
+            p.triangles.capacity()
+        );
+    }
+
+    /// An element count beyond 2^64 - 1, or negative, was "needs a count",
+    /// though one is there.
+    #[test]
+    fn an_element_count_that_is_no_count_is_named() {
+        for count in ["18446744073709551616", "-4", "4.5"] {
+            let text = ascii_quad(4, "3 1 2 0\n", 1)
+                .replace("element vertex 4", &format!("element vertex {count}"));
+            let e = parse(text.as_bytes(), "c.ply").unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!(
+                    "c.ply:3: element 'vertex' has count '{count}', not a whole number"
+                )),
+                "{e}"
+            );
+        }
+        let text = ascii_quad(4, "3 1 2 0\n", 1).replace("element vertex 4", "element vertex");
+        let e = parse(text.as_bytes(), "c.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with("c.ply:3: element 'vertex' needs a count"),
+            "{e}"
+        );
     }
 
     /// QA round 16 F1: a face count lowered in the header (a real scan's
