@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
 use crate::demo::{self, antennas, parts::DemoPart, test_part};
-use crate::gcode::{MachineProfile, MAX_GCODE_BYTES};
+use crate::gcode::{GcodeError, MachineProfile, MAX_GCODE_BYTES};
 use crate::job::{self, JobSettings, RegistrationSettings};
 use crate::mesh::MAX_SCAN_BYTES;
 use crate::pipeline::{self, PlanSettings};
@@ -124,6 +124,15 @@ fn core_err(e: crate::Error) -> JsValue {
     if let Error::UnitsDoubt { stray: true, .. } = &e {
         // No units mend it: the page offers none.
         let _ = js_sys::Reflect::set(&err, &"stray".into(), &true.into());
+    }
+    if let Error::Gcode(GcodeError::ProfileField { file, field, .. }) = &e {
+        // The machine profile's own doing (its end block homes, its start
+        // moves into the part): the page does not take a profile on trial
+        // that cannot write the job (web/main.js `profileRefused`).
+        let o = js_sys::Object::new();
+        set(&o, "file", &file.into());
+        set(&o, "field", &field.into());
+        let _ = js_sys::Reflect::set(&err, &"profile".into(), &o);
     }
     if let Error::Touching(t) = &e {
         // Without it the message alone still names the first moves.

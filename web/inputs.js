@@ -236,8 +236,15 @@ function otherJson(text) {
   return null;
 }
 
+// The dialect list's entry in use, as the page names it.
+const profileLabel = () => $('dialect').selectedOptions[0]?.textContent || settings.dialect;
+
 // A user's machine profile: checked by the core (the error names the file
 // and the field); a bad file changes nothing, the previous dialect stays.
+// A valid one is used on trial (state.pendingProfile) until a plan writes
+// its G-code: one that cannot write this job's (its end block homes, or
+// moves into the part; its travel height leaves the build volume) is not
+// taken either, and the profile used before it comes back (main.js).
 async function openProfile(file) {
   let text;
   try {
@@ -249,7 +256,7 @@ async function openProfile(file) {
   const other = otherJson(text);
   if (other) {
     showError(`${file.name} is not a machine profile`,
-      `${other}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`, file.name);
+      `${other}\nStill using ${profileLabel()}.`, file.name);
     return;
   }
   let name;
@@ -257,20 +264,66 @@ async function openProfile(file) {
     name = checkProfile(text, file.name);
   } catch (e) {
     showError(`Could not use the machine profile ${file.name}`,
-      `${e.message}\nStill using ${$('dialect').selectedOptions[0]?.textContent || settings.dialect}.`, file.name);
+      `${e.message}\nStill using ${profileLabel()}.`, file.name);
     return;
   }
   clearError();
+  // What the page goes back to if it cannot write this job's G-code: the
+  // profile before it (the one before a profile still on trial), where
+  // the drawing lay, and whether it wrote the plan on screen for the
+  // settings as they are (the plan goes once the scan is read again on
+  // the new bed).
+  const trial = state.pendingProfile;
+  const inputs = hooks.currentInputs();
+  const before = trial ? trial.before : {
+    dialect: settings.dialect,
+    customProfile: settings.customProfile,
+    placement: { ...settings.placement },
+    planned: !!inputs && !!state.lastPlan && state.lastPlan.inputs === inputs,
+  };
   // Its bed may differ: a scan placed on the bed moves with it.
   moveScan(() => {
     settings.customProfile = { name, file: file.name, text };
     settings.dialect = 'custom';
   });
+  state.pendingProfile = {
+    profile: settings.customProfile, before, placement: { ...settings.placement }, inputs: hooks.currentInputs(),
+  };
   syncProfileOption();
   showScanPlacement();
   saveSettings();
   writeForm();
   hooks.schedulePlan(0);
+}
+
+// The profile on trial wrote a plan's G-code (or failed for something
+// else than itself): it is the user's profile, kept over a reload.
+export function adoptPendingProfile() {
+  if (!state.pendingProfile) return;
+  state.pendingProfile = null;
+  saveSettings();
+}
+
+// The profile on trial cannot write this job's G-code: the one used before
+// it comes back (built-in or the user's), with the drawing where it lay
+// if it was not moved since. Returns how the dialect list names it.
+export function dropPendingProfile() {
+  const trial = state.pendingProfile;
+  if (!trial) return profileLabel();
+  state.pendingProfile = null;
+  const { before } = trial;
+  const unmoved = JSON.stringify(settings.placement) === JSON.stringify(trial.placement);
+  moveScan(() => {
+    settings.dialect = before.dialect;
+    settings.customProfile = before.customProfile;
+  });
+  // (As it was, not carried back and rounded.)
+  if (unmoved) settings.placement = { ...before.placement };
+  syncProfileOption();
+  showScanPlacement();
+  saveSettings();
+  writeForm();
+  return profileLabel();
 }
 
 export function bindFiles() {

@@ -18,8 +18,8 @@ import {
 import { initFiducials, showFiducials } from './fiducials.js';
 import { loadWasm, startWorker } from './engine.js';
 import {
-  acceptScan, bindFiles, demoScanEntry, dropCentre, dropPendingScan, dropPendingSvg, endRestoring, isScanName, keep,
-  loadDemo, restoreInputs,
+  acceptScan, adoptPendingProfile, bindFiles, demoScanEntry, dropCentre, dropPendingProfile, dropPendingScan, dropPendingSvg,
+  endRestoring, isScanName, keep, loadDemo, restoreInputs,
 } from './inputs.js';
 import {
   $, fmt, hooks, profile, settings, state,
@@ -135,7 +135,13 @@ function runPlan() {
     // The demo drawing on a user's scan, not placed by the user since the
     // scan's first plan (see `onPlanError`).
     demoOnUserScan: demoOnUserScan(scan),
+    // The machine profile on trial, if this plan writes with it (see
+    // `profileRefused`).
+    trial: profileOnTrial(),
+    // The error on screen says why a profile was not taken: kept.
+    keepProfileError: state.keepProfileError,
   };
+  state.keepProfileError = false;
   state.queued = false;
   checkFrameLeaving(state.busy.checkFrame);
   laterProgress('starting');
@@ -172,6 +178,13 @@ function runPlan() {
     // Centre the drawing on the scan before planning (a new scan or drawing).
     centre,
   }, transfer);
+}
+
+// The machine profile on trial (inputs.js openProfile) if it is the one
+// plans are written with now.
+function profileOnTrial() {
+  const trial = state.pendingProfile;
+  return trial && settings.dialect === 'custom' && settings.customProfile === trial.profile ? trial : null;
 }
 
 // What a plan is planned from, as one string: the scan, the drawing, the
@@ -433,6 +446,8 @@ function onWorkerMessage(e) {
       break;
     case 'result': {
       if (settings.pathSource === 'file' && state.pendingSvg && busy.svg === state.pendingSvg) adoptPendingSvg();
+      // The profile on trial wrote this plan's G-code: taken.
+      if (busy.trial && busy.trial === state.pendingProfile) adoptPendingProfile();
       state.lastPlan = keptPlan(m, busy);
       const latency = performance.now() - busy.t0;
       const st = state.stats;
@@ -441,7 +456,9 @@ function onWorkerMessage(e) {
       st.latencyMs.push(latency);
       if (st.planMs.length > 1000) { st.planMs.shift(); st.latencyMs.shift(); }
       $('plan-time').textContent = `plan ${Math.round(m.planMs)} ms, on screen ${Math.round(latency)} ms after the change`;
-      clearError();
+      // (Not the error saying why a profile was not taken, by the plan
+      // with the profile kept.)
+      clearError(busy.keepProfileError ? [null, 'file', 'check'] : undefined);
       planOutcome(null, busy.gen);
       state.lastRefusal = null;
       // Planned: the worker's scan is registered by the settings now (a
@@ -511,8 +528,56 @@ function adoptPendingSvg() {
   saveSettings();
 }
 
+// Whether the plan `busy`, written with the machine profile on trial,
+// failed (error `m`) because of that profile: the core names the
+// profile's file and field (its end block homes, or moves into the part:
+// the error's `profile`, src/wasm.rs core_err), or nothing but the
+// profile changed since a plan that wrote its G-code (its travel height or
+// build volume does not fit this job, its moves touch the part...). A
+// failure of something else (the drawing misses the scan) is not the
+// profile's; nor is a crash.
+function profileRefused(m, busy) {
+  const trial = busy.trial;
+  if (!trial || trial !== state.pendingProfile || m.kind === 'crash') return false;
+  if (m.profile && m.profile.file === trial.profile.file) return true;
+  return busy.gen === state.gen && !state.queued && currentInputs() === trial.inputs && trial.before.planned;
+}
+
+// The machine profile on trial cannot write this job's G-code (error `m`
+// of the plan `busy`): it is not taken, as a profile that fails validation
+// is not (inputs.js openProfile). The profile used before comes back, and
+// with it its plan and G-code, or its refusal; otherwise the plan with it
+// is made again (the error stays on screen).
+function profileNotTaken(m, busy) {
+  const file = busy.trial.profile.file;
+  const label = dropPendingProfile();
+  const r = state.lastRefusal;
+  const kept = r && r.inputs && r.inputs === currentInputs() ? r : null;
+  let message = `${ended(m.message)}\nStill using ${label}.`;
+  if (kept) message += `\nIts plan ${kept.refused ? 'stays refused' : 'still fails'}: ${kept.title}.`;
+  showError(`Could not use the machine profile ${file}`, message, file, 'profile');
+  if (busy.gen === state.gen && restorePlan()) return;
+  if (state.lastPlan) labelPlan(state.lastPlan, true);
+  hideDownloads();
+  if (kept && busy.gen === state.gen && !state.queued) {
+    setStatus(...kept.status);
+    return;
+  }
+  state.keepProfileError = true;
+  schedulePlan(0);
+}
+
 function onPlanError(m, busy) {
   dropPress();
+  if (profileRefused(m, busy)) {
+    profileNotTaken(m, busy);
+    return;
+  }
+  // Failed for something else than the profile on trial: it is the user's
+  // profile (a failure of settings since changed says nothing yet).
+  if (busy.trial && busy.trial === state.pendingProfile && busy.gen === state.gen && m.kind !== 'crash') {
+    adoptPendingProfile();
+  }
   // The worker holds another drawing than the page thinks: the next plan
   // sends it again.
   if (/did not reach the planner/.test(m.message)) state.sentSvgKey = null;
@@ -800,6 +865,11 @@ function cancelPlan() {
     dropped.push(state.pendingSvg.name);
     dropPendingSvg();
   }
+  // A machine profile on trial, too: the one before it comes back.
+  if (busy.trial && busy.trial === state.pendingProfile) {
+    dropped.push(busy.trial.profile.file);
+    dropPendingProfile();
+  }
   // The plan on screen is that of the inputs as they are again: offered
   // (its G-code; its report went with the worker).
   if (dropped.length && restorePlan()) {
@@ -863,7 +933,7 @@ async function start() {
   $('scan-limit').textContent = `${pageLimits().scan_bytes / (1 << 20)} MiB`;
   Object.assign(settings, loadSettings());
   Object.assign(hooks, {
-    schedulePlan, planNow, requestPlan, endInteraction, loadDemo, showErrorPlot,
+    schedulePlan, planNow, requestPlan, endInteraction, loadDemo, showErrorPlot, currentInputs,
     viewShowsChanged: () => { syncCheckButton(); syncPreviewButton(); },
     viewClick: previewClick,
     checkShown: previewCheckShown,

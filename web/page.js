@@ -41,7 +41,7 @@ export const settings = {};
 // Calls into modules that import this one's users: schedulePlan(delay),
 // planNow(), requestPlan(), endInteraction(), loadDemo(part),
 // showErrorPlot(), viewShowsChanged(), viewClick(px, py) -> handled,
-// planShown(plan).
+// planShown(plan), currentInputs() -> what a plan now is planned from.
 export const hooks = {};
 
 // The machine profile a plan or preview is written with: `dialect` a
@@ -110,6 +110,13 @@ export const state = {
   pendingScan: null, // a scan loaded but not yet read by the worker
   svgFile: null, // the accepted SVG file {key, name, bytes}
   pendingSvg: null,
+  // A machine profile opened but not yet shown to write this job's G-code
+  // ({profile, before, placement, inputs}; inputs.js openProfile): the
+  // profile used before it (`before`) comes back if it cannot (main.js).
+  pendingProfile: null,
+  // The error on screen says why a profile was not taken: the plan with
+  // the profile kept does not clear it (main.js).
+  keepProfileError: false,
   svgMade: null, // the last generated path {key, name, bytes} (antennas, demo)
   nextKey: 1,
   module: null,

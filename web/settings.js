@@ -115,11 +115,25 @@ export function pathSourceBefore(svg) {
 // source and placement, but those of the drawing kept, as it was placed
 // (a drawing too long for the page left its centring and fit on the good
 // one).
+// A machine profile on trial is not kept either (main.js takes it once it
+// wrote a plan's G-code): the profile before it is, with where the drawing
+// lay on that profile's bed.
 function keptSettings() {
+  let kept = settings;
+  const trial = state.pendingProfile;
+  if (trial) {
+    kept = {
+      ...kept,
+      dialect: trial.before.dialect,
+      customProfile: trial.before.customProfile,
+      placement: JSON.stringify(kept.placement) === JSON.stringify(trial.placement)
+        ? trial.before.placement : kept.placement,
+    };
+  }
   const svg = state.pendingSvg;
-  if (settings.pathSource !== 'file' || !svg || !svg.before) return settings;
+  if (settings.pathSource !== 'file' || !svg || !svg.before) return kept;
   return {
-    ...settings,
+    ...kept,
     pathSource: pathSourceBefore(svg),
     placement: svg.before.placement,
     fit: svg.before.fit,
@@ -371,7 +385,12 @@ export function bindForm() {
       if (reread) leaveReading();
       // A new profile has its own bed: a scan placed on it moves, and the
       // drawing with it.
-      if (id === 'dialect') moveScan(() => set(value));
+      if (id === 'dialect') {
+        // Chosen by the user: a profile on trial is the user's custom
+        // profile from now on, whatever is chosen.
+        state.pendingProfile = null;
+        moveScan(() => set(value));
+      }
       else set(value);
       // The user places the drawing: no centring over it.
       if (/^pl-/.test(id)) userPlaced();

@@ -56,6 +56,8 @@ function errorOf(err) {
   if (err && err.blocked) out.blocked = true;
   // A scan made huge by stray vertices: no units mend it.
   if (err && err.stray) out.stray = true;
+  // A machine profile's field that cannot write the job: {file, field}.
+  if (err && err.profile) out.profile = { file: String(err.profile.file), field: String(err.profile.field) };
   if (err && err.comparison) {
     out.comparison = err.comparison;
     out.comparisonNotes = err.comparisonNotes || [];
