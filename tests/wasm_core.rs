@@ -891,6 +891,44 @@ fn demo_parts_load_as_the_cli_makes_them() {
     );
 }
 
+/// QA round 19 F4: the page took a profile that passed validation and
+/// then could not write the job, dropping the one in use; it tells them
+/// apart by the error's `profile` (its file and field), which only the
+/// profile's own faults carry.
+#[wasm_bindgen_test]
+fn a_profile_that_cannot_write_the_job_is_named_by_its_error() {
+    let (mut session, settings) = demo_part_session("stepped-block");
+    let mut homes = MachineProfile::builtin("marlin").unwrap();
+    homes.end = vec!["M107".into(), "G28".into()];
+    let text = homes.to_json().unwrap();
+    let err = session
+        .plan_live(
+            js(&settings.plan),
+            &text,
+            false,
+            Some("end_G28.json".into()),
+            false,
+            None,
+        )
+        .expect_err("an end block that homes");
+    let profile = get(&err, "profile");
+    assert_eq!(
+        get(&profile, "file").as_string().as_deref(),
+        Some("end_G28.json")
+    );
+    assert_eq!(
+        get(&profile, "field").as_string().as_deref(),
+        Some("end[1]")
+    );
+    // A refusal that is not the profile's carries none.
+    let mut plan = settings.plan;
+    plan.planner = PlannerKind::Slope;
+    let err = session
+        .plan_live(js(&plan), "marlin", false, None, false, None)
+        .expect_err("slope runs into the steps' walls");
+    assert!(get(&err, "profile").is_undefined());
+}
+
 #[wasm_bindgen_test]
 fn live_plans_that_touch_are_refused_by_line_unless_the_risk_is_accepted() {
     let (mut session, settings) = demo_part_session("stepped-block");
