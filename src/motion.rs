@@ -287,7 +287,16 @@ fn resolve(
     out: &mut Vec<DVec3>,
     made: &mut usize,
 ) -> bool {
-    let Some(worst) = known.or_else(|| c.touching(surface, p, q)) else {
+    // Most sub-moves clear: that is asked first, of the first contact
+    // (`is_clear`, no smallest clearance sought), and the worst place only
+    // of those that touch; the same answer, as `touching` is `None`
+    // exactly when `is_clear` holds (both ask below `touch_limit`).
+    let worst = match known {
+        Some(g) => Some(g),
+        None if c.is_clear(surface, p, q) => None,
+        None => c.touching(surface, p, q),
+    };
+    let Some(worst) = worst else {
         return true;
     };
     if *made >= MAX_WAYPOINTS_PER_MOVE {
