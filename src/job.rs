@@ -1315,7 +1315,11 @@ pub fn write_outputs(
     accept_risk: bool,
 ) -> Result<(Report, String)> {
     let mut report = report(scan, path_file, plan, settings);
-    report.warnings.extend(notes.iter().cloned());
+    // The drawing's notes (its dashes, units, layers left out) before the
+    // plan's warnings, which they often explain (QA round 20 F1: a dotted
+    // stroke's note came 269th, past what the command line shows).
+    let at = report.warnings.len() - plan.warnings.len();
+    report.warnings.splice(at..at, notes.iter().cloned());
     // A scan partly outside the build volume whose tool path is inside
     // (QA: 2 mm of a scan below the bed, taken as it is: the page showed
     // a banner, the command line said nothing). If the part stands on the

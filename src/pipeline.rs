@@ -208,6 +208,10 @@ pub fn surface_path(
     // The longest of them as placed: all a hundredth of the spacing or
     // less are dots as drawn (zero-length strokes), which no scale prints.
     let mut longest_dot_mm: f64 = 0.0;
+    // The paths with subpaths that miss the scan entirely, in the
+    // drawing's order: how many, the first one's first and last sample,
+    // and the path's warning's slot (one warning a path).
+    let mut missed: Vec<(String, usize, DVec2, DVec2, usize)> = Vec::new();
     // Whether any subpath was large enough to print.
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
@@ -247,13 +251,25 @@ pub fn surface_path(
         }
         any_line |= samples.len() >= 2;
         drawn_mm += xy_length(&samples);
-        for piece in project_subpath(
+        let projected = project_subpath(
             surface,
             &sub.source,
             &samples,
             nozzle.outer_diameter_mm,
             &mut warnings,
-        ) {
+        );
+        if projected.is_empty() && samples.iter().all(|&p| surface.highest_hit(p).is_none()) {
+            match missed.iter_mut().find(|m| m.0 == sub.source) {
+                Some(m) => m.1 += 1,
+                None => {
+                    // The path's warning's place: where its first was met.
+                    warnings.push(String::new());
+                    let (from, to) = (samples[0], samples[samples.len() - 1]);
+                    missed.push((sub.source.clone(), 1, from, to, warnings.len() - 1));
+                }
+            }
+        }
+        for piece in projected {
             let geometry = local_geometry(&piece.points)
                 .map_err(|e| Error::Plan(format!("path '{}': {e}", piece.source)))?;
             let xy: Vec<DVec2> = piece.points.iter().map(|p| p.truncate()).collect();
@@ -265,6 +281,26 @@ pub fn surface_path(
             });
         }
         sampled.push((sub.source.as_str(), samples, placed.closed, placed.points));
+    }
+    // One warning a path for its subpaths that miss the scan (QA round 20
+    // F1: a dotted circle's 268 dashes beside a bunny gave 268, and the
+    // warning that said why, its dashes, was the 269th).
+    for (source, count, from, to, at) in &missed {
+        let xy = |p: &DVec2| format!("({:.3}, {:.3})", p.x, p.y);
+        warnings[*at] = if *count == 1 {
+            format!(
+                "path '{source}' misses the scan entirely (from {} to {}); it is not printed",
+                xy(from),
+                xy(to)
+            )
+        } else {
+            format!(
+                "path '{source}': {count} of its pieces miss the scan entirely (the first from \
+                 {} to {}); they are not printed",
+                xy(from),
+                xy(to)
+            )
+        };
     }
     // The one warning for every part too small to print (QA: a set of
     // icons gave 680).

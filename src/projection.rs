@@ -43,14 +43,10 @@ pub fn project_subpath(
         arc.push(s);
     }
     let n = samples.len();
+    // A subpath that misses the scan entirely is the caller's to tell (one
+    // warning for all of them: a dashed circle's 268 dashes off a bunny
+    // gave 268, QA round 20 F1): no piece and no warning here.
     let Some(first) = hits.iter().position(Option::is_some) else {
-        if n > 0 {
-            warnings.push(format!(
-                "path '{source}' misses the scan entirely (from {} to {}); it is not printed",
-                fmt_xy(samples[0]),
-                fmt_xy(samples[n - 1])
-            ));
-        }
         return Vec::new();
     };
     let last = hits.iter().rposition(Option::is_some).unwrap_or(first);
@@ -206,7 +202,8 @@ mod tests {
             .map(|p| *p + DVec2::new(100.0, 0.0))
             .collect();
         assert!(project_subpath(&s, "a", &far, 0.908, &mut w).is_empty());
-        assert!(w[0].contains("misses the scan entirely"));
+        // (Told by the caller, once for all such subpaths.)
+        assert!(w.is_empty(), "{w:?}");
         // One sample off at each end: a point, not a stretch of 0 mm.
         let mut w = Vec::new();
         let one: Vec<DVec2> = (0..12).map(|i| DVec2::new(-0.5 + i as f64, 5.0)).collect();

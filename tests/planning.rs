@@ -1431,3 +1431,49 @@ fn backward_moves_are_said_in_the_plans_warnings() {
     }
     assert!(said > 0, "no planner fell back on the loop or the hairpin");
 }
+
+/// QA round 20 F1: Inkscape's dotted circle partly off a bunny: each of
+/// its 268 dashes off the scan had a warning of its own, and the one that
+/// said why (its dashes) was the 269th of 270, past the 24 the command
+/// line shows. Now the subpaths of a path that miss the scan are one
+/// warning, and the drawing's notes come before the plan's warnings.
+#[test]
+fn dashes_off_the_scan_are_one_warning_after_the_note_on_dashes() {
+    let xs = range(0.0, 20.0, 40);
+    let mesh = height_field(&xs, &xs, |x, _| 1.0 + 0.1 * x);
+    let scan = prepared_ply(&mesh, "plate.ply");
+    let profile = pcpp::gcode::MachineProfile::builtin("marlin").unwrap();
+    // A dashed line from x = 5 to x = 35 mm (dashes 1 mm, gaps 1 mm): its
+    // 8 dashes past x = 20 miss the scan; a solid line of another path
+    // misses it too.
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="60mm" height="20mm" viewBox="0 0 60 20">
+      <path id="dashed" d="M5 10 H35" stroke="black" fill="none" stroke-dasharray="1 1"/>
+      <path id="solid" d="M40 5 H50" stroke="black" fill="none"/>
+    </svg>"#;
+    let mut settings = PlanSettings::default();
+    settings.placement.offset_mm = DVec2::new(0.0, 20.0);
+    let out = pcpp::job::run_on(
+        &scan,
+        svg.as_bytes(),
+        "dashes.svg",
+        &settings,
+        &profile,
+        true,
+    )
+    .unwrap();
+    let w = &out.report.warnings;
+    let at = |text: &str| w.iter().position(|x| x.contains(text));
+    let dashes = at("have dashed strokes").expect("the note on dashes");
+    let missed: Vec<&String> = w.iter().filter(|x| x.contains("miss")).collect();
+    assert_eq!(
+        missed,
+        [
+            "path 'dashed': 7 of its pieces miss the scan entirely (the first from (21.000, \
+             10.000) to (22.000, 10.000)); they are not printed",
+            "path 'solid' misses the scan entirely (from (40.000, 15.000) to (50.000, \
+             15.000)); it is not printed"
+        ],
+        "{w:#?}"
+    );
+    assert!(dashes < at("of its pieces miss").unwrap(), "{w:#?}");
+}

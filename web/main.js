@@ -202,7 +202,7 @@ function currentInputs() {
 
 // The core's projection warnings for a drawing path that leaves the scan
 // (spec section 4: not printed there), naming the path.
-const OFF_SCAN = /^path '(.*)'(?:: its .* lies off the scan; not printed| misses the scan entirely)/;
+const OFF_SCAN = /^path '(.*)'(?:: its .* lies off the scan; not printed| misses the scan entirely|: \d+ of its pieces miss the scan entirely)/;
 
 // The status line of a plan offered for download. Paths of the drawing
 // that leave the scan are said there too, where the user looks after a
