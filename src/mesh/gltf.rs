@@ -148,7 +148,7 @@ pub(super) fn parse(
     check_position_accessors(&root, file)?;
     let bounded = fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
-    let (buffers, read) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
+    let (buffers, read, buffer_notes) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
     let views = decode_views(&gltf, &compressed, &buffers, file)?;
     let mut scene = SceneReader {
         file,
@@ -241,7 +241,8 @@ pub(super) fn parse(
             }
         }
     }
-    let mut warnings = scene.warnings;
+    let mut warnings = buffer_notes;
+    warnings.extend(scene.warnings);
     // Said once the units are known (import::Rounding).
     let rounding = (!rounding.is_empty()).then(|| Rounding {
         names: rounding,
@@ -671,8 +672,12 @@ fn load_buffers<'a>(
     file: &str,
     external: &'a ExternalFiles,
     fallbacks: &std::collections::HashSet<usize>,
-) -> Result<(Buffers<'a>, Vec<String>), MeshError> {
+) -> Result<(Buffers<'a>, Vec<String>, Vec<String>), MeshError> {
     let mut read: Vec<String> = Vec::new();
+    // What is said of the files read (QA round 20 F5: a `uri` of
+    // `../../../../etc/passwd` was read as the scan's buffer, without a
+    // word naming it, nor that it held far more than its byteLength).
+    let mut notes: Vec<String> = Vec::new();
     let buffers = gltf
         .buffers()
         .map(|buffer| {
@@ -713,6 +718,23 @@ fn load_buffers<'a>(
                                 path: path.clone(),
                             })?;
                     from = format!(" (file '{path}')");
+                    if path.split('/').any(|c| c == "..") {
+                        notes.push(format!(
+                            "{file}: buffer {index} is read from '{path}', outside the .gltf's \
+                             folder: check that it is the scan's"
+                        ));
+                    }
+                    // An exporter writes a buffer's file to its byteLength
+                    // (GLB pads to 4 bytes).
+                    if bytes.len() > buffer.length() + 3 {
+                        notes.push(format!(
+                            "{file}: buffer {index}{from} holds {} bytes, more than its byteLength \
+                             {}: only those are read; is it the buffer the .gltf was written \
+                             with?",
+                            bytes.len(),
+                            buffer.length()
+                        ));
+                    }
                     if !read.contains(&path) {
                         read.push(path);
                     }
@@ -733,7 +755,7 @@ fn load_buffers<'a>(
             Ok(data)
         })
         .collect::<Result<Buffers, MeshError>>()?;
-    Ok((buffers, read))
+    Ok((buffers, read, notes))
 }
 
 /// The meshopt-compressed views that hold what the import reads (the
@@ -2083,6 +2105,35 @@ mod tests {
         // The same bytes as a data URI read the same vertices.
         let embedded = parse(triangle_gltf("", &triangle_uri()).as_bytes(), "t.gltf").unwrap();
         assert_eq!(p.vertices, embedded.vertices);
+    }
+
+    /// QA round 20 F5: `../../../../etc/passwd` was read as the buffer,
+    /// with no word naming it, nor that it held far more than its
+    /// byteLength. Both are said now; a file beside the .gltf of its own
+    /// length is read without a word.
+    #[test]
+    fn a_buffer_read_from_outside_the_folder_or_longer_than_declared_is_named() {
+        let files = ExternalFiles::new().with("scan.bin", triangle_bytes());
+        let (p, _) =
+            super::parse(triangle_gltf("", "scan.bin").as_bytes(), "t.gltf", &files).unwrap();
+        assert_eq!(p.warnings, Vec::<String>::new());
+        let mut long = triangle_bytes();
+        long.extend([0u8; 100]);
+        let files = ExternalFiles::new().with("../../up.bin", long);
+        let json = triangle_gltf("", "../../up.bin");
+        let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
+        assert_eq!(read, ["../../up.bin"]);
+        assert_eq!(p.triangles, vec![[0, 1, 2]]);
+        assert_eq!(
+            p.warnings,
+            [
+                "t.gltf: buffer 0 is read from '../../up.bin', outside the .gltf's folder: \
+                 check that it is the scan's",
+                "t.gltf: buffer 0 (file '../../up.bin') holds 136 bytes, more than its \
+                 byteLength 36: only those are read; is it the buffer the .gltf was written \
+                 with?"
+            ]
+        );
     }
 
     #[test]
