@@ -209,7 +209,10 @@ pub fn volume_fit(
     // A hair out is on the face (a registration's rounding).
     let inside = outside.max_element() <= crate::gcode::VOLUME_HAIR_MM;
     let size = hi - lo;
-    let room = volume.max_mm - volume.min_mm;
+    // Up from the bed, where a part stands (QA round 20 F3: a 125 mm
+    // scan on Grbl's -100..100 mm was told to move back inside, and the
+    // only way, down, sank it into the bed).
+    let room = (volume.max_mm - volume.min_mm).with_z(volume.max_mm.z - Bed::of(volume).z_mm);
     let fits_on_bed = size.cmple(room).all();
     let mut placed_message = String::new();
     let message = if inside {
@@ -242,8 +245,10 @@ pub fn volume_fit(
                 .into_iter()
                 .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
             let larger = format!(
-                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm)",
-                size[k], room[k]
+                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm{})",
+                size[k],
+                room[k],
+                if k == 2 { " above its bed" } else { "" }
             );
             // Read in larger units than mm: the smaller ones it fits in
             // (QA round 16 F10: a 2-unit glTF cube read in its metres was
@@ -740,7 +745,7 @@ mod tests {
         assert!(!fit.inside && !fit.fits_on_bed);
         assert!(
             fit.message
-                .contains("it is larger than the volume (z 260.4 mm, the volume 250.0 mm)")
+                .contains("it is larger than the volume (z 260.4 mm, the volume 250.0 mm above its bed)")
                 && !fit.message.contains("place it on the bed")
                 // (QA round 9 L2: a 1.1 m model in every unit offered.)
                 && fit.message.ends_with(
@@ -781,7 +786,7 @@ mod tests {
         );
         assert!(
             fit.message.contains(
-                "(z 154.3 mm, the volume 100.0 mm), read in metres; in smaller units it would \
+                "(z 154.3 mm, the volume 100.0 mm above its bed), read in metres; in smaller units it would \
                  fit only as a part under 5 mm across: check the scan's up axis, or use a \
                  profile whose build volume holds it"
             ) && !fit.message.contains("--scan-units"),
@@ -839,6 +844,34 @@ mod tests {
             ScanUnits::Mm,
         );
         assert!(!fit.inside);
+    }
+
+    /// QA round 20 F3: a 125 mm tall scan on Grbl's -100..100 mm volume
+    /// (bed at z = 0) was told to move back inside, and the only way,
+    /// down, sank it into the bed: the room is what lies above the bed.
+    #[test]
+    fn a_scan_taller_than_the_room_above_the_bed_does_not_fit_on_it() {
+        let grbl = BuildVolume {
+            min_mm: DVec3::splat(-100.0),
+            max_mm: DVec3::splat(100.0),
+        };
+        let tall = (DVec3::new(-60.0, -90.0, 0.0), DVec3::new(60.0, 90.0, 125.4));
+        let fit = volume_fit(tall, &grbl, "grbl", ScanUnits::Mm);
+        assert!(!fit.inside && !fit.fits_on_bed);
+        assert!(
+            fit.message.contains(
+                "it is larger than the volume (z 125.4 mm, the volume 100.0 mm above its bed)"
+            ) && !fit.message.contains("move it back inside"),
+            "{}",
+            fit.message
+        );
+        // One that fits above the bed is still offered a place there.
+        let short = (
+            DVec3::new(-60.0, -90.0, 150.0),
+            DVec3::new(60.0, 90.0, 249.0),
+        );
+        let fit = volume_fit(short, &grbl, "grbl", ScanUnits::Mm);
+        assert!(!fit.inside && fit.fits_on_bed, "{}", fit.message);
     }
 
     #[test]
