@@ -467,7 +467,12 @@ fn centre_on_surface_exact(
 ) -> Option<(Placement, Option<String>)> {
     let (lo, hi) = surface.bbox();
     let (flo, fhi) = (lo.truncate(), hi.truncate());
-    let (placement, note) = centre_drawing(drawn, (flo, fhi), current, fit)?;
+    // Not fitted to a scan seen edge-on, nor said to be larger than its
+    // footprint: planning refuses it as such (QA round 20 F6: "scaled by
+    // 0.576 to fit" a 20 x 0.0 mm footprint, then the refusal).
+    let edge_on = crate::pipeline::edge_on(fhi - flo, hi.z - lo.z);
+    let (placement, note) = centre_drawing(drawn, (flo, fhi), current, fit && !edge_on)?;
+    let note = note.filter(|_| !edge_on);
     let middle = 0.5 * (flo + fhi);
     if surface.highest_hit(middle).is_some() {
         return Some((placement, note));
@@ -872,6 +877,30 @@ mod tests {
         );
         let fit = volume_fit(short, &grbl, "grbl", ScanUnits::Mm);
         assert!(!fit.inside && fit.fits_on_bed, "{}", fit.message);
+    }
+
+    #[test]
+    fn a_drawing_is_not_fitted_to_a_scan_seen_edge_on() {
+        // A 20 mm square plate standing on its edge (a glTF read +Z up).
+        let wall = crate::mesh::TriMesh {
+            vertices: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(20.0, 0.0, 0.0),
+                DVec3::new(20.0, 0.0, 20.0),
+                DVec3::new(0.0, 0.0, 20.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        let surface = Surface::new(wall).unwrap();
+        let drawn = vec![Subpath2 {
+            points: vec![DVec2::ZERO, DVec2::new(31.3, 31.5)],
+            corner: vec![true, true],
+            closed: false,
+            source: "line".into(),
+        }];
+        let (placed, note) =
+            centre_on_surface(&drawn, &surface, &Placement::default(), true).unwrap();
+        assert_eq!((placed.scale, note), (1.0, None));
     }
 
     #[test]
