@@ -9,7 +9,7 @@ import {
   userPlacements,
 } from './placement.js';
 import {
-  demoInfo, demoUiSettings, pathSourceBefore, saveSettings, syncProfileOption, writeForm,
+  FILE_DEFAULTS_NOTE, demoInfo, demoUiSettings, pathSourceBefore, saveSettings, syncProfileOption, writeForm,
 } from './settings.js';
 import { clearError, showError } from './status.js';
 import { keepInput, keptInput } from './store.js';
@@ -483,7 +483,7 @@ export function acceptScan(info) {
     saveSettings();
     writeForm();
     const chosen = [units && `units ${units}`, up && `up axis ${up.startsWith('-') ? '' : '+'}${up.toUpperCase()}`].filter(Boolean).join(' and ');
-    $('scan-note').textContent = `Read in the file's own units and up axis: ${chosen} were chosen for ${from} `
+    $('scan-note').textContent = `${FILE_DEFAULTS_NOTE} ${chosen} were chosen for ${from} `
       + '(Units and Up axis above set them for this file).';
   }
   if (scan.asScanned) {

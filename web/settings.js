@@ -254,13 +254,25 @@ export function currentSvg() {
 
 // ---------- form binding ----------
 
+// The note that a new scan was read in its file's own units and up axis,
+// not those chosen for the scan before it (inputs.js acceptScan), is past
+// once the user chooses them for this one (QA round 20 F4: it went on
+// naming the previous file).
+function fileDefaultsNoteDone() {
+  const note = $('scan-note');
+  if (note.textContent.startsWith(FILE_DEFAULTS_NOTE)) note.textContent = '';
+}
+
+// How that note begins.
+export const FILE_DEFAULTS_NOTE = "Read in the file's own units and up axis:";
+
 // [element id, getter, setter, when to re-plan]: 'live' on every input
 // event at once (sliders; the comparison of every planner waits for the
 // release), 'typed' on every keystroke after a short pause, otherwise on
 // change. Re-plans are coalesced: only the newest settings are planned.
 const FIELDS = [
-  ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; }],
-  ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; }],
+  ['scan-units', () => settings.scanUnits, (v) => { settings.scanUnits = v; fileDefaultsNoteDone(); }],
+  ['scan-up', () => settings.scanUp, (v) => { settings.scanUp = v; fileDefaultsNoteDone(); }],
   ['scan-max-edge', () => settings.scanMaxEdge, (v) => { settings.scanMaxEdge = v; }],
   ['fid-source', () => settings.fidSource, (v) => { settings.fidSource = v; }],
   ['fid-method', () => settings.fidMethod, (v) => { settings.fidMethod = v; }],

@@ -189,6 +189,9 @@ test('units chosen for one scan file are not applied to the next file; chosen on
   // scan still used.
   await page.selectOption('#scan-up', 'y');
   await waitIdle(page);
+  // Chosen for this file: the note on the file before is past (QA round
+  // 20 F4: it went on naming film-m.obj).
+  assert.equal(await page.textContent('#scan-note'), '');
   await page.setInputFiles('#scan-input', { name: 'broken.obj', mimeType: 'text/plain', buffer: Buffer.from('v 1 2\nf 1 2 3\n') });
   await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
   await waitIdle(page);
