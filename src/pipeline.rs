@@ -212,6 +212,8 @@ pub fn surface_path(
     // drawing's order: how many, the first one's first and last sample,
     // and the path's warning's slot (one warning a path).
     let mut missed: Vec<(String, usize, DVec2, DVec2, usize)> = Vec::new();
+    let mut missed_index: std::collections::HashMap<String, usize> =
+        std::collections::HashMap::new();
     // Whether any subpath was large enough to print.
     let mut any_line = false;
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
@@ -258,13 +260,15 @@ pub fn surface_path(
             nozzle.outer_diameter_mm,
             &mut warnings,
         );
-        if projected.is_empty() && samples.iter().all(|&p| surface.highest_hit(p).is_none()) {
-            match missed.iter_mut().find(|m| m.0 == sub.source) {
-                Some(m) => m.1 += 1,
+        let off = projected.is_empty() && samples.iter().all(|&p| surface.highest_hit(p).is_none());
+        if let (true, [from, .., to]) = (off, samples.as_slice()) {
+            let (from, to) = (*from, *to);
+            match missed_index.get(&sub.source) {
+                Some(&k) => missed[k].1 += 1,
                 None => {
                     // The path's warning's place: where its first was met.
                     warnings.push(String::new());
-                    let (from, to) = (samples[0], samples[samples.len() - 1]);
+                    missed_index.insert(sub.source.clone(), missed.len());
                     missed.push((sub.source.clone(), 1, from, to, warnings.len() - 1));
                 }
             }
