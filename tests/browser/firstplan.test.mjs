@@ -243,12 +243,16 @@ test('a scan seen edge-on from above is told to choose its up axis, not to open 
   await page.waitForFunction(() => window.pcpp.state.info && window.pcpp.state.info.name === 'edge-on.obj',
     null, { timeout: 120_000 });
   await waitIdle(page);
-  // The demo drawing, fitted to the plate's top edge, plans there: its
-  // warnings say the scan is seen edge-on, and which control turns it.
-  assert.equal(await page.isHidden('#error-panel'), true, await page.textContent('#error-message'));
-  assert.match(await page.textContent('#warnings'), /the scan is seen edge-on from above, 100\.000 x 0\.500 mm wide and 100\.000 mm tall .*choose its up axis \(Up axis; glTF files are \+Y up\)/);
-  // Refused (a line across the edge's middle at the user's own scale):
-  // an error with the same advice, not the demo drawing's notice.
+  // The demo drawing is not fitted to the plate's top edge (QA round 20
+  // F6: a drawing scaled to fit a footprint of no width): refused, saying
+  // the scan is seen edge-on and which control turns it, not the demo
+  // drawing's notice.
+  await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
+  assert.match(await page.textContent('#error-message'), /the scan is seen edge-on from above, 100\.000 x 0\.500 mm wide and 100\.000 mm tall .*choose its up axis \(Up axis; glTF files are \+Y up\)/);
+  assert.doesNotMatch(await page.textContent('#error-title'), /demo drawing/);
+  assert.equal(await page.evaluate(() => document.getElementById('error-panel').classList.contains('notice')), false);
+  // At the user's own scale (a line across the edge's middle): refused
+  // the same way.
   await page.fill('#pl-scale', '1');
   await page.press('#pl-scale', 'Enter');
   await page.waitForFunction(() => !document.getElementById('error-panel').hidden, null, { timeout: 120_000 });
