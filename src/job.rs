@@ -1674,21 +1674,15 @@ pub fn write_outputs(
         .chain(end_moves)
         .find(|(_, to)| !profile.build_volume.contains(*to));
     if let Some((field, to)) = out_of_volume {
-        let (lo, hi) = (profile.build_volume.min_mm, profile.build_volume.max_mm);
         report.warnings.push(format!(
             "profile {}: its `{field}` moves the head to ({:.3}, {:.3}, {:.3}), outside its \
-             build volume (x {}..{}, y {}..{}, z {}..{}), where the program's own moves never \
-             go: keep the block's moves inside the volume, or correct `build_volume`",
+             build volume ({}), where the program's own moves never go: keep the block's moves \
+             inside the volume, or correct `build_volume`",
             profile.label(),
             to.x,
             to.y,
             to.z,
-            lo.x,
-            hi.x,
-            lo.y,
-            hi.y,
-            lo.z,
-            hi.z
+            profile.build_volume
         ));
     }
     let start_check = check_moves(

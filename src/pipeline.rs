@@ -155,10 +155,10 @@ impl Coverage {
 }
 
 /// The size of `drawn` as stage 4 samples it (d/2 after `placement`,
-/// spec section 3), refused past [`crate::sampling::MAX_DRAWING_SAMPLES`]
-/// before a sample is made. A subpath too long by itself is named by its
-/// own error ([`try_sample_subpath`]'s, which counts before it
-/// allocates).
+/// spec section 3), counted before a sample is made; a subpath too long
+/// by itself is refused, named by its own error ([`try_sample_subpath`]'s,
+/// which counts before it allocates). The limit for the whole drawing is
+/// its caller's ([`DrawingSize::check`] for the core's, the page its own).
 pub fn drawing_size(
     drawn: &[Subpath2],
     nozzle: &Nozzle,
@@ -166,14 +166,14 @@ pub fn drawing_size(
 ) -> Result<DrawingSize> {
     let spacing = 0.5 * nozzle.inner_diameter_mm;
     let size = DrawingSize::of(drawn, placement.scale, spacing);
-    if size.check().is_err() {
+    // (A subpath past the limit puts the drawing past it.)
+    if size.samples > MAX_SAMPLES as f64 {
         for sub in drawn {
             let one = DrawingSize::of(std::slice::from_ref(sub), placement.scale, spacing);
             if one.samples > MAX_SAMPLES as f64 {
                 try_sample_subpath(&placement.apply_subpath(sub), spacing)?;
             }
         }
-        size.check()?;
     }
     Ok(size)
 }
@@ -191,7 +191,7 @@ pub fn surface_path(
     if drawn.is_empty() {
         return Err(Error::Plan("the drawing has no path to print".into()));
     }
-    drawing_size(drawn, nozzle, placement)?;
+    drawing_size(drawn, nozzle, placement)?.check()?;
     let spacing = 0.5 * nozzle.inner_diameter_mm;
     let mut warnings = Vec::new();
     let mut pieces = Vec::new();
@@ -260,8 +260,7 @@ pub fn surface_path(
             nozzle.outer_diameter_mm,
             &mut warnings,
         );
-        let off = projected.is_empty() && samples.iter().all(|&p| surface.highest_hit(p).is_none());
-        if let (true, [from, .., to]) = (off, samples.as_slice()) {
+        if let (None, [from, .., to]) = (&projected, samples.as_slice()) {
             let (from, to) = (*from, *to);
             match missed_index.get(&sub.source) {
                 Some(&k) => missed[k].1 += 1,
@@ -273,7 +272,7 @@ pub fn surface_path(
                 }
             }
         }
-        for piece in projected {
+        for piece in projected.into_iter().flatten() {
             let geometry = local_geometry(&piece.points)
                 .map_err(|e| Error::Plan(format!("path '{}': {e}", piece.source)))?;
             let xy: Vec<DVec2> = piece.points.iter().map(|p| p.truncate()).collect();

@@ -25,14 +25,15 @@ fn fmt_xy(p: DVec2) -> String {
 }
 
 /// Projects one sampled subpath. `bridge_max_mm` is the outer diameter do:
-/// a gap between two hit samples shorter than that is bridged.
+/// a gap between two hit samples shorter than that is bridged. `None` when
+/// no sample lies over the surface.
 pub fn project_subpath(
     surface: &Surface,
     source: &str,
     samples: &[DVec2],
     bridge_max_mm: f64,
     warnings: &mut Vec<String>,
-) -> Vec<ProjectedPiece> {
+) -> Option<Vec<ProjectedPiece>> {
     let hits: Vec<Option<f64>> = samples.iter().map(|&p| surface.highest_hit(p)).collect();
     let mut arc = Vec::with_capacity(samples.len());
     let mut s = 0.0;
@@ -43,12 +44,10 @@ pub fn project_subpath(
         arc.push(s);
     }
     let n = samples.len();
-    // A subpath that misses the scan entirely is the caller's to tell (one
-    // warning for all of them: a dashed circle's 268 dashes off a bunny
-    // gave 268, QA round 20 F1): no piece and no warning here.
-    let Some(first) = hits.iter().position(Option::is_some) else {
-        return Vec::new();
-    };
+    // A subpath that misses the scan entirely (`None`) is the caller's to
+    // tell (one warning a path: a dashed circle's 268 dashes off a bunny
+    // gave 268, QA round 20 F1).
+    let first = hits.iter().position(Option::is_some)?;
     let last = hits.iter().rposition(Option::is_some).unwrap_or(first);
     // (One sample off the scan is a point, not a stretch of 0 mm.)
     if first == 1 {
@@ -129,7 +128,7 @@ pub fn project_subpath(
             }),
         }
     }
-    out
+    Some(out)
 }
 
 #[cfg(test)]
@@ -147,7 +146,7 @@ mod tests {
         let s = Surface::new(sine_grid(40, 20.0)).unwrap();
         let samples: Vec<DVec2> = (0..50).map(|i| DVec2::new(0.37 * i as f64, 7.3)).collect();
         let mut w = Vec::new();
-        let pieces = project_subpath(&s, "line", &samples, 0.908, &mut w);
+        let pieces = project_subpath(&s, "line", &samples, 0.908, &mut w).unwrap();
         assert_eq!(pieces.len(), 1);
         assert!(w.is_empty(), "{w:?}");
         for p in &pieces[0].points {
@@ -172,14 +171,14 @@ mod tests {
         // A 0.5 mm wide hole: bridged.
         let s = Surface::new(grid_with_hole((5.0, 5.5))).unwrap();
         let mut w = Vec::new();
-        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w);
+        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w).unwrap();
         assert_eq!(pieces.len(), 1);
         assert_eq!(pieces[0].points.len(), 60);
         assert!(w.len() == 1 && w[0].contains("bridged"), "{w:?}");
         // A 3 mm wide hole: split into two, reported with coordinates.
         let s = Surface::new(grid_with_hole((5.0, 8.0))).unwrap();
         let mut w = Vec::new();
-        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w);
+        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w).unwrap();
         assert_eq!(pieces.len(), 2);
         assert!(
             w.len() == 1 && w[0].contains("split") && w[0].contains("(5.1"),
@@ -192,7 +191,7 @@ mod tests {
         let s = Surface::new(sine_grid(10, 10.0)).unwrap();
         let samples: Vec<DVec2> = (0..20).map(|i| DVec2::new(-2.0 + i as f64, 5.0)).collect();
         let mut w = Vec::new();
-        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w);
+        let pieces = project_subpath(&s, "a", &samples, 0.908, &mut w).unwrap();
         assert_eq!(pieces.len(), 1);
         assert_eq!(pieces[0].points.len(), 11);
         assert_eq!(w.len(), 2, "{w:?}");
@@ -201,13 +200,16 @@ mod tests {
             .iter()
             .map(|p| *p + DVec2::new(100.0, 0.0))
             .collect();
-        assert!(project_subpath(&s, "a", &far, 0.908, &mut w).is_empty());
+        assert!(project_subpath(&s, "a", &far, 0.908, &mut w).is_none());
         // (Told by the caller, once for all such subpaths.)
         assert!(w.is_empty(), "{w:?}");
         // One sample off at each end: a point, not a stretch of 0 mm.
         let mut w = Vec::new();
         let one: Vec<DVec2> = (0..12).map(|i| DVec2::new(-0.5 + i as f64, 5.0)).collect();
-        assert_eq!(project_subpath(&s, "a", &one, 0.908, &mut w).len(), 1);
+        assert_eq!(
+            project_subpath(&s, "a", &one, 0.908, &mut w).unwrap().len(),
+            1
+        );
         assert_eq!(
             w,
             [

@@ -158,7 +158,7 @@ fn duration_text(s: f64) -> String {
 
 /// Samples a subpath of `length_mm` with `points` drawn points needs at
 /// `spacing_mm`, at most (see [`DrawingSize::samples`]).
-pub fn estimated_samples(length_mm: f64, points: usize, spacing_mm: f64) -> f64 {
+fn estimated_samples(length_mm: f64, points: usize, spacing_mm: f64) -> f64 {
     (length_mm / spacing_mm).ceil() + points as f64
 }
 

@@ -26,6 +26,16 @@ fn prepared_ply(mesh: &TriMesh, name: &str) -> pcpp::job::PreparedScan {
     .unwrap()
 }
 
+/// A level 40 mm square plate at height `z`.
+fn plate(z: f64) -> Surface {
+    Surface::new(height_field(
+        &range(0.0, 40.0, 4),
+        &range(0.0, 40.0, 4),
+        |_, _| z,
+    ))
+    .unwrap()
+}
+
 fn range(from: f64, to: f64, n: usize) -> Vec<f64> {
     (0..=n)
         .map(|i| from + (to - from) * i as f64 / n as f64)
@@ -462,12 +472,7 @@ fn a_drawing_too_large_as_a_whole_is_refused_before_it_is_sampled() {
     // made 9.7 M samples together, and a run of 7.6 min and 5.3 GB.
     // Here 1.8 km lines at d/2 = 0.3015 mm: 6 M samples each, 12 M both.
     let settings = PlanSettings::default();
-    let flat = Surface::new(height_field(
-        &range(0.0, 40.0, 4),
-        &range(0.0, 40.0, 4),
-        |_, _| 0.0,
-    ))
-    .unwrap();
+    let flat = plate(0.0);
     let long = line(DVec2::new(0.0, 5.0), DVec2::new(1.8e6, 5.0));
     let e = pipeline::plan(&flat, &[long.clone(), long.clone()], &settings)
         .unwrap_err()
@@ -494,12 +499,7 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
     // Two pads of a footprint drawn as zero-length lines (their width is
     // the stroke's): nothing the nozzle can draw.
     let pads = vec![line(DVec2::new(5.0, 5.0), DVec2::new(5.0, 5.0)); 2];
-    let flat = Surface::new(height_field(
-        &range(0.0, 40.0, 4),
-        &range(0.0, 40.0, 4),
-        |_, _| 0.0,
-    ))
-    .unwrap();
+    let flat = plate(0.0);
     let e = pipeline::plan(&flat, &pads, &settings)
         .unwrap_err()
         .to_string();
@@ -1225,12 +1225,7 @@ fn a_scan_seen_edge_on_from_above_is_said_when_it_is_planned_on() {
 #[test]
 fn the_share_of_the_drawing_printed_is_said_when_part_of_it_is_lost() {
     let settings = PlanSettings::default();
-    let flat = Surface::new(height_field(
-        &range(0.0, 40.0, 4),
-        &range(0.0, 40.0, 4),
-        |_, _| 1.0,
-    ))
-    .unwrap();
+    let flat = plate(1.0);
     // 30 mm on the 40 mm plate, then 90 mm beside it.
     let half = vec![line(DVec2::new(10.0, 20.0), DVec2::new(130.0, 20.0))];
     let plan = pipeline::plan(&flat, &half, &settings).unwrap();
@@ -1258,12 +1253,7 @@ fn the_share_of_the_drawing_printed_is_said_when_part_of_it_is_lost() {
 /// with the count; other paths keep their own.
 #[test]
 fn pieces_too_small_to_print_are_one_warning_a_path() {
-    let flat = Surface::new(height_field(
-        &range(0.0, 40.0, 4),
-        &range(0.0, 40.0, 4),
-        |_, _| 1.0,
-    ))
-    .unwrap();
+    let flat = plate(1.0);
     let mut drawing: Vec<pcpp::svg::Subpath2> = (0..40)
         .map(|i| {
             let x = 5.0 + 0.5 * i as f64;

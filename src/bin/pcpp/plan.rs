@@ -114,6 +114,11 @@ pub fn registration_line(r: &Registration, method: RegistrationMethod) -> String
     )
 }
 
+/// The drawing as read once for the command line's own steps before the
+/// plan (centring it, telling how large it is); an error is said by the
+/// step that needs it, or by the plan.
+type Drawn = Result<pcpp::pipeline::DrawnPath, pcpp::Error>;
+
 /// With `--place centre`, the drawing centred on the scan's footprint, or
 /// on the surface nearest its middle when that is a gap (scaled down to
 /// fit, with a warning, when it is larger, unless a scale was given: that
@@ -121,13 +126,15 @@ pub fn registration_line(r: &Registration, method: RegistrationMethod) -> String
 fn centre_on_scan(
     a: &JobArgs,
     inputs: &Inputs,
+    drawn: &Drawn,
     plan: &mut pcpp::pipeline::PlanSettings,
     progress: &Progress,
 ) -> CliResult<()> {
     let Some(place) = a.place.filter(|p| p.centre) else {
         return Ok(());
     };
-    let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name)
+    let drawn = drawn
+        .as_ref()
         .map_err(|e| Failure::Input(in_file(&inputs.svg_path, &inputs.svg_name, &e.to_string())))?;
     let Some((place, note)) = pcpp::placement::centre_on_surface(
         &drawn.subpaths,
@@ -148,13 +155,19 @@ fn centre_on_scan(
 /// week of print took 7.6 min and 5.3 GB to plan, with no word until it
 /// was done). A drawing that cannot be read or is too large is left to
 /// the plan's own error.
-fn warn_large_drawing(inputs: &Inputs, plan: &pcpp::pipeline::PlanSettings, progress: &Progress) {
-    let Ok(drawn) = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name) else {
+fn warn_large_drawing(
+    inputs: &Inputs,
+    drawn: &Drawn,
+    plan: &pcpp::pipeline::PlanSettings,
+    progress: &Progress,
+) {
+    let Ok(drawn) = drawn else {
         return;
     };
     let size = pcpp::pipeline::drawing_size(&drawn.subpaths, &plan.nozzle, &plan.placement);
     if let Some(note) = size
         .ok()
+        .filter(|s| s.check().is_ok())
         .and_then(|s| s.large_note(plan.process.speed_mm_s))
     {
         progress.warn(&[format!("{}: {note}", input_shown(&inputs.svg_path))]);
@@ -279,8 +292,9 @@ pub fn cmd_plan(a: &PlanArgs, progress: &Progress) -> CliResult<()> {
             job::refuse_bad_registration(&inputs.prepared.registration, nozzle, a.accept_risk)
         })
         .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
-    centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
-    warn_large_drawing(&inputs, &settings.plan, progress);
+    let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name);
+    centre_on_scan(&a.job, &inputs, &drawn, &mut settings.plan, progress)?;
+    warn_large_drawing(&inputs, &drawn, &settings.plan, progress);
     progress.step(format!("planning ({})...", settings.plan.planner));
     let mut noted = Vec::new();
     let output = job::run_on_noting(
@@ -379,8 +393,9 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
     // planner for reasons that hide it ("seen edge-on from above").
     job::refuse_blocking_strays(&inputs.prepared, &profile)
         .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
-    centre_on_scan(&a.job, &inputs, &mut settings.plan, progress)?;
-    warn_large_drawing(&inputs, &settings.plan, progress);
+    let drawn = pcpp::pipeline::load_path(&inputs.svg, &inputs.svg_name);
+    centre_on_scan(&a.job, &inputs, &drawn, &mut settings.plan, progress)?;
+    warn_large_drawing(&inputs, &drawn, &settings.plan, progress);
     progress.step("planning with all five planners...");
     let comparison = job::compare_on(
         &inputs.prepared,
