@@ -23,7 +23,7 @@ use crate::mesh::MAX_SCAN_BYTES;
 use crate::pipeline::{self, PlanSettings};
 use crate::placement::{self, Bed, ScanPlacement};
 use crate::planners::PlannerKind;
-use crate::sampling::{DrawingSize, SamplingError, MAX_DRAWING_SAMPLES, MAX_SAMPLES};
+use crate::sampling::{MAX_DRAWING_SAMPLES, MAX_SAMPLES};
 use crate::svg::Placement;
 
 mod scan;
@@ -768,22 +768,10 @@ struct RegistrationView<'a> {
 /// allocates) the page shows as the CLI would.
 fn check_samples(path: &LoadedPath, settings: &PlanSettings) -> Result<(), JsValue> {
     let placement = &settings.placement;
-    let size =
-        match crate::pipeline::drawing_size(&path.drawn.subpaths, &settings.nozzle, placement) {
-            Ok(size) => size,
-            // Past the core's limit for a drawing, the page's own (lower) one
-            // is the one to name.
-            Err(crate::Error::Sampling(SamplingError::DrawingTooLarge {
-                count,
-                length_mm,
-                spacing_mm,
-            })) => DrawingSize {
-                samples: count,
-                length_mm,
-                spacing_mm,
-            },
-            Err(e) => return Err(core_err(e)),
-        };
+    // The page's limit, lower than the core's for a drawing, is the one
+    // named.
+    let size = crate::pipeline::drawing_size(&path.drawn.subpaths, &settings.nozzle, placement)
+        .map_err(core_err)?;
     if size.samples > PAGE_MAX_SAMPLES as f64 {
         return Err(kind_err(
             "limit",
