@@ -807,6 +807,22 @@ fn run_piece_to_beat(
     })
 }
 
+/// Piece `k`'s points the nozzle still touches: those whose move the
+/// safe-motion stage could not make safe (`unresolved`, spec 6f), then
+/// those the planner could not clear; each once (a point in both is listed
+/// as the planner's).
+fn uncleared_points(
+    k: usize,
+    planned: &crate::planners::PlannedPoints,
+    unresolved: &[usize],
+) -> Vec<(usize, usize, DVec3)> {
+    let moves = unresolved.iter().filter(|j| !planned.uncleared.contains(j));
+    moves
+        .chain(&planned.uncleared)
+        .map(|&j| (k, j, planned.toolpath[j]))
+        .collect()
+}
+
 fn defects(quality: &[PointQuality]) -> usize {
     quality.iter().filter(|q| q.defect != Defect::Good).count()
 }
@@ -950,12 +966,8 @@ fn plan_stage(
             };
             motion.waypoints += waypoints;
             motion.extra_length_mm += extra;
-            for &j in &unresolved {
-                if !planned.uncleared.contains(&j) {
-                    uncleared.push((k, j, planned.toolpath[j]));
-                }
-            }
         }
+        uncleared.extend(uncleared_points(k, &planned, &unresolved));
         // The guarded planners' moves were checked as their waypoints were
         // placed, with the planning margin; the others' are checked here.
         if safe_motion && !planner.is_guarded() {
@@ -1019,12 +1031,6 @@ fn plan_stage(
                     }
                 }
             }
-        }
-        for &j in &planned.uncleared {
-            uncleared.push((k, j, planned.toolpath[j]));
-        }
-        for &j in &planned.uncleared {
-            uncleared.push((k, j, planned.toolpath[j]));
         }
         pieces.push(PlannedPiece {
             source: piece.source.clone(),
@@ -1294,6 +1300,28 @@ mod tests {
             "no second run stopped early ({compared} compared)"
         );
         assert!(taken > 0, "no second run taken ({compared} compared)");
+    }
+
+    /// Each point the plan could not clear is listed once: a point the
+    /// planner could not clear was listed twice (since 033e1e3), so the
+    /// refusal counted it twice; one whose move is unresolved too is the
+    /// planner's.
+    #[test]
+    fn each_uncleared_point_is_listed_once() {
+        let planned = crate::planners::PlannedPoints {
+            toolpath: (0..5).map(|i| DVec3::new(i as f64, 0.0, 1.0)).collect(),
+            uncleared: vec![1, 3],
+            ..Default::default()
+        };
+        let listed: Vec<(usize, usize)> = uncleared_points(2, &planned, &[0, 3])
+            .iter()
+            .map(|&(k, j, p)| {
+                assert_eq!(p, planned.toolpath[j]);
+                (k, j)
+            })
+            .collect();
+        assert_eq!(listed, vec![(2, 0), (2, 1), (2, 3)]);
+        assert!(uncleared_points(0, &planned, &[]).len() == 2);
     }
 
     /// QA round 10 L1: a tip leading its point round a corner is off the
