@@ -94,6 +94,9 @@ const ON_PLANE_MM: f64 = 1e-9;
 /// T*_j, a few samples at d/2 spacing.
 pub(crate) const SEARCH: usize = 8;
 
+/// Points a thread takes at least at a time.
+const CHUNK: usize = 256;
+
 /// Predicts the quality along one subpath planned as `toolpath`.
 pub fn predict(
     surface: &Surface,
@@ -104,10 +107,9 @@ pub fn predict(
     process: &Process,
 ) -> Vec<PointQuality> {
     let r = 0.5 * nozzle.outer_diameter_mm;
-    let contact: Vec<bool> = toolpath
-        .iter()
-        .map(|&t| surface.disk_contact(t, r).is_some())
-        .collect();
+    let contact = crate::parallel::map(toolpath.len(), CHUNK, |j| {
+        surface.disk_contact(toolpath[j], r).is_some()
+    });
     predict_given_contact(ta, geometry, toolpath, &contact, nozzle, process)
 }
 
@@ -182,76 +184,82 @@ pub(crate) fn predict_given_contact(
         Some(c) => c.params().to_vec(),
         None => (0..back.len()).map(|i| i as f64).collect(),
     };
-    let hint = std::cell::Cell::new(usize::MAX);
-    // The last point evaluated: a root search's last step is usually the
-    // root, which is then evaluated again for the crossing (the same u,
-    // so the same point).
-    let last: std::cell::Cell<Option<(u64, DVec3)>> = std::cell::Cell::new(None);
-    let eval = |u: f64| -> DVec3 {
-        match &curve {
-            Some(c) => match last.get() {
-                Some((bits, at)) if bits == u.to_bits() => at,
-                _ => {
-                    let at = c.eval_near(u, &hint);
-                    last.set(Some((u.to_bits(), at)));
-                    at
+    // Each point's crossing on its own, on every core natively; the span
+    // hint and the last point evaluated are each chunk's own (neither
+    // changes a result), and the chunks come back in order.
+    let chunks = crate::parallel::map_chunks(ta.len(), CHUNK, |range| {
+        let hint = std::cell::Cell::new(usize::MAX);
+        // The last point evaluated: a root search's last step is usually the
+        // root, which is then evaluated again for the crossing (the same u,
+        // so the same point).
+        let last: std::cell::Cell<Option<(u64, DVec3)>> = std::cell::Cell::new(None);
+        let eval = |u: f64| -> DVec3 {
+            match &curve {
+                Some(c) => match last.get() {
+                    Some((bits, at)) if bits == u.to_bits() => at,
+                    _ => {
+                        let at = c.eval_near(u, &hint);
+                        last.set(Some((u.to_bits(), at)));
+                        at
+                    }
+                },
+                None => {
+                    let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
+                    let f = u - i as f64;
+                    back[i].lerp(back[(i + 1).min(back.len() - 1)], f)
                 }
-            },
-            None => {
-                let i = (u.floor().max(0.0) as usize).min(back.len().saturating_sub(2));
-                let f = u - i as f64;
-                back[i].lerp(back[(i + 1).min(back.len() - 1)], f)
             }
-        }
-    };
+        };
 
-    let mut out = Vec::with_capacity(ta.len());
-    // The position of each kept point in `back`.
-    let mut slot = 0usize;
-    for j in 0..ta.len() {
-        if contact[j] {
-            out.push(PointQuality {
-                defect: Defect::Contact,
-                thickness_mm: None,
-                error_mm: None,
-            });
-            continue;
-        }
-        let pj = slot;
-        slot += 1;
-        let (a, g) = (ta[j], &geometry[j]);
-        let crossing = if back.len() < 2 {
-            None
-        } else {
-            crossing_near(&back, &params, &eval, pj, a, g.tangent)
-        };
-        let thickness = crossing.and_then(|p| {
-            let lambda = (p - a).dot(g.n);
-            // The crossing lies on the normal line only within 2d of Ta_j
-            // (section 7): one further away, up the line or off it to the
-            // side (where the path turns, the curve may cross the plane
-            // normal to t_j far from the line), is no intersection.
-            if lambda > 2.0 * d || p.distance(a) > 2.0 * d {
-                None
-            } else if lambda < 0.0 {
-                Some(0.0) // the filament's top is under the surface: crushed
-            } else {
-                Some(p.distance(a))
+        let mut out = Vec::with_capacity(range.len());
+        // The position of each kept point in `back`.
+        let mut slot = kept.partition_point(|&k| k < range.start);
+        for j in range {
+            if contact[j] {
+                out.push(PointQuality {
+                    defect: Defect::Contact,
+                    thickness_mm: None,
+                    error_mm: None,
+                });
+                continue;
             }
-        });
-        let (defect, error) = match thickness {
-            None => (Defect::Floating, d),
-            Some(t) if t < d - tol => (Defect::Flattening, t - d),
-            Some(t) if t > d + tol => (Defect::Floating, t - d),
-            Some(t) => (Defect::Good, t - d),
-        };
-        out.push(PointQuality {
-            defect,
-            thickness_mm: thickness,
-            error_mm: Some(error),
-        });
-    }
-    out
+            let pj = slot;
+            slot += 1;
+            let (a, g) = (ta[j], &geometry[j]);
+            let crossing = if back.len() < 2 {
+                None
+            } else {
+                crossing_near(&back, &params, &eval, pj, a, g.tangent)
+            };
+            let thickness = crossing.and_then(|p| {
+                let lambda = (p - a).dot(g.n);
+                // The crossing lies on the normal line only within 2d of Ta_j
+                // (section 7): one further away, up the line or off it to the
+                // side (where the path turns, the curve may cross the plane
+                // normal to t_j far from the line), is no intersection.
+                if lambda > 2.0 * d || p.distance(a) > 2.0 * d {
+                    None
+                } else if lambda < 0.0 {
+                    Some(0.0) // the filament's top is under the surface: crushed
+                } else {
+                    Some(p.distance(a))
+                }
+            });
+            let (defect, error) = match thickness {
+                None => (Defect::Floating, d),
+                Some(t) if t < d - tol => (Defect::Flattening, t - d),
+                Some(t) if t > d + tol => (Defect::Floating, t - d),
+                Some(t) => (Defect::Good, t - d),
+            };
+            out.push(PointQuality {
+                defect,
+                thickness_mm: thickness,
+                error_mm: Some(error),
+            });
+        }
+        out
+    });
+    chunks.into_iter().flatten().collect()
 }
 
 /// p_j: where the filament curve c (through `back`, parameters `params`,

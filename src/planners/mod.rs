@@ -152,13 +152,11 @@ fn pcpp_point(surface: &Surface, ta: DVec3, g: &LocalGeometry, nozzle: &Nozzle, 
 /// clear where pushing does not do it.
 fn guarded_point(
     surface: &Surface,
-    j: usize,
     p: DVec3,
     g: &LocalGeometry,
     nozzle: &Nozzle,
     tol: f64,
-    out: &mut PlannedPoints,
-) -> DVec3 {
+) -> PointPlanned {
     let c = Clearance::new(nozzle, tol).with_margin(PLANNING_MARGIN_MM);
     let r_clear = c.radius_mm + c.tol_mm;
     let start = pcpp_point(surface, p, g, nozzle, tol);
@@ -190,14 +188,33 @@ fn guarded_point(
     };
     if lift > 0.0 {
         t.z += lift;
-        out.lifted.push((j, lift));
     }
     // Checked again, so rounding can never pass an uncleared point.
-    if !t.is_finite() || !c.is_clear(surface, t, t) {
-        out.uncleared.push(j);
-    }
-    t
+    let cleared = t.is_finite() && c.is_clear(surface, t, t);
+    PointPlanned { t, lift, cleared }
 }
+
+/// One point planned on its own: T*, the lift the guarded planner added,
+/// and whether it clears.
+struct PointPlanned {
+    t: DVec3,
+    lift: f64,
+    cleared: bool,
+}
+
+impl PointPlanned {
+    fn at(t: DVec3) -> PointPlanned {
+        PointPlanned {
+            t,
+            lift: 0.0,
+            cleared: true,
+        }
+    }
+}
+
+/// Points a thread takes at least at a time, for the planners whose point
+/// asks the surface (`pcpp`, `pcpp-guarded`).
+const MIN_CHUNK: usize = 256;
 
 /// Plans one subpath's points (one per sample; the guarded planners'
 /// waypoints come after, see [`crate::motion::insert_waypoints`]). `ta`
@@ -213,20 +230,36 @@ pub fn plan_points(
     let d = nozzle.inner_diameter_mm;
     let r = 0.5 * nozzle.outer_diameter_mm;
     let tol = process.tolerance_mm;
+    // The paper's planners place each point on its own (Algorithms 2-4,
+    // section 6d), so those that ask the surface do it on every core
+    // natively; the points come back in order, the same for any number
+    // of threads.
+    type Place<'a> = &'a (dyn Fn(DVec3, &LocalGeometry) -> PointPlanned + Sync);
+    let (place, min_chunk): (Place, usize) = match kind {
+        PlannerKind::Constant => (&|p, _| PointPlanned::at(p + d * DVec3::Z), ta.len()),
+        PlannerKind::Slope => (&|p, g| PointPlanned::at(p + d * g.n + r * g.v), ta.len()),
+        PlannerKind::Pcpp => (
+            &|p, g| PointPlanned::at(pcpp_point(surface, p, g, nozzle, tol)),
+            MIN_CHUNK,
+        ),
+        PlannerKind::PcppGuarded => (&|p, g| guarded_point(surface, p, g, nozzle, tol), MIN_CHUNK),
+        // Planned as a whole, not point by point.
+        PlannerKind::Even => return even::plan(surface, ta, geometry, nozzle, process),
+    };
+    let n = ta.len().min(geometry.len());
+    let points = crate::parallel::map(n, min_chunk, |j| place(ta[j], &geometry[j]));
     let mut out = PlannedPoints {
-        toolpath: Vec::with_capacity(ta.len()),
+        toolpath: Vec::with_capacity(points.len()),
         ..Default::default()
     };
-    for (j, (&p, g)) in ta.iter().zip(geometry).enumerate() {
-        let t = match kind {
-            PlannerKind::Constant => p + d * DVec3::Z,
-            PlannerKind::Slope => p + d * g.n + r * g.v,
-            PlannerKind::Pcpp => pcpp_point(surface, p, g, nozzle, tol),
-            PlannerKind::PcppGuarded => guarded_point(surface, j, p, g, nozzle, tol, &mut out),
-            // Planned as a whole, not point by point.
-            PlannerKind::Even => return even::plan(surface, ta, geometry, nozzle, process),
-        };
-        out.toolpath.push(t);
+    for (j, point) in points.into_iter().enumerate() {
+        if point.lift > 0.0 {
+            out.lifted.push((j, point.lift));
+        }
+        if !point.cleared {
+            out.uncleared.push(j);
+        }
+        out.toolpath.push(point.t);
     }
     out
 }
