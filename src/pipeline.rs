@@ -23,8 +23,8 @@ use crate::params::{Nozzle, Process};
 use crate::planners::{plan_points, PlannerKind};
 use crate::projection::project_subpath;
 use crate::quality::{
-    nozzle_contacts, predict, predict_given_contact, summarize, Defect, PointQuality,
-    QualitySummary,
+    nozzle_contacts, predict, predict_asking, predict_given_contact, summarize, Defect,
+    PointQuality, QualitySummary,
 };
 use crate::registration::Registration;
 use crate::sampling::{try_sample_subpath, DrawingSize, MAX_SAMPLES};
@@ -731,8 +731,33 @@ fn run_piece_to_beat(
     if bar.is_some_and(|b| planned.uncleared.len() > b.uncleared) {
         return None;
     }
+    let guarded_motion = safe_motion && planner.is_guarded();
     let predicted = match planned.quality.take() {
         Some(q) => q,
+        // A guarded planner's points clear by tol, but for those it names
+        // (spec 6d): only those can have a contact. Where none is named and
+        // the bar allows no unresolved move, the run's prediction is this
+        // one (no contact of the nozzle's body, no move asked: see below),
+        // so it stops as soon as it has as many defects as the bar.
+        None if planner.is_guarded() => {
+            let mut ask = vec![false; planned.toolpath.len()];
+            for &j in &planned.uncleared {
+                ask[j] = true;
+            }
+            let below = bar
+                .filter(|b| guarded_motion && b.unresolved == 0 && planned.uncleared.is_empty())
+                .map(|b| b.defects);
+            predict_asking(
+                surface,
+                &piece.ta,
+                &piece.geometry,
+                &planned.toolpath,
+                nozzle,
+                process,
+                |j| ask[j],
+                below,
+            )?
+        }
         None => predict(
             surface,
             &piece.ta,
@@ -742,7 +767,6 @@ fn run_piece_to_beat(
             process,
         ),
     };
-    let guarded_motion = safe_motion && planner.is_guarded();
     // The prediction with no unresolved move, asked before the
     // safe-motion stage where the bar allows none (`Ok`: the run's
     // quality if no move is left unresolved; `Err`: the prediction still

@@ -106,11 +106,41 @@ pub fn predict(
     nozzle: &Nozzle,
     process: &Process,
 ) -> Vec<PointQuality> {
+    let all = predict_asking(
+        surface,
+        ta,
+        geometry,
+        toolpath,
+        nozzle,
+        process,
+        |_| true,
+        None,
+    );
+    all.unwrap_or_default() // (with no bound, always a prediction)
+}
+
+/// [`predict`], asking the tip disk's contact only at the points `ask`
+/// names: a point the nozzle is known to clear by tol has none (its tip
+/// disk is tol away from the surface), so a guarded planner asks only of
+/// the points it could not clear. The same prediction, to the last bit;
+/// `None` as soon as `below` points have a defect, where given (a run
+/// that must predict fewer defects than that stops as soon as it cannot).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn predict_asking(
+    surface: &Surface,
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    toolpath: &[DVec3],
+    nozzle: &Nozzle,
+    process: &Process,
+    ask: impl Fn(usize) -> bool + Sync,
+    below: Option<usize>,
+) -> Option<Vec<PointQuality>> {
     let r = 0.5 * nozzle.outer_diameter_mm;
     let contact = crate::parallel::map(toolpath.len(), CHUNK, |j| {
-        surface.disk_contact(toolpath[j], r).is_some()
+        ask(j) && surface.disk_contact(toolpath[j], r).is_some()
     });
-    predict_given_contact(ta, geometry, toolpath, &contact, nozzle, process)
+    predict_below(ta, geometry, toolpath, &contact, nozzle, process, below)
 }
 
 /// The points where the nozzle runs into the part beyond what section 7's
@@ -165,6 +195,22 @@ pub(crate) fn predict_given_contact(
     nozzle: &Nozzle,
     process: &Process,
 ) -> Vec<PointQuality> {
+    let all = predict_below(ta, geometry, toolpath, contact, nozzle, process, None);
+    all.unwrap_or_default() // (with no bound, always a prediction)
+}
+
+/// [`predict_given_contact`], or `None` as soon as `below` points have a
+/// defect, where given. Each point's prediction is its own, so stopping
+/// changes none: `Some` is the same prediction.
+fn predict_below(
+    ta: &[DVec3],
+    geometry: &[LocalGeometry],
+    toolpath: &[DVec3],
+    contact: &[bool],
+    nozzle: &Nozzle,
+    process: &Process,
+    below: Option<usize>,
+) -> Option<Vec<PointQuality>> {
     let d = nozzle.inner_diameter_mm;
     let tol = process.tolerance_mm;
     // c(t) runs through the F_j of the points without contact only
@@ -186,7 +232,11 @@ pub(crate) fn predict_given_contact(
     };
     // Each point's crossing on its own, on every core natively; the span
     // hint and the last point evaluated are each chunk's own (neither
-    // changes a result), and the chunks come back in order.
+    // changes a result), and the chunks come back in order. The defects
+    // are counted over all chunks only where there is a bound.
+    let defects = std::sync::atomic::AtomicUsize::new(0);
+    let bound = below.unwrap_or(usize::MAX);
+    let stopped = || defects.load(std::sync::atomic::Ordering::Relaxed) >= bound;
     let chunks = crate::parallel::map_chunks(ta.len(), CHUNK, |range| {
         let hint = std::cell::Cell::new(usize::MAX);
         // The last point evaluated: a root search's last step is usually the
@@ -215,12 +265,18 @@ pub(crate) fn predict_given_contact(
         // The position of each kept point in `back`.
         let mut slot = kept.partition_point(|&k| k < range.start);
         for j in range {
+            if below.is_some() && stopped() {
+                return None;
+            }
             if contact[j] {
                 out.push(PointQuality {
                     defect: Defect::Contact,
                     thickness_mm: None,
                     error_mm: None,
                 });
+                if below.is_some() {
+                    defects.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                }
                 continue;
             }
             let pj = slot;
@@ -251,15 +307,25 @@ pub(crate) fn predict_given_contact(
                 Some(t) if t > d + tol => (Defect::Floating, t - d),
                 Some(t) => (Defect::Good, t - d),
             };
+            if below.is_some() && defect != Defect::Good {
+                defects.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
             out.push(PointQuality {
                 defect,
                 thickness_mm: thickness,
                 error_mm: Some(error),
             });
         }
-        out
+        Some(out)
     });
-    chunks.into_iter().flatten().collect()
+    if stopped() {
+        return None;
+    }
+    let mut out = Vec::with_capacity(ta.len());
+    for chunk in chunks {
+        out.extend(chunk?);
+    }
+    Some(out)
 }
 
 /// p_j: where the filament curve c (through `back`, parameters `params`,
@@ -560,6 +626,62 @@ mod tests {
         assert_eq!(s.points, 20);
         assert!(s.mean_negative_error_mm < -0.2 && s.mean_positive_error_mm == 0.0);
         assert!(s.flattening_pct > 50.0);
+    }
+
+    /// A run that must predict fewer defects than a bar stops as soon as
+    /// it cannot (`below`): `None` exactly when the whole prediction has at
+    /// least that many defects, that prediction otherwise (over several
+    /// chunks natively); and the tip disk's contact asked only where it is
+    /// named gives the same prediction when the others have none.
+    #[test]
+    fn a_prediction_below_a_bar_stops_exactly_when_it_cannot_be_below() {
+        let s = Surface::new(crate::mesh::TriMesh::height_field(
+            &[-110.0, 110.0],
+            &[-10.0, 10.0],
+            |_, y| 0.001 * y, // (a plane the tip disk at z = 0 cuts)
+        ))
+        .unwrap();
+        let ta: Vec<DVec3> = (0..700)
+            .map(|i| DVec3::new(-105.0 + i as f64 * 0.3, 0.0, 0.0))
+            .collect();
+        let g = crate::spline::local_geometry(&ta).unwrap();
+        let (n, p) = (Nozzle::DEFAULT, Process::DEFAULT);
+        let tp: Vec<DVec3> = ta
+            .iter()
+            .enumerate()
+            .map(|(j, a)| {
+                let h = if j % 97 == 0 {
+                    0.0
+                } else {
+                    0.6 + 0.25 * (j as f64 * 0.1).sin()
+                };
+                *a + h * DVec3::Z
+            })
+            .collect();
+        let full = predict(&s, &ta, &g, &tp, &n, &p);
+        let defects = full.iter().filter(|q| q.defect != Defect::Good).count();
+        assert!(defects > 20 && defects + 20 < full.len(), "{defects}");
+        for below in [
+            0,
+            1,
+            defects / 2,
+            defects - 1,
+            defects,
+            defects + 1,
+            usize::MAX,
+        ] {
+            let got = predict_asking(&s, &ta, &g, &tp, &n, &p, |_| true, Some(below));
+            assert_eq!(got.is_none(), defects >= below, "below {below}");
+            if let Some(got) = got {
+                assert_eq!(got, full, "below {below}");
+            }
+        }
+        let contact: Vec<usize> = (0..ta.len())
+            .filter(|&j| full[j].defect == Defect::Contact)
+            .collect();
+        assert_eq!(contact.len(), 8);
+        let asked = predict_asking(&s, &ta, &g, &tp, &n, &p, |j| contact.contains(&j), None);
+        assert_eq!(asked, Some(full));
     }
 
     /// A plate with a sheet (a lid's rim) held 1.5 mm above it from

@@ -189,8 +189,10 @@ fn guarded_point(
     if lift > 0.0 {
         t.z += lift;
     }
-    // Checked again, so rounding can never pass an uncleared point.
-    let cleared = t.is_finite() && c.is_clear(surface, t, t);
+    // Checked again where lifted, so rounding can never pass an uncleared
+    // point (a point found clear as it stands was just asked that, of the
+    // same t).
+    let cleared = t.is_finite() && (clear || c.is_clear(surface, t, t));
     PointPlanned { t, lift, cleared }
 }
 
