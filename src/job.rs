@@ -1048,7 +1048,8 @@ pub fn run_on_noting(
     refuse_bad_registration(&scan.registration, &settings.nozzle, accept_risk)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
     noted.extend(drawn.notes.iter().cloned());
-    let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)?;
+    let plan = pipeline::plan(&scan.surface, &drawn.subpaths, settings)
+        .map_err(|e| with_units_hint(e, scan, profile))?;
     noted.extend(plan.warnings.iter().cloned());
     refuse_uncleared(&plan, accept_risk)?;
     let path_file = InputFile::new(svg_name, svg);
@@ -1067,6 +1068,35 @@ pub fn run_on_noting(
         report,
         gcode,
     })
+}
+
+/// A planning refusal ([`Error::Plan`]: the drawing misses the scan, the
+/// scan is seen edge-on from above, ...) of a scan whose size is
+/// implausible in the units it was read in, with the advice to check them
+/// ([`crate::placement::units_hint`]): whatever failed first, the units
+/// are then the likelier fault. QA round 20 F6: glTF parts 1 m across in
+/// glTF's metres were refused as seen edge-on, or missed by the drawing,
+/// with no word of their units, while the refusal for the build volume
+/// said them (in the same words, from the same test). Other errors are
+/// returned as they are, and so is a scan made large by stray vertices,
+/// which no units mend ([`crate::mesh::StrayVertices`]).
+pub fn with_units_hint(e: Error, scan: &PreparedScan, profile: &MachineProfile) -> Error {
+    let Error::Plan(message) = e else {
+        return e;
+    };
+    let strays = scan.units_doubt.is_some_and(|d| d.stray.is_some());
+    let hint = crate::placement::units_hint(
+        scan.surface.bbox(),
+        &profile.build_volume,
+        &profile.name,
+        scan.units,
+    );
+    match hint {
+        Some(hint) if !strays && !message.contains(&hint) => {
+            Error::Plan(format!("{message}; {hint}"))
+        }
+        _ => Error::Plan(message),
+    }
 }
 
 /// [`Error::MostlyOffScan`] (alone or first of the risks) with its

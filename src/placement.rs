@@ -209,11 +209,7 @@ pub fn volume_fit(
     // A hair out is on the face (a registration's rounding).
     let inside = outside.max_element() <= crate::gcode::VOLUME_HAIR_MM;
     let size = hi - lo;
-    // Up from the bed, where a part stands (QA round 20 F3: a 125 mm
-    // scan on Grbl's -100..100 mm was told to move back inside, and the
-    // only way, down, sank it into the bed).
-    let room = (volume.max_mm - volume.min_mm).with_z(volume.max_mm.z - Bed::of(volume).z_mm);
-    let fits_on_bed = size.cmple(room).all();
+    let fits_on_bed = size.cmple(room(volume)).all();
     let mut placed_message = String::new();
     let message = if inside {
         format!("the scan lies inside the build volume of profile {profile}")
@@ -240,46 +236,8 @@ pub fn volume_fit(
             // Placing it cannot help, on the bed or elsewhere (QA: a scan
             // read in metres, placed on the bed, was told to be moved back
             // inside): name the axis it is too large on.
-            let over = size - room;
-            let (axis, k) = [("x", 0), ("y", 1), ("z", 2)]
-                .into_iter()
-                .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
-            let larger = format!(
-                "{spans}; it is larger than the volume ({axis} {:.1} mm, the volume {:.1} mm{})",
-                size[k],
-                room[k],
-                if k == 2 { " above its bed" } else { "" }
-            );
-            // Read in larger units than mm: the smaller ones it fits in
-            // (QA round 16 F10: a 2-unit glTF cube read in its metres was
-            // told it was too large "even read in mm").
-            let fitting: Vec<(ScanUnits, DVec3)> = [ScanUnits::Cm, ScanUnits::In, ScanUnits::Mm]
-                .into_iter()
-                .filter(|u| u.to_mm() < read_in.to_mm())
-                .map(|u| (u, size * (u.to_mm() / read_in.to_mm())))
-                .filter(|(_, s)| s.cmple(room).all())
-                .collect();
-            // Only units in which it is a part to print on (QA round 17
-            // F8: a 155 mm bunny given in metres, too tall for a 100 mm
-            // volume, was offered 1.6 mm in cm and 0.2 mm in mm, each of
-            // which the units check itself calls too small).
-            let tiny = !fitting.is_empty()
-                && fitting
-                    .iter()
-                    .all(|(_, s)| s.max_element() < crate::mesh::SMALL_SCAN_MM);
-            let smaller: Vec<String> = fitting
-                .into_iter()
-                .filter(|(_, s)| s.max_element() >= crate::mesh::SMALL_SCAN_MM)
-                .map(|(u, s)| {
-                    format!(
-                        "in {} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
-                        u.words(),
-                        s.x,
-                        s.y,
-                        s.z
-                    )
-                })
-                .collect();
+            let over = Oversize::of(size, room(volume), read_in);
+            let larger = format!("{spans}; it is larger than the volume {}", over.axis);
             if read_in == ScanUnits::Mm {
                 format!(
                     "{larger}: check the scan's units and up axis, or use a profile whose build \
@@ -287,7 +245,7 @@ pub fn volume_fit(
                      the smallest unit it reads, must be scaled down in the program that exported \
                      it)"
                 )
-            } else if tiny {
+            } else if over.tiny {
                 format!(
                     "{larger}, read in {}; in smaller units it would fit only as a part under \
                      {} mm across: check the scan's up axis, or use a profile whose build volume \
@@ -295,7 +253,7 @@ pub fn volume_fit(
                     read_in.words(),
                     crate::mesh::SMALL_SCAN_MM
                 )
-            } else if smaller.is_empty() {
+            } else if over.smaller.is_empty() {
                 format!(
                     "{larger}, read in {}, and in any smaller units too: check the scan's up \
                      axis, or use a profile whose build volume holds it (pcpp does not scale a \
@@ -304,12 +262,7 @@ pub fn volume_fit(
                     read_in.words()
                 )
             } else {
-                format!(
-                    "{larger}, read in {}: {}; check the scan's units and up axis, or use a \
-                     profile whose build volume holds it",
-                    read_in.words(),
-                    smaller.join(", ")
-                )
+                format!("{larger}{}", over.units_advice(read_in))
             }
         }
     };
@@ -323,6 +276,120 @@ pub fn volume_fit(
         message,
         placed_message,
     }
+}
+
+/// The room a part has in `volume`: its extent, up from the bed, where a
+/// part stands (QA round 20 F3: a 125 mm scan on Grbl's -100..100 mm was
+/// told to move back inside, and the only way, down, sank it into the
+/// bed).
+fn room(volume: &BuildVolume) -> DVec3 {
+    (volume.max_mm - volume.min_mm).with_z(volume.max_mm.z - Bed::of(volume).z_mm)
+}
+
+/// How a scan too large for a build volume's room exceeds it, and the
+/// smaller units it would fit in ([`volume_fit`], [`units_hint`]).
+struct Oversize {
+    /// The axis it exceeds most, with its size and the room's:
+    /// "(x 1000.0 mm, the volume 220.0 mm)".
+    axis: String,
+    /// The units smaller than the ones it was read in that it fits in, as
+    /// parts a nozzle prints on, with its size in each: "in centimetres it
+    /// would be 10.0 x 10.0 x 10.0 mm (--scan-units cm)".
+    smaller: Vec<String>,
+    /// It fits in some smaller units, but only as a speck in each.
+    tiny: bool,
+}
+
+impl Oversize {
+    /// A scan `size` (mm, read in `read_in`) against a volume's `room`
+    /// (its extent, z from its bed).
+    fn of(size: DVec3, room: DVec3, read_in: ScanUnits) -> Oversize {
+        let over = size - room;
+        let (axis, k) = [("x", 0), ("y", 1), ("z", 2)]
+            .into_iter()
+            .fold(("x", 0), |m, a| if over[a.1] > over[m.1] { a } else { m });
+        let axis = format!(
+            "({axis} {:.1} mm, the volume {:.1} mm{})",
+            size[k],
+            room[k],
+            if k == 2 { " above its bed" } else { "" }
+        );
+        // Read in larger units than mm: the smaller ones it fits in
+        // (QA round 16 F10: a 2-unit glTF cube read in its metres was
+        // told it was too large "even read in mm").
+        let fitting: Vec<(ScanUnits, DVec3)> = [ScanUnits::Cm, ScanUnits::In, ScanUnits::Mm]
+            .into_iter()
+            .filter(|u| u.to_mm() < read_in.to_mm())
+            .map(|u| (u, size * (u.to_mm() / read_in.to_mm())))
+            .filter(|(_, s)| s.cmple(room).all())
+            .collect();
+        // Only units in which it is a part to print on (QA round 17
+        // F8: a 155 mm bunny given in metres, too tall for a 100 mm
+        // volume, was offered 1.6 mm in cm and 0.2 mm in mm, each of
+        // which the units check itself calls too small).
+        let tiny = !fitting.is_empty()
+            && fitting
+                .iter()
+                .all(|(_, s)| s.max_element() < crate::mesh::SMALL_SCAN_MM);
+        let smaller = fitting
+            .into_iter()
+            .filter(|(_, s)| s.max_element() >= crate::mesh::SMALL_SCAN_MM)
+            .map(|(u, s)| {
+                format!(
+                    "in {} it would be {:.1} x {:.1} x {:.1} mm (--scan-units {u})",
+                    u.words(),
+                    s.x,
+                    s.y,
+                    s.z
+                )
+            })
+            .collect();
+        Oversize {
+            axis,
+            smaller,
+            tiny,
+        }
+    }
+
+    /// What follows "larger than the volume (x 1000.0 mm, the volume 220.0
+    /// mm)" for a scan the smaller units of [`Oversize::smaller`] mend.
+    fn units_advice(&self, read_in: ScanUnits) -> String {
+        format!(
+            ", read in {}: {}; check the scan's units and up axis, or use a profile whose build \
+             volume holds it",
+            read_in.words(),
+            self.smaller.join(", ")
+        )
+    }
+}
+
+/// The units advice for a scan with bounds `bbox` (printer frame), read in
+/// `read_in`, whose size is implausible in those units: it cannot stand
+/// on the bed of `volume` (profile `profile`), and in some smaller units
+/// it would, as a part a nozzle prints on. The same sentence, on the same
+/// test, as [`volume_fit`]'s for such a scan outside the volume; `None`
+/// for any other scan. QA round 20 F6: glTF's metres made 1 m parts of
+/// 1 mm ones, and only a refusal for the build volume said to check the
+/// units; one seen edge-on, or missed by the drawing, did not.
+pub fn units_hint(
+    bbox: (DVec3, DVec3),
+    volume: &BuildVolume,
+    profile: &str,
+    read_in: ScanUnits,
+) -> Option<String> {
+    let size = bbox.1 - bbox.0;
+    let space = room(volume);
+    if read_in == ScanUnits::Mm || size.cmple(space).all() || !size.is_finite() {
+        return None;
+    }
+    let over = Oversize::of(size, space, read_in);
+    (!over.smaller.is_empty()).then(|| {
+        format!(
+            "the scan is larger than the build volume of profile {profile} {}{}",
+            over.axis,
+            over.units_advice(read_in)
+        )
+    })
 }
 
 /// How much of the footprint a drawing may fill when it is scaled to fit.
@@ -830,6 +897,49 @@ mod tests {
             "{}",
             fit.placed_message
         );
+    }
+
+    /// QA round 20 F6: the units advice for a scan that cannot stand on the
+    /// printer in its units, and would in smaller ones, is the build
+    /// volume's refusal's, wherever it lies (a refusal for something else
+    /// says it too); a scan that fits, one read in mm, or one a speck in
+    /// every smaller unit gets none.
+    #[test]
+    fn the_units_hint_is_the_volume_refusals() {
+        let metre = (
+            DVec3::new(-500.0, -500.0, 0.0),
+            DVec3::new(500.0, 500.0, 1.0),
+        );
+        let hint = units_hint(metre, &volume(), "marlin", ScanUnits::M).unwrap();
+        assert_eq!(
+            hint,
+            "the scan is larger than the build volume of profile marlin (x 1000.0 mm, the volume \
+             220.0 mm), read in metres: in centimetres it would be 10.0 x 10.0 x 0.0 mm \
+             (--scan-units cm), in inches it would be 25.4 x 25.4 x 0.0 mm (--scan-units in); \
+             check the scan's units and up axis, or use a profile whose build volume holds it"
+        );
+        let fit = volume_fit(metre, &volume(), "marlin", ScanUnits::M);
+        let tail = hint.replace(
+            "the scan is larger than the build volume of profile marlin",
+            "it is larger than the volume",
+        );
+        assert!(fit.message.ends_with(&tail), "{}", fit.message);
+        // Inside the volume or not, the same hint.
+        let moved = (metre.0 + 600.0, metre.1 + 600.0);
+        assert_eq!(
+            units_hint(moved, &volume(), "marlin", ScanUnits::M),
+            Some(hint)
+        );
+        assert_eq!(units_hint(metre, &volume(), "marlin", ScanUnits::Mm), None);
+        let part = (DVec3::ZERO, DVec3::new(0.15, 0.1, 0.01));
+        assert_eq!(units_hint(part, &volume(), "marlin", ScanUnits::M), None);
+        // QA round 17 F8's bunny, too tall for a 100 mm volume in metres.
+        let low = BuildVolume {
+            min_mm: DVec3::ZERO,
+            max_mm: DVec3::new(300.0, 300.0, 100.0),
+        };
+        let bunny = (DVec3::ZERO, DVec3::new(155.7, 120.7, 154.3));
+        assert_eq!(units_hint(bunny, &low, "lab", ScanUnits::M), None);
     }
 
     #[test]

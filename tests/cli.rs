@@ -3360,6 +3360,110 @@ fn a_scan_too_large_in_its_units_is_told_the_units_it_fits_in() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// QA round 20 F6: a square 1 unit across read in metres (glTF's unit)
+/// and standing on its edge was refused as seen edge-on with no word of
+/// its units, while a 1 m part refused for the build volume was told them.
+/// The refusal says them too, in the build volume's words, whatever
+/// failed first (edge-on, or the drawing missing it, and for `compare`);
+/// read in units in which it stands on the printer, it is not.
+#[test]
+fn a_scan_too_large_in_its_units_is_told_them_whatever_refuses_it() {
+    let dir = temp_dir("too-large-edge-on");
+    // A square 1 unit across standing on its edge, and one lying flat.
+    let square = dir.join("square.obj");
+    std::fs::write(
+        &square,
+        "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let flat = dir.join("flat.obj");
+    std::fs::write(
+        &flat,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let svg = dir.join("line.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M 2 5 L 8 5" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let out = dir.join("out.gcode");
+    // Its size in centimetres and in inches, as the hint gives them.
+    let hint = |cm: &str, inches: &str| {
+        format!(
+            "the scan is larger than the build volume of profile marlin (x 1000.0 mm, the \
+             volume 220.0 mm), read in metres: in centimetres it would be {cm} mm \
+             (--scan-units cm), in inches it would be {inches} mm (--scan-units in); check the \
+             scan's units and up axis, or use a profile whose build volume holds it"
+        )
+    };
+    let on_edge = hint("10.0 x 0.0 x 10.0", "25.4 x 0.0 x 25.4");
+    let flat_hint = hint("10.0 x 10.0 x 0.0", "25.4 x 25.4 x 0.0");
+    for (scan, place, refused, hint) in [
+        (
+            &square,
+            "centre",
+            "seen edge-on from above",
+            on_edge.as_str(),
+        ),
+        (
+            &flat,
+            "2000,2000",
+            "the path misses the scan entirely",
+            flat_hint.as_str(),
+        ),
+    ] {
+        let o = plan_on(
+            scan,
+            &svg,
+            &["--scan-units", "m", "--place", place, "-o", s(&out)],
+        );
+        assert_eq!(code(&o), 1, "{}", stderr(&o));
+        let err = stderr(&o);
+        assert!(err.contains(refused), "{err}");
+        assert_eq!(err.matches(hint).count(), 1, "{hint}\n{err}");
+    }
+    let o = pcpp(&[
+        "compare",
+        "--scan",
+        s(&square),
+        "--path",
+        s(&svg),
+        "--scan-units",
+        "m",
+    ]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("seen edge-on") && stderr(&o).contains(&on_edge),
+        "{}",
+        stderr(&o)
+    );
+    // Refused for the build volume, in the same words.
+    let o = plan_on(
+        &flat,
+        &svg,
+        &["--scan-units", "m", "--place-scan", "bed", "-o", s(&out)],
+    );
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let same = flat_hint.replace(
+        "the scan is larger than the build volume of profile marlin",
+        "it is larger than the volume",
+    );
+    assert_eq!(stderr(&o).matches(&same).count(), 1, "{}", stderr(&o));
+    // In centimetres, 100 mm across: edge-on all the same, its units not
+    // in doubt.
+    let o = plan_on(&square, &svg, &["--scan-units", "cm", "-o", s(&out)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("seen edge-on") && !err.contains("--scan-units"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// QA round 17 F5: a registration whose fiducials fit 0.7 mm apart (one
 /// printer point mistyped) was planned with "min clearance 0.204 mm (tol
 /// 0.1 mm)" and no word that the part may be further off than that. The

@@ -753,6 +753,32 @@ fn a_failed_registration_keeps_the_import_and_bad_paths_keep_the_drawing() {
     );
 }
 
+/// QA round 20 F6: a scan 1 m across in the metres it was read in, seen
+/// edge-on, is refused on the page with the units advice of the build
+/// volume's refusal, as on the command line.
+#[wasm_bindgen_test]
+fn a_scan_too_large_in_its_units_is_told_them_whatever_refuses_it() {
+    let square = b"v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3\nf 1 3 4\n";
+    let mut settings = JobSettings::default();
+    settings.scan.units = Some(ScanUnits::M);
+    let mut session = staged_session(square, "square.obj", &settings);
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" viewBox="0 0 10 10"><path d="M 2 5 L 8 5" stroke="black"/></svg>"#;
+    session.set_path(svg.as_bytes(), "line.svg").unwrap();
+    let err = session
+        .plan_live(js(&settings.plan), "marlin", false, None, false, None)
+        .expect_err("a scan seen edge-on is refused");
+    let (message, _) = message_and_kind(&err);
+    assert!(
+        message.contains("seen edge-on from above")
+            && message.contains(
+                "the scan is larger than the build volume of profile marlin (x 1000.0 mm, the \
+                 volume 220.0 mm), read in metres: in centimetres it would be 10.0 x 0.0 x 10.0 \
+                 mm (--scan-units cm)"
+            ),
+        "{message}"
+    );
+}
+
 #[wasm_bindgen_test]
 fn the_page_refuses_scans_past_its_size_limit_before_reading() {
     let limit = pcpp::wasm::PAGE_MAX_SCAN_BYTES as f64;

@@ -123,6 +123,19 @@ pub enum MeshError {
         /// Why it is refused ("a remote URI", ...).
         reason: String,
     },
+    /// A glTF that could not be read after one of its buffers was read
+    /// from a file that may not be its own: one outside the `.gltf`'s
+    /// folder, or longer than the buffer's byteLength. The refusal names
+    /// that file (QA round 20 F5: bytes of `../../../../etc/passwd` were
+    /// refused as a damaged POSITION accessor, and the file they came
+    /// from was named only in a warning that a failed import never shows).
+    #[error("{error}; {doubt}")]
+    DoubtfulBuffer {
+        /// The failure, as it would be said of any file.
+        error: Box<MeshError>,
+        /// Which buffer was read from which file, and why it is doubted.
+        doubt: String,
+    },
 }
 
 fn line_suffix(line: Option<usize>) -> String {
@@ -142,6 +155,18 @@ impl MeshError {
             file: file.into(),
             line,
             message: message.into(),
+        }
+    }
+
+    /// The error with `doubt` about the files the scan's buffers were read
+    /// from ([`MeshError::DoubtfulBuffer`]), where there is one.
+    pub(crate) fn with_doubt(self, doubt: Option<&str>) -> Self {
+        match doubt {
+            Some(doubt) => MeshError::DoubtfulBuffer {
+                error: Box::new(self),
+                doubt: doubt.into(),
+            },
+            None => self,
         }
     }
 

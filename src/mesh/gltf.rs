@@ -29,12 +29,39 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
     GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
 );
 
-/// The scan, and the paths of the external files it read (each once, in
-/// buffer order).
+/// The external files a glTF's buffers were read from.
+#[derive(Debug, Default)]
+pub(super) struct BuffersRead {
+    /// Their paths, each once, in buffer order.
+    pub files: Vec<String>,
+    /// Those outside the `.gltf`'s folder or longer than their buffer's
+    /// byteLength, named for a refusal of the scan
+    /// ([`MeshError::DoubtfulBuffer`]); their warnings say it of a scan
+    /// read.
+    pub doubt: Option<String>,
+}
+
+/// The scan, and the external files it read.
 pub(super) fn parse(
     bytes: &[u8],
     file: &str,
     external: &ExternalFiles,
+) -> Result<(Parsed, BuffersRead), MeshError> {
+    // Known once the buffers are loaded: a refusal after that may be of
+    // bytes from a file that is not the scan's, and names it.
+    let mut doubt = None;
+    match read(bytes, file, external, &mut doubt) {
+        Ok((parsed, files)) => Ok((parsed, BuffersRead { files, doubt })),
+        Err(e) => Err(e.with_doubt(doubt.as_deref())),
+    }
+}
+
+/// [`parse`], with `doubt` set once the buffers are loaded.
+fn read(
+    bytes: &[u8],
+    file: &str,
+    external: &ExternalFiles,
+    doubt: &mut Option<String>,
 ) -> Result<(Parsed, Vec<String>), MeshError> {
     let not_gltf = |e: &dyn std::fmt::Display| {
         MeshError::invalid(file, format!("not a valid glTF 2.0 file: {e}"))
@@ -148,7 +175,9 @@ pub(super) fn parse(
     check_position_accessors(&root, file)?;
     let bounded = fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
-    let (buffers, read, buffer_notes) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
+    let (buffers, loaded, buffer_notes) = load_buffers(&gltf, blob, file, external, &fallbacks)?;
+    *doubt = loaded.doubt;
+    let read = loaded.files;
     let views = decode_views(&gltf, &compressed, &buffers, file)?;
     let mut scene = SceneReader {
         file,
@@ -665,19 +694,21 @@ fn fill_position_bounds(root: &mut gltf::json::Root) -> std::collections::HashSe
 /// The bytes of each buffer.
 type Buffers<'a> = Vec<Cow<'a, [u8]>>;
 
-/// The bytes of each buffer, and the paths of the external files read.
+/// The bytes of each buffer, the external files read, and the warnings
+/// about those files.
 fn load_buffers<'a>(
     gltf: &Document,
     blob: Option<&'a [u8]>,
     file: &str,
     external: &'a ExternalFiles,
     fallbacks: &std::collections::HashSet<usize>,
-) -> Result<(Buffers<'a>, Vec<String>, Vec<String>), MeshError> {
+) -> Result<(Buffers<'a>, BuffersRead, Vec<String>), MeshError> {
     let mut read: Vec<String> = Vec::new();
     // What is said of the files read (QA round 20 F5: a `uri` of
     // `../../../../etc/passwd` was read as the scan's buffer, without a
     // word naming it, nor that it held far more than its byteLength).
     let mut notes: Vec<String> = Vec::new();
+    let mut doubts: Vec<String> = Vec::new();
     let buffers = gltf
         .buffers()
         .map(|buffer| {
@@ -718,11 +749,13 @@ fn load_buffers<'a>(
                                 path: path.clone(),
                             })?;
                     from = format!(" (file '{path}')");
+                    let mut why = Vec::new();
                     if path.split('/').any(|c| c == "..") {
                         notes.push(format!(
                             "{file}: buffer {index} is read from '{path}', outside the .gltf's \
                              folder: check that it is the scan's"
                         ));
+                        why.push("outside the .gltf's folder".to_string());
                     }
                     // An exporter writes a buffer's file to its byteLength
                     // (GLB pads to 4 bytes).
@@ -733,6 +766,18 @@ fn load_buffers<'a>(
                              with?",
                             bytes.len(),
                             buffer.length()
+                        ));
+                        why.push(format!(
+                            "a file of {} bytes where its byteLength is {}",
+                            bytes.len(),
+                            buffer.length()
+                        ));
+                    }
+                    if !why.is_empty() {
+                        doubts.push(format!(
+                            "buffer {index} was read from '{path}', {}: is that the scan's \
+                             buffer?",
+                            why.join(", ")
                         ));
                     }
                     if !read.contains(&path) {
@@ -755,6 +800,10 @@ fn load_buffers<'a>(
             Ok(data)
         })
         .collect::<Result<Buffers, MeshError>>()?;
+    let read = BuffersRead {
+        files: read,
+        doubt: (!doubts.is_empty()).then(|| doubts.join("; ")),
+    };
     Ok((buffers, read, notes))
 }
 
@@ -2101,7 +2150,8 @@ mod tests {
         let json = triangle_gltf("", "scan.bin");
         let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
         assert_eq!(p.triangles, vec![[0, 1, 2]]);
-        assert_eq!(read, ["scan.bin"]);
+        assert_eq!(read.files, ["scan.bin"]);
+        assert_eq!(read.doubt, None);
         // The same bytes as a data URI read the same vertices.
         let embedded = parse(triangle_gltf("", &triangle_uri()).as_bytes(), "t.gltf").unwrap();
         assert_eq!(p.vertices, embedded.vertices);
@@ -2122,7 +2172,7 @@ mod tests {
         let files = ExternalFiles::new().with("../../up.bin", long);
         let json = triangle_gltf("", "../../up.bin");
         let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
-        assert_eq!(read, ["../../up.bin"]);
+        assert_eq!(read.files, ["../../up.bin"]);
         assert_eq!(p.triangles, vec![[0, 1, 2]]);
         assert_eq!(
             p.warnings,
@@ -2136,6 +2186,52 @@ mod tests {
         );
     }
 
+    /// QA round 20 F5 (rest): the bytes of `../../../../etc/passwd` were
+    /// refused as a damaged accessor, and the file they came from was named
+    /// only in a warning, which a refused scan never shows. The refusal
+    /// names it now; a file beside the .gltf of its own length is refused
+    /// as before, in the same words.
+    #[test]
+    fn a_refusal_names_a_doubtful_buffer_file() {
+        // Positions far outside the bounds the accessor declares.
+        let garbage: Vec<u8> = b"root:x:0:0:root:/root:/bin/bash\n"
+            .iter()
+            .cycle()
+            .take(36)
+            .copied()
+            .collect();
+        let refused = |path: &str, bytes: Vec<u8>| {
+            let files = ExternalFiles::new().with(path, bytes);
+            let json = triangle_gltf("", path);
+            super::parse(json.as_bytes(), "t.gltf", &files)
+                .unwrap_err()
+                .to_string()
+        };
+        let plain = refused("scan.bin", garbage.clone());
+        assert!(
+            plain.starts_with("t.gltf: mesh 0 primitive 0: POSITION element 0 ("),
+            "{plain}"
+        );
+        assert!(plain.ends_with("(export the scan again)"), "{plain}");
+        let mut long = garbage.clone();
+        long.extend([b'x'; 964]);
+        assert_eq!(
+            refused("../../../../etc/passwd", long),
+            format!(
+                "{plain}; buffer 0 was read from '../../../../etc/passwd', outside the .gltf's \
+                 folder, a file of 1000 bytes where its byteLength is 36: is that the scan's \
+                 buffer?"
+            )
+        );
+        assert_eq!(
+            refused("../scan.bin", garbage),
+            format!(
+                "{plain}; buffer 0 was read from '../scan.bin', outside the .gltf's folder: is \
+                 that the scan's buffer?"
+            )
+        );
+    }
+
     #[test]
     fn percent_encoded_uris_name_the_decoded_file() {
         // A browser gives file names only: matched by the last component.
@@ -2144,7 +2240,10 @@ mod tests {
             let json = triangle_gltf("", uri);
             let (p, read) = super::parse(json.as_bytes(), "t.gltf", &files).unwrap();
             assert_eq!(p.triangles.len(), 1, "{uri}");
-            assert_eq!(read, [uri.trim_start_matches("./").replace("%20", " ")]);
+            assert_eq!(
+                read.files,
+                [uri.trim_start_matches("./").replace("%20", " ")]
+            );
         }
     }
 

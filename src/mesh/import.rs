@@ -290,9 +290,12 @@ pub fn import_mesh_unwelded(
         file: file.into(),
         hint: conversion_hint(file),
     })?;
-    let (parsed, external_files) =
+    let (parsed, read) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
-    finish_import(parsed, format, file, options, external_files)
+    // A refusal of what its buffers hold names a file they were read from
+    // that may not be the scan's (QA round 20 F5), as the parser's do.
+    finish_import(parsed, format, file, options, read.files)
+        .map_err(|e| e.with_doubt(read.doubt.as_deref()))
 }
 
 /// Whether the bytes are a ZIP archive (a local file header, or the end
@@ -402,7 +405,7 @@ fn parse_as(
     bytes: &[u8],
     file: &str,
     external: &ExternalFiles,
-) -> Result<(Parsed, Vec<String>), MeshError> {
+) -> Result<(Parsed, gltf::BuffersRead), MeshError> {
     if let Some(e) = binary_in_text(bytes, file, format) {
         return Err(e);
     }
@@ -424,7 +427,7 @@ fn parse_as(
             }
         }
     };
-    Ok((parsed, Vec::new()))
+    Ok((parsed, gltf::BuffersRead::default()))
 }
 
 /// `e`, the error of reading a file as the format its name gives, with
@@ -1845,6 +1848,46 @@ mod tests {
         let stl = b"solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
         let u = import_mesh_unwelded(stl, "t.stl", &opts, &none).unwrap();
         assert_eq!(u.weld_map(), None);
+    }
+
+    /// QA round 20 F5 (rest): a scan refused in the shared steps after
+    /// its buffer was read from outside the .gltf's folder names that file
+    /// too, as the glTF reader's refusals do; one beside it is refused in
+    /// the words of any file.
+    #[test]
+    fn a_refusal_after_parsing_names_a_doubtful_buffer_file() {
+        // One triangle whose corners are one point: no triangle left.
+        let gltf = |uri: &str| {
+            format!(
+                r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+                "nodes":[{{"mesh":0}}],
+                "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+                "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}}],
+                "bufferViews":[{{"buffer":0,"byteLength":36}}],
+                "buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
+            )
+        };
+        let refused = |uri: &str| {
+            let files = ExternalFiles::new().with(uri, vec![0u8; 36]);
+            import_mesh_with(
+                gltf(uri).as_bytes(),
+                "t.gltf",
+                &ImportOptions::DEFAULT,
+                &files,
+            )
+            .unwrap_err()
+        };
+        assert_eq!(
+            refused("t.bin"),
+            MeshError::Empty {
+                file: "t.gltf".into()
+            }
+        );
+        assert_eq!(
+            refused("../t.bin").to_string(),
+            "t.gltf: the mesh has no triangles; buffer 0 was read from '../t.bin', outside the \
+             .gltf's folder: is that the scan's buffer?"
+        );
     }
 
     #[test]

@@ -144,8 +144,14 @@ impl Session {
     }
 
     /// Projects the drawing for the nozzle and placement of `settings`
-    /// unless the cache already holds that surface path.
-    fn ensure_surface_path(&mut self, settings: &PlanSettings) -> Result<(), JsValue> {
+    /// unless the cache already holds that surface path; its refusal says
+    /// the units of a scan implausibly large in them for `profile`, as
+    /// [`job::run_on`]'s does.
+    fn ensure_surface_path(
+        &mut self,
+        settings: &PlanSettings,
+        profile: &crate::gcode::MachineProfile,
+    ) -> Result<(), JsValue> {
         let path = self
             .path
             .as_ref()
@@ -164,7 +170,7 @@ impl Session {
                 &settings.nozzle,
                 &settings.placement,
             )
-            .map_err(core_err)?;
+            .map_err(|e| core_err(job::with_units_hint(e, &self.scan, profile)))?;
             self.cache = Some(PathCache {
                 nozzle: settings.nozzle,
                 placement: settings.placement,
@@ -478,7 +484,7 @@ impl Session {
         job::refuse_blocking_strays(&self.scan, &profile).map_err(core_err)?;
         job::refuse_bad_registration(&self.scan.registration, &settings.nozzle, accept_risk)
             .map_err(core_err)?;
-        if let Err(err) = self.ensure_surface_path(&settings) {
+        if let Err(err) = self.ensure_surface_path(&settings, &profile) {
             // The drawing's notes go with a failure of its surface path
             // as with a refusal, and as `pcpp plan` prints them (a
             // drawing read at 90 px per inch may be why it misses the

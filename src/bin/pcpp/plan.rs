@@ -403,6 +403,7 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
         &inputs.svg_name,
         &settings.plan,
     )
+    .map_err(|e| job::with_units_hint(e, &inputs.prepared, &profile))
     .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     let rows = comparison.rows;
     if let Some(r) = &a.report {
