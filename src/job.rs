@@ -1404,6 +1404,11 @@ pub fn write_outputs(
             profile.name
         ));
     }
+    for caution in crate::gcode::start_block_cautions(profile) {
+        report
+            .warnings
+            .push(format!("profile {}: its {caution}", profile.name));
+    }
     // What the G-code would have been refused for but for the accepted
     // risk, known before it is written: said in its header (one line, so
     // the header's length does not change) and in the report.
@@ -3162,6 +3167,42 @@ mod tests {
         let w = warned(&homing);
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("start[2] `G28` first"), "{}", w[0]);
+        // QA round 21 F4: probing and compensation turned on are each
+        // said, in the report and the header, naming their line.
+        let mut levelling = marlin.clone();
+        levelling.start = [
+            "G21",
+            "G90",
+            "G28",
+            "G29",
+            "M420 S1 Z10",
+            "G1 Z5 F{travel_f}",
+        ]
+        .map(String::from)
+        .to_vec();
+        let out = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &levelling, false).unwrap();
+        let said = |what: &str| {
+            let w = out.report.warnings.iter().find(|w| w.contains(what));
+            assert!(
+                w.is_some_and(|w| out.gcode.contains(w.as_str())),
+                "{what}: {:?}",
+                out.report.warnings
+            );
+        };
+        said("profile marlin: its start[3] `G29` probes the bed");
+        said("profile marlin: its start[4] `M420 S1 Z10` turns bed-levelling compensation on");
+        let mut klipper = marlin.clone();
+        klipper.start = ["G21", "BED_MESH_PROFILE LOAD=default"]
+            .map(String::from)
+            .to_vec();
+        let out = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &klipper, false).unwrap();
+        assert!(
+            out.report.warnings.iter().any(|w| w.contains(
+                "its start[1] `BED_MESH_PROFILE LOAD=default` turns bed-levelling compensation on"
+            )),
+            "{:?}",
+            out.report.warnings
+        );
     }
 
     /// The header printed `-0.000000` in G and `mean e- -0.0000 mm` for

@@ -163,6 +163,11 @@ pub struct GcodeProgram {
     /// known position (a checker that says of each unknown move whether it
     /// cleared it drops this note for its own).
     pub unknown_start_note: Option<usize>,
+    /// The first line that turns bed-levelling compensation on (Marlin's
+    /// `M420 S1`, Klipper's `BED_MESH_PROFILE LOAD`): the firmware then
+    /// moves Z by its bed mesh under every move after it, which the file
+    /// does not give (QA round 21 F4; a note says so too).
+    pub compensation_line: Option<usize>,
     /// Lines in the file (`\n`, `\r\n` or `\r` end a line).
     pub lines: usize,
 }
@@ -436,11 +441,19 @@ fn read_with_limits(
         .0
         .iter()
         .position(|n| n.kind == NoteKind::UnknownStart);
+    let compensation_line = reader
+        .notes
+        .0
+        .iter()
+        .find(|n| n.kind == NoteKind::Compensation)
+        .and_then(|n| n.ranges.first())
+        .map(|r| r.0);
     Ok(GcodeProgram {
         moves: reader.moves,
         unknown_moves: reader.unknown,
         notes: reader.notes.finish(),
         unknown_start_note,
+        compensation_line,
         lines,
     })
 }
@@ -1083,6 +1096,7 @@ enum NoteKind {
     Jog,
     Statement,
     Park,
+    Compensation,
 }
 
 impl NoteKind {
@@ -1244,9 +1258,20 @@ impl Note {
                 "{lines}: controller commands or start macros that move the head ({codes}): \
                  {unknown_after}"
             ),
+            NoteKind::Compensation => format!("{lines}: {codes} {COMPENSATION_NOTE}"),
         }
     }
 }
+
+/// What turning bed-levelling compensation on does to a program's moves
+/// (QA round 21 F4: `M420 S1` and Klipper's `BED_MESH_PROFILE LOAD`
+/// passed `plan` and `check` without a word).
+pub const COMPENSATION_NOTE: &str = "turns bed-levelling compensation on: the firmware then \
+     raises and lowers the nozzle under every move by its bed mesh, which the file does not \
+     give, and the moves are checked where the file puts them; the clearances hold only if the \
+     scan was registered with the same compensation on, or if the mesh corrects the bed under \
+     the part by far less than tol; turn it off (M420 S0, BED_MESH_CLEAR) to print where the \
+     file says";
 
 #[derive(Debug, Default)]
 struct Notes(Vec<Note>);
@@ -1449,6 +1474,13 @@ impl<'f> Reader<'f> {
                     what: "a call, jump, loop or condition",
                 })
             }
+            // Klipper's mesh loaded is its compensation on.
+            "BED_MESH_PROFILE" if upper(text).contains("LOAD") => {
+                self.notes
+                    .add(NoteKind::Compensation, n)
+                    .code("BED_MESH_PROFILE LOAD");
+                Ok(())
+            }
             _ => {
                 let note = self.notes.add(NoteKind::NotGcode, n);
                 if note.example.is_empty() {
@@ -1634,6 +1666,13 @@ impl<'f> Reader<'f> {
                 }
                 _ => {}
             }
+        }
+        // Marlin's `M420 S1` (S0 turns it off; Z alone sets the fade height).
+        let switched_on = words
+            .iter()
+            .any(|w| w.letter == b'S' && matches!(w.value, Value::Number(v) if v != 0.0));
+        if m.flatten() == Some(420) && switched_on {
+            self.notes.add(NoteKind::Compensation, n).code("M420 S1");
         }
         match (consumer, first_axis) {
             (Some((Consumer::SetPosition, _, column)), None) if !other_axes => {
@@ -2437,6 +2476,27 @@ mod tests {
         let p = read("G90\nG0 X60 Y50 Z5\nG1 Z1\nM420 S1 Z10\nG1 X61\n");
         assert_eq!(p.moves[1].from, DVec3::new(60.0, 50.0, 1.0));
         assert!(p.unknown_moves.len() == 1);
+        // QA round 21 F4: compensation turned on is said, off or only its
+        // fade height set is not.
+        assert_eq!(p.compensation_line, Some(4));
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.starts_with("line 4: M420 S1 turns bed-levelling compensation on")),
+            "{:?}",
+            p.notes
+        );
+        for (text, line) in [
+            ("G90\nM420 S0\nM420 Z10\nM420 V\nG0 X1 Y1 Z1\n", None),
+            ("G21\nBED_MESH_PROFILE LOAD=default\nG0 X1 Y1 Z1\n", Some(2)),
+            ("G21\nBED_MESH_PROFILE SAVE=default\nG0 X1 Y1 Z1\n", None),
+            ("G21\nM420 S1\nM420 S1\nG0 X1 Y1 Z1\n", Some(2)),
+        ] {
+            let p = read(text);
+            assert_eq!(p.compensation_line, line, "{text}");
+            let said = p.notes.iter().any(|n| n.contains(COMPENSATION_NOTE));
+            assert_eq!(said, line.is_some(), "{text}: {:?}", p.notes);
+        }
         // The probe test probes: the position is unknown after it.
         let p = read("G90\nG0 X60 Y50 Z5\nM48 P10 X100 Y100\nG1 X61\n");
         let kinds: Vec<UnknownMoveKind> = p.unknown_moves.iter().map(|u| u.kind).collect();

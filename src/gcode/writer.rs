@@ -229,6 +229,9 @@ fn read_start_block(text: &str, name: &str) -> Result<super::GcodeProgram, super
     for u in &mut read.unknown_moves {
         u.line -= 1;
     }
+    if let Some(n) = &mut read.compensation_line {
+        *n -= 1;
+    }
     Ok(read)
 }
 
@@ -245,31 +248,14 @@ const FIRST_RISE_NOTE: &str = "first move: a rise to the safe travel height from
 /// filled with stand-in values: a line moves the head or not whatever
 /// they are.
 pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
-    // Which profile line each line of the text comes from (a profile
-    // line may hold several).
-    let mut text = String::new();
-    let mut from = Vec::new();
-    for (i, line) in profile.start.iter().enumerate() {
-        let filled = template::fill(line, |token| {
-            BLOCK_TOKENS.contains(&token).then(|| "100".to_string())
-        })
-        .unwrap_or_else(|_| line.clone());
-        for part in filled.lines() {
-            text.push_str(part);
-            text.push('\n');
-            from.push(i);
-        }
-    }
-    if text.trim().is_empty() {
-        return None;
-    }
-    let read = match read_start_block(&text, &profile.name) {
+    let block = StartBlock::of(profile)?;
+    let read = match &block.read {
         Ok(read) => read,
         Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
     };
     // A firmware macro (Klipper's PRINT_START, BED_MESH_CALIBRATE) the
     // reader skips may home and move the head as well (review).
-    let macro_line = text.lines().position(is_macro).map(|k| k + 1);
+    let macro_line = block.text.lines().position(is_macro).map(|k| k + 1);
     let first = read
         .moves
         .iter()
@@ -277,13 +263,87 @@ pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
         .chain(read.unknown_moves.iter().map(|u| u.line))
         .chain(macro_line)
         .min()?;
-    let i = from.get(first - 1).copied().unwrap_or_default();
     let what = if Some(first) == macro_line {
         " (a firmware macro, which may home or move the head)"
     } else {
         ""
     };
-    Some(format!("start[{i}] `{}`{what}", profile.start[i].trim()))
+    Some(format!("{}{what}", block.field(profile, first)))
+}
+
+/// A profile's start block as the G-code reader reads it, with stand-in
+/// values for its tokens (a line moves the head or not whatever they are),
+/// and the profile line each line of its text comes from (a profile line
+/// may hold several). `None` for a block with nothing in it.
+struct StartBlock {
+    text: String,
+    from: Vec<usize>,
+    read: Result<super::GcodeProgram, super::GcodeReadError>,
+}
+
+impl StartBlock {
+    fn of(profile: &MachineProfile) -> Option<StartBlock> {
+        let mut text = String::new();
+        let mut from = Vec::new();
+        for (i, line) in profile.start.iter().enumerate() {
+            let filled = template::fill(line, |token| {
+                BLOCK_TOKENS.contains(&token).then(|| "100".to_string())
+            })
+            .unwrap_or_else(|_| line.clone());
+            for part in filled.lines() {
+                text.push_str(part);
+                text.push('\n');
+                from.push(i);
+            }
+        }
+        if text.trim().is_empty() {
+            return None;
+        }
+        let read = read_start_block(&text, &profile.name);
+        Some(StartBlock { text, from, read })
+    }
+
+    /// "start[i] `line`" for the block's text line `n` (from 1).
+    fn field(&self, profile: &MachineProfile, n: usize) -> String {
+        let i = self.from.get(n - 1).copied().unwrap_or_default();
+        format!("start[{i}] `{}`", profile.start[i].trim())
+    }
+}
+
+/// What a profile's start block does that the moves' checks cannot see,
+/// beyond moving the head ([`start_block_motion`]), each naming its line
+/// (QA round 21 F4: `G29` and `M420 S1` in a start block were written
+/// without a word): probing the bed, which with the part on it comes down
+/// across the part, and bed-levelling compensation turned on, which moves
+/// every move by the firmware's mesh.
+pub fn start_block_cautions(profile: &MachineProfile) -> Vec<String> {
+    let Some(block) = StartBlock::of(profile) else {
+        return Vec::new();
+    };
+    let Ok(read) = &block.read else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    let probing = read
+        .unknown_moves
+        .iter()
+        .find(|u| u.kind == super::read::UnknownMoveKind::Probing);
+    if let Some(u) = probing {
+        out.push(format!(
+            "{} probes the bed (or levels or calibrates): with the part on the bed the probe \
+             comes down across it, where pcpp cannot check it; probe before the part is placed \
+             and keep the mesh, or take the line out",
+            block.field(profile, u.line)
+        ));
+    }
+    if let Some(n) = read.compensation_line {
+        out.push(format!(
+            "{} {}",
+            block.field(profile, n),
+            super::read::COMPENSATION_NOTE
+        ));
+    }
+    out
 }
 
 /// Whether a line calls a firmware macro: its first word a name (letters,
