@@ -60,6 +60,11 @@
 //!   `style` (one set in a stylesheet prints solid without a note).
 //! - External files are never opened (`use` of another file, `image` hrefs).
 //! - Compressed `.svgz` must be unzipped first.
+//! - SVG fonts (`<font>`s of `<glyph>`s) are not read: a glyph draws only as
+//!   a letter of text; a file whose only shapes are glyphs is an error that
+//!   says so.
+//! - A DXF, DWG, PDF, Illustrator, EPS or PostScript file or a raster image
+//!   chosen as the drawing is an error that names it and the way to an SVG.
 
 use std::collections::{HashMap, HashSet};
 use std::f64::consts::TAU;
@@ -271,14 +276,11 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                 .into(),
         ));
     }
-    // A picture or a document chosen as the drawing (a wrong pick in a
-    // downloads folder): named as what it is (QA round 7 F12: a PNG was
-    // told to be saved as UTF-8).
-    if let Some(kind) = crate::mesh::other_file_kind(bytes) {
-        return Err(parse_err(format!(
-            "this is {kind}, not an SVG drawing: a drawing is read from its paths; open the SVG \
-             file, or trace the picture to paths first (Inkscape: Path, Trace Bitmap)"
-        )));
+    // A picture, a document or a CAD drawing chosen as the drawing (a
+    // wrong pick in a downloads folder): named as what it is (QA round 7
+    // F12: a PNG was told to be saved as UTF-8).
+    if let Some(message) = other_drawing(bytes, file) {
+        return Err(parse_err(message));
     }
     let text = decode_text(bytes).map_err(|e| {
         // A binary scan chosen as the drawing, named as one.
@@ -804,7 +806,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             }
         }
         let unused = &prepared.unused;
-        let reason = if let Some(how) = root_hidden(text) {
+        let fonts = &prepared.fonts;
+        let reason = if prepared.shapes.is_empty() && fonts.glyphs > 0 {
+            // QA round 21 F6: Inkscape's SVG-font example was called an icon
+            // sprite sheet, lucide's icon font a document of no shapes.
+            font_words(fonts, prepared.texts, prepared.text_note, &notes)
+        } else if let Some(how) = root_hidden(text) {
             // QA round 18 F10: an icon sprite sheet hides its root; told to
             // add a <use>, the user did, and was told "none does" again.
             format!(
@@ -878,6 +885,59 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         subpaths: out,
         notes,
     })
+}
+
+/// Why a document whose only shapes are an SVG font's glyphs prints
+/// nothing, with the notes other than the one on its text.
+fn font_words(
+    fonts: &SvgFonts,
+    texts: usize,
+    text_note: Option<usize>,
+    notes: &[String],
+) -> String {
+    let named: Vec<String> = fonts
+        .names
+        .iter()
+        .take(MAX_NAMED)
+        .map(|id| format!("'{id}'"))
+        .collect();
+    let more = if fonts.names.len() > named.len() {
+        ", ..."
+    } else {
+        ""
+    };
+    let fonts_words = match fonts.names.len() {
+        0 => "an SVG font".to_string(),
+        1 => format!("the SVG font {}", named.join("")),
+        _ => format!("the SVG fonts {}{more}", named.join(", ")),
+    };
+    let others: Vec<&str> = notes
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| Some(i) != text_note)
+        .map(|(_, n)| n.as_str())
+        .collect();
+    let others = if others.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", others.join("; "))
+    };
+    let glyphs = fonts.glyphs;
+    if texts > 0 {
+        format!(
+            "the document's only shapes are the {glyphs} glyph(s) of {fonts_words}, which draw \
+             only as the letters of its {texts} text element(s), and text is not printed (no \
+             font is read): convert the text to paths (Inkscape: select it, Path > Object to \
+             Path) and save that, or choose the drawing's own SVG{others}"
+        )
+    } else {
+        format!(
+            "the document is {fonts_words} ({glyphs} glyph(s)), not a drawing: a glyph draws \
+             only as a letter of text, and text is not printed; choose the drawing's own SVG \
+             (of an icon font, the one icon's .svg), or set the text and convert it to paths \
+             (Inkscape: Path > Object to Path){others}"
+        )
+    }
 }
 
 /// What px were read as: CSS's 96 per inch, an old Inkscape's 90 or
@@ -973,6 +1033,17 @@ struct UnusedDefinitions {
     symbols: usize,
 }
 
+/// The SVG fonts a document defines (`<font>`s of `<glyph>`s, drawn only
+/// as the letters of text): named when their glyphs are its only shapes.
+#[derive(Debug, Default)]
+struct SvgFonts {
+    /// The `<font>`s' ids (else their `<font-face>`'s family), in document
+    /// order.
+    names: Vec<String>,
+    /// `<glyph>`s in all of them.
+    glyphs: usize,
+}
+
 struct Prepared {
     /// The document with an id on every shape (usvg keeps ids on paths),
     /// without markers, and with a hidden copy (id `{copy_prefix}{index}`)
@@ -984,6 +1055,11 @@ struct Prepared {
     copy_prefix: String,
     notes: Vec<String>,
     unused: UnusedDefinitions,
+    fonts: SvgFonts,
+    /// `<text>` elements (not printed), and the index in `notes` of the
+    /// note that says so.
+    texts: usize,
+    text_note: Option<usize>,
     /// The root's user units to mm (y down), from [`root_user_to_mm`].
     user_to_mm: Option<DAffine2>,
     /// Id of a hidden, untransformed path at the root: its usvg transform
@@ -1983,6 +2059,93 @@ fn use_expansion(text: &str) -> String {
     too_big
 }
 
+/// A drawing or picture in another format chosen as the drawing, named as
+/// what it is with the way to an SVG (QA round 21 F5: LibreCAD's DXF got
+/// "it does not start with '<'"). A file named .dxf that is not XML is
+/// taken for one whatever its first lines (a DXF's header varies by writer).
+fn other_drawing(bytes: &[u8], file: &str) -> Option<String> {
+    let head = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let head = head.trim_ascii_start();
+    let lower = file.to_ascii_lowercase();
+    // (A file named .dxf that is XML is read as the SVG it is.)
+    let dxf = head.starts_with(b"AutoCAD Binary DXF")
+        || dxf_text(head)
+        || (lower.ends_with(".dxf") && !head.starts_with(b"<"));
+    if dxf {
+        return Some(
+            "this is a DXF drawing (2-D CAD), not an SVG: export it as SVG (LibreCAD: File > \
+             Export > Export as SVG; Inkscape opens DXF too) and choose that file"
+                .into(),
+        );
+    }
+    // AutoCAD's own format: its version, "AC1015" and on.
+    if head.len() >= 6 && head.starts_with(b"AC10") && head[4..6].iter().all(u8::is_ascii_digit) {
+        return Some(
+            "this is a DWG drawing (AutoCAD), not an SVG: save it as DXF and export that as SVG \
+             (LibreCAD, Inkscape), or export SVG from the CAD program"
+                .into(),
+        );
+    }
+    // Illustrator writes PDF (its .ai since version 9) or PostScript (before).
+    let has = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).any(|w| w == needle);
+    let first_line = head.split(|&b| b == b'\n').next().unwrap_or_default();
+    let illustrator = lower.ends_with(".ai")
+        || has(
+            &head[..head.len().min(2048)],
+            b"%%Creator: Adobe Illustrator",
+        );
+    let eps = head.starts_with(&[0xC5, 0xD0, 0xD3, 0xC6])
+        || (head.starts_with(b"%!PS") && has(first_line, b"EPSF"));
+    let save_as = "open it in Inkscape, which imports its paths, and save it as SVG, or export \
+                   SVG from the program that made it";
+    if head.starts_with(b"%PDF") || head.starts_with(b"%!PS") || eps {
+        let kind = if illustrator {
+            "an Adobe Illustrator file (.ai)"
+        } else if head.starts_with(b"%PDF") {
+            "a PDF document"
+        } else if eps {
+            "an EPS file (Encapsulated PostScript)"
+        } else {
+            "a PostScript file"
+        };
+        return Some(format!(
+            "this is {kind}, not an SVG drawing: {save_as}{}",
+            if illustrator {
+                " (Illustrator: File > Save As, SVG)"
+            } else {
+                ""
+            }
+        ));
+    }
+    let kind = crate::mesh::other_file_kind(bytes)?;
+    Some(if kind.ends_with(" image") {
+        format!(
+            "this is {kind}, not an SVG drawing: a raster image, not a path: trace it to paths \
+             (Inkscape: Path > Trace Bitmap) and save that as SVG"
+        )
+    } else {
+        format!(
+            "this is {kind}, not an SVG drawing: a drawing is read from its paths; choose the \
+             drawing's .svg file (unpack an archive first)"
+        )
+    })
+}
+
+/// A text DXF: pairs of lines, a group code then its value, starting with
+/// a section (group code 0, "SECTION"), perhaps after comments (999).
+fn dxf_text(head: &[u8]) -> bool {
+    let mut lines = head[..head.len().min(4096)]
+        .split(|&b| b == b'\n')
+        .map(<[u8]>::trim_ascii);
+    loop {
+        match (lines.next(), lines.next()) {
+            (Some(b"999"), Some(_)) => continue,
+            (Some(b"0"), Some(value)) => return value == b"SECTION",
+            _ => return false,
+        }
+    }
+}
+
 /// What a file that is not XML at all looks like: a scan or a program
 /// chosen as the drawing (an OBJ read "not well-formed XML: unknown token
 /// at 1:1"; found by a QA run).
@@ -2160,6 +2323,10 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         n.ancestors()
             .any(|a| a.is_element() && is_svg(&a) && a.tag_name().name() == "marker")
     };
+    let in_font = |n: &roxmltree::Node| {
+        n.ancestors()
+            .any(|a| a.is_element() && is_svg(&a) && a.tag_name().name() == "font")
+    };
     // A stylesheet can set `transform` (usvg reads it as a presentation
     // attribute): shapes are then placed by usvg's transforms alone.
     let css_transform = root.descendants().any(|n| {
@@ -2179,6 +2346,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
     let mut images = 0usize;
     let mut markers = 0usize;
     let mut unused = UnusedDefinitions::default();
+    let mut fonts = SvgFonts::default();
     let mut unused_seen: HashSet<&str> = HashSet::new();
     for node in root.descendants().filter(|n| n.is_element() && is_svg(n)) {
         let name = node.tag_name().name();
@@ -2198,6 +2366,24 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             texts += 1;
             continue;
         }
+        // An SVG font (SVG 1.1; browsers other than old Safari never drew
+        // them, nor does usvg): its glyphs, and shapes inside them, are
+        // drawn only as the letters of text.
+        if name == "font" {
+            let family = || {
+                node.children()
+                    .find(|c| c.tag_name().name() == "font-face")?
+                    .attribute("font-family")
+            };
+            if let Some(id) = node.attribute("id").or_else(family) {
+                fonts.names.push(id.to_string());
+            }
+            continue;
+        }
+        if name == "glyph" {
+            fonts.glyphs += 1;
+            continue;
+        }
         // Inkscape 0.92's flowed text (SVG 1.2 drafts; browsers show
         // nothing for it, Inkscape does) and raster images: not outlines.
         if name == "flowRoot" {
@@ -2208,7 +2394,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             images += 1;
             continue;
         }
-        if !SHAPES.contains(&name) || in_marker(&node) {
+        if !SHAPES.contains(&name) || in_marker(&node) || in_font(&node) {
             continue;
         }
         index += 1;
@@ -2360,6 +2546,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         }
     }
     let mut notes = root_size.notes;
+    let text_note = (texts > 0).then_some(notes.len());
     if texts > 0 {
         notes.push(format!(
             "{texts} text element(s) skipped: text is not converted to paths (no fonts are loaded); \
@@ -2405,6 +2592,9 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         copy_prefix: format!("{prefix}copy-"),
         notes,
         unused,
+        fonts,
+        texts,
+        text_note,
         user_to_mm: root_user_to_mm(root),
         root_probe,
         empty_viewbox: root_size.empty_viewbox,
@@ -3660,5 +3850,136 @@ mod tests {
         let text = svg(r#"<path d="M0 0 L9 0" stroke="red" fill="blue"/>"#);
         let import = import_svg_with_notes(text.as_bytes(), "line.svg").unwrap();
         assert!(import.notes.is_empty(), "{:?}", import.notes);
+    }
+
+    fn error_of(bytes: &[u8], file: &str) -> String {
+        match import_svg_with_notes(bytes, file) {
+            Ok(import) => panic!("{file} read: {:?}", import.notes),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// QA round 21 F6: Inkscape's SVG-font example (a `<font>` in `<defs>`
+    /// whose glyph holds a circle, used by `<text>`) was refused as "an
+    /// icon sprite sheet?", lucide's icon font as "the document contains
+    /// no shapes". Both now say the shapes are a font's glyphs.
+    #[test]
+    fn svg_font_glyphs_are_named_as_a_font_not_a_sprite_sheet() {
+        let font = r#"<defs><font id="FirstExample" horiz-adv-x="1010"><font-face font-family="Super Sans"/><glyph unicode="!" d="M0,0h500v500h-500z"><circle r="500" cx="500" cy="500" style="fill:none;stroke:green"/></glyph><glyph unicode="@" d="M500,500h500v500h-500z"/><missing-glyph d="M0,0h1000v1000h-1000z"/></font></defs>"#;
+        let text = svg(&format!(
+            r#"{font}<text x="5" y="10" style="font-family:Super Sans">Hi!</text><text x="5" y="30">@</text><image href="a.png" width="1" height="1"/>"#
+        ));
+        let e = error_of(text.as_bytes(), "svgfont.svg");
+        assert!(
+            e.starts_with("svgfont.svg: nothing printable: ")
+                && e.contains("2 glyph(s) of the SVG font 'FirstExample'")
+                && e.contains("2 text element(s)")
+                && e.contains("Path > Object to Path")
+                && e.contains("1 image(s) ignored")
+                && !e.contains("sprite")
+                && !e.contains("<use")
+                && !e.contains("no fonts are loaded"),
+            "{e}"
+        );
+        // A font file alone (lucide's font/lucide.svg), named by its face
+        // where the font has no id.
+        let text = svg(
+            r#"<defs><font horiz-adv-x="1000"><font-face font-family="lucide"/><missing-glyph/><glyph glyph-name="a" unicode="&#xE585;" d="M0 0L10 10"/><glyph glyph-name="b" unicode="&#xE586;" d="M0 0L10 0"/></font></defs>"#,
+        );
+        let e = error_of(text.as_bytes(), "lucide.svg");
+        assert!(
+            e.contains("the document is the SVG font 'lucide' (2 glyph(s)), not a drawing")
+                && e.contains("choose the drawing's own SVG")
+                && !e.contains("contains no shapes"),
+            "{e}"
+        );
+        // A font beside a drawing: the drawing prints.
+        let text = svg(&format!(r#"{font}<path d="M0 0 L9 0" stroke="red"/>"#));
+        let import = import_svg_with_notes(text.as_bytes(), "both.svg").unwrap();
+        assert_eq!(import.subpaths.len(), 1);
+        // A sprite sheet is still one.
+        let text = svg(&format!(
+            r#"{font}<defs><symbol id="icon-a"><path d="M0 0 L9 0" stroke="red"/></symbol></defs>"#
+        ));
+        let e = error_of(text.as_bytes(), "sprite.svg");
+        assert!(e.contains("sprite sheet") && e.contains("'icon-a'"), "{e}");
+    }
+
+    /// Text alone says that text is not printed and how to print it.
+    #[test]
+    fn a_document_of_text_alone_says_text_is_not_printed() {
+        let text = svg(r#"<text x="5" y="10">Hello</text>"#);
+        let e = error_of(text.as_bytes(), "text.svg");
+        assert!(
+            e.starts_with("text.svg: nothing printable")
+                && e.contains("1 text element(s) skipped")
+                && e.contains("convert text to paths"),
+            "{e}"
+        );
+    }
+
+    /// QA round 21 F5: LibreCAD's DXF chosen as the drawing was told only
+    /// that it "does not start with '<'". A DXF (text, by content or by
+    /// name, or binary), a DWG, PDF, Illustrator, EPS and PostScript file
+    /// are named with the way to an SVG; a raster image is told to be
+    /// traced.
+    #[test]
+    fn other_drawing_formats_are_named_with_the_way_to_an_svg() {
+        let dxf = "DXF drawing (2-D CAD), not an SVG: export it as SVG (LibreCAD: File > \
+                   Export > Export as SVG; Inkscape opens DXF too)";
+        let inkscape = "open it in Inkscape, which imports its paths, and save it as SVG";
+        let cases: [(&[u8], &str, &str); 13] = [
+            (
+                b"  0\nSECTION\n  2\nHEADER\n  9\n$LIMMIN\n",
+                "hexagon_b.dxf",
+                dxf,
+            ),
+            (b"\r\n0\r\nSECTION\r\n2\r\nENTITIES\r\n", "part.svg", dxf),
+            (b"999\r\nwritten by hand\r\n0\r\nSECTION\r\n", "p.txt", dxf),
+            (b"AutoCAD Binary DXF\r\n\x1a\0\0\0", "b.svg", dxf),
+            // Latin-1 bytes, not UTF-8: told by the name.
+            (b"\xe9\n  0\nSECTION\n", "caf\u{e9}.DXF", dxf),
+            (b"AC1032\0\0\0\0", "house.dwg", "a DWG drawing (AutoCAD)"),
+            (
+                b"%PDF-1.5\n%\xe2\xe3",
+                "p.pdf",
+                "this is a PDF document, not an SVG drawing",
+            ),
+            (b"%PDF-1.5\n", "logo.ai", "an Adobe Illustrator file (.ai)"),
+            (
+                b"%!PS-Adobe-3.0\n%%Creator: Adobe Illustrator(R) 8.0\n",
+                "old.svg",
+                "an Adobe Illustrator file (.ai)",
+            ),
+            (
+                b"%!PS-Adobe-3.0 EPSF-3.0\n%%BoundingBox: 0 0 1 1\n",
+                "a.eps",
+                "an EPS file (Encapsulated PostScript)",
+            ),
+            (b"\xc5\xd0\xd3\xc6\x1e\0\0\0", "dos.eps", "an EPS file"),
+            (b"%!PS-Adobe-3.0\n", "a.ps", "a PostScript file"),
+            (
+                b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR",
+                "logo.png",
+                "this is a PNG image, not an SVG drawing: a raster image, not a path: trace it \
+                 to paths (Inkscape: Path > Trace Bitmap) and save that as SVG",
+            ),
+        ];
+        for (bytes, file, expected) in cases {
+            let e = error_of(bytes, file);
+            assert!(
+                e.starts_with(&format!("{file}: ")) && e.contains(expected),
+                "{file}: {e}"
+            );
+            if !file.ends_with("png") && expected != dxf {
+                assert!(e.contains(inkscape) || e.contains("DWG"), "{e}");
+            }
+        }
+        // A file named .dxf that is an SVG is read as one; text that is
+        // neither keeps its words.
+        let text = svg(r#"<path d="M0 0 L9 0" stroke="red"/>"#);
+        assert!(import_svg_with_notes(text.as_bytes(), "named.dxf").is_ok());
+        let e = error_of(b"0\nLINE\n", "notes.svg");
+        assert!(e.contains("does not start with '<'"), "{e}");
     }
 }
