@@ -191,6 +191,7 @@ fn read(
         skipped_primitives: 0,
         points: Vec::new(),
         step: Some(0.0),
+        step_is_bound: false,
         quantized,
         bounded,
         meshes_drawn: 0,
@@ -276,6 +277,7 @@ fn read(
     let rounding = (!rounding.is_empty()).then(|| Rounding {
         names: rounding,
         step: scene.step.filter(|s| *s > 0.0),
+        step_is_bound: scene.step_is_bound,
     });
     let skipped = scene.skipped_primitives + scene.points.len();
     if skipped > 0 {
@@ -349,6 +351,10 @@ pub(super) fn external_refs(bytes: &[u8], file: &str) -> Result<Vec<ExternalRef>
 /// The grid Draco-decoded positions lie on, at most: the smallest gap
 /// between two of their distinct coordinates along an axis (each a whole
 /// number of the quantization step apart); `None` for a single position.
+/// Close to the grid only on a dense mesh: a low-poly one's vertices lie
+/// many steps apart (QA round 21 F2: 3.0 mm said of Szilassi's 14
+/// vertices, whose grid was 0.041 mm), so it is used only where
+/// [`draco_quantization`] finds nothing.
 fn grid_step(points: &[DVec3]) -> Option<f64> {
     let mut step = f64::INFINITY;
     let mut c = Vec::with_capacity(points.len());
@@ -363,6 +369,82 @@ fn grid_step(points: &[DVec3]) -> Option<f64> {
         }
     }
     step.is_finite().then_some(step)
+}
+
+/// The grid a Draco primitive's positions lie on, in the file's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum DracoGrid {
+    /// The stream's own quantization ([`draco_quantization`]): its range
+    /// over 2^bits - 1.
+    Quantized(f64),
+    /// Not found in the stream: no coarser than this ([`grid_step`]).
+    AtMost(f64),
+    /// A single position: nothing to go by.
+    Unknown,
+}
+
+/// The quantization Draco decoded `points` (POSITION's values, as decoded)
+/// with, read from the stream: `(bits, range)`. `draco-core` dequantizes
+/// without handing over its parameters, which the stream stores as the
+/// minimum of each component (f32), the range (f32) and the bits (u8),
+/// after the attribute's values (before them in streams older than 2.0).
+/// The minima are the decoded values of the points quantized to zero, so
+/// they are known, and the parameters are found where the stream holds
+/// those three floats and a range and bits that give back every decoded
+/// value bit for bit (`q * (range / (2^bits - 1)) + min` in f32, as the
+/// decoder computes it); the coarsest such, should several. `None` where
+/// there is none: positions not quantized, or quantized over a volume
+/// given to the encoder (the minima are then not among the values).
+fn draco_quantization(stream: &[u8], points: &[[f32; 3]]) -> Option<(u8, f32)> {
+    /// Places in the stream tried: each costs a pass over the points, which
+    /// a wrong one leaves at its first value off the grid.
+    const MAX_TRIED: usize = 64;
+    let first = points.first()?;
+    let min = points.iter().fold(*first, |m, p| {
+        [m[0].min(p[0]), m[1].min(p[1]), m[2].min(p[2])]
+    });
+    let f32_at = |at: usize| {
+        stream
+            .get(at..at + 4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    let fits = |bits: u8, range: f32| {
+        let max_q = ((1u32 << bits) - 1) as f32;
+        let delta = range / max_q;
+        // `delta` as Draco's Dequantizer makes it; every value must be
+        // some whole number of it above its minimum, as computed there.
+        points.iter().all(|p| {
+            (0..3).all(|k| {
+                let q = (f64::from(p[k] - min[k]) / f64::from(delta)).round();
+                (0.0..=f64::from(max_q)).contains(&q)
+                    && [q - 1.0, q, q + 1.0]
+                        .iter()
+                        .any(|&q| (q as f32) * delta + min[k] == p[k])
+            })
+        })
+    };
+    let mut found: Option<(u8, f32)> = None;
+    let mut tried = 0;
+    for at in 0..stream.len().saturating_sub(16) {
+        if (0..3).any(|k| f32_at(at + 4 * k) != Some(min[k])) {
+            continue;
+        }
+        let (Some(range), Some(&bits)) = (f32_at(at + 12), stream.get(at + 16)) else {
+            continue;
+        };
+        if !((1..=30).contains(&bits) && range.is_finite() && range > 0.0) {
+            continue;
+        }
+        tried += 1;
+        let step = range / ((1u32 << bits) - 1) as f32;
+        if found.is_none_or(|(b, r)| step > r / ((1u32 << b) - 1) as f32) && fits(bits, range) {
+            found = Some((bits, range));
+        }
+        if tried == MAX_TRIED {
+            break;
+        }
+    }
+    found
 }
 
 /// Draco's extension, which compresses a primitive's geometry (its
@@ -384,8 +466,8 @@ const DRACO_FACES_ANYWAY: u64 = 65_536;
 const DRACO_BYTES_PER_POINT: u64 = 64;
 
 /// A decoded Draco primitive: its points in the file's frame, its
-/// triangles' indices and the grid its points lie on ([`grid_step`]).
-type DecodedDraco = (Vec<DVec3>, Vec<usize>, Option<f64>);
+/// triangles' indices and the grid its points lie on.
+type DecodedDraco = (Vec<DVec3>, Vec<usize>, DracoGrid);
 
 /// Where a Draco-compressed primitive's data lies, and which of its
 /// attributes is POSITION (KHR_draco_mesh_compression).
@@ -915,6 +997,9 @@ struct SceneReader<'f, 'b> {
     /// as the nodes place them; [`super::import::Rounding`]); `None` once
     /// some compressed positions' grid is not known.
     step: Option<f64>,
+    /// Some positions' grid in `step` is only a bound on it (a Draco
+    /// primitive's smallest gap between coordinates, [`DracoGrid::AtMost`]).
+    step_is_bound: bool,
     /// The file uses KHR_mesh_quantization: positions may be integers.
     quantized: bool,
     /// The POSITION accessors whose `min` and `max` the file gave.
@@ -1222,14 +1307,22 @@ impl SceneReader<'_, '_> {
                 }
                 // Decoded once however many nodes draw the mesh.
                 let key = (mesh.index(), primitive.index());
-                let (points, indices, step) = match self.decoded.remove(&key) {
+                let (points, indices, grid) = match self.decoded.remove(&key) {
                     Some(found) => found,
                     None => self.decode_draco(&d, &at)?,
                 };
                 let corners = self.place(&points, world, &at)?;
+                let step = match grid {
+                    DracoGrid::Quantized(step) => Some(step),
+                    DracoGrid::AtMost(step) => {
+                        self.step_is_bound = true;
+                        Some(step)
+                    }
+                    DracoGrid::Unknown => None,
+                };
                 self.note_step(step, world);
                 let out = (corners, indices.clone());
-                self.decoded.insert(key, (points, indices, step));
+                self.decoded.insert(key, (points, indices, grid));
                 out
             } else {
                 let Some(accessor) = primitive.get(&Semantic::Positions) else {
@@ -1538,9 +1631,13 @@ impl SceneReader<'_, '_> {
                 attribute.num_components()
             )));
         }
-        let points: Vec<DVec3> = attribute
+        let values: Vec<[f32; 3]> = attribute
             .read_f32s(n, 3)
             .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        let points: Vec<DVec3> = values
+            .iter()
             .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
             .collect();
         let mut indices = Vec::with_capacity(3 * mesh.num_faces());
@@ -1555,8 +1652,13 @@ impl SceneReader<'_, '_> {
                 indices.push(i);
             }
         }
-        let step = grid_step(&points);
-        Ok((points, indices, step))
+        let grid = match draco_quantization(bytes, &values) {
+            Some((bits, range)) => {
+                DracoGrid::Quantized(f64::from(range / ((1u32 << bits) - 1) as f32))
+            }
+            None => grid_step(&points).map_or(DracoGrid::Unknown, DracoGrid::AtMost),
+        };
+        Ok((points, indices, grid))
     }
 
     /// `points` placed in the scene by `world` and welded; point `i`
@@ -2381,5 +2483,106 @@ mod tests {
         assert_eq!(component(&[255], 0, DataType::U8, true), 1.0);
         assert_eq!(component(&[0x80], 0, DataType::I8, true), -1.0);
         assert_eq!(component(&[0, 1], 0, DataType::U16, false), 256.0);
+    }
+
+    /// `points` quantized to `bits` and decoded as Draco does it (the
+    /// encoder's minima and range over the points, `floor(v * (max_q /
+    /// range) + 0.5)`, then `q * (range / max_q) + min`, all in f32), and
+    /// the 17 bytes of parameters the stream stores.
+    fn draco_round_trip(points: &[[f32; 3]], bits: u8) -> (Vec<[f32; 3]>, Vec<u8>) {
+        let mut min = points[0];
+        let mut max = points[0];
+        for p in points {
+            for k in 0..3 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        let range = (0..3).map(|k| max[k] - min[k]).fold(0.0f32, f32::max);
+        let max_q = ((1u32 << bits) - 1) as f32;
+        let (inverse, delta) = (max_q / range, range / max_q);
+        let decoded = points
+            .iter()
+            .map(|p| [0, 1, 2].map(|k| ((p[k] - min[k]) * inverse + 0.5).floor() * delta + min[k]))
+            .collect();
+        let mut params: Vec<u8> = min.iter().flat_map(|m| m.to_le_bytes()).collect();
+        params.extend(range.to_le_bytes());
+        params.push(bits);
+        (decoded, params)
+    }
+
+    /// QA round 21 F2: Szilassi's polyhedron (14 vertices, as Inkscape's
+    /// OBJ has them) Draco-compressed at gltf-pipeline's 11 bits was said
+    /// to be rounded to a grid "no coarser than" its smallest gap between
+    /// coordinates, 60 times the real one, and the user told to raise tol
+    /// by that. The stream's own parameters are found (here among bytes
+    /// that also hold the minima alone, and zeros) and give the grid.
+    #[test]
+    fn a_draco_streams_own_quantization_gives_the_grid() {
+        let szilassi: [[f32; 3]; 14] = [
+            [-4.8, 0.0, 4.8],
+            [-2.8, -1.0, 0.8],
+            [-2.8, 0.0, 0.8],
+            [-1.8, 1.0, 0.8],
+            [-1.5, -1.5, -1.2],
+            [-0.8, 2.0, -3.2],
+            [0.0, -5.04, -4.8],
+            [0.0, 5.04, -4.8],
+            [0.8, -2.0, -3.2],
+            [1.5, 1.5, -1.2],
+            [1.8, -1.0, 0.8],
+            [2.8, 0.0, 0.8],
+            [2.8, 1.0, 0.8],
+            [4.8, 0.0, 4.8],
+        ];
+        let (decoded, params) = draco_round_trip(&szilassi, 11);
+        let mut stream = vec![0u8; 40];
+        stream.extend(&params[..12]);
+        stream.extend([7u8, 0, 0, 0, 200]);
+        stream.extend(&params);
+        stream.extend([0u8; 9]);
+        let (bits, range) = draco_quantization(&stream, &decoded).expect("found");
+        assert_eq!((bits, range), (11, 10.08));
+        let step = f64::from(range / 2047.0);
+        let points: Vec<DVec3> = decoded
+            .iter()
+            .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+            .collect();
+        let gap = grid_step(&points).unwrap();
+        assert!(gap > 40.0 * step, "{gap} vs {step}");
+        // Every vertex is within half the grid of where it was.
+        for (p, d) in szilassi.iter().zip(&decoded) {
+            for k in 0..3 {
+                assert!(f64::from((p[k] - d[k]).abs()) <= step / 2.0 * 1.0001);
+            }
+        }
+        // Parameters the values do not fit (other bits, or another range),
+        // and a stream without them, give nothing: the grid is then only
+        // bounded by the smallest gap.
+        for bad in [10u8, 12] {
+            let mut s = params.clone();
+            s[16] = bad;
+            assert_eq!(draco_quantization(&s, &decoded), None, "{bad} bits");
+        }
+        let mut s = params.clone();
+        s[12..16].copy_from_slice(&25.0f32.to_le_bytes());
+        assert_eq!(draco_quantization(&s, &decoded), None);
+        assert_eq!(draco_quantization(&stream[..60], &decoded), None);
+        assert_eq!(draco_quantization(&[], &decoded), None);
+        assert_eq!(draco_quantization(&stream, &[]), None);
+    }
+
+    /// The same end to end, on a Draco stream from Google's encoder (the
+    /// textured box, 14 bits, tests/data/realworld/SOURCES.md): all its
+    /// coordinates are +-0.5, so their smallest gap is the box's size (it
+    /// was said to be rounded to a 1 m grid); its grid is 1/16383 of it.
+    #[test]
+    fn a_draco_box_states_its_streams_grid() {
+        let bytes =
+            include_bytes!("../../tests/data/realworld/mesh/BoxTextured-draco-sequential.glb");
+        let rounding = parse(bytes, "box.glb").unwrap().rounding.expect("said");
+        let step = rounding.step.expect("known");
+        assert!(!rounding.step_is_bound);
+        assert!((step - 1.0 / 16383.0).abs() < 1e-9, "{step}");
     }
 }

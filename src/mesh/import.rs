@@ -26,9 +26,13 @@ pub(super) struct Rounding {
     pub names: Vec<&'static str>,
     /// The coarsest the grid the positions are rounded to can be, in the
     /// file's units as its nodes place them, where it is known for every
-    /// primitive (a Draco primitive's is the smallest gap between its
-    /// coordinates: a whole number of its quantization steps).
+    /// primitive (a Draco primitive's read from its stream, else the
+    /// smallest gap between its coordinates: a whole number of its
+    /// quantization steps).
     pub step: Option<f64>,
+    /// Some primitive's grid in `step` is only that smallest gap, a bound
+    /// that is close to the grid only on a dense mesh.
+    pub step_is_bound: bool,
 }
 
 impl Rounding {
@@ -43,9 +47,18 @@ impl Rounding {
     /// raise tol instead: every vertex lies within half the grid along each
     /// axis of where it was, so within sqrt(3)/2 of the grid, and so does
     /// every point of the surface between them.
+    /// QA round 21 F2: a grid that is only a bound (a low-poly Draco mesh's
+    /// smallest gap, 60 times its grid) is said to be one, and no rise of
+    /// tol is drawn from it.
     fn message(&self, file: &str, scale: f64) -> String {
         let step = self.step.map(|s| s * scale).filter(|s| *s > 0.0);
         let rounds = match step {
+            Some(mm) if self.step_is_bound => format!(
+                "which rounds vertex positions to a grid that could not be read from the file: \
+                 at most {} mm (the smallest gap between two of its coordinates, which is \
+                 close to the grid only on a dense mesh)",
+                crate::error::significant(mm, 2, 0)
+            ),
             Some(mm) => format!(
                 "which rounds vertex positions to a grid no coarser than {} mm (each moved by \
                  up to half of it)",
@@ -56,12 +69,12 @@ impl Rounding {
                 .to_string(),
         };
         let or_raise = match step {
-            Some(mm) => format!(
+            Some(mm) if !self.step_is_bound => format!(
                 ", or raise tol by {} mm (--tol; every point of the surface lies within that of \
                  where it was)",
                 up_to_two_digits(mm * 3f64.sqrt() / 2.0)
             ),
-            None => String::new(),
+            _ => String::new(),
         };
         format!(
             "{file}: its geometry is compressed ({}), {rounds}: the plan keeps tol from the \
@@ -89,28 +102,175 @@ pub fn detect_format(bytes: &[u8], file: &str) -> Option<MeshFormat> {
 }
 
 /// How to turn a scan in a format this program does not read, known by
-/// its extension, into one it reads (QA: CGAL's and MeshLab's .off files
-/// got the list of formats alone).
-fn conversion_hint(file: &str) -> String {
+/// its content or its extension, into one it reads (QA: CGAL's and
+/// MeshLab's .off files got the list of formats alone; QA round 21 F5:
+/// KiCad's VRML models too).
+fn conversion_hint(bytes: &[u8], file: &str) -> String {
     let ext = file
         .rsplit_once('.')
         .map(|(_, e)| e.to_ascii_lowercase())
         .unwrap_or_default();
-    let what = match ext.as_str() {
-        "off" => "an OFF mesh (Geomview, MeshLab, CGAL)",
-        "3mf" => "a 3MF model",
-        "fbx" => "an FBX scene",
-        "dae" => "a COLLADA scene",
-        "3ds" => "a 3DS scene",
-        "vtk" | "vtp" => "a VTK file",
-        "e57" | "las" | "laz" => "a laser scanner's point cloud",
-        "step" | "stp" | "iges" | "igs" => "a CAD model (STEP or IGES), not a mesh",
-        _ => return String::new(),
+    let Some(format) = other_format(bytes).or_else(|| other_format_named(&ext)) else {
+        return String::new();
     };
-    format!(
-        "; this is {what}: export it as PLY, OBJ or STL (MeshLab: File > Export Mesh As; a CAD \
-         program or CloudCompare for the others)"
-    )
+    let (what, way) = format.hint();
+    format!("; this is {what}: {way}")
+}
+
+/// 3-D formats this program does not read, named for the way out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum OtherFormat {
+    Off,
+    Vrml,
+    X3d,
+    Collada,
+    Fbx,
+    ThreeDs,
+    ThreeMf,
+    Step,
+    Iges,
+    Vtk,
+    LaserCloud,
+    Blend,
+}
+
+impl OtherFormat {
+    /// What the file is, and how to export it as a scan this program reads.
+    fn hint(self) -> (&'static str, &'static str) {
+        const MESHLAB: &str = "export it as PLY, OBJ or STL (MeshLab: File > Export Mesh As; \
+                               a CAD program or CloudCompare for the others)";
+        const IMPORT: &str = "open it in MeshLab (File > Import Mesh) or Blender and export it \
+                              as PLY, OBJ or STL";
+        match self {
+            OtherFormat::Off => ("an OFF mesh (Geomview, MeshLab, CGAL)", MESHLAB),
+            OtherFormat::Vrml => (
+                "a VRML model (KiCad's and many CAD tools' 3-D models)",
+                IMPORT,
+            ),
+            OtherFormat::X3d => ("an X3D model", IMPORT),
+            OtherFormat::Collada => ("a COLLADA scene (.dae)", IMPORT),
+            OtherFormat::Fbx => (
+                "an FBX scene",
+                "open it in Blender and export it as OBJ, STL or glTF (File > Export)",
+            ),
+            OtherFormat::ThreeDs => ("a 3DS scene", IMPORT),
+            OtherFormat::ThreeMf => (
+                "a 3MF model (a slicer's or CAD program's)",
+                "export it as STL or OBJ from the program that wrote it (PrusaSlicer, Cura and \
+                 Blender open 3MF too)",
+            ),
+            OtherFormat::Step | OtherFormat::Iges => (
+                "a CAD model (STEP or IGES), not a mesh",
+                "export it as STL from its CAD program (FreeCAD opens STEP and IGES)",
+            ),
+            OtherFormat::Vtk => ("a VTK file", MESHLAB),
+            OtherFormat::LaserCloud => ("a laser scanner's point cloud", MESHLAB),
+            OtherFormat::Blend => (
+                "a Blender file",
+                "export it from Blender as OBJ, STL or glTF (File > Export)",
+            ),
+        }
+    }
+}
+
+/// A format this program does not read, by its extension.
+fn other_format_named(ext: &str) -> Option<OtherFormat> {
+    Some(match ext {
+        "off" => OtherFormat::Off,
+        "wrl" | "vrml" => OtherFormat::Vrml,
+        "x3d" | "x3dv" | "x3db" | "x3dz" => OtherFormat::X3d,
+        "dae" => OtherFormat::Collada,
+        "fbx" => OtherFormat::Fbx,
+        "3ds" => OtherFormat::ThreeDs,
+        "3mf" => OtherFormat::ThreeMf,
+        "step" | "stp" => OtherFormat::Step,
+        "iges" | "igs" => OtherFormat::Iges,
+        "vtk" | "vtp" => OtherFormat::Vtk,
+        "e57" | "las" | "laz" => OtherFormat::LaserCloud,
+        "blend" => OtherFormat::Blend,
+        _ => return None,
+    })
+}
+
+/// A format this program does not read, by its first bytes (whatever the
+/// file is named).
+fn other_format(bytes: &[u8]) -> Option<OtherFormat> {
+    let text = skip_bom_and_space(bytes);
+    let head = &text[..text.len().min(1024)];
+    let first_line = head
+        .split(|&c| c == b'\n')
+        .next()
+        .unwrap_or_default()
+        .trim_ascii_end();
+    let contains = |needle: &[u8]| head.windows(needle.len()).any(|w| w == needle);
+    let first_word = first_line
+        .split(|c| c.is_ascii_whitespace())
+        .next()
+        .unwrap_or_default();
+    if text.starts_with(b"#VRML") {
+        Some(OtherFormat::Vrml)
+    } else if text.starts_with(b"#X3D") || (text.starts_with(b"<") && contains(b"<X3D")) {
+        Some(OtherFormat::X3d)
+    } else if text.starts_with(b"<") && contains(b"<COLLADA") {
+        Some(OtherFormat::Collada)
+    } else if bytes.starts_with(b"Kaydara FBX Binary") || text.starts_with(b"; FBX ") {
+        Some(OtherFormat::Fbx)
+    } else if text.starts_with(b"ISO-10303-21;") {
+        Some(OtherFormat::Step)
+    } else if first_line.len() == 80
+        && first_line[72] == b'S'
+        && first_line[73..].trim_ascii_start() == b"1"
+    {
+        // IGES: 80-column records, the first of the Start section.
+        Some(OtherFormat::Iges)
+    } else if matches!(
+        first_word,
+        b"OFF" | b"COFF" | b"NOFF" | b"CNOFF" | b"STOFF" | b"4OFF" | b"nOFF"
+    ) {
+        Some(OtherFormat::Off)
+    } else if text.starts_with(b"# vtk DataFile") || text.starts_with(b"<VTKFile") {
+        Some(OtherFormat::Vtk)
+    } else if bytes.starts_with(b"LASF") || bytes.starts_with(b"ASTM-E57") {
+        Some(OtherFormat::LaserCloud)
+    } else if bytes.starts_with(b"BLENDER") {
+        Some(OtherFormat::Blend)
+    } else if bytes.len() >= 6
+        && bytes.starts_with(&[0x4D, 0x4D])
+        && u32::from_le_bytes([bytes[2], bytes[3], bytes[4], bytes[5]]) as usize == bytes.len()
+    {
+        // 3DS: the main chunk (0x4D4D) and its length, the file's.
+        Some(OtherFormat::ThreeDs)
+    } else if is_zip(bytes)
+        && zip_entry_names(bytes, 64)
+            .iter()
+            .any(|n| n.eq_ignore_ascii_case("3D/3dmodel.model"))
+    {
+        Some(OtherFormat::ThreeMf)
+    } else {
+        None
+    }
+}
+
+/// Whether the bytes are a DXF drawing: a binary DXF's sentinel, or an
+/// ascii DXF's first group (`0`, then `SECTION`, each on its own line,
+/// after any `999` comment groups) (QA round 21 F5: LibreCAD's
+/// hexagon_b.dxf given as the scan).
+fn is_dxf(bytes: &[u8], file: &str) -> bool {
+    if bytes.starts_with(b"AutoCAD Binary DXF") {
+        return true;
+    }
+    let named = file.to_ascii_lowercase().ends_with(".dxf");
+    let head = &bytes[..bytes.len().min(4096)];
+    let mut lines = head.split(|&c| c == b'\n').map(<[u8]>::trim_ascii);
+    loop {
+        match (lines.next(), lines.next()) {
+            (Some(b"999"), Some(_)) => continue,
+            (Some(b"0"), Some(b"SECTION")) => return true,
+            // A DXF by name that does not start so (a damaged one) is
+            // named as one all the same.
+            _ => return named,
+        }
+    }
 }
 
 fn from_extension(file: &str) -> Option<MeshFormat> {
@@ -274,8 +434,22 @@ pub fn import_mesh_unwelded(
              to the file; download the file itself (on GitHub, its \"raw\" or download link)",
         ));
     }
-    if is_zip(bytes) && !file.to_ascii_lowercase().ends_with(".3mf") {
+    if is_zip(bytes)
+        && !file.to_ascii_lowercase().ends_with(".3mf")
+        && other_format(bytes) != Some(OtherFormat::ThreeMf)
+    {
         return Err(MeshError::invalid(file, zip_message(bytes)));
+    }
+    if is_dxf(bytes, file) {
+        // The drawing a DXF holds is the path to print, not the surface
+        // (QA round 21 F5: it was "not a scan this program reads").
+        return Err(MeshError::invalid(
+            file,
+            "the file is a 2-D CAD drawing (DXF), not a scan; a DXF drawing is the path: export \
+             it as SVG (LibreCAD: File > Export; Inkscape opens DXF and saves SVG) and open that \
+             as the drawing (the command line's --path), and the scan (a mesh or point cloud) \
+             as the scan",
+        ));
     }
     if is_svg(bytes) {
         // The drawing given as the scan (QA: an SVG named .ply was "line 1:
@@ -288,7 +462,7 @@ pub fn import_mesh_unwelded(
     }
     let format = detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat {
         file: file.into(),
-        hint: conversion_hint(file),
+        hint: conversion_hint(bytes, file),
     })?;
     let (parsed, read) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
@@ -1926,5 +2100,171 @@ mod tests {
             weld_map(&[DVec3::new(0.0, 1.0, 2.0), DVec3::new(-0.0, 1.0, 2.0)]),
             Some(vec![0, 0])
         );
+    }
+
+    /// QA round 21 F2: a grid known only as the smallest gap between a
+    /// Draco mesh's coordinates is said to be a bound, and no rise of tol
+    /// is drawn from it (3.0 mm said of a grid of 0.049 mm, and "raise tol
+    /// by 2.7 mm"); a grid read from the file keeps its margin.
+    #[test]
+    fn a_grid_known_only_as_a_bound_gives_no_tol_rise() {
+        let draco = |step_is_bound| Rounding {
+            names: vec!["KHR_draco_mesh_compression"],
+            step: Some(0.3),
+            step_is_bound,
+        };
+        let bound = draco(true).message("szilassi_draco.glb", 10.0);
+        assert!(
+            bound.starts_with(
+                "szilassi_draco.glb: its geometry is compressed (KHR_draco_mesh_compression), \
+                 which rounds vertex positions to a grid that could not be read from the file: \
+                 at most 3.0 mm (the smallest gap"
+            ) && bound.contains("plan on the scan as it was before compression")
+                && !bound.contains("raise tol")
+                && !bound.contains("no coarser than"),
+            "{bound}"
+        );
+        let known = draco(false).message("szilassi_draco.glb", 10.0);
+        assert!(
+            known.contains("to a grid no coarser than 3.0 mm (each moved by up to half of it)")
+                && known.ends_with(
+                    "or raise tol by 2.6 mm (--tol; every point of the surface \
+                                    lies within that of where it was)"
+                ),
+            "{known}"
+        );
+    }
+
+    /// A ZIP archive of empty stored entries `names`.
+    fn zip_of(names: &[&str]) -> Vec<u8> {
+        let (mut b, mut central) = (Vec::new(), Vec::new());
+        for n in names {
+            let offset = b.len() as u32;
+            b.extend(b"PK\x03\x04");
+            b.extend([0u8; 22]);
+            b.extend((n.len() as u16).to_le_bytes());
+            b.extend([0u8; 2]);
+            b.extend(n.as_bytes());
+            central.extend(b"PK\x01\x02");
+            central.extend([0u8; 24]);
+            central.extend((n.len() as u16).to_le_bytes());
+            central.extend([0u8; 12]);
+            central.extend(offset.to_le_bytes());
+            central.extend(n.as_bytes());
+        }
+        let (at, size) = (b.len() as u32, central.len() as u32);
+        b.extend(central);
+        b.extend(b"PK\x05\x06");
+        b.extend([0u8; 4]);
+        b.extend((names.len() as u16).to_le_bytes());
+        b.extend((names.len() as u16).to_le_bytes());
+        b.extend(size.to_le_bytes());
+        b.extend(at.to_le_bytes());
+        b.extend([0u8; 2]);
+        b
+    }
+
+    /// QA round 21 F5: KiCad's VRML model and LibreCAD's DXF given as the
+    /// scan got the list of formats alone, where an OFF got its format and
+    /// a way out. Other 3-D formats are named by their first bytes, however
+    /// the file is named, or by their extension, each with how to export
+    /// it; a DXF is the drawing, to export as SVG.
+    #[test]
+    fn other_3d_formats_and_a_dxf_are_named_with_a_way_out() {
+        let refused = |bytes: &[u8], name: &str| {
+            import_mesh(bytes, name, &ImportOptions::DEFAULT)
+                .unwrap_err()
+                .to_string()
+        };
+        let tds = vec![0x4D, 0x4D, 16, 0, 0, 0, 2, 0, 10, 0, 0, 0, 3, 0, 0, 0];
+        let mut iges = format!("{:<72}S{:>7}\n", "IGES written by a CAD program", 1);
+        iges += &format!("{:<72}G{:>7}\n", "1H,,1H;", 1);
+        for (bytes, what, way) in [
+            (
+                b"#VRML V2.0 utf8\n#Exported from Wings 3D\nDEF cube Transform {\n}\n".to_vec(),
+                "; this is a VRML model (KiCad's and many CAD tools' 3-D models): open it in \
+                 MeshLab",
+                "export it as PLY, OBJ or STL",
+            ),
+            (
+                b"<?xml version=\"1.0\"?>\n<X3D profile=\"Immersive\">".to_vec(),
+                "; this is an X3D model",
+                "MeshLab",
+            ),
+            (
+                b"<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"x\" version=\"1.4.1\">".to_vec(),
+                "; this is a COLLADA scene (.dae)",
+                "MeshLab",
+            ),
+            (
+                b"Kaydara FBX Binary  \x00\x1a\x00".to_vec(),
+                "; this is an FBX scene",
+                "Blender",
+            ),
+            (
+                b"ISO-10303-21;\nHEADER;\n".to_vec(),
+                "; this is a CAD model (STEP or IGES), not a mesh",
+                "export it as STL from its CAD program",
+            ),
+            (
+                iges.into_bytes(),
+                "; this is a CAD model (STEP or IGES)",
+                "STL",
+            ),
+            (tds, "; this is a 3DS scene", "MeshLab"),
+            (
+                b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
+                "; this is an OFF mesh (Geomview, MeshLab, CGAL): export it as PLY, OBJ or STL",
+                "Export Mesh As",
+            ),
+            (
+                zip_of(&["[Content_Types].xml", "3D/3dmodel.model"]),
+                "; this is a 3MF model",
+                "export it as STL or OBJ",
+            ),
+        ] {
+            let e = refused(&bytes, "upload");
+            assert!(
+                e.starts_with("upload: not a scan this program reads")
+                    && e.contains(what)
+                    && e.contains(way),
+                "{what}: {e}"
+            );
+        }
+        // By extension alone.
+        for (name, what) in [
+            ("Jack.wrl", "a VRML model"),
+            ("part.x3d", "an X3D model"),
+            ("part.3mf", "a 3MF model"),
+            ("part.igs", "a CAD model"),
+            ("part.blend", "a Blender file"),
+        ] {
+            let e = refused(b"\x01\x02junk", name);
+            assert!(e.contains(&format!("; this is {what}")), "{name}: {e}");
+        }
+        // Nothing said of what is none of them.
+        let e = refused(b"\x01\x02junk", "x.bin");
+        assert!(!e.contains("this is"), "{e}");
+        // LibreCAD's DXF (its first lines), by content or by name.
+        let dxf = b"  0\nSECTION\n  2\nHEADER\n  9\n$LIMMIN\n 10\n0.000000\n";
+        for (bytes, name) in [
+            (&dxf[..], "hexagon_b.dxf"),
+            (&dxf[..], "upload"),
+            (
+                b"999\r\ndxfrw 0.6.3\r\n  0\r\nSECTION\r\n".as_slice(),
+                "upload",
+            ),
+            (b"AutoCAD Binary DXF\r\n\x1a\x00".as_slice(), "upload"),
+            (b"\x01\x02junk".as_slice(), "plate.DXF"),
+        ] {
+            let e = refused(bytes, name);
+            assert!(
+                e.starts_with(&format!(
+                    "{name}: the file is a 2-D CAD drawing (DXF), not a scan; a DXF drawing is \
+                     the path: export it as SVG"
+                )),
+                "{e}"
+            );
+        }
     }
 }

@@ -1,6 +1,9 @@
 //! Wavefront OBJ: `v` and `f` statements only; everything else (texture
 //! coordinates, normals, groups, materials, lines) says nothing about the
-//! surface the nozzle follows and is skipped.
+//! surface the nozzle follows and is skipped. Lines (`l`) and free-form
+//! curves and surfaces (`curv`, `surf`) are counted, so that a file whose
+//! only geometry they are is refused as what it is rather than read as the
+//! point cloud its vertices alone would be ([`Others`]).
 //!
 //! Byte-level on purpose: scans run to millions of triangles, so no line is
 //! copied into a `String` and numbers are parsed from borrowed slices.
@@ -11,6 +14,12 @@ use super::import::Parsed;
 use super::MeshError;
 
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+    let (parsed, others) = read(bytes, file)?;
+    others.check(parsed, file)
+}
+
+/// The `v` and `f` statements read, and the other geometry counted.
+fn read(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> {
     // The format's line continuation (a statement goes on on the next line
     // when its line ends in a backslash) is rare, and looking for it at
     // every line cost 5 % of the reading: a file is read as if it had
@@ -45,7 +54,9 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         // A joined line's number in the file: one more for each
         // continuation on the joined lines before it.
         let in_file = |l: usize| l + within.iter().filter(|&&w| w < l).count();
-        parse_lines(&joined, file).map_err(|e| e.with_line_mapped(in_file))
+        parse_lines(&joined, file)
+            .map(|(parsed, others)| (parsed, others.with_lines_mapped(in_file)))
+            .map_err(|e| e.with_line_mapped(in_file))
     })
 }
 
@@ -68,7 +79,7 @@ fn continuations(bytes: &[u8]) -> Vec<(usize, usize)> {
 }
 
 /// Reads the `v` and `f` statements, line by line.
-fn parse_lines(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
+fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> {
     let mut p = Parser {
         file,
         cur: Cursor { bytes, pos: 0 },
@@ -78,6 +89,7 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         polygon: Vec::with_capacity(8),
         faces: 0,
         ended: false,
+        others: Others::default(),
     };
     // A batch of lines per call: V8 runs a long wasm call in its baseline
     // tier to its end and tiers a function up only for its later calls (see
@@ -91,12 +103,120 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
         .flatten()
         .into_iter()
         .collect();
-    Ok(Parsed {
-        vertices: p.vertices,
-        triangles: p.triangles,
-        warnings,
-        rounding: None,
-    })
+    Ok((
+        Parsed {
+            vertices: p.vertices,
+            triangles: p.triangles,
+            warnings,
+            rounding: None,
+        },
+        p.others,
+    ))
+}
+
+/// Statements of an OBJ's geometry other than vertices and faces that
+/// are not read: how many, and the line of the first.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+struct Counted {
+    count: usize,
+    first_line: usize,
+}
+
+impl Counted {
+    fn note(&mut self, line: usize) {
+        if self.count == 0 {
+            self.first_line = line;
+        }
+        self.count += 1;
+    }
+}
+
+/// The geometry of an OBJ that describes no surface and is counted: lines
+/// (`l`), and free-form curves and surfaces (`curv`, `curv2`, `surf`).
+/// Points (`p`) name vertices a cloud holds anyway.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+struct Others {
+    lines: Counted,
+    curves: Counted,
+    surfaces: Counted,
+}
+
+impl Others {
+    /// The lines as the file numbers them (`in_file`: from the lines of a
+    /// text whose continued lines were joined).
+    fn with_lines_mapped(mut self, in_file: impl Fn(usize) -> usize) -> Self {
+        for c in [&mut self.lines, &mut self.curves, &mut self.surfaces] {
+            if c.count > 0 {
+                c.first_line = in_file(c.first_line);
+            }
+        }
+        self
+    }
+
+    /// `parsed`, or the refusal of a file whose geometry is no surface.
+    /// QA round 21 F1: Inkscape's ball-and-stick molecules (`v` and `l`
+    /// lines, no `f`) were read as a cloud of 5 atom centres and a pyramid
+    /// meshed through them. A file of lines and no faces is a wireframe,
+    /// and one of free-form curves or surfaces and no faces holds their
+    /// control points, neither of which is a scan's surface; a file of
+    /// vertices alone, or of points (`p`), is a point cloud, as scanners
+    /// write them. Beside faces, lines and points are what exporters add
+    /// (edges, loose vertices) and are skipped without a word; free-form
+    /// surfaces are said, as the surface planned on lacks them.
+    fn check(self, mut parsed: Parsed, file: &str) -> Result<Parsed, MeshError> {
+        let n = parsed.vertices.len();
+        let free_form = |c: Counted, what: &str, keyword: &str| {
+            (c.count > 0).then(|| {
+                format!(
+                    "{} free-form {what} (`{keyword}`, the first on line {})",
+                    c.count, c.first_line
+                )
+            })
+        };
+        let free: Vec<String> = [
+            free_form(self.surfaces, "surface(s)", "surf"),
+            free_form(self.curves, "curve(s)", "curv"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !parsed.triangles.is_empty() {
+            if self.surfaces.count > 0 {
+                parsed.warnings.push(format!(
+                    "{file}: its {} were not read, only its faces: this program does not \
+                     evaluate free-form geometry, and the plan follows only the faces; where \
+                     they are part of the surface, export the model with them as a triangle \
+                     mesh",
+                    free.join(" and ")
+                ));
+            }
+            return Ok(parsed);
+        }
+        if self.lines.count > 0 {
+            return Err(MeshError::invalid(
+                file,
+                format!(
+                    "a wireframe, not a surface: its {n} vertices are joined by {} line \
+                     element(s) (`l`, the first on line {}) and by no face (`f`), so there is \
+                     no surface to print on; export the surface itself, with its faces (an \
+                     OBJ with `f` lines, or PLY or STL)",
+                    self.lines.count, self.lines.first_line
+                ),
+            ));
+        }
+        if !free.is_empty() {
+            return Err(MeshError::invalid(
+                file,
+                format!(
+                    "its geometry is {}, which this program does not evaluate, and it has no \
+                     faces (`f`): its {n} vertices are control points, not the surface; export \
+                     the model as a triangle mesh (an OBJ with `f` lines, or PLY or STL)",
+                    free.join(" and ")
+                ),
+            ));
+        }
+        Ok(parsed)
+    }
 }
 
 /// The share of a meshed OBJ's vertices no face uses from which the file
@@ -154,6 +274,8 @@ struct Parser<'a> {
     /// cut short (QA round 20 F2: a complete MeshLab export, 23 % of
     /// whose vertices no face uses, was said to be maybe cut short).
     ended: bool,
+    /// The geometry that is not read, counted.
+    others: Others,
 }
 
 impl Parser<'_> {
@@ -178,11 +300,30 @@ impl Parser<'_> {
                     self.ended = false;
                 }
                 (Some(b'#'), _) => self.ended = self.faces > 0,
+                (Some(b'l'), Some(c)) if is_space(c) => self.others.lines.note(self.line_no),
+                (Some(b'c' | b's'), _) => self.free_form(),
                 _ => {}
             }
             self.cur.next_line();
         }
         Ok(())
+    }
+
+    /// Counts a free-form statement (`curv`, `curv2`, `surf`) at the
+    /// cursor; anything else starting with its letters (`s 1`, `cstype`)
+    /// is not one.
+    #[cold]
+    fn free_form(&mut self) {
+        let rest = &self.cur.bytes[self.cur.pos..];
+        let word = rest
+            .iter()
+            .position(|&c| is_space(c))
+            .map_or(rest, |end| &rest[..end]);
+        match word {
+            b"surf" => self.others.surfaces.note(self.line_no),
+            b"curv" | b"curv2" => self.others.curves.note(self.line_no),
+            _ => {}
+        }
     }
 
     fn vertex(&mut self) -> Result<(), MeshError> {
@@ -575,6 +716,75 @@ mod tests {
             let text = format!("{cut}{tail}");
             let w = parse(text.as_bytes(), "g.obj").unwrap().warnings;
             assert_eq!(!w.is_empty(), said, "{tail:?}: {w:?}");
+        }
+    }
+
+    /// Inkscape's Poly3DObjects methane.obj, as it is.
+    const METHANE: &str = "#Name:Methane Molecule\n#Type:edge_specified\n\n\
+        v   0   0   0\nv   0   0   0.61237244\nv   -0.28867513   -0.50000000   -0.20412415\n\
+        v   -0.28867513   0.50000000   -0.20412415\nv   0.57735027   0   -0.20412415\n\n\
+        l   1   2\nl   1   3\nl   1   4\nl   1   5\n";
+
+    /// QA round 21 F1: an OBJ of vertices and lines (`l`) and no faces, a
+    /// ball-and-stick wireframe, was read as a 5-point cloud and planned
+    /// on a pyramid through its atoms. It is refused as a wireframe,
+    /// naming the count of its lines, the first one's line and what to
+    /// export; so is a file of free-form curves or surfaces and no faces.
+    /// A file of vertices alone, or with points (`p`), stays a cloud, and
+    /// lines beside faces are skipped as before.
+    #[test]
+    fn a_wireframe_obj_is_refused_not_read_as_a_point_cloud() {
+        let e = parse(METHANE.as_bytes(), "methane.obj")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "methane.obj: a wireframe, not a surface: its 5 vertices are joined by 4 line \
+             element(s) (`l`, the first on line 10) and by no face (`f`), so there is no \
+             surface to print on; export the surface itself, with its faces (an OBJ with `f` \
+             lines, or PLY or STL)"
+        );
+        // Its line counted as the file has it when continuations are joined.
+        let continued = "v 0 0 \\\n 0\nv 1 0 0\nv 0 1 \\\n0\nl 1 2 3\nl 2 3\n";
+        let e = parse_str(continued).unwrap_err().to_string();
+        assert!(
+            e.contains("by 2 line element(s) (`l`, the first on line 6)"),
+            "{e}"
+        );
+        // Free-form geometry with no faces.
+        let free = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ncstype bspline\ndeg 1 1\n\
+                    surf 0 1 0 1 1 2 4 3\nparm u 0 0 1 1\nparm v 0 0 1 1\nend\n\
+                    curv 0 1 1 2\ncurv2 1 2\n";
+        let e = parse_str(free).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "t.obj: its geometry is 1 free-form surface(s) (`surf`, the first on line 7) \
+                 and 2 free-form curve(s) (`curv`, the first on line 11), which this program \
+                 does not evaluate, and it has no faces (`f`)"
+            ) && e.contains("export the model as a triangle mesh"),
+            "{e}"
+        );
+        // Beside faces, a free-form surface is said; lines are not.
+        let p = parse_str(&format!("{free}f 1 2 3\nl 1 3\n")).unwrap();
+        assert_eq!(p.triangles.len(), 1);
+        assert!(
+            p.warnings.len() == 1
+                && p.warnings[0].starts_with("t.obj: its 1 free-form surface(s) (`surf`, the first on line 7) and 2 free-form curve(s)")
+                && p.warnings[0].contains("the plan follows only the faces"),
+            "{:?}",
+            p.warnings
+        );
+        let p = parse_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nl 1 2\nl 2 3\n").unwrap();
+        assert_eq!((p.triangles.len(), p.warnings.len()), (1, 0));
+        // Clouds: vertices alone, with points, and with smoothing groups
+        // and other statements that start as the free-form ones do.
+        for cloud in [
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\n",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\np 1 2 3 4\n",
+            "s 1\ncstype bezier\nsurfx 1\nv 0 0 0\nv 1 0 0\nv 1 1 0\nc 1\n",
+        ] {
+            let p = parse_str(cloud).unwrap_or_else(|e| panic!("{cloud:?}: {e}"));
+            assert!(p.triangles.is_empty() && p.vertices.len() >= 3, "{cloud:?}");
         }
     }
 
