@@ -1474,8 +1474,13 @@ impl<'f> Reader<'f> {
                     what: "a call, jump, loop or condition",
                 })
             }
-            // Klipper's mesh loaded is its compensation on.
-            "BED_MESH_PROFILE" if upper(text).contains("LOAD") => {
+            // Klipper's mesh loaded is its compensation on (`LOAD=name`;
+            // not `SAVE=autoload` or a comment that says load: review).
+            "BED_MESH_PROFILE"
+                if without_comment(text)
+                    .split_whitespace()
+                    .any(|w| upper(w).starts_with("LOAD=")) =>
+            {
                 self.notes
                     .add(NoteKind::Compensation, n)
                     .code("BED_MESH_PROFILE LOAD");
@@ -2490,6 +2495,14 @@ mod tests {
             ("G90\nM420 S0\nM420 Z10\nM420 V\nG0 X1 Y1 Z1\n", None),
             ("G21\nBED_MESH_PROFILE LOAD=default\nG0 X1 Y1 Z1\n", Some(2)),
             ("G21\nBED_MESH_PROFILE SAVE=default\nG0 X1 Y1 Z1\n", None),
+            // Review: not a profile saved under a name with "load" in it,
+            // nor a comment that says load.
+            ("G21\nBED_MESH_PROFILE SAVE=autoload\nG0 X1 Y1 Z1\n", None),
+            (
+                "G21\nBED_MESH_PROFILE SAVE=x ; load later\nG0 X1 Y1 Z1\n",
+                None,
+            ),
+            ("G21\nbed_mesh_profile load=default\nG0 X1 Y1 Z1\n", Some(2)),
             ("G21\nM420 S1\nM420 S1\nG0 X1 Y1 Z1\n", Some(2)),
         ] {
             let p = read(text);

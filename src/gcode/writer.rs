@@ -331,8 +331,8 @@ pub fn start_block_cautions(profile: &MachineProfile) -> Vec<String> {
     if let Some(u) = probing {
         out.push(format!(
             "{} probes the bed (or levels or calibrates): with the part on the bed the probe \
-             comes down across it, where pcpp cannot check it; probe before the part is placed \
-             and keep the mesh, or take the line out",
+             comes down across it, where pcpp cannot check it; probe before the part is placed, \
+             or take the line out",
             block.field(profile, u.line)
         ));
     }

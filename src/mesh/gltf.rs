@@ -371,6 +371,22 @@ fn grid_step(points: &[DVec3]) -> Option<f64> {
     step.is_finite().then_some(step)
 }
 
+/// The coarser of two grids, each `(step, only a bound)`: unknown if
+/// either is, and a bound only where the coarsest is one.
+fn coarsest(a: (Option<f64>, bool), b: (Option<f64>, bool)) -> (Option<f64>, bool) {
+    match (a, b) {
+        ((Some(x), x_bound), (Some(y), y_bound)) if x == y => (Some(x), x_bound && y_bound),
+        ((Some(x), x_bound), (Some(y), y_bound)) => {
+            if y > x {
+                (Some(y), y_bound)
+            } else {
+                (Some(x), x_bound)
+            }
+        }
+        _ => (None, false),
+    }
+}
+
 /// The grid a Draco primitive's positions lie on, in the file's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum DracoGrid {
@@ -1312,15 +1328,12 @@ impl SceneReader<'_, '_> {
                     None => self.decode_draco(&d, &at)?,
                 };
                 let corners = self.place(&points, world, &at)?;
-                let step = match grid {
-                    DracoGrid::Quantized(step) => Some(step),
-                    DracoGrid::AtMost(step) => {
-                        self.step_is_bound = true;
-                        Some(step)
-                    }
-                    DracoGrid::Unknown => None,
+                let (step, bound) = match grid {
+                    DracoGrid::Quantized(step) => (Some(step), false),
+                    DracoGrid::AtMost(step) => (Some(step), true),
+                    DracoGrid::Unknown => (None, false),
                 };
-                self.note_step(step, world);
+                self.note_step(step, bound, world);
                 let out = (corners, indices.clone());
                 self.decoded.insert(key, (points, indices, grid));
                 out
@@ -1333,7 +1346,7 @@ impl SceneReader<'_, '_> {
                     continue;
                 };
                 let step = self.accessor_step(&accessor);
-                self.note_step(step, world);
+                self.note_step(step, false, world);
                 let corners = match morphed(weights, &primitive) {
                     // The shape the file shows at rest (glTF 3.7.2.2: the
                     // base plus each target's offsets times its default
@@ -1405,13 +1418,19 @@ impl SceneReader<'_, '_> {
 
     /// Notes the grid positions drawn with `world` are rounded to (`step`
     /// in the file's frame; `None`: not known).
-    fn note_step(&mut self, step: Option<f64>, world: &DMat4) {
+    /// `bound`: `step` is only a bound on the grid ([`DracoGrid::AtMost`]);
+    /// the coarsest grid says whether it is known or bounded (review: one
+    /// primitive's bound made another's exact, coarser grid a bound).
+    fn note_step(&mut self, step: Option<f64>, bound: bool, world: &DMat4) {
         // The longest a unit vector of the file's frame becomes.
         let scale = [world.x_axis, world.y_axis, world.z_axis]
             .iter()
             .map(|c| c.truncate().length())
             .fold(0.0, f64::max);
-        self.step = self.step.zip(step).map(|(a, s)| a.max(s * scale));
+        (self.step, self.step_is_bound) = coarsest(
+            (self.step, self.step_is_bound),
+            (step.map(|s| s * scale), bound),
+        );
     }
 
     /// The grid an accessor's positions are rounded to in the file's frame:
@@ -2576,6 +2595,19 @@ mod tests {
     /// textured box, 14 bits, tests/data/realworld/SOURCES.md): all its
     /// coordinates are +-0.5, so their smallest gap is the box's size (it
     /// was said to be rounded to a 1 m grid); its grid is 1/16383 of it.
+    /// Review: one primitive's grid known only as a bound made another's
+    /// exact, coarser grid a bound too (its tol advice was dropped).
+    #[test]
+    fn the_coarsest_grid_says_whether_it_is_known() {
+        let known = (Some(0.01), false);
+        let bound = (Some(0.004), true);
+        assert_eq!(coarsest(known, bound), known);
+        assert_eq!(coarsest(bound, known), known);
+        assert_eq!(coarsest((Some(0.0), false), bound), bound);
+        assert_eq!(coarsest((Some(0.01), true), known), known);
+        assert_eq!(coarsest(known, (None, false)), (None, false));
+    }
+
     #[test]
     fn a_draco_box_states_its_streams_grid() {
         let bytes =

@@ -259,8 +259,13 @@ fn is_dxf(bytes: &[u8], file: &str) -> bool {
     if bytes.starts_with(b"AutoCAD Binary DXF") {
         return true;
     }
-    let named = file.to_ascii_lowercase().ends_with(".dxf");
     let head = &bytes[..bytes.len().min(4096)];
+    let head = head
+        .strip_prefix(b"\xEF\xBB\xBF")
+        .unwrap_or(head)
+        .trim_ascii_start();
+    // By name only when it is not XML (an SVG named .dxf: review).
+    let named = file.to_ascii_lowercase().ends_with(".dxf") && !head.starts_with(b"<");
     let mut lines = head.split(|&c| c == b'\n').map(<[u8]>::trim_ascii);
     loop {
         match (lines.next(), lines.next()) {
@@ -434,10 +439,17 @@ pub fn import_mesh_unwelded(
              to the file; download the file itself (on GitHub, its \"raw\" or download link)",
         ));
     }
-    if is_zip(bytes)
-        && !file.to_ascii_lowercase().ends_with(".3mf")
-        && other_format(bytes) != Some(OtherFormat::ThreeMf)
-    {
+    if is_zip(bytes) {
+        // A 3MF is a ZIP: named as the format it is, whatever the file's
+        // name (a 3MF saved as .stl was read as a binary STL: review).
+        if file.to_ascii_lowercase().ends_with(".3mf")
+            || other_format(bytes) == Some(OtherFormat::ThreeMf)
+        {
+            return Err(MeshError::UnknownFormat {
+                file: file.into(),
+                hint: conversion_hint(bytes, file),
+            });
+        }
         return Err(MeshError::invalid(file, zip_message(bytes)));
     }
     if is_dxf(bytes, file) {
@@ -2266,5 +2278,17 @@ mod tests {
                 "{e}"
             );
         }
+        // Review: a 3MF saved under a mesh's extension is named as a 3MF
+        // (it was read as that mesh), and an SVG named .dxf, or a DXF after
+        // a byte-order mark, as what it is.
+        let three_mf = zip_of(&["[Content_Types].xml", "3D/3dmodel.model"]);
+        for name in ["part.stl", "part.obj", "part.ply"] {
+            let e = refused(&three_mf, name);
+            assert!(e.contains("; this is a 3MF model"), "{name}: {e}");
+        }
+        let e = refused(b"<svg xmlns=\"http://www.w3.org/2000/svg\"/>", "logo.dxf");
+        assert!(!e.contains("(DXF)"), "{e}");
+        let e = refused(b"\xEF\xBB\xBF  0\r\nSECTION\r\n", "upload");
+        assert!(e.contains("(DXF)"), "{e}");
     }
 }

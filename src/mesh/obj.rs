@@ -199,7 +199,8 @@ impl Others {
                     "a wireframe, not a surface: its {n} vertices are joined by {} line \
                      element(s) (`l`, the first on line {}) and by no face (`f`), so there is \
                      no surface to print on; export the surface itself, with its faces (an \
-                     OBJ with `f` lines, or PLY or STL)",
+                     OBJ with `f` lines, or PLY or STL), or a scanner's points as a point cloud \
+                     (XYZ or PLY, or an OBJ of vertices alone)",
                     self.lines.count, self.lines.first_line
                 ),
             ));
@@ -742,7 +743,8 @@ mod tests {
             "methane.obj: a wireframe, not a surface: its 5 vertices are joined by 4 line \
              element(s) (`l`, the first on line 10) and by no face (`f`), so there is no \
              surface to print on; export the surface itself, with its faces (an OBJ with `f` \
-             lines, or PLY or STL)"
+             lines, or PLY or STL), or a scanner's points as a point cloud (XYZ or PLY, or an \
+             OBJ of vertices alone)"
         );
         // Its line counted as the file has it when continuations are joined.
         let continued = "v 0 0 \\\n 0\nv 1 0 0\nv 0 1 \\\n0\nl 1 2 3\nl 2 3\n";

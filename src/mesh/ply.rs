@@ -443,7 +443,7 @@ fn ascii_out_of_step<'h>(header: &'h Header, body: &[u8]) -> Option<OutOfStep<'h
                 Kind::List { .. } => {
                     let n = usize::try_from(ascii_int(values.get(want)?)?).ok()?;
                     lists.push(format!("{}: the count {n}, then {n} values", p.name));
-                    want = want.checked_add(1 + n)?;
+                    want = want.checked_add(n.checked_add(1)?)?;
                 }
             }
         }
