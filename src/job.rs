@@ -1396,18 +1396,20 @@ pub fn write_outputs(
     }
     // Spec 6(f): every move is checked but those that start where nothing
     // says; the header names the first rise, this the profile's own.
-    if let Some(line) = crate::gcode::start_block_motion(profile) {
-        report.warnings.push(format!(
-            "profile {}: its start block moves the head ({line} first) before the program's \
-             first rise, from wherever the head stands, so pcpp cannot check those moves \
-             against the scan: make sure they clear the part",
-            profile.name
-        ));
-    }
-    for caution in crate::gcode::start_block_cautions(profile) {
-        report
-            .warnings
-            .push(format!("profile {}: its {caution}", profile.name));
+    if let Some(block) = crate::gcode::StartBlock::of(profile) {
+        if let Some(line) = block.motion() {
+            report.warnings.push(format!(
+                "profile {}: its start block moves the head ({line} first) before the \
+                 program's first rise, from wherever the head stands, so pcpp cannot check \
+                 those moves against the scan: make sure they clear the part",
+                profile.name
+            ));
+        }
+        for caution in block.cautions() {
+            report
+                .warnings
+                .push(format!("profile {}: its {caution}", profile.name));
+        }
     }
     // What the G-code would have been refused for but for the accepted
     // risk, known before it is written: said in its header (one line, so

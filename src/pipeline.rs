@@ -23,8 +23,8 @@ use crate::params::{Nozzle, Process};
 use crate::planners::{plan_points, PlannerKind};
 use crate::projection::project_subpath;
 use crate::quality::{
-    nozzle_contacts, predict, predict_asking, predict_given_contact, summarize, Defect,
-    PointQuality, QualitySummary,
+    nozzle_contacts, predict_asking, predict_given_contact, summarize, Defect, PointQuality,
+    QualitySummary,
 };
 use crate::registration::Registration;
 use crate::sampling::{try_sample_subpath, DrawingSize, MAX_SAMPLES};
@@ -739,11 +739,12 @@ fn run_piece_to_beat(
         // the bar allows no unresolved move, the run's prediction is this
         // one (no contact of the nozzle's body, no move asked: see below),
         // so it stops as soon as it has as many defects as the bar.
-        None if planner.is_guarded() => {
-            let mut ask = vec![false; planned.toolpath.len()];
-            for &j in &planned.uncleared {
-                ask[j] = true;
-            }
+        None => {
+            let ask = point_flags(
+                planned.toolpath.len(),
+                !planner.is_guarded(),
+                &planned.uncleared,
+            );
             let below = bar
                 .filter(|b| guarded_motion && b.unresolved == 0 && planned.uncleared.is_empty())
                 .map(|b| b.defects);
@@ -758,14 +759,6 @@ fn run_piece_to_beat(
                 below,
             )?
         }
-        None => predict(
-            surface,
-            &piece.ta,
-            &piece.geometry,
-            &planned.toolpath,
-            nozzle,
-            process,
-        ),
     };
     // The prediction with no unresolved move, asked before the
     // safe-motion stage where the bar allows none (`Ok`: the run's
@@ -847,6 +840,18 @@ fn uncleared_points(
         .collect()
 }
 
+/// `n` flags, all `all`, and those in `list` set (a lookup per point,
+/// however many points a list names).
+fn point_flags(n: usize, all: bool, list: &[usize]) -> Vec<bool> {
+    let mut f = vec![all; n];
+    for &j in list {
+        if let Some(x) = f.get_mut(j) {
+            *x = true;
+        }
+    }
+    f
+}
+
 fn defects(quality: &[PointQuality]) -> usize {
     quality.iter().filter(|q| q.defect != Defect::Good).count()
 }
@@ -869,21 +874,12 @@ fn with_nozzle_contacts(
     nozzle: &Nozzle,
     process: &Process,
 ) -> Vec<PointQuality> {
-    // (As flags: a lookup per point, however many there are.)
-    let flags = |all: bool, list: &[usize]| {
-        let mut f = vec![all; planned.toolpath.len()];
-        for &j in list {
-            if let Some(x) = f.get_mut(j) {
-                *x = true;
-            }
-        }
-        f
-    };
-    let asked = flags(!planner.is_guarded(), &planned.uncleared);
+    let n = planned.toolpath.len();
+    let asked = point_flags(n, !planner.is_guarded(), &planned.uncleared);
     let commanded = if safe_motion {
-        flags(!planner.is_guarded(), unresolved)
+        point_flags(n, !planner.is_guarded(), unresolved)
     } else {
-        vec![false; planned.toolpath.len()]
+        vec![false; n]
     };
     let into = nozzle_contacts(
         surface,

@@ -268,53 +268,51 @@ fn predict_below(
             if below.is_some() && stopped() {
                 return None;
             }
-            if contact[j] {
-                out.push(PointQuality {
+            let q = if contact[j] {
+                PointQuality {
                     defect: Defect::Contact,
                     thickness_mm: None,
                     error_mm: None,
-                });
-                if below.is_some() {
-                    defects.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 }
-                continue;
-            }
-            let pj = slot;
-            slot += 1;
-            let (a, g) = (ta[j], &geometry[j]);
-            let crossing = if back.len() < 2 {
-                None
             } else {
-                crossing_near(&back, &params, &eval, pj, a, g.tangent)
-            };
-            let thickness = crossing.and_then(|p| {
-                let lambda = (p - a).dot(g.n);
-                // The crossing lies on the normal line only within 2d of Ta_j
-                // (section 7): one further away, up the line or off it to the
-                // side (where the path turns, the curve may cross the plane
-                // normal to t_j far from the line), is no intersection.
-                if lambda > 2.0 * d || p.distance(a) > 2.0 * d {
+                let pj = slot;
+                slot += 1;
+                let (a, g) = (ta[j], &geometry[j]);
+                let crossing = if back.len() < 2 {
                     None
-                } else if lambda < 0.0 {
-                    Some(0.0) // the filament's top is under the surface: crushed
                 } else {
-                    Some(p.distance(a))
+                    crossing_near(&back, &params, &eval, pj, a, g.tangent)
+                };
+                let thickness = crossing.and_then(|p| {
+                    let lambda = (p - a).dot(g.n);
+                    // The crossing lies on the normal line only within 2d of Ta_j
+                    // (section 7): one further away, up the line or off it to the
+                    // side (where the path turns, the curve may cross the plane
+                    // normal to t_j far from the line), is no intersection.
+                    if lambda > 2.0 * d || p.distance(a) > 2.0 * d {
+                        None
+                    } else if lambda < 0.0 {
+                        Some(0.0) // the filament's top is under the surface: crushed
+                    } else {
+                        Some(p.distance(a))
+                    }
+                });
+                let (defect, error) = match thickness {
+                    None => (Defect::Floating, d),
+                    Some(t) if t < d - tol => (Defect::Flattening, t - d),
+                    Some(t) if t > d + tol => (Defect::Floating, t - d),
+                    Some(t) => (Defect::Good, t - d),
+                };
+                PointQuality {
+                    defect,
+                    thickness_mm: thickness,
+                    error_mm: Some(error),
                 }
-            });
-            let (defect, error) = match thickness {
-                None => (Defect::Floating, d),
-                Some(t) if t < d - tol => (Defect::Flattening, t - d),
-                Some(t) if t > d + tol => (Defect::Floating, t - d),
-                Some(t) => (Defect::Good, t - d),
             };
-            if below.is_some() && defect != Defect::Good {
+            if below.is_some() && q.defect != Defect::Good {
                 defects.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             }
-            out.push(PointQuality {
-                defect,
-                thickness_mm: thickness,
-                error_mm: Some(error),
-            });
+            out.push(q);
         }
         Some(out)
     });

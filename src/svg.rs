@@ -2068,10 +2068,7 @@ fn other_drawing(bytes: &[u8], file: &str) -> Option<String> {
     let head = head.trim_ascii_start();
     let lower = file.to_ascii_lowercase();
     // (A file named .dxf that is XML is read as the SVG it is.)
-    let dxf = head.starts_with(b"AutoCAD Binary DXF")
-        || dxf_text(head)
-        || (lower.ends_with(".dxf") && !head.starts_with(b"<"));
-    if dxf {
+    if crate::mesh::is_dxf(bytes, file) {
         return Some(
             "this is a DXF drawing (2-D CAD), not an SVG: export it as SVG (LibreCAD: File > \
              Export > Export as SVG; Inkscape opens DXF too) and choose that file"
@@ -2129,21 +2126,6 @@ fn other_drawing(bytes: &[u8], file: &str) -> Option<String> {
              drawing's .svg file (unpack an archive first)"
         )
     })
-}
-
-/// A text DXF: pairs of lines, a group code then its value, starting with
-/// a section (group code 0, "SECTION"), perhaps after comments (999).
-fn dxf_text(head: &[u8]) -> bool {
-    let mut lines = head[..head.len().min(4096)]
-        .split(|&b| b == b'\n')
-        .map(<[u8]>::trim_ascii);
-    loop {
-        match (lines.next(), lines.next()) {
-            (Some(b"999"), Some(_)) => continue,
-            (Some(b"0"), Some(value)) => return value == b"SECTION",
-            _ => return false,
-        }
-    }
 }
 
 /// What a file that is not XML at all looks like: a scan or a program

@@ -1314,3 +1314,119 @@ fn regression_a_web_page_saved_as_a_scan_was_read_as_one() {
     .to_string();
     assert!(e.contains("web page (HTML)"), "{e}");
 }
+
+/// QA round 21 F5: KiCad's VRML model and LibreCAD's DXF given as the
+/// scan got the list of formats alone, where an OFF got its format and
+/// a way out. Other 3-D formats are named by their first bytes, however
+/// the file is named, or by their extension, each with how to export
+/// it; a DXF is the drawing, to export as SVG.
+#[test]
+fn other_3d_formats_and_a_dxf_are_named_with_a_way_out() {
+    let refused = |bytes: &[u8], name: &str| {
+        import_mesh(bytes, name, &ImportOptions::DEFAULT)
+            .unwrap_err()
+            .to_string()
+    };
+    let tds = vec![0x4D, 0x4D, 16, 0, 0, 0, 2, 0, 10, 0, 0, 0, 3, 0, 0, 0];
+    let mut iges = format!("{:<72}S{:>7}\n", "IGES written by a CAD program", 1);
+    iges += &format!("{:<72}G{:>7}\n", "1H,,1H;", 1);
+    for (bytes, what, way) in [
+        (
+            b"#VRML V2.0 utf8\n#Exported from Wings 3D\nDEF cube Transform {\n}\n".to_vec(),
+            "; this is a VRML model (KiCad's and many CAD tools' 3-D models): open it in \
+             MeshLab",
+            "export it as PLY, OBJ or STL",
+        ),
+        (
+            b"<?xml version=\"1.0\"?>\n<X3D profile=\"Immersive\">".to_vec(),
+            "; this is an X3D model",
+            "MeshLab",
+        ),
+        (
+            b"<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"x\" version=\"1.4.1\">".to_vec(),
+            "; this is a COLLADA scene (.dae)",
+            "MeshLab",
+        ),
+        (
+            b"Kaydara FBX Binary  \x00\x1a\x00".to_vec(),
+            "; this is an FBX scene",
+            "Blender",
+        ),
+        (
+            b"ISO-10303-21;\nHEADER;\n".to_vec(),
+            "; this is a CAD model (STEP or IGES), not a mesh",
+            "export it as STL from its CAD program",
+        ),
+        (
+            iges.into_bytes(),
+            "; this is a CAD model (STEP or IGES)",
+            "STL",
+        ),
+        (tds, "; this is a 3DS scene", "MeshLab"),
+        (
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec(),
+            "; this is an OFF mesh (Geomview, MeshLab, CGAL): export it as PLY, OBJ or STL",
+            "Export Mesh As",
+        ),
+        (
+            zip_of(&["[Content_Types].xml", "3D/3dmodel.model"]),
+            "; this is a 3MF model",
+            "export it as STL or OBJ",
+        ),
+    ] {
+        let e = refused(&bytes, "upload");
+        assert!(
+            e.starts_with("upload: not a scan this program reads")
+                && e.contains(what)
+                && e.contains(way),
+            "{what}: {e}"
+        );
+    }
+    // By extension alone.
+    for (name, what) in [
+        ("Jack.wrl", "a VRML model"),
+        ("part.x3d", "an X3D model"),
+        ("part.3mf", "a 3MF model"),
+        ("part.igs", "a CAD model"),
+        ("part.blend", "a Blender file"),
+    ] {
+        let e = refused(b"\x01\x02junk", name);
+        assert!(e.contains(&format!("; this is {what}")), "{name}: {e}");
+    }
+    // Nothing said of what is none of them.
+    let e = refused(b"\x01\x02junk", "x.bin");
+    assert!(!e.contains("this is"), "{e}");
+    // LibreCAD's DXF (its first lines), by content or by name.
+    let dxf = b"  0\nSECTION\n  2\nHEADER\n  9\n$LIMMIN\n 10\n0.000000\n";
+    for (bytes, name) in [
+        (&dxf[..], "hexagon_b.dxf"),
+        (&dxf[..], "upload"),
+        (
+            b"999\r\ndxfrw 0.6.3\r\n  0\r\nSECTION\r\n".as_slice(),
+            "upload",
+        ),
+        (b"AutoCAD Binary DXF\r\n\x1a\x00".as_slice(), "upload"),
+        (b"\x01\x02junk".as_slice(), "plate.DXF"),
+    ] {
+        let e = refused(bytes, name);
+        assert!(
+            e.starts_with(&format!(
+                "{name}: the file is a 2-D CAD drawing (DXF), not a scan; a DXF drawing is \
+                 the path: export it as SVG"
+            )),
+            "{e}"
+        );
+    }
+    // Review: a 3MF saved under a mesh's extension is named as a 3MF
+    // (it was read as that mesh), and an SVG named .dxf, or a DXF after
+    // a byte-order mark, as what it is.
+    let three_mf = zip_of(&["[Content_Types].xml", "3D/3dmodel.model"]);
+    for name in ["part.stl", "part.obj", "part.ply"] {
+        let e = refused(&three_mf, name);
+        assert!(e.contains("; this is a 3MF model"), "{name}: {e}");
+    }
+    let e = refused(b"<svg xmlns=\"http://www.w3.org/2000/svg\"/>", "logo.dxf");
+    assert!(!e.contains("(DXF)"), "{e}");
+    let e = refused(b"\xEF\xBB\xBF  0\r\nSECTION\r\n", "upload");
+    assert!(e.contains("(DXF)"), "{e}");
+}

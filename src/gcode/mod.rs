@@ -54,8 +54,8 @@ pub use read::{
     UnknownMove, UnknownMoveKind, MAX_COORDINATE_MM, MAX_GCODE_BYTES, MAX_GCODE_LINES,
 };
 pub use writer::{
-    checked_safe_height, start_block_cautions, start_block_motion, write_gcode, write_program,
-    GcodeJob, MoveKind, WrittenMove, WrittenProgram,
+    checked_safe_height, write_gcode, write_program, GcodeJob, MoveKind, StartBlock, WrittenMove,
+    WrittenProgram,
 };
 
 /// Why a profile cannot be loaded or a job cannot be written. Each variant

@@ -1673,10 +1673,12 @@ impl<'f> Reader<'f> {
             }
         }
         // Marlin's `M420 S1` (S0 turns it off; Z alone sets the fade height).
-        let switched_on = words
-            .iter()
-            .any(|w| w.letter == b'S' && matches!(w.value, Value::Number(v) if v != 0.0));
-        if m.flatten() == Some(420) && switched_on {
+        let switched_on = || {
+            words
+                .iter()
+                .any(|w| w.letter == b'S' && matches!(w.value, Value::Number(v) if v != 0.0))
+        };
+        if m.flatten() == Some(420) && switched_on() {
             self.notes.add(NoteKind::Compensation, n).code("M420 S1");
         }
         match (consumer, first_axis) {

@@ -76,7 +76,7 @@ impl WrittenProgram {
     /// The moves of the profile's `start` block (its `lines` lines after
     /// the header) whose end the G-code reader knows, as it follows the
     /// block from wherever the head stands: (from, where known; to;
-    /// program line; index in `start`). `start_block_motion` warns that
+    /// program line; index in `start`). `StartBlock::motion` warns that
     /// these run before any checked move; where a move ends is still
     /// known, and a start that drives the nozzle into the part there is
     /// refused (QA round 19 F6). Empty for a block the reader cannot
@@ -239,50 +239,21 @@ fn read_start_block(text: &str, name: &str) -> Result<super::GcodeProgram, super
 const FIRST_RISE_NOTE: &str = "first move: a rise to the safe travel height from wherever the \
      head stands, which pcpp cannot check (start with the nozzle above the part)";
 
-/// The first line of `profile`'s `start` block that moves the head (a
-/// move, homing, probing), as written: the block runs before the program's
-/// first rise, from wherever the head stands, so pcpp can no more check
-/// those moves against the scan than that rise (spec 6(f); safety audit,
-/// finding 4). `None` when the block moves nothing. A block the G-code
-/// reader cannot follow is taken to move the head. The block's tokens are
-/// filled with stand-in values: a line moves the head or not whatever
-/// they are.
-pub fn start_block_motion(profile: &MachineProfile) -> Option<String> {
-    let block = StartBlock::of(profile)?;
-    let read = match &block.read {
-        Ok(read) => read,
-        Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
-    };
-    // A firmware macro (Klipper's PRINT_START, BED_MESH_CALIBRATE) the
-    // reader skips may home and move the head as well (review).
-    let macro_line = block.text.lines().position(is_macro).map(|k| k + 1);
-    let first = read
-        .moves
-        .iter()
-        .map(|m| m.line)
-        .chain(read.unknown_moves.iter().map(|u| u.line))
-        .chain(macro_line)
-        .min()?;
-    let what = if Some(first) == macro_line {
-        " (a firmware macro, which may home or move the head)"
-    } else {
-        ""
-    };
-    Some(format!("{}{what}", block.field(profile, first)))
-}
-
-/// A profile's start block as the G-code reader reads it, with stand-in
-/// values for its tokens (a line moves the head or not whatever they are),
-/// and the profile line each line of its text comes from (a profile line
-/// may hold several). `None` for a block with nothing in it.
-struct StartBlock {
+/// A profile's start block as the G-code reader reads it, read once for
+/// what it does that the moves' checks cannot see ([`Self::motion`],
+/// [`Self::cautions`]). Its tokens are filled with stand-in values (a line
+/// moves the head or not whatever they are), and each line of its text
+/// keeps the profile line it comes from (a profile line may hold several).
+pub struct StartBlock<'p> {
+    profile: &'p MachineProfile,
     text: String,
     from: Vec<usize>,
     read: Result<super::GcodeProgram, super::GcodeReadError>,
 }
 
-impl StartBlock {
-    fn of(profile: &MachineProfile) -> Option<StartBlock> {
+impl<'p> StartBlock<'p> {
+    /// `None` for a block with nothing in it.
+    pub fn of(profile: &'p MachineProfile) -> Option<StartBlock<'p>> {
         let mut text = String::new();
         let mut from = Vec::new();
         for (i, line) in profile.start.iter().enumerate() {
@@ -300,50 +271,81 @@ impl StartBlock {
             return None;
         }
         let read = read_start_block(&text, &profile.name);
-        Some(StartBlock { text, from, read })
+        Some(StartBlock {
+            profile,
+            text,
+            from,
+            read,
+        })
     }
 
     /// "start[i] `line`" for the block's text line `n` (from 1).
-    fn field(&self, profile: &MachineProfile, n: usize) -> String {
+    fn field(&self, n: usize) -> String {
         let i = self.from.get(n - 1).copied().unwrap_or_default();
-        format!("start[{i}] `{}`", profile.start[i].trim())
+        format!("start[{i}] `{}`", self.profile.start[i].trim())
     }
-}
 
-/// What a profile's start block does that the moves' checks cannot see,
-/// beyond moving the head ([`start_block_motion`]), each naming its line
-/// (QA round 21 F4: `G29` and `M420 S1` in a start block were written
-/// without a word): probing the bed, which with the part on it comes down
-/// across the part, and bed-levelling compensation turned on, which moves
-/// every move by the firmware's mesh.
-pub fn start_block_cautions(profile: &MachineProfile) -> Vec<String> {
-    let Some(block) = StartBlock::of(profile) else {
-        return Vec::new();
-    };
-    let Ok(read) = &block.read else {
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    let probing = read
-        .unknown_moves
-        .iter()
-        .find(|u| u.kind == super::read::UnknownMoveKind::Probing);
-    if let Some(u) = probing {
-        out.push(format!(
-            "{} probes the bed (or levels or calibrates): with the part on the bed the probe \
-             comes down across it, where pcpp cannot check it; probe before the part is placed, \
-             or take the line out",
-            block.field(profile, u.line)
-        ));
+    /// The first line that moves the head (a move, homing, probing), as
+    /// written: the block runs before the program's first rise, from
+    /// wherever the head stands, so pcpp can no more check those moves
+    /// against the scan than that rise (spec 6(f); safety audit, finding
+    /// 4). `None` when the block moves nothing. A block the G-code reader
+    /// cannot follow is taken to move the head.
+    pub fn motion(&self) -> Option<String> {
+        let read = match &self.read {
+            Ok(read) => read,
+            Err(e) => return Some(format!("a line the G-code reader cannot follow ({e})")),
+        };
+        // A firmware macro (Klipper's PRINT_START, BED_MESH_CALIBRATE) the
+        // reader skips may home and move the head as well (review).
+        let macro_line = self.text.lines().position(is_macro).map(|k| k + 1);
+        let first = read
+            .moves
+            .iter()
+            .map(|m| m.line)
+            .chain(read.unknown_moves.iter().map(|u| u.line))
+            .chain(macro_line)
+            .min()?;
+        let what = if Some(first) == macro_line {
+            " (a firmware macro, which may home or move the head)"
+        } else {
+            ""
+        };
+        Some(format!("{}{what}", self.field(first)))
     }
-    if let Some(n) = read.compensation_line {
-        out.push(format!(
-            "{} {}",
-            block.field(profile, n),
-            super::read::COMPENSATION_NOTE
-        ));
+
+    /// What the block does beyond moving the head that the moves' checks
+    /// cannot see, each naming its line (QA round 21 F4: `G29` and `M420
+    /// S1` in a start block were written without a word): probing the bed,
+    /// which with the part on it comes down across the part, and
+    /// bed-levelling compensation turned on, which moves every move by the
+    /// firmware's mesh.
+    pub fn cautions(&self) -> Vec<String> {
+        let Ok(read) = &self.read else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        let probing = read
+            .unknown_moves
+            .iter()
+            .find(|u| u.kind == super::read::UnknownMoveKind::Probing);
+        if let Some(u) = probing {
+            out.push(format!(
+                "{} probes the bed (or levels or calibrates): with the part on the bed the \
+                 probe comes down across it, where pcpp cannot check it; probe before the part \
+                 is placed, or take the line out",
+                self.field(u.line)
+            ));
+        }
+        if let Some(n) = read.compensation_line {
+            out.push(format!(
+                "{} {}",
+                self.field(n),
+                super::read::COMPENSATION_NOTE
+            ));
+        }
+        out
     }
-    out
 }
 
 /// Whether a line calls a firmware macro: its first word a name (letters,
@@ -897,7 +899,7 @@ M84
     fn start_blocks_that_move_the_head_are_named() {
         for name in MachineProfile::builtin_names() {
             let p = MachineProfile::builtin(name).unwrap();
-            assert_eq!(start_block_motion(&p), None, "{name}");
+            assert_eq!(StartBlock::of(&p).and_then(|b| b.motion()), None, "{name}");
         }
         let mut p = marlin();
         for (start, named) in [
@@ -924,7 +926,8 @@ M84
             (vec![], None),
         ] {
             p.start = start.iter().map(|l| l.to_string()).collect();
-            assert_eq!(start_block_motion(&p).as_deref(), named, "{start:?}");
+            let motion = StartBlock::of(&p).and_then(|b| b.motion());
+            assert_eq!(motion.as_deref(), named, "{start:?}");
         }
     }
 

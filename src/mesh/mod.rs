@@ -33,11 +33,11 @@ mod xyz;
 pub use cloud::{triangulate, CloudInfo, EDGE_LIMIT_PER_SPACING};
 pub use error::MeshError;
 pub use external::{ExternalFiles, ExternalRef};
-pub(crate) use import::other_file_kind;
 pub use import::{
     detect_format, external_files_needed, import_mesh, import_mesh_unwelded, import_mesh_with,
     StrayVertices, UnitsDoubt, Unwelded, WeldMap, LARGE_SCAN_MM, SMALL_SCAN_MM,
 };
+pub(crate) use import::{is_dxf, other_file_kind};
 pub use topology::{Topology, MAX_TOPOLOGY_TRIANGLES};
 
 /// Largest scan file read (bytes). A 20 M triangle binary STL is 1 GB; a
