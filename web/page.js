@@ -124,6 +124,9 @@ export const state = {
   sentSvgKey: null, // the drawing whose bytes the current worker holds
   busy: null, // the plan request in flight
   queued: false, // a newer request waits for it: only the newest is planned
+  // Files chosen whose bytes are still being read (inputs.js): until then
+  // the plan on screen is the one before them.
+  reading: 0,
   // Every change of an input or setting counts up; a plan is offered for
   // download only if nothing changed since it was requested.
   gen: 0,

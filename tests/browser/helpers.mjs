@@ -67,13 +67,13 @@ export async function openPage(browser, url) {
 export async function waitForPlan(page, timeout = 120_000) {
   await page.waitForFunction(() => {
     const s = window.pcpp && window.pcpp.state;
-    return s && !s.busy && s.lastPlan && !document.getElementById('dl-gcode').hidden;
+    return s && !s.busy && !s.reading && s.lastPlan && !document.getElementById('dl-gcode').hidden;
   }, null, { timeout });
 }
 
 export async function waitIdle(page, timeout = 120_000) {
   await page.waitForFunction(() => window.pcpp && window.pcpp.state && !window.pcpp.state.busy
-    && !window.pcpp.state.queued, null, { timeout });
+    && !window.pcpp.state.queued && !window.pcpp.state.reading, null, { timeout });
 }
 
 // Waits until the browser has stored the last inputs (before a reload).
@@ -86,7 +86,7 @@ export async function waitKept(page, timeout = 60_000) {
 export async function waitSettled(page, timeout = 120_000) {
   await page.waitForFunction(() => {
     const s = window.pcpp && window.pcpp.state;
-    return s && !s.busy && !s.queued && !s.interacting && s.lastPlan && s.lastPlan.gen === s.gen
+    return s && !s.busy && !s.queued && !s.reading && !s.interacting && s.lastPlan && s.lastPlan.gen === s.gen
       && s.lastPlan.compared && !document.getElementById('dl-gcode').hidden;
   }, null, { timeout });
 }

@@ -73,6 +73,26 @@ async function headerMatchesFields(page) {
   assert.ok(line.includes(`offset (${x}, ${y}) mm, rotation ${rot} deg, scale ${scale}`), `${line} vs ${[x, y, rot, scale]}`);
 }
 
+test('a chosen file still being read keeps the page unsettled: the plan waited for is the new drawing\'s', async () => {
+  const { page, context, problems } = await openPage(env.chrome.browser, env.server.url);
+  await waitSettled(page);
+  // A slow disk: the drawing's bytes arrive a second and a half after it
+  // is chosen, and until then the demo's plan is on screen, settled.
+  await page.evaluate(() => {
+    const read = Blob.prototype.arrayBuffer;
+    Blob.prototype.arrayBuffer = function slow() {
+      return new Promise((ok) => setTimeout(ok, 1500)).then(() => read.call(this));
+    };
+  });
+  await page.setInputFiles('#svg-input', svgFile('small.svg', SMALL_SVG));
+  assert.equal(await page.evaluate(() => window.pcpp.state.reading), 1);
+  await waitSettled(page);
+  assert.equal(await page.evaluate(() => window.pcpp.state.lastPlan.svgName), 'small.svg');
+  assert.equal(await page.evaluate(() => window.pcpp.state.reading), 0);
+  assert.deepEqual(problems, []);
+  await context.close();
+});
+
 test('a cancelled scan import is dropped: the scan before it, its name and its G-code stay, and nothing resumes it', async () => {
   const cloud = join(dir, 'big_cloud.xyz');
   writeFileSync(cloud, bigCloud(800));
