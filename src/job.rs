@@ -1079,11 +1079,15 @@ pub fn run_on_noting(
 /// with no word of their units, while the refusal for the build volume
 /// said them (in the same words, from the same test). Other errors are
 /// returned as they are, and so is a scan made large by stray vertices,
-/// which no units mend ([`crate::mesh::StrayVertices`]).
+/// which no units mend ([`crate::mesh::StrayVertices`]), and a drawing
+/// with nothing to print ([`pipeline::NO_PATH`]), whatever the scan.
 pub fn with_units_hint(e: Error, scan: &PreparedScan, profile: &MachineProfile) -> Error {
     let Error::Plan(message) = e else {
         return e;
     };
+    if message == pipeline::NO_PATH {
+        return Error::Plan(message);
+    }
     let strays = scan.units_doubt.is_some_and(|d| d.stray.is_some());
     let hint = crate::placement::units_hint(
         scan.surface.bbox(),
@@ -3387,6 +3391,31 @@ mod tests {
                 "{text}"
             );
         }
+    }
+
+    #[test]
+    fn a_drawing_with_nothing_to_print_gets_no_advice_on_the_scans_units() {
+        // A 1-unit square read in metres: a metre across, past any bed.
+        let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+        let options = ImportOptions {
+            units: Some(ScanUnits::M),
+            ..ImportOptions::DEFAULT
+        };
+        let scan = prepare_scan(
+            obj,
+            "square.obj",
+            &options,
+            &RegistrationSettings::default(),
+        )
+        .unwrap();
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let about_units = |e: Error| e.to_string().contains("--scan-units");
+        // Refused for the scan (missed by the drawing): the units advised.
+        let missed = Error::Plan("the path misses the scan entirely".into());
+        assert!(about_units(with_units_hint(missed, &scan, &profile)));
+        // Refused for the drawing alone: no word of the scan's units.
+        let empty = with_units_hint(Error::Plan(pipeline::NO_PATH.into()), &scan, &profile);
+        assert_eq!(empty.to_string(), pipeline::NO_PATH);
     }
 
     #[test]

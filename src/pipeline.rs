@@ -189,7 +189,7 @@ pub fn surface_path(
     nozzle.validate()?;
     placement.validate()?;
     if drawn.is_empty() {
-        return Err(Error::Plan("the drawing has no path to print".into()));
+        return Err(Error::Plan(NO_PATH.into()));
     }
     drawing_size(drawn, nozzle, placement)?.check()?;
     let spacing = 0.5 * nozzle.inner_diameter_mm;
@@ -478,7 +478,7 @@ pub fn surface_path(
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
         } else {
-            "the drawing has no path to print".into()
+            NO_PATH.into()
         }));
     }
     // Most of a drawing off the scan still printed its fragments with
@@ -552,6 +552,10 @@ pub struct Plan {
     /// How much of the drawing lies over the scan and is printed.
     pub coverage: Coverage,
 }
+
+/// The refusal of a drawing with nothing to print: about the drawing
+/// alone, so no advice on the scan goes with it ([`crate::job::with_units_hint`]).
+pub const NO_PATH: &str = "the drawing has no path to print";
 
 /// A plan's smallest clearance is found exactly up to tol plus this (mm);
 /// above it a comparison says only that it is more (the G-code's own check,
