@@ -1142,6 +1142,47 @@ fn gltf_extensions_versions_and_missing_bounds() {
     assert_eq!(m.mesh.triangle_count(), 1);
 }
 
+/// A textured scan optimised by glTF-Transform (`optimize`'s default
+/// turns its textures into WebP: EXT_texture_webp, required) names each
+/// texture's image only in the extension, as the spec allows, and was
+/// refused "not a valid glTF 2.0 file: textures[0].source: Missing data"
+/// (every 2025 cookie scan of github:curtgrimes/stephen-desserts, Polycam
+/// scans). Appearance never changes the surface: materials, textures,
+/// images and samplers are not read, whatever they hold or lack.
+#[test]
+fn regression_a_texture_named_only_by_an_extension_stopped_the_import() {
+    let mut g = GltfBuilder::default();
+    g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let webp = r#""EXT_texture_webp""#;
+    let appearance = format!(
+        r#"{ONE_NODE},"extensionsUsed":[{webp}],"extensionsRequired":[{webp}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+        "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}},
+          "normalTexture":{{"index":1}}}}],
+        "textures":[{{"sampler":0,"extensions":{{{webp}:{{"source":0}}}}}},
+          {{"extensions":{{{webp}:{{"source":1}}}}}}],
+        "images":[{{"mimeType":"image/webp","uri":"baseColor_1.webp"}},
+          {{"mimeType":"image/webp","uri":"normal_1.webp"}}],
+        "samplers":[{{"magFilter":9729}}]"#
+    );
+    let m = import_mesh(&g.gltf(&appearance), "cookie.gltf", &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
+    // A material pointing at a texture the file does not have changes no
+    // surface either.
+    let dangling = format!(
+        r#"{ONE_NODE},"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+        "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":3}}}}}}]"#
+    );
+    let m = import_mesh(&g.gltf(&dangling), "cookie.gltf", &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
+    // Nor does a primitive's material index past the file's materials.
+    let missing = format!(
+        r#"{ONE_NODE},"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":5}}]}}]"#
+    );
+    let m = import_mesh(&g.gltf(&missing), "cookie.gltf", &ImportOptions::DEFAULT).unwrap();
+    assert_eq!(m.mesh.triangle_count(), 1);
+}
+
 /// A PNG renamed .obj (the page's file picker takes any name) read as
 /// lines of nothing: "the mesh has no triangles". Now named as binary data,
 /// with what it looks like (found by exploratory runs in the page).

@@ -1414,3 +1414,95 @@ fn even_is_no_worse_than_a_safe_paper_planner_with_the_large_nozzle() {
         "no piece of even's was taken from pcpp-guarded"
     );
 }
+
+/// A phone scan as the web serves it: a Polycam scan of a cookie, optimised
+/// by glTF-Transform (its textures turned into WebP, EXT_texture_webp
+/// required, each texture's image named only in that extension; the
+/// geometry in a separate `.optimized.bin`). It was refused "not a valid
+/// glTF 2.0 file: textures[0].source: Missing data". It is read (the .bin
+/// the only file it needs: the .webp images are never asked for), and
+/// planned on: a real logo centred on its crust, `even` no worse than any
+/// of the paper's planners whose moves keep tol, and every print move
+/// clear by the independent oracle.
+#[test]
+fn a_gltf_transform_phone_scan_with_webp_textures_is_read_and_planned_on() {
+    use pcpp::pipeline;
+    use pcpp::placement::centre_drawing;
+    use pcpp::planners::PlannerKind;
+    use pcpp::surface::Surface;
+
+    let gltf = data!("mesh/phone-scan/molasses-cookies.gltf");
+    let needed: Vec<String> = external_files_needed(gltf, "molasses-cookies.gltf")
+        .unwrap()
+        .into_iter()
+        .map(|r| r.path)
+        .collect();
+    assert_eq!(needed, ["molasses-cookies.optimized.bin"]);
+    let files = ExternalFiles::new().with(
+        "molasses-cookies.optimized.bin",
+        data!("mesh/phone-scan/molasses-cookies.optimized.bin"),
+    );
+    let m = import_mesh_with(
+        gltf,
+        "molasses-cookies.gltf",
+        &ImportOptions::DEFAULT,
+        &files,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    // 6454 triangles; glTF's metres and +Y up, the node's translation
+    // applied: 346 x 341 mm, standing 0..46 mm (the site scaled its scans).
+    assert_eq!(m.mesh.triangles.len(), 6454);
+    assert_bbox(
+        &m.mesh,
+        [-173.2145, -170.6982, 0.0],
+        [173.2145, 170.6982, 46.0129],
+        0.001,
+    );
+    let mesh = m.mesh.clone();
+    let surface = Surface::new(m.mesh).unwrap();
+    let (lo, hi) = surface.bbox();
+    let drawn = load_path(data!("svg/simple-icons-vulkan.svg"), "vulkan.svg").unwrap();
+    let (placement, _) = centre_drawing(
+        &drawn.subpaths,
+        (lo.truncate(), hi.truncate()),
+        &Placement::IDENTITY,
+        false,
+    )
+    .unwrap();
+    let settings = PlanSettings {
+        placement,
+        ..PlanSettings::default()
+    };
+    let plans =
+        pipeline::compare(&surface, &drawn.subpaths, &settings).unwrap_or_else(|e| panic!("{e}"));
+    let by = |k: PlannerKind| plans.iter().find(|p| p.planner == k).unwrap();
+    let even = by(PlannerKind::Even);
+    assert!(even.uncleared.is_empty());
+    assert_eq!(even.motion.touching_moves, 0);
+    for p in [
+        PlannerKind::Constant,
+        PlannerKind::Slope,
+        PlannerKind::Pcpp,
+        PlannerKind::PcppGuarded,
+    ]
+    .into_iter()
+    .map(by)
+    .filter(|p| p.motion.touching_moves == 0 && p.quality.contact_pct == 0.0)
+    {
+        assert!(
+            even.quality.defect_pct() <= p.quality.defect_pct(),
+            "even {:.2}% defects, {} {:.2}%",
+            even.quality.defect_pct(),
+            p.planner.name(),
+            p.quality.defect_pct()
+        );
+    }
+    // The logo's 14 outlines, each printed.
+    let points: usize = even.pieces.iter().map(|p| p.toolpath.len()).sum();
+    assert!(
+        even.pieces.len() == 14 && points > 150,
+        "{} pieces, {points} points",
+        even.pieces.len()
+    );
+    oracle_clears_every_move(even, &mesh, &settings, "cookie");
+}

@@ -172,6 +172,18 @@ fn read(
             ),
         ));
     }
+    // Appearance never changes the surface, so it is not read, nor checked:
+    // a texture whose image only an extension names (glTF-Transform's
+    // EXT_texture_webp, KHR_texture_basisu) failed the document's check
+    // ("textures[0].source: Missing data"), and so would a material's
+    // dangling texture.
+    root.materials.clear();
+    root.textures.clear();
+    root.images.clear();
+    root.samplers.clear();
+    for primitive in root.meshes.iter_mut().flat_map(|m| &mut m.primitives) {
+        primitive.material = None;
+    }
     check_position_accessors(&root, file)?;
     let bounded = fill_position_bounds(&mut root);
     let gltf = Document::from_json(root).map_err(|e| not_gltf(&e))?;
