@@ -1414,6 +1414,24 @@ fn other_3d_formats_and_a_dxf_are_named_with_a_way_out() {
             "; this is a 3MF model",
             "export it as STL or OBJ",
         ),
+        // An iPhone scanning app's USDZ (its USD layer first, binary or
+        // text), and a bare USD layer: QA found the USDZ called a ZIP
+        // archive to unpack, which holds no scan this program reads.
+        (
+            zip_of(&["Model.usdc", "0/texture.png"]),
+            "; this is a USD scene (.usdz",
+            "export the scan as glTF/GLB, OBJ, PLY or STL",
+        ),
+        (
+            b"PXR-USDC\x00\x08\x00\x00\x00\x00\x00\x00".to_vec(),
+            "; this is a USD scene",
+            "Blender",
+        ),
+        (
+            b"#usda 1.0\n(\n    defaultPrim = \"root\"\n)\n".to_vec(),
+            "; this is a USD scene",
+            "Blender",
+        ),
     ] {
         let e = refused(&bytes, "upload");
         assert!(
@@ -1430,6 +1448,8 @@ fn other_3d_formats_and_a_dxf_are_named_with_a_way_out() {
         ("part.3mf", "a 3MF model"),
         ("part.igs", "a CAD model"),
         ("part.blend", "a Blender file"),
+        ("Cookie.usdz", "a USD scene"),
+        ("scan.usda", "a USD scene"),
     ] {
         let e = refused(b"\x01\x02junk", name);
         assert!(e.contains(&format!("; this is {what}")), "{name}: {e}");

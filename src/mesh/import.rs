@@ -132,6 +132,7 @@ enum OtherFormat {
     Vtk,
     LaserCloud,
     Blend,
+    Usd,
 }
 
 impl OtherFormat {
@@ -169,6 +170,12 @@ impl OtherFormat {
                 "a Blender file",
                 "export it from Blender as OBJ, STL or glTF (File > Export)",
             ),
+            OtherFormat::Usd => (
+                "a USD scene (.usdz: what iPhone scanning apps share by default)",
+                "export the scan as glTF/GLB, OBJ, PLY or STL instead (phone scanning apps offer \
+                 GLB or OBJ beside USDZ), or open it in Blender (File > Import > Universal \
+                 Scene Description) and export it as OBJ, STL or glTF",
+            ),
         }
     }
 }
@@ -188,6 +195,7 @@ fn other_format_named(ext: &str) -> Option<OtherFormat> {
         "vtk" | "vtp" => OtherFormat::Vtk,
         "e57" | "las" | "laz" => OtherFormat::LaserCloud,
         "blend" => OtherFormat::Blend,
+        "usdz" | "usd" | "usda" | "usdc" => OtherFormat::Usd,
         _ => return None,
     })
 }
@@ -234,6 +242,8 @@ fn other_format(bytes: &[u8]) -> Option<OtherFormat> {
         Some(OtherFormat::LaserCloud)
     } else if bytes.starts_with(b"BLENDER") {
         Some(OtherFormat::Blend)
+    } else if bytes.starts_with(b"PXR-USDC") || first_word == b"#usda" {
+        Some(OtherFormat::Usd)
     } else if bytes.len() >= 6
         && bytes.starts_with(&[0x4D, 0x4D])
         && u32::from_le_bytes([bytes[2], bytes[3], bytes[4], bytes[5]]) as usize == bytes.len()
@@ -246,6 +256,14 @@ fn other_format(bytes: &[u8]) -> Option<OtherFormat> {
             .any(|n| n.eq_ignore_ascii_case("3D/3dmodel.model"))
     {
         Some(OtherFormat::ThreeMf)
+    } else if is_zip(bytes)
+        && zip_entry_names(bytes, 1).first().is_some_and(|n| {
+            let n = n.to_ascii_lowercase();
+            n.ends_with(".usdc") || n.ends_with(".usda") || n.ends_with(".usd")
+        })
+    {
+        // A USDZ: an uncompressed ZIP whose first file is the USD layer.
+        Some(OtherFormat::Usd)
     } else {
         None
     }
@@ -440,10 +458,17 @@ pub fn import_mesh_unwelded(
         ));
     }
     if is_zip(bytes) {
-        // A 3MF is a ZIP: named as the format it is, whatever the file's
-        // name (a 3MF saved as .stl was read as a binary STL: review).
-        if file.to_ascii_lowercase().ends_with(".3mf")
-            || other_format(bytes) == Some(OtherFormat::ThreeMf)
+        // A 3MF is a ZIP, and so is a USDZ: named as the format it is,
+        // whatever the file's name (a 3MF saved as .stl was read as a
+        // binary STL: review), not as an archive to unpack (a USDZ holds
+        // no scan this program reads).
+        let name = file.to_ascii_lowercase();
+        if name.ends_with(".3mf")
+            || name.ends_with(".usdz")
+            || matches!(
+                other_format(bytes),
+                Some(OtherFormat::ThreeMf | OtherFormat::Usd)
+            )
         {
             return Err(MeshError::UnknownFormat {
                 file: file.into(),
