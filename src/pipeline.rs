@@ -1065,7 +1065,27 @@ fn plan_stage(
             quality,
         });
     }
-    if floating > 0 {
+    // A planner that keeps tol holds the tip at least tol over the surface,
+    // and section 7 finds filament only within 2 d of it: with tol that
+    // high the filament floats everywhere, whatever the part's shape (QA
+    // round 22 F1: a 0.25 mm tip with tol 0.5 mm was told of features it
+    // was wider than, at every point of a smooth face).
+    let floor = FLOATING_HEIGHT_PER_D * nozzle.inner_diameter_mm;
+    if planner.is_guarded() && process.tolerance_mm >= floor {
+        warnings.push(format!(
+            "{}: tol {} mm is at least {FLOATING_HEIGHT_PER_D} d ({} mm, the nozzle's inner \
+             diameter d {} mm): the tip is kept at least tol from the surface, and filament \
+             dispensed {FLOATING_HEIGHT_PER_D} d or more above it does not reach it (section 7), \
+             so expect floating filament at every point; lower tol below {} mm, or use a nozzle \
+             wider than {} mm inside",
+            planner.name(),
+            process.tolerance_mm,
+            floor,
+            nozzle.inner_diameter_mm,
+            floor,
+            process.tolerance_mm / FLOATING_HEIGHT_PER_D,
+        ));
+    } else if floating > 0 {
         let p = highest.1;
         warnings.push(format!(
             "{}: {floating} point(s) of the tool path lifted where the nozzle (outer diameter \

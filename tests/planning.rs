@@ -1467,3 +1467,45 @@ fn dashes_off_the_scan_are_one_warning_after_the_note_on_dashes() {
     );
     assert!(dashes < at("of its pieces miss").unwrap(), "{w:#?}");
 }
+
+/// QA round 22 F1: with tol at or above 2 d (a fine tip, a cautious tol)
+/// every point floats, since section 7 finds filament only within 2 d of
+/// the surface and the tip is kept tol over it; the plan blamed features
+/// of the part the nozzle was wider than. It now names tol and d, with the
+/// way out, and says nothing of features; below 2 d it says nothing.
+#[test]
+fn a_tol_of_2_d_or_more_is_named_as_why_every_point_floats() {
+    let flat = plate(0.0);
+    let drawn = [line(DVec2::new(5.0, 20.0), DVec2::new(35.0, 20.0))];
+    let fine = Nozzle {
+        inner_diameter_mm: 0.25,
+        outer_diameter_mm: 0.52,
+    };
+    let plan_with = |tol: f64| {
+        let settings = PlanSettings {
+            nozzle: fine,
+            process: Process::DEFAULT.with_tolerance_mm(tol),
+            ..PlanSettings::default()
+        };
+        pipeline::plan(&flat, &drawn, &settings).unwrap()
+    };
+    let named = |plan: &pipeline::Plan| {
+        plan.warnings
+            .iter()
+            .any(|w| w.contains("is at least 2 d (0.5 mm") && w.contains("lower tol below 0.5 mm"))
+    };
+    let plan = plan_with(0.5);
+    assert!(named(&plan), "{:?}", plan.warnings);
+    assert!(
+        !plan
+            .warnings
+            .iter()
+            .any(|w| w.contains("wider than the feature")),
+        "{:?}",
+        plan.warnings
+    );
+    assert_eq!(plan.quality.floating_pct, 100.0);
+    let plan = plan_with(0.1);
+    assert!(!named(&plan), "{:?}", plan.warnings);
+    assert_eq!(plan.quality.floating_pct, 0.0);
+}
