@@ -454,23 +454,42 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut dashed = (0usize, 0usize, None::<String>);
     let mut solid: Vec<(String, String, String)> = Vec::new();
     let mut widest: Option<(f64, String)> = None;
-    // Shapes under a clip path or mask: printed whole (the first's label).
+    // Shapes a clip path or mask cuts: printed whole (the first's label).
     let (mut clipped, mut first_clipped) = (0usize, None::<String>);
+    // White shapes behind everything (a plot's page and axes), not printed.
+    let (mut backgrounds, mut first_background) = (0usize, None::<String>);
+    // Whether a shape has been printed yet: a white one before any is a
+    // background.
+    let mut painted = false;
     // Each node with whether an ancestor group is fully transparent
-    // (`opacity="0"`: it draws nothing) and whether one clips or masks.
-    let mut stack: Vec<(&usvg::Node, bool, bool)> = tree
+    // (`opacity="0"`: it draws nothing) and the clips and masks of its
+    // ancestors: each the canvas rectangle it keeps, where it is one
+    // ([`clip_rect`]), else `None` (it may cut any shape under it).
+    type Clips = Vec<Option<usvg::Rect>>;
+    let mut stack: Vec<(&usvg::Node, bool, Clips)> = tree
         .root()
         .children()
         .iter()
         .rev()
-        .map(|n| (n, false, false))
+        .map(|n| (n, false, Vec::new()))
         .collect();
-    while let Some((node, transparent, clip)) = stack.pop() {
+    while let Some((node, transparent, clips)) = stack.pop() {
         let path = match node {
             usvg::Node::Group(g) => {
                 let transparent = transparent || g.opacity().get() <= 0.0;
-                let clip = clip || g.clip_path().is_some() || g.mask().is_some();
-                stack.extend(g.children().iter().rev().map(|n| (n, transparent, clip)));
+                let mut clips = clips;
+                if g.clip_path().is_some() {
+                    clips.push(clip_rect(g));
+                }
+                if g.mask().is_some() {
+                    clips.push(None);
+                }
+                stack.extend(
+                    g.children()
+                        .iter()
+                        .rev()
+                        .map(|n| (n, transparent, clips.clone())),
+                );
                 continue;
             }
             usvg::Node::Path(p) => p,
@@ -509,7 +528,28 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             first_unpainted.get_or_insert(label);
             continue;
         }
-        if clip {
+        // A white shape with no stroke, before anything printed, shows
+        // nothing on the white page (matplotlib writes its figure's and
+        // axes' backgrounds so): its outline is not printed either (QA
+        // round 22 F2: a square of ink round a plotted antenna).
+        if !stroked && !painted && path.fill().is_some_and(|f| is_white(f.paint())) {
+            backgrounds += 1;
+            first_background.get_or_insert(label);
+            continue;
+        }
+        painted = true;
+        // Clipped where a clip or mask may cut it: a shape inside the
+        // rectangle its clip keeps (a plotted line inside its axes) is
+        // printed as the viewer shows it.
+        let bbox = path.abs_bounding_box();
+        let inside = |r: &usvg::Rect| {
+            let slack = 1e-3 * (r.width() + r.height());
+            bbox.left() >= r.left() - slack
+                && bbox.right() <= r.right() + slack
+                && bbox.top() >= r.top() - slack
+                && bbox.bottom() <= r.bottom() + slack
+        };
+        if clips.iter().any(|c| !c.as_ref().is_some_and(inside)) {
             clipped += 1;
             first_clipped.get_or_insert_with(|| label.clone());
         }
@@ -755,6 +795,13 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         notes.push(format!(
             "{unpainted} shape(s) with no stroke and no fill, or hidden or transparent, were not \
              printed (the first: '{first}')"
+        ));
+    }
+    if let Some(first) = &first_background {
+        notes.push(format!(
+            "{backgrounds} white shape(s) with no stroke behind the drawing (the first: \
+             '{first}'; a plotting program's page or axes background) show nothing on the page \
+             and were not printed"
         ));
     }
     if let Some(first) = &first_clipped {
@@ -2848,6 +2895,46 @@ fn pt(p: tiny_skia_path::Point) -> DVec2 {
 
 /// usvg's own (f32) geometry: exact for lines, polylines, polygons and plain
 /// rects; the fallback for anything not re-read exactly.
+/// Whether a paint is opaque-or-not plain white (a page's colour).
+fn is_white(paint: &usvg::Paint) -> bool {
+    matches!(paint, usvg::Paint::Color(c) if (c.red, c.green, c.blue) == (255, 255, 255))
+}
+
+/// The canvas rectangle that the clip path of group `g` keeps, where it is
+/// one rectangle without rotation or skew (a plotting program clips its
+/// lines to the axes so); `None` for any other clip, which may cut a shape
+/// anywhere.
+fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
+    let clip = g.clip_path()?;
+    if clip.clip_path().is_some() {
+        return None;
+    }
+    let [usvg::Node::Path(p)] = clip.root().children() else {
+        return None;
+    };
+    let t = g
+        .abs_transform()
+        .pre_concat(clip.transform())
+        .pre_concat(p.abs_transform());
+    if t.kx != 0.0 || t.ky != 0.0 {
+        return None;
+    }
+    // A rectangle: every point of its outline a corner of its box, each
+    // side along an axis.
+    let b = p.data().bounds();
+    let points = p.data().points();
+    let corner = |q: &tiny_skia_path::Point| {
+        (q.x == b.left() || q.x == b.right()) && (q.y == b.top() || q.y == b.bottom())
+    };
+    let along_an_axis =
+        |(a, c): (&tiny_skia_path::Point, &tiny_skia_path::Point)| a.x == c.x || a.y == c.y;
+    let sides = points.iter().zip(points.iter().cycle().skip(1));
+    if points.len() > 5 || !points.iter().all(corner) || !sides.clone().all(along_an_axis) {
+        return None;
+    }
+    b.transform(t)
+}
+
 fn from_tiny_skia(path: &tiny_skia_path::Path) -> Vec<LocalSubpath> {
     let mut asm = Assembler::default();
     for seg in path.segments() {

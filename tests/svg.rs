@@ -1695,6 +1695,40 @@ fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_uns
     );
 }
 
+/// QA round 22 F2: matplotlib's `savefig` writes its figure's and axes'
+/// backgrounds as white rectangles with no stroke, and clips every plotted
+/// line to the axes: the rectangles were printed as squares of ink round
+/// the drawing, and every line was said to be clipped. A white unstroked
+/// shape before anything printed is a background, left out with a note;
+/// a white one over other shapes (a knock-out) is still printed; a clip
+/// that is a rectangle holding the whole shape cuts nothing, and one that
+/// cuts a shape is still named.
+#[test]
+fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not_said() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r##"<defs><clipPath id="axes"><rect x="5" y="5" width="40" height="30"/></clipPath></defs>
+           <path id="patch_1" d="M 0 50 L 50 50 L 50 0 L 0 0 z" style="fill: #ffffff"/>
+           <rect id="patch_2" x="5" y="5" width="40" height="30" fill="white"/>
+           <path id="line2d_1" d="M 10 10 L 40 30" clip-path="url(#axes)" style="fill: none; stroke: #1f77b4"/>
+           <path id="line2d_2" d="M 10 20 L 60 20" clip-path="url(#axes)" style="fill: none; stroke: #ff7f0e"/>
+           <circle id="knockout" cx="25" cy="42" r="3" fill="#fff"/>"##,
+    ));
+    assert_eq!(subs.len(), 3, "{subs:?}");
+    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
+    assert_eq!(sources, ["line2d_1", "line2d_2", "knockout"]);
+    let note = note_with(&notes, "background");
+    assert!(
+        note.starts_with("2 white shape(s) with no stroke") && note.contains("'patch_1'"),
+        "{note}"
+    );
+    let note = note_with(&notes, "clipped or masked");
+    assert!(
+        note.starts_with("1 shape(s)") && note.contains("the first: 'line2d_2'"),
+        "{note}"
+    );
+}
+
 /// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
 /// utf-8 sequence of 1 bytes from index 0)", then refused with "save it as
 /// UTF-8"; its byte-order mark says how to read it, and it is read.
