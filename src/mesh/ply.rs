@@ -374,6 +374,10 @@ struct OutOfStep<'h> {
     lists: Vec<String>,
     /// How many lines differ so in all.
     differing: usize,
+    /// Whether every line that differs is one of this element's, with as
+    /// many values as this one, more than its properties make: the header
+    /// leaves out what each line holds, no line is damaged.
+    uniform: bool,
     /// The body's last line that holds a value.
     last: usize,
 }
@@ -391,6 +395,18 @@ impl OutOfStep<'_> {
         } else {
             format!("its properties make {want} ({})", self.lists.join("; "))
         };
+        if self.uniform && self.differing > 1 {
+            return MeshError::syntax(
+                file,
+                self.line,
+                format!(
+                    "'{}' element {} has {} values, {make}; all {} '{}' lines have {}: they \
+                     hold values the header does not list (a property left out of it); correct \
+                     the header, or export the scan again",
+                    element.name, self.record, self.got, self.differing, element.name, self.got
+                ),
+            );
+        }
         MeshError::syntax(
             file,
             self.line,
@@ -452,6 +468,9 @@ fn ascii_out_of_step<'h>(header: &'h Header, body: &[u8]) -> Option<OutOfStep<'h
     let mut line = header.lines;
     let mut found: Option<OutOfStep> = None;
     let (mut differing, mut compared) = (0, 0);
+    // While every line that differs is one element's, with the same
+    // surplus of values: (the element, the values, those wanted).
+    let mut uniform: Option<Option<(&Element, usize, usize)>> = None;
     let mut last = 0;
     let mut values = Vec::new();
     for text in body.split(|&c| c == b'\n') {
@@ -474,7 +493,15 @@ fn ascii_out_of_step<'h>(header: &'h Header, body: &[u8]) -> Option<OutOfStep<'h
         compared += 1;
         if want != values.len() {
             differing += 1;
-            if differing > OUT_OF_STEP_LINES {
+            let this = (element, values.len(), want);
+            let same = |&(e, got, w): &(&Element, usize, usize)| {
+                std::ptr::eq(e, element) && (got, w) == (this.1, this.2)
+            };
+            uniform = Some(match uniform {
+                None => (this.1 > want).then_some(this),
+                Some(u) => u.filter(same),
+            });
+            if differing > OUT_OF_STEP_LINES && !matches!(uniform, Some(Some(_))) {
                 return None;
             }
             found.get_or_insert(OutOfStep {
@@ -485,15 +512,19 @@ fn ascii_out_of_step<'h>(header: &'h Header, body: &[u8]) -> Option<OutOfStep<'h
                 want,
                 lists,
                 differing: 0,
+                uniform: false,
                 last: 0,
             });
         }
     }
-    // A small body whose lines mostly differ is a layout too.
+    let uniform = matches!(uniform, Some(Some(_)));
+    // A small body whose lines mostly differ is a layout too, unless each
+    // holds the same surplus.
     found
-        .filter(|_| 2 * differing <= compared)
+        .filter(|_| uniform || 2 * differing <= compared)
         .map(|f| OutOfStep {
             differing,
+            uniform,
             last,
             ..f
         })
@@ -2588,6 +2619,35 @@ mod tests {
             }
         }
         text
+    }
+
+    /// QA round 22 F3: trimesh's fuze_ascii.ply (VCGLIB) holds on every
+    /// face line a list the header does not declare. Where a misplaced
+    /// value first failed to read as an index, the error named the second
+    /// face's line; past 8 such lines it was taken for a writer that spreads
+    /// an element over lines. Lines that all hold the same surplus are named
+    /// at the first, as the header's fault.
+    #[test]
+    fn face_lines_that_all_hold_values_the_header_leaves_out_are_named_at_the_first() {
+        let grid = ascii_grid();
+        let extra: String = grid
+            .lines()
+            .map(|l| match l.strip_prefix("3 ") {
+                Some(_) if l.split(' ').count() == 4 => {
+                    format!("{l} 6 0.62 0.41 0.59 0.42 0.62 0.44 9 1 1 1 1 1 1 1 1 1\n")
+                }
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        let e = parse(extra.as_bytes(), "fuze.ply").unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "fuze.ply:26: 'face' element 0 has 21 values, its properties make 4 \
+                 (vertex_indices: the count 3, then 3 values); all 18 'face' lines have 21: \
+                 they hold values the header does not list"
+            ),
+            "{e}"
+        );
     }
 
     /// `text` with its line `line` (1-based) replaced by `by`.
