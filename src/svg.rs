@@ -456,11 +456,14 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     let mut widest: Option<(f64, String)> = None;
     // Shapes a clip path or mask cuts: printed whole (the first's label).
     let (mut clipped, mut first_clipped) = (0usize, None::<String>);
-    // White shapes behind everything (a plot's page and axes), not printed.
-    let (mut backgrounds, mut first_background) = (0usize, None::<String>);
-    // Whether a shape has been printed yet: a white one before any is a
-    // background.
+    // White shapes with no stroke before any other printed shape: each
+    // (label, canvas box, its subpaths in `out`), a background where its
+    // box holds everything printed after it (see below).
+    let mut whites: Vec<(String, usvg::Rect, std::ops::Range<usize>)> = Vec::new();
+    // Whether a shape other than those has been printed, and the canvas
+    // box of all such.
     let mut painted = false;
+    let mut painted_box: Option<usvg::Rect> = None;
     // Each node with whether an ancestor group is fully transparent
     // (`opacity="0"`: it draws nothing) and the clips and masks of its
     // ancestors: each the canvas rectangle it keeps, where it is one
@@ -528,20 +531,23 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             first_unpainted.get_or_insert(label);
             continue;
         }
-        // A white shape with no stroke, before anything printed, shows
-        // nothing on the white page (matplotlib writes its figure's and
-        // axes' backgrounds so): its outline is not printed either (QA
-        // round 22 F2: a square of ink round a plotted antenna).
-        if !stroked && !painted && path.fill().is_some_and(|f| is_white(f.paint())) {
-            backgrounds += 1;
-            first_background.get_or_insert(label);
-            continue;
+        if let Some(w) = whites.last_mut().filter(|w| w.2.end == usize::MAX) {
+            w.2.end = out.len();
         }
-        painted = true;
+        let bbox = path.abs_bounding_box();
+        // A white shape with no stroke before any other shape printed may
+        // be the page's background (matplotlib writes its figure's so), which
+        // shows nothing: known once the rest is read.
+        let white = !stroked && !painted && path.fill().is_some_and(|f| is_white(f.paint()));
+        if white {
+            whites.push((label.clone(), bbox, out.len()..usize::MAX));
+        } else {
+            painted = true;
+            painted_box = Some(painted_box.map_or(bbox, |b| union(b, bbox)));
+        }
         // Clipped where a clip or mask may cut it: a shape inside the
         // rectangle its clip keeps (a plotted line inside its axes) is
         // printed as the viewer shows it.
-        let bbox = path.abs_bounding_box();
         let inside = |r: &usvg::Rect| {
             let slack = 1e-3 * (r.width() + r.height());
             bbox.left() >= r.left() - slack
@@ -555,7 +561,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         }
         // A filled shape with no stroke (an icon, a PCB pad) is printed
         // along its outline: the nozzle draws lines, it does not fill.
-        if !stroked {
+        if !stroked && !white {
             filled_only += 1;
             first_filled.get_or_insert_with(|| label.clone());
         }
@@ -796,6 +802,42 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             "{unpainted} shape(s) with no stroke and no fill, or hidden or transparent, were not \
              printed (the first: '{first}')"
         ));
+    }
+    // A white shape behind the rest, holding it all or the whole page, is
+    // the page's background: it shows nothing, and its outline is not printed (QA
+    // round 22 F2: a square of ink round a plotted antenna). A white one
+    // that holds less (a pad drawn first, the axes of a plot with its
+    // labels outside them) is printed, and so is a drawing of white shapes
+    // alone (a logo for a dark page).
+    if let Some(w) = whites.last_mut().filter(|w| w.2.end == usize::MAX) {
+        w.2.end = out.len();
+    }
+    let (mut backgrounds, mut first_background) = (0usize, None::<String>);
+    let mut first_white_printed = None;
+    let page = usvg::Rect::from_xywh(0.0, 0.0, tree.size().width(), tree.size().height());
+    for (label, bbox, range) in whites.iter().rev() {
+        let slack = 1e-3 * (bbox.width() + bbox.height());
+        let holds = |p: &usvg::Rect| {
+            p.left() >= bbox.left() - slack
+                && p.right() <= bbox.right() + slack
+                && p.top() >= bbox.top() - slack
+                && p.bottom() <= bbox.bottom() + slack
+        };
+        // (Or it covers the whole page: a plot's tick labels and glyphs may
+        // lie past it.)
+        if painted_box.is_some_and(|p| holds(&p) || page.as_ref().is_some_and(holds)) {
+            out.drain(range.clone());
+            backgrounds += 1;
+            first_background = Some(label.clone());
+        } else {
+            filled_only += 1;
+            first_white_printed = Some(label.clone());
+        }
+    }
+    // The white shapes came before every other: the first printed is the
+    // first filled one.
+    if first_white_printed.is_some() {
+        first_filled = first_white_printed;
     }
     if let Some(first) = &first_background {
         notes.push(format!(
@@ -2893,9 +2935,18 @@ fn pt(p: tiny_skia_path::Point) -> DVec2 {
     DVec2::new(f64::from(p.x), f64::from(p.y))
 }
 
-/// usvg's own (f32) geometry: exact for lines, polylines, polygons and plain
-/// rects; the fallback for anything not re-read exactly.
-/// Whether a paint is opaque-or-not plain white (a page's colour).
+/// The box holding both `a` and `b`.
+fn union(a: usvg::Rect, b: usvg::Rect) -> usvg::Rect {
+    usvg::Rect::from_ltrb(
+        a.left().min(b.left()),
+        a.top().min(b.top()),
+        a.right().max(b.right()),
+        a.bottom().max(b.bottom()),
+    )
+    .unwrap_or(a)
+}
+
+/// Whether a paint is plain white (the page's colour), at any opacity.
 fn is_white(paint: &usvg::Paint) -> bool {
     matches!(paint, usvg::Paint::Color(c) if (c.red, c.green, c.blue) == (255, 255, 255))
 }
@@ -2929,12 +2980,20 @@ fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
     let along_an_axis =
         |(a, c): (&tiny_skia_path::Point, &tiny_skia_path::Point)| a.x == c.x || a.y == c.y;
     let sides = points.iter().zip(points.iter().cycle().skip(1));
-    if points.len() > 5 || !points.iter().all(corner) || !sides.clone().all(along_an_axis) {
+    // (A rectangle of no area keeps nothing: it cuts every shape.)
+    if points.len() > 5
+        || b.width() <= 0.0
+        || b.height() <= 0.0
+        || !points.iter().all(corner)
+        || !sides.clone().all(along_an_axis)
+    {
         return None;
     }
     b.transform(t)
 }
 
+/// usvg's own (f32) geometry: exact for lines, polylines, polygons and plain
+/// rects; the fallback for anything not re-read exactly.
 fn from_tiny_skia(path: &tiny_skia_path::Path) -> Vec<LocalSubpath> {
     let mut asm = Assembler::default();
     for seg in path.segments() {

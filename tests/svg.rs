@@ -1699,22 +1699,24 @@ fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_uns
 /// backgrounds as white rectangles with no stroke, and clips every plotted
 /// line to the axes: the rectangles were printed as squares of ink round
 /// the drawing, and every line was said to be clipped. A white unstroked
-/// shape before anything printed is a background, left out with a note;
-/// a white one over other shapes (a knock-out) is still printed; a clip
-/// that is a rectangle holding the whole shape cuts nothing, and one that
-/// cuts a shape is still named.
+/// shape before anything else printed, whose box holds all that is printed
+/// after it, is a background, left out with a note; a clip that is a
+/// rectangle holding the whole shape cuts nothing, and one that cuts a
+/// shape is still named. A white shape drawn over others (a knock-out),
+/// one that holds less (a pad drawn first) and a drawing of white shapes
+/// alone (a logo for a dark page: review) are printed, as before.
 #[test]
 fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not_said() {
     let (subs, notes) = notes_of(&doc(
         MM,
-        r##"<defs><clipPath id="axes"><rect x="5" y="5" width="40" height="30"/></clipPath></defs>
+        r##"<defs><clipPath id="axes"><rect x="5" y="5" width="40" height="30"/></clipPath>
+           <clipPath id="half"><rect x="5" y="5" width="20" height="30"/></clipPath></defs>
            <path id="patch_1" d="M 0 50 L 50 50 L 50 0 L 0 0 z" style="fill: #ffffff"/>
            <rect id="patch_2" x="5" y="5" width="40" height="30" fill="white"/>
            <path id="line2d_1" d="M 10 10 L 40 30" clip-path="url(#axes)" style="fill: none; stroke: #1f77b4"/>
-           <path id="line2d_2" d="M 10 20 L 60 20" clip-path="url(#axes)" style="fill: none; stroke: #ff7f0e"/>
-           <circle id="knockout" cx="25" cy="42" r="3" fill="#fff"/>"##,
+           <path id="line2d_2" d="M 10 20 L 40 20" clip-path="url(#half)" style="fill: none; stroke: #ff7f0e"/>
+           <circle id="knockout" cx="25" cy="15" r="3" fill="#fff"/>"##,
     ));
-    assert_eq!(subs.len(), 3, "{subs:?}");
     let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
     assert_eq!(sources, ["line2d_1", "line2d_2", "knockout"]);
     let note = note_with(&notes, "background");
@@ -1725,6 +1727,44 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
     let note = note_with(&notes, "clipped or masked");
     assert!(
         note.starts_with("1 shape(s)") && note.contains("the first: 'line2d_2'"),
+        "{note}"
+    );
+    let note = note_with(&notes, "filled but not stroked");
+    assert!(
+        note.starts_with("1 shape(s)") && note.contains("'knockout'"),
+        "{note}"
+    );
+    // A white page under a line that runs past it (a plot's glyphs may):
+    // the page covers the whole page, a background all the same.
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<rect id="page" x="0" y="0" width="100" height="100" fill="white"/>
+           <path id="long" d="M 10 10 L 120 10" stroke="black"/>"#,
+    ));
+    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
+    assert_eq!(sources, ["long"]);
+    assert!(note_with(&notes, "background").contains("'page'"));
+    // A white pad drawn first, beside a trace: printed.
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r#"<rect id="pad" x="0" y="0" width="4" height="4" fill="white"/>
+           <path id="trace" d="M 10 10 L 30 10" stroke="black"/>"#,
+    ));
+    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
+    assert_eq!(sources, ["pad", "trace"]);
+    assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+    assert!(note_with(&notes, "filled but not stroked").contains("'pad'"));
+    // White shapes alone: printed.
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r##"<path id="logo" d="M 5 5 L 20 5 L 20 20 z" fill="#fff"/>
+           <circle id="dot" cx="30" cy="30" r="2" fill="white"/>"##,
+    ));
+    assert_eq!(subs.len(), 2, "{subs:?}");
+    assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+    let note = note_with(&notes, "filled but not stroked");
+    assert!(
+        note.starts_with("2 shape(s)") && note.contains("'logo'"),
         "{note}"
     );
 }
