@@ -1071,19 +1071,20 @@ fn plan_stage(
     // round 22 F1: a 0.25 mm tip with tol 0.5 mm was told of features it
     // was wider than, at every point of a smooth face).
     let floor = FLOATING_HEIGHT_PER_D * nozzle.inner_diameter_mm;
-    if planner.is_guarded() && process.tolerance_mm >= floor {
+    let kept = process.tolerance_mm + PLANNING_MARGIN_MM;
+    if planner.is_guarded() && kept >= floor {
         warnings.push(format!(
-            "{}: tol {} mm is at least {FLOATING_HEIGHT_PER_D} d ({} mm, the nozzle's inner \
-             diameter d {} mm): the tip is kept at least tol from the surface, and filament \
-             dispensed {FLOATING_HEIGHT_PER_D} d or more above it does not reach it (section 7), \
-             so expect floating filament at every point; lower tol below {} mm, or use a nozzle \
-             wider than {} mm inside",
+            "{}: tol {} mm, kept with the planners' margin of {PLANNING_MARGIN_MM} mm, reaches \
+             {FLOATING_HEIGHT_PER_D} d ({:.3} mm, the nozzle's inner diameter d {} mm): the tip \
+             is kept that far from the surface, and filament dispensed {FLOATING_HEIGHT_PER_D} d \
+             or more above it does not reach it (section 7), so expect floating filament at \
+             every point; lower tol below {:.3} mm, or use a nozzle wider than {:.3} mm inside",
             planner.name(),
             process.tolerance_mm,
             floor,
             nozzle.inner_diameter_mm,
-            floor,
-            process.tolerance_mm / FLOATING_HEIGHT_PER_D,
+            floor - PLANNING_MARGIN_MM,
+            kept / FLOATING_HEIGHT_PER_D,
         ));
     } else if floating > 0 {
         let p = highest.1;
