@@ -1419,7 +1419,7 @@ fn other_3d_formats_and_a_dxf_are_named_with_a_way_out() {
         // archive to unpack, which holds no scan this program reads.
         (
             zip_of(&["Model.usdc", "0/texture.png"]),
-            "; this is a USD scene (.usdz",
+            "; this is a USD scene (Universal Scene Description; a .usdz",
             "export the scan as glTF/GLB, OBJ, PLY or STL",
         ),
         (

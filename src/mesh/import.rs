@@ -171,7 +171,8 @@ impl OtherFormat {
                 "export it from Blender as OBJ, STL or glTF (File > Export)",
             ),
             OtherFormat::Usd => (
-                "a USD scene (.usdz: what iPhone scanning apps share by default)",
+                "a USD scene (Universal Scene Description; a .usdz is what iPhone scanning apps \
+                 share by default)",
                 "export the scan as glTF/GLB, OBJ, PLY or STL instead (phone scanning apps offer \
                  GLB or OBJ beside USDZ), or open it in Blender (File > Import > Universal \
                  Scene Description) and export it as OBJ, STL or glTF",

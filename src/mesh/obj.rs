@@ -118,7 +118,8 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
         p.triangles.truncate(before);
         w.push_str(&format!(
             "; its last line ({face_line}), a face, ends without a line end, as a file cut in \
-             the middle of a line does: that face was left out"
+             the middle of a line does: that face was left out, since a cut index names another \
+             vertex"
         ));
     }
     Ok((
@@ -726,7 +727,8 @@ mod tests {
         assert!(
             w.contains(&format!(
                 "its last line ({lines}), a face, ends without a line end, as a file cut in \
-                 the middle of a line does: that face was left out"
+                 the middle of a line does: that face was left out, since a cut index names \
+                 another vertex"
             )),
             "{w}"
         );
