@@ -2980,12 +2980,17 @@ fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
     let along_an_axis =
         |(a, c): (&tiny_skia_path::Point, &tiny_skia_path::Point)| a.x == c.x || a.y == c.y;
     let sides = points.iter().zip(points.iter().cycle().skip(1));
-    // (A rectangle of no area keeps nothing: it cuts every shape.)
+    // Enclosing its box's area (review: an outline along two sides of
+    // its box, of no area, keeps nothing and cuts every shape).
+    let twice_area: f64 = sides
+        .clone()
+        .map(|(a, c)| f64::from(a.x) * f64::from(c.y) - f64::from(c.x) * f64::from(a.y))
+        .sum();
+    let box_area = f64::from(b.width()) * f64::from(b.height());
     if points.len() > 5
-        || b.width() <= 0.0
-        || b.height() <= 0.0
         || !points.iter().all(corner)
         || !sides.clone().all(along_an_axis)
+        || !(box_area > 0.0 && (0.5 * twice_area.abs() - box_area).abs() <= 1e-6 * box_area)
     {
         return None;
     }

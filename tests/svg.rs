@@ -1744,6 +1744,14 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
     let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
     assert_eq!(sources, ["long"]);
     assert!(note_with(&notes, "background").contains("'page'"));
+    // A clip whose outline runs along two sides of its box, of no area:
+    // it cuts (review).
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r#"<defs><clipPath id="z"><path d="M0 0 L100 0 L0 0 L0 100"/></clipPath></defs>
+           <path id="gone" d="M 10 10 L 40 40" stroke="black" clip-path="url(#z)"/>"#,
+    ));
+    assert!(note_with(&notes, "clipped or masked").contains("'gone'"));
     // A white pad drawn first, beside a trace: printed.
     let (subs, notes) = notes_of(&doc(
         MM,
