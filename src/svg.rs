@@ -2987,10 +2987,11 @@ fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
         .map(|(a, c)| f64::from(a.x) * f64::from(c.y) - f64::from(c.x) * f64::from(a.y))
         .sum();
     let box_area = f64::from(b.width()) * f64::from(b.height());
+    let encloses = box_area > 0.0 && (0.5 * twice_area.abs() - box_area).abs() <= 1e-6 * box_area;
     if points.len() > 5
         || !points.iter().all(corner)
         || !sides.clone().all(along_an_axis)
-        || !(box_area > 0.0 && (0.5 * twice_area.abs() - box_area).abs() <= 1e-6 * box_area)
+        || !encloses
     {
         return None;
     }
