@@ -518,17 +518,22 @@ fn gltf_meshopt_box_with_octahedral_normals_is_the_box() {
     assert_same_surface(&m.mesh, &original.mesh, 0.04, "box");
 }
 
+/// The paths of the files the `.gltf` `gltf` names and needs.
+fn needed_files(gltf: &[u8], name: &str) -> Vec<String> {
+    external_files_needed(gltf, name)
+        .unwrap()
+        .into_iter()
+        .map(|r| r.path)
+        .collect()
+}
+
 /// gltfpack's `.gltf` with a fallback: the compressed data in one `.bin`
 /// and the uncompressed data, for readers without meshopt, in a second,
 /// which is neither asked for nor read (it is not in this folder).
 #[test]
 fn gltf_meshopt_fallback_file_is_not_needed() {
     let gltf = data!("mesh/bunny-meshopt-cf.gltf");
-    let needed: Vec<String> = external_files_needed(gltf, "bunny-meshopt-cf.gltf")
-        .unwrap()
-        .into_iter()
-        .map(|r| r.path)
-        .collect();
+    let needed = needed_files(gltf, "bunny-meshopt-cf.gltf");
     assert_eq!(needed, ["bunny-meshopt-cf.bin"]);
     let files =
         ExternalFiles::new().with("bunny-meshopt-cf.bin", data!("mesh/bunny-meshopt-cf.bin"));
@@ -863,11 +868,7 @@ fn gltf_with_its_bin_reads_as_the_glb() {
 #[test]
 fn trimesh_gltf_with_two_bins_reads_as_its_glb() {
     let gltf = data!("mesh/trimesh/trimesh-icosphere.gltf");
-    let needed: Vec<String> = external_files_needed(gltf, "trimesh-icosphere.gltf")
-        .unwrap()
-        .into_iter()
-        .map(|r| r.path)
-        .collect();
+    let needed = needed_files(gltf, "trimesh-icosphere.gltf");
     assert_eq!(needed, ["gltf_buffer_0.bin", "gltf_buffer_1.bin"]);
     let files = ExternalFiles::new()
         .with("gltf_buffer_1.bin", data!("mesh/trimesh/gltf_buffer_1.bin"))
@@ -1216,8 +1217,6 @@ fn plan_over_a_cad_export_writes_finite_gcode() {
 fn even_prints_real_logos_on_the_bunny_no_worse_than_a_safe_paper_planner() {
     use pcpp::mesh::{ImportOptions, ScanUnits, UpAxis};
     use pcpp::pipeline;
-    use pcpp::placement::centre_drawing;
-    use pcpp::planners::PlannerKind;
     use pcpp::surface::Surface;
 
     let options = ImportOptions {
@@ -1233,7 +1232,6 @@ fn even_prints_real_logos_on_the_bunny_no_worse_than_a_safe_paper_planner() {
     .unwrap_or_else(|e| panic!("{e}"));
     let mesh = scan.mesh.clone();
     let surface = Surface::new(scan.mesh).unwrap();
-    let (lo, hi) = surface.bbox();
     let logos: [(&str, &[u8]); 7] = [
         ("abusedotch", data!("svg/simple-icons-abusedotch.svg")),
         ("actix", data!("svg/simple-icons-actix.svg")),
@@ -1245,44 +1243,68 @@ fn even_prints_real_logos_on_the_bunny_no_worse_than_a_safe_paper_planner() {
     ];
     for (name, bytes) in logos {
         let drawn = load_path(bytes, name).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let (placement, _) = centre_drawing(
-            &drawn.subpaths,
-            (lo.truncate(), hi.truncate()),
-            &Placement::IDENTITY,
-            false,
-        )
-        .unwrap();
-        let settings = PlanSettings {
-            placement,
-            ..PlanSettings::default()
-        };
-        let plans = pipeline::compare(&surface, &drawn.subpaths, &settings)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let by = |k: PlannerKind| plans.iter().find(|p| p.planner == k).unwrap();
-        let even = by(PlannerKind::Even);
+        let (settings, plans) = compare_centred(&surface, &drawn, name);
+        let even = even_no_worse_than_the_safe_paper_planners(&plans, name);
         assert_eq!(even.quality.contact_pct, 0.0, "{name}");
         assert_eq!(even.motion.touching_moves, 0, "{name}");
         assert!(even.uncleared.is_empty(), "{name}");
-        let safe_paper = [
-            PlannerKind::Constant,
-            PlannerKind::Slope,
-            PlannerKind::Pcpp,
-            PlannerKind::PcppGuarded,
-        ]
-        .into_iter()
-        .map(by)
-        .filter(|p| p.motion.touching_moves == 0 && p.quality.contact_pct == 0.0);
-        for p in safe_paper {
-            assert!(
-                even.quality.defect_pct() <= p.quality.defect_pct(),
-                "{name}: even {:.2}% defects, {} {:.2}%",
-                even.quality.defect_pct(),
-                p.planner.name(),
-                p.quality.defect_pct()
-            );
-        }
         oracle_clears_every_move(even, &mesh, &settings, name);
     }
+}
+
+/// `drawn` centred on `surface` at its own size and turn, compared with
+/// every planner at the default settings: (those settings, the plans).
+fn compare_centred(
+    surface: &pcpp::surface::Surface,
+    drawn: &pcpp::pipeline::DrawnPath,
+    case: &str,
+) -> (PlanSettings, Vec<pcpp::pipeline::Plan>) {
+    let (lo, hi) = surface.bbox();
+    let (placement, _) = pcpp::placement::centre_drawing(
+        &drawn.subpaths,
+        (lo.truncate(), hi.truncate()),
+        &Placement::IDENTITY,
+        false,
+    )
+    .unwrap();
+    let settings = PlanSettings {
+        placement,
+        ..PlanSettings::default()
+    };
+    let plans = pcpp::pipeline::compare(surface, &drawn.subpaths, &settings)
+        .unwrap_or_else(|e| panic!("{case}: {e}"));
+    (settings, plans)
+}
+
+/// Promise 2: `even`'s plan of `plans`, which predicts no more defects
+/// (section 7, a share of the points) than any of the paper's planners
+/// whose moves keep tol and whose nozzle meets nothing.
+fn even_no_worse_than_the_safe_paper_planners<'p>(
+    plans: &'p [pcpp::pipeline::Plan],
+    case: &str,
+) -> &'p pcpp::pipeline::Plan {
+    use pcpp::planners::PlannerKind;
+    let by = |k: PlannerKind| plans.iter().find(|p| p.planner == k).unwrap();
+    let even = by(PlannerKind::Even);
+    let safe_paper = [
+        PlannerKind::Constant,
+        PlannerKind::Slope,
+        PlannerKind::Pcpp,
+        PlannerKind::PcppGuarded,
+    ]
+    .into_iter()
+    .map(by)
+    .filter(|p| p.motion.touching_moves == 0 && p.quality.contact_pct == 0.0);
+    for p in safe_paper {
+        assert!(
+            even.quality.defect_pct() <= p.quality.defect_pct(),
+            "{case}: even {:.2}% defects, {} {:.2}%",
+            even.quality.defect_pct(),
+            p.planner.name(),
+            p.quality.defect_pct()
+        );
+    }
+    even
 }
 
 /// Every print move of `plan` (waypoints included), piece by piece,
@@ -1426,17 +1448,10 @@ fn even_is_no_worse_than_a_safe_paper_planner_with_the_large_nozzle() {
 /// clear by the independent oracle.
 #[test]
 fn a_gltf_transform_phone_scan_with_webp_textures_is_read_and_planned_on() {
-    use pcpp::pipeline;
-    use pcpp::placement::centre_drawing;
-    use pcpp::planners::PlannerKind;
     use pcpp::surface::Surface;
 
     let gltf = data!("mesh/phone-scan/molasses-cookies.gltf");
-    let needed: Vec<String> = external_files_needed(gltf, "molasses-cookies.gltf")
-        .unwrap()
-        .into_iter()
-        .map(|r| r.path)
-        .collect();
+    let needed = needed_files(gltf, "molasses-cookies.gltf");
     assert_eq!(needed, ["molasses-cookies.optimized.bin"]);
     let files = ExternalFiles::new().with(
         "molasses-cookies.optimized.bin",
@@ -1460,43 +1475,11 @@ fn a_gltf_transform_phone_scan_with_webp_textures_is_read_and_planned_on() {
     );
     let mesh = m.mesh.clone();
     let surface = Surface::new(m.mesh).unwrap();
-    let (lo, hi) = surface.bbox();
     let drawn = load_path(data!("svg/simple-icons-vulkan.svg"), "vulkan.svg").unwrap();
-    let (placement, _) = centre_drawing(
-        &drawn.subpaths,
-        (lo.truncate(), hi.truncate()),
-        &Placement::IDENTITY,
-        false,
-    )
-    .unwrap();
-    let settings = PlanSettings {
-        placement,
-        ..PlanSettings::default()
-    };
-    let plans =
-        pipeline::compare(&surface, &drawn.subpaths, &settings).unwrap_or_else(|e| panic!("{e}"));
-    let by = |k: PlannerKind| plans.iter().find(|p| p.planner == k).unwrap();
-    let even = by(PlannerKind::Even);
+    let (settings, plans) = compare_centred(&surface, &drawn, "cookie");
+    let even = even_no_worse_than_the_safe_paper_planners(&plans, "cookie");
     assert!(even.uncleared.is_empty());
     assert_eq!(even.motion.touching_moves, 0);
-    for p in [
-        PlannerKind::Constant,
-        PlannerKind::Slope,
-        PlannerKind::Pcpp,
-        PlannerKind::PcppGuarded,
-    ]
-    .into_iter()
-    .map(by)
-    .filter(|p| p.motion.touching_moves == 0 && p.quality.contact_pct == 0.0)
-    {
-        assert!(
-            even.quality.defect_pct() <= p.quality.defect_pct(),
-            "even {:.2}% defects, {} {:.2}%",
-            even.quality.defect_pct(),
-            p.planner.name(),
-            p.quality.defect_pct()
-        );
-    }
     // The logo's 14 outlines, each printed.
     let points: usize = even.pieces.iter().map(|p| p.toolpath.len()).sum();
     assert!(

@@ -438,8 +438,7 @@ fn inkscape_file_with_layers_styles_and_text() {
         Err(e) => panic!("{e}"),
     };
     let subs = &import.subpaths;
-    let names: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
-    assert_eq!(names, ["loop", "ring", "half", "pad"]);
+    assert_eq!(sources(subs), ["loop", "ring", "half", "pad"]);
     // The layer's translate(-10,-20), then y flipped.
     let expect = [
         v(10.0, -10.0),
@@ -891,6 +890,11 @@ fn notes_of(text: &str) -> (Vec<Subpath2>, Vec<String>) {
 }
 
 /// The one note that contains `word`.
+/// The element each subpath comes from, in order.
+fn sources(subs: &[Subpath2]) -> Vec<&str> {
+    subs.iter().map(|s| s.source.as_str()).collect()
+}
+
 fn note_with<'a>(notes: &'a [String], word: &str) -> &'a str {
     let found: Vec<&String> = notes.iter().filter(|n| n.contains(word)).collect();
     assert_eq!(found.len(), 1, "one note with {word:?}: {notes:?}");
@@ -1717,8 +1721,7 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
            <path id="line2d_2" d="M 10 20 L 40 20" clip-path="url(#half)" style="fill: none; stroke: #ff7f0e"/>
            <circle id="knockout" cx="25" cy="15" r="3" fill="#fff"/>"##,
     ));
-    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
-    assert_eq!(sources, ["line2d_1", "line2d_2", "knockout"]);
+    assert_eq!(sources(&subs), ["line2d_1", "line2d_2", "knockout"]);
     let note = note_with(&notes, "background");
     assert!(
         note.starts_with("2 white shape(s) with no stroke") && note.contains("'patch_1'"),
@@ -1741,8 +1744,7 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
         r#"<rect id="page" x="0" y="0" width="100" height="100" fill="white"/>
            <path id="long" d="M 10 10 L 120 10" stroke="black"/>"#,
     ));
-    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
-    assert_eq!(sources, ["long"]);
+    assert_eq!(sources(&subs), ["long"]);
     assert!(note_with(&notes, "background").contains("'page'"));
     // A clip whose outline runs along two sides of its box, of no area:
     // it cuts (review).
@@ -1758,8 +1760,7 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
         r#"<rect id="pad" x="0" y="0" width="4" height="4" fill="white"/>
            <path id="trace" d="M 10 10 L 30 10" stroke="black"/>"#,
     ));
-    let sources: Vec<&str> = subs.iter().map(|s| s.source.as_str()).collect();
-    assert_eq!(sources, ["pad", "trace"]);
+    assert_eq!(sources(&subs), ["pad", "trace"]);
     assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
     assert!(note_with(&notes, "filled but not stroked").contains("'pad'"));
     // White shapes alone: printed.
