@@ -457,13 +457,12 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // Shapes a clip path or mask cuts: printed whole (the first's label).
     let (mut clipped, mut first_clipped) = (0usize, None::<String>);
     // White shapes with no stroke before any other printed shape: each
-    // (label, canvas box, its subpaths in `out`), a background where its
-    // box holds everything printed after it (see below).
-    let mut whites: Vec<(String, usvg::Rect, std::ops::Range<usize>)> = Vec::new();
-    // Whether a shape other than those has been printed, and the canvas
-    // box of all such.
-    let mut painted = false;
-    let mut painted_box: Option<usvg::Rect> = None;
+    // (label, canvas box, where its subpaths start in `out`), a background
+    // where its box holds everything printed after it (see below).
+    let mut whites: Vec<(String, usvg::Rect, usize)> = Vec::new();
+    // The canvas box of the other shapes printed, and where in `out` the
+    // first of them starts (the white shapes' subpaths end there).
+    let mut painted: Option<(usvg::Rect, usize)> = None;
     // Each node with whether an ancestor group is fully transparent
     // (`opacity="0"`: it draws nothing) and the clips and masks of its
     // ancestors: each the canvas rectangle it keeps, where it is one
@@ -531,31 +530,21 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             first_unpainted.get_or_insert(label);
             continue;
         }
-        if let Some(w) = whites.last_mut().filter(|w| w.2.end == usize::MAX) {
-            w.2.end = out.len();
-        }
         let bbox = path.abs_bounding_box();
         // A white shape with no stroke before any other shape printed may
         // be the page's background (matplotlib writes its figure's so), which
         // shows nothing: known once the rest is read.
-        let white = !stroked && !painted && path.fill().is_some_and(|f| is_white(f.paint()));
+        let white =
+            !stroked && painted.is_none() && path.fill().is_some_and(|f| is_white(f.paint()));
         if white {
-            whites.push((label.clone(), bbox, out.len()..usize::MAX));
+            whites.push((label.clone(), bbox, out.len()));
         } else {
-            painted = true;
-            painted_box = Some(painted_box.map_or(bbox, |b| union(b, bbox)));
+            painted = Some(painted.map_or((bbox, out.len()), |(b, at)| (union(b, bbox), at)));
         }
         // Clipped where a clip or mask may cut it: a shape inside the
         // rectangle its clip keeps (a plotted line inside its axes) is
         // printed as the viewer shows it.
-        let inside = |r: &usvg::Rect| {
-            let slack = 1e-3 * (r.width() + r.height());
-            bbox.left() >= r.left() - slack
-                && bbox.right() <= r.right() + slack
-                && bbox.top() >= r.top() - slack
-                && bbox.bottom() <= r.bottom() + slack
-        };
-        if clips.iter().any(|c| !c.as_ref().is_some_and(inside)) {
+        if clips.iter().any(|c| !c.is_some_and(|r| holds(&r, &bbox))) {
             clipped += 1;
             first_clipped.get_or_insert_with(|| label.clone());
         }
@@ -809,24 +798,20 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // that holds less (a pad drawn first, the axes of a plot with its
     // labels outside them) is printed, and so is a drawing of white shapes
     // alone (a logo for a dark page).
-    if let Some(w) = whites.last_mut().filter(|w| w.2.end == usize::MAX) {
-        w.2.end = out.len();
-    }
     let (mut backgrounds, mut first_background) = (0usize, None::<String>);
     let mut first_white_printed = None;
     let page = usvg::Rect::from_xywh(0.0, 0.0, tree.size().width(), tree.size().height());
-    for (label, bbox, range) in whites.iter().rev() {
-        let slack = 1e-3 * (bbox.width() + bbox.height());
-        let holds = |p: &usvg::Rect| {
-            p.left() >= bbox.left() - slack
-                && p.right() <= bbox.right() + slack
-                && p.top() >= bbox.top() - slack
-                && p.bottom() <= bbox.bottom() + slack
-        };
+    // Each white shape's subpaths end where the next one's start, the last
+    // one's where the other shapes' do.
+    let mut end = painted.map_or(out.len(), |(_, at)| at);
+    for (label, bbox, start) in whites.iter().rev() {
+        let range = *start..std::mem::replace(&mut end, *start);
         // (Or it covers the whole page: a plot's tick labels and glyphs may
         // lie past it.)
-        if painted_box.is_some_and(|p| holds(&p) || page.as_ref().is_some_and(holds)) {
-            out.drain(range.clone());
+        if painted.is_some_and(|(p, _)| {
+            holds(bbox, &p) || page.as_ref().is_some_and(|page| holds(bbox, page))
+        }) {
+            out.drain(range);
             backgrounds += 1;
             first_background = Some(label.clone());
         } else {
@@ -2935,6 +2920,16 @@ fn pt(p: tiny_skia_path::Point) -> DVec2 {
     DVec2::new(f64::from(p.x), f64::from(p.y))
 }
 
+/// Whether box `outer` holds box `inner`, up to a thousandth of its size
+/// (rounding in the boxes' transforms).
+fn holds(outer: &usvg::Rect, inner: &usvg::Rect) -> bool {
+    let slack = 1e-3 * (outer.width() + outer.height());
+    inner.left() >= outer.left() - slack
+        && inner.right() <= outer.right() + slack
+        && inner.top() >= outer.top() - slack
+        && inner.bottom() <= outer.bottom() + slack
+}
+
 /// The box holding both `a` and `b`.
 fn union(a: usvg::Rect, b: usvg::Rect) -> usvg::Rect {
     usvg::Rect::from_ltrb(
@@ -2970,29 +2965,23 @@ fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
     if t.kx != 0.0 || t.ky != 0.0 {
         return None;
     }
-    // A rectangle: every point of its outline a corner of its box, each
-    // side along an axis.
+    // A rectangle: every point of its outline a corner of its box, and
+    // the outline enclosing the box's area (corners in another order
+    // enclose less: a bow tie, or the review's outline along two sides of
+    // its box, which keeps nothing and cuts every shape).
     let b = p.data().bounds();
     let points = p.data().points();
     let corner = |q: &tiny_skia_path::Point| {
         (q.x == b.left() || q.x == b.right()) && (q.y == b.top() || q.y == b.bottom())
     };
-    let along_an_axis =
-        |(a, c): (&tiny_skia_path::Point, &tiny_skia_path::Point)| a.x == c.x || a.y == c.y;
-    let sides = points.iter().zip(points.iter().cycle().skip(1));
-    // Enclosing its box's area (review: an outline along two sides of
-    // its box, of no area, keeps nothing and cuts every shape).
-    let twice_area: f64 = sides
-        .clone()
+    let twice_area: f64 = points
+        .iter()
+        .zip(points.iter().cycle().skip(1))
         .map(|(a, c)| f64::from(a.x) * f64::from(c.y) - f64::from(c.x) * f64::from(a.y))
         .sum();
     let box_area = f64::from(b.width()) * f64::from(b.height());
     let encloses = box_area > 0.0 && (0.5 * twice_area.abs() - box_area).abs() <= 1e-6 * box_area;
-    if points.len() > 5
-        || !points.iter().all(corner)
-        || !sides.clone().all(along_an_axis)
-        || !encloses
-    {
+    if points.len() > 5 || !points.iter().all(corner) || !encloses {
         return None;
     }
     b.transform(t)
