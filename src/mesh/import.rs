@@ -105,16 +105,22 @@ pub fn detect_format(bytes: &[u8], file: &str) -> Option<MeshFormat> {
 /// its content or its extension, into one it reads (QA: CGAL's and
 /// MeshLab's .off files got the list of formats alone; QA round 21 F5:
 /// KiCad's VRML models too).
-fn conversion_hint(bytes: &[u8], file: &str) -> String {
-    let ext = file
-        .rsplit_once('.')
-        .map(|(_, e)| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    let Some(format) = other_format(bytes).or_else(|| other_format_named(&ext)) else {
+fn conversion_hint(format: Option<OtherFormat>) -> String {
+    let Some(format) = format else {
         return String::new();
     };
     let (what, way) = format.hint();
     format!("; this is {what}: {way}")
+}
+
+/// The format this program does not read that a file is, by its content,
+/// else by its extension.
+fn other_kind(bytes: &[u8], file: &str) -> Option<OtherFormat> {
+    let ext = file
+        .rsplit_once('.')
+        .map(|(_, e)| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    other_format(bytes).or_else(|| other_format_named(&ext))
 }
 
 /// 3-D formats this program does not read, named for the way out.
@@ -251,20 +257,23 @@ fn other_format(bytes: &[u8]) -> Option<OtherFormat> {
     {
         // 3DS: the main chunk (0x4D4D) and its length, the file's.
         Some(OtherFormat::ThreeDs)
-    } else if is_zip(bytes)
-        && zip_entry_names(bytes, 64)
-            .iter()
-            .any(|n| n.eq_ignore_ascii_case("3D/3dmodel.model"))
-    {
-        Some(OtherFormat::ThreeMf)
-    } else if is_zip(bytes)
-        && zip_entry_names(bytes, 1).first().is_some_and(|n| {
+    } else if is_zip(bytes) {
+        let names = zip_entry_names(bytes, 64);
+        let usd = |n: &String| {
             let n = n.to_ascii_lowercase();
             n.ends_with(".usdc") || n.ends_with(".usda") || n.ends_with(".usd")
-        })
-    {
-        // A USDZ: an uncompressed ZIP whose first file is the USD layer.
-        Some(OtherFormat::Usd)
+        };
+        if names
+            .iter()
+            .any(|n| n.eq_ignore_ascii_case("3D/3dmodel.model"))
+        {
+            Some(OtherFormat::ThreeMf)
+        } else if names.first().is_some_and(usd) {
+            // A USDZ: an uncompressed ZIP whose first file is the USD layer.
+            Some(OtherFormat::Usd)
+        } else {
+            None
+        }
     } else {
         None
     }
@@ -460,20 +469,14 @@ pub fn import_mesh_unwelded(
     }
     if is_zip(bytes) {
         // A 3MF is a ZIP, and so is a USDZ: named as the format it is,
-        // whatever the file's name (a 3MF saved as .stl was read as a
+        // by its content or its name (a 3MF saved as .stl was read as a
         // binary STL: review), not as an archive to unpack (a USDZ holds
         // no scan this program reads).
-        let name = file.to_ascii_lowercase();
-        if name.ends_with(".3mf")
-            || name.ends_with(".usdz")
-            || matches!(
-                other_format(bytes),
-                Some(OtherFormat::ThreeMf | OtherFormat::Usd)
-            )
-        {
+        let kind = other_kind(bytes, file);
+        if matches!(kind, Some(OtherFormat::ThreeMf | OtherFormat::Usd)) {
             return Err(MeshError::UnknownFormat {
                 file: file.into(),
-                hint: conversion_hint(bytes, file),
+                hint: conversion_hint(kind),
             });
         }
         return Err(MeshError::invalid(file, zip_message(bytes)));
@@ -500,7 +503,7 @@ pub fn import_mesh_unwelded(
     }
     let format = detect_format(bytes, file).ok_or_else(|| MeshError::UnknownFormat {
         file: file.into(),
-        hint: conversion_hint(bytes, file),
+        hint: conversion_hint(other_kind(bytes, file)),
     })?;
     let (parsed, read) =
         parse_as(format, bytes, file, external).map_err(|e| misnamed(e, format, bytes, file))?;
