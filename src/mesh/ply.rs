@@ -477,9 +477,9 @@ fn ascii_out_of_step<'h>(
     let mut line = header.lines;
     let mut found: Option<OutOfStep> = None;
     let (mut differing, mut compared) = (0, 0);
-    // While every line that differs is one element's, with the same
-    // surplus of values: (the element, the values, those wanted).
-    let mut uniform: Option<Option<(&Element, usize, usize)>> = None;
+    // Whether every line that differs is the first's element's, with the
+    // first's surplus of values.
+    let mut same_surplus = surplus_whole;
     let mut last = 0;
     let mut values = Vec::new();
     for text in body.split(|&c| c == b'\n') {
@@ -502,18 +502,7 @@ fn ascii_out_of_step<'h>(
         compared += 1;
         if want != values.len() {
             differing += 1;
-            let this = (element, values.len(), want);
-            let same = |&(e, got, w): &(&Element, usize, usize)| {
-                std::ptr::eq(e, element) && (got, w) == (this.1, this.2)
-            };
-            uniform = Some(match uniform {
-                None => (surplus_whole && this.1 > want).then_some(this),
-                Some(u) => u.filter(same),
-            });
-            if differing > OUT_OF_STEP_LINES && !matches!(uniform, Some(Some(_))) {
-                return None;
-            }
-            found.get_or_insert(OutOfStep {
+            let first = found.get_or_insert(OutOfStep {
                 line,
                 element,
                 record,
@@ -524,10 +513,19 @@ fn ascii_out_of_step<'h>(
                 uniform: false,
                 last: 0,
             });
+            same_surplus &= std::ptr::eq(first.element, element)
+                && (first.got, first.want) == (values.len(), want)
+                && values.len() > want;
+            if differing > OUT_OF_STEP_LINES && !same_surplus {
+                return None;
+            }
         }
     }
     // Every line of one element (none of another) holds the same surplus.
-    let uniform = matches!(uniform, Some(Some((e, _, _))) if e.count == differing as u64);
+    let uniform = same_surplus
+        && found
+            .as_ref()
+            .is_some_and(|f| f.element.count == differing as u64);
     if differing > OUT_OF_STEP_LINES && !uniform {
         return None;
     }
