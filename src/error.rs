@@ -60,6 +60,10 @@ pub enum Error {
     /// Planning could not produce a tool path (names the path and point).
     #[error("{0}")]
     Plan(String),
+    /// The drawing has no path to print: about the drawing alone, so no
+    /// advice on the scan goes with it ([`crate::job::with_units_hint`]).
+    #[error("the drawing has no path to print")]
+    NoPath,
     /// G-code refused for a point cloud of a whole object (points under
     /// its top were left out): its surface between the points on steep
     /// sides is a guess, so the motion check does not hold for the part.

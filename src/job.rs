@@ -1079,15 +1079,12 @@ pub fn run_on_noting(
 /// with no word of their units, while the refusal for the build volume
 /// said them (in the same words, from the same test). Other errors are
 /// returned as they are, and so is a scan made large by stray vertices,
-/// which no units mend ([`crate::mesh::StrayVertices`]), and a drawing
-/// with nothing to print ([`pipeline::NO_PATH`]), whatever the scan.
+/// which no units mend ([`crate::mesh::StrayVertices`]); a drawing with
+/// nothing to print is refused as [`Error::NoPath`], whatever the scan.
 pub fn with_units_hint(e: Error, scan: &PreparedScan, profile: &MachineProfile) -> Error {
     let Error::Plan(message) = e else {
         return e;
     };
-    if message == pipeline::NO_PATH {
-        return Error::Plan(message);
-    }
     let strays = scan.units_doubt.is_some_and(|d| d.stray.is_some());
     let hint = crate::placement::units_hint(
         scan.surface.bbox(),
@@ -3413,9 +3410,11 @@ mod tests {
         // Refused for the scan (missed by the drawing): the units advised.
         let missed = Error::Plan("the path misses the scan entirely".into());
         assert!(about_units(with_units_hint(missed, &scan, &profile)));
-        // Refused for the drawing alone: no word of the scan's units.
-        let empty = with_units_hint(Error::Plan(pipeline::NO_PATH.into()), &scan, &profile);
-        assert_eq!(empty.to_string(), pipeline::NO_PATH);
+        // Refused for the drawing alone (planned with nothing to print):
+        // no word of the scan's units.
+        let none = pipeline::plan(&scan.surface, &[], &PlanSettings::default()).unwrap_err();
+        let empty = with_units_hint(none, &scan, &profile);
+        assert_eq!(empty.to_string(), "the drawing has no path to print");
     }
 
     #[test]

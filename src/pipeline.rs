@@ -189,7 +189,7 @@ pub fn surface_path(
     nozzle.validate()?;
     placement.validate()?;
     if drawn.is_empty() {
-        return Err(Error::Plan(NO_PATH.into()));
+        return Err(Error::NoPath);
     }
     drawing_size(drawn, nozzle, placement)?.check()?;
     let spacing = 0.5 * nozzle.inner_diameter_mm;
@@ -383,6 +383,9 @@ pub fn surface_path(
         ));
     }
     if pieces.is_empty() {
+        if !any_sample && (any_line || dot_paths.is_empty()) {
+            return Err(Error::NoPath);
+        }
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
         // Thin along X only (a bar or needle thin both ways may lie down
         // under another up axis: a review's 0.5 x 0.6 x 50 mm one did).
@@ -469,7 +472,7 @@ pub fn surface_path(
                  closes wider gaps",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
-        } else if any_sample {
+        } else {
             format!(
                 "the path misses the scan entirely: the path spans x {:.3}..{:.3}, y {:.3}..{:.3} mm \
                  but the scan spans x {:.3}..{:.3}, y {:.3}..{:.3} mm (printer frame); check the \
@@ -477,8 +480,6 @@ pub fn surface_path(
                  scan's footprint)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )
-        } else {
-            NO_PATH.into()
         }));
     }
     // Most of a drawing off the scan still printed its fragments with
@@ -552,10 +553,6 @@ pub struct Plan {
     /// How much of the drawing lies over the scan and is printed.
     pub coverage: Coverage,
 }
-
-/// The refusal of a drawing with nothing to print: about the drawing
-/// alone, so no advice on the scan goes with it ([`crate::job::with_units_hint`]).
-pub const NO_PATH: &str = "the drawing has no path to print";
 
 /// A plan's smallest clearance is found exactly up to tol plus this (mm);
 /// above it a comparison says only that it is more (the G-code's own check,
