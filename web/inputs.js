@@ -101,11 +101,7 @@ function openFiles(files, scans = false) {
   // Only a .txt is read before it is opened: the others open at once, in
   // the order they came (a scan, then a drawing right after it).
   if (!scans && files.some((f) => TEXT_FILE.test(f.name))) {
-    state.reading++;
-    Promise.all(files.map(fileKind)).then((kinds) => {
-      state.reading--;
-      openKinds(files, kinds);
-    });
+    reading(() => Promise.all(files.map(fileKind))).then((kinds) => openKinds(files, kinds));
     return;
   }
   openKinds(files, files.map((f) => {
@@ -114,6 +110,17 @@ function openFiles(files, scans = false) {
     if (PROFILE_FILE.test(f.name)) return 'profile';
     return GCODE_FILE.test(f.name) ? 'gcode' : 'scan';
   }));
+}
+
+// `read()`'s promise, counted as a file being read (state.reading) until
+// it settles: until then the plan on screen is the one before the file.
+async function reading(read) {
+  state.reading++;
+  try {
+    return await read();
+  } finally {
+    state.reading--;
+  }
 }
 
 function openKinds(files, kinds) {
@@ -193,15 +200,12 @@ async function openSvg(file) {
   // not centred over (a typed 20 became the centre's 19.99999944).
   const placed = userPlacements();
   let bytes;
-  state.reading++;
   try {
     // Bytes go to wasm as a Uint8Array, never through a JS string.
-    bytes = new Uint8Array(await file.arrayBuffer());
+    bytes = new Uint8Array(await reading(() => file.arrayBuffer()));
   } catch (e) {
     showError(`Could not read ${file.name}`, e.message);
     return;
-  } finally {
-    state.reading--;
   }
   // The path source it replaces, taken back if it cannot be read, and
   // that drawing's placement: kept in the browser until this one is
@@ -254,14 +258,11 @@ const profileLabel = () => $('dialect').selectedOptions[0]?.textContent || setti
 // taken either, and the profile used before it comes back (main.js).
 async function openProfile(file) {
   let text;
-  state.reading++;
   try {
-    text = await file.text();
+    text = await reading(() => file.text());
   } catch (e) {
     showError(`Could not read ${file.name}`, e.message);
     return;
-  } finally {
-    state.reading--;
   }
   const other = otherJson(text);
   if (other) {
