@@ -79,12 +79,17 @@ pub enum MeshError {
     },
     /// A face refers to a vertex that does not exist.
     #[error(
-        "{file}{}: face {face} refers to vertex index {index}, but only {vertex_count} vertices are defined",
-        line_suffix(*.line)
+        "{file}{}: {} refers to vertex index {index}, but only {vertex_count} vertices are defined",
+        line_suffix(*.line),
+        record(element, *.face)
     )]
     IndexOutOfRange {
         file: String,
-        /// The face as the file numbers it (0-based; OBJ names its line instead).
+        /// The element the record belongs to: `face`, or a PLY's
+        /// `tristrips` (one record holds many strips).
+        element: &'static str,
+        /// The record as the file numbers it (0-based; OBJ names its line
+        /// instead).
         face: usize,
         line: Option<usize>,
         index: i64,
@@ -184,6 +189,16 @@ impl MeshError {
     }
 }
 
+/// A record of a mesh's surface element as errors name it: "face 2", or
+/// "'tristrips' element 2" (a strip record is no face).
+fn record(element: &str, i: usize) -> String {
+    if element == "face" {
+        format!("face {i}")
+    } else {
+        format!("'{element}' element {i}")
+    }
+}
+
 /// Where the CLI looks for a `.gltf`'s separate files: beside it, or in the
 /// current folder for one read from standard input (a QA run was told to
 /// keep the file "next to standard input").
@@ -213,6 +228,7 @@ mod tests {
         );
         let e = MeshError::IndexOutOfRange {
             file: "a.ply".into(),
+            element: "face",
             face: 2,
             line: None,
             index: 9,

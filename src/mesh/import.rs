@@ -1307,6 +1307,7 @@ fn finish(
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(MeshError::IndexOutOfRange {
                 file: file.into(),
+                element: "face",
                 face,
                 line: None,
                 index: i64::from(bad),

@@ -1054,11 +1054,24 @@ struct Body<'f> {
 }
 
 impl Body<'_> {
-    fn index(&self, face: usize, value: i64, line: Option<usize>) -> Result<u32, MeshError> {
+    /// `value` as a vertex index of record `face` of the surface list
+    /// `role`, or the error naming that record.
+    fn index(
+        &self,
+        role: Role,
+        face: usize,
+        value: i64,
+        line: Option<usize>,
+    ) -> Result<u32, MeshError> {
         match u32::try_from(value) {
             Ok(i) if u64::from(i) < self.vertex_count => Ok(i),
             _ => Err(MeshError::IndexOutOfRange {
                 file: self.file.into(),
+                element: if role == Role::StripIndices {
+                    "tristrips"
+                } else {
+                    "face"
+                },
                 face,
                 line,
                 index: value,
@@ -1182,7 +1195,7 @@ impl Body<'_> {
             polygon.clear();
             return Ok(());
         }
-        polygon.push(self.index(i, value, line)?);
+        polygon.push(self.index(role, i, value, line)?);
         Ok(())
     }
 
@@ -1448,7 +1461,7 @@ impl Body<'_> {
                     let mut tri = [0u32; 3];
                     for v in &mut tri {
                         let value = r.int(item).unwrap_or(-1);
-                        *v = self.index(i, value, None)?;
+                        *v = self.index(Role::FaceIndices, i, value, None)?;
                     }
                     self.triangles.push(tri);
                     i += 1;
@@ -2563,20 +2576,25 @@ mod tests {
                 e,
                 MeshError::IndexOutOfRange {
                     file: "s.ply".into(),
+                    element: "tristrips",
                     face: 1,
                     line: Some(18),
                     index,
                     vertex_count: 6,
                 }
             );
-            assert!(e.to_string().starts_with("s.ply:18: face 1"), "{e}");
+            assert!(
+                e.to_string()
+                    .starts_with("s.ply:18: 'tristrips' element 1 refers"),
+                "{e}"
+            );
         }
         for big in [false, true] {
             for index in [6, -2, i64::from(i32::MIN)] {
                 let b = binary_strips(&[0, 1, 2, -1, 2, index, 4], big, "int", "int");
                 let e = parse(&b, "s.ply").unwrap_err().to_string();
                 assert!(
-                    e.starts_with("s.ply: face 0 refers to vertex index")
+                    e.starts_with("s.ply: 'tristrips' element 0 refers to vertex index")
                         && e.contains(&format!("index {index},")),
                     "{big}: {e}"
                 );
