@@ -12,6 +12,7 @@ use glam::DVec3;
 
 use super::import::Parsed;
 use super::MeshError;
+use crate::error::significant;
 
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Parsed, MeshError> {
     let (parsed, others) = read(bytes, file)?;
@@ -96,32 +97,87 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
     // tier to its end and tiers a function up only for its later calls (see
     // `job::hash_in_pieces`), so one call over the whole file would read
     // it all in the baseline tier.
-    while p.cur.pos < bytes.len() {
-        p.lines(LINES_PER_CALL)?;
-    }
-    let mut warnings: Vec<String> = (!p.ended)
-        .then(|| unused_vertices(&p.vertices, &p.triangles, p.line_no, file))
-        .flatten()
-        .into_iter()
-        .collect();
-    // A file cut short (said above) that stops inside a face line: what is
-    // left of the line names other vertices, or fewer (QA round 22 F4: `f
-    // 11604 11603 11` of `f 11604 11603 11536`, a 98.6 mm needle through a
-    // bunny), and is left out. A whole file may end without a line end;
-    // one that is not said to be cut keeps its last face.
-    let (face_line, before) = p.last_face;
+    // A file cut in the middle of its last line (an interrupted copy or
+    // download) ends without a line end, and what is left of that line
+    // may not read (`f 12/` of `f 12/40/12`) or may name other vertices
+    // (QA round 22 F4: `f 11604 11603 11` of `f 11604 11603 11536`, a
+    // 98.6 mm needle through a bunny). Such a face line, after other
+    // faces, is left out, with a warning; a whole file may end without a
+    // line end too, so a last face that reads and is no needle is kept.
+    // Any other last line that does not read is refused, saying it may
+    // have been cut.
     let cut_inside = !bytes.ends_with(b"\n") && !bytes.ends_with(b"\r");
-    if let Some(w) = warnings
-        .first_mut()
-        .filter(|_| cut_inside && face_line == p.line_no)
-    {
-        p.triangles.truncate(before);
-        w.push_str(&format!(
-            "; its last line ({face_line}), a face, ends without a line end, as a file cut in \
-             the middle of a line does: that face was left out, since a cut index names another \
-             vertex"
-        ));
+    let mut unread = None;
+    while p.cur.pos < bytes.len() {
+        if let Err(e) = p.lines(LINES_PER_CALL) {
+            // The cursor is still on the line that failed.
+            let ends = |c: &u8| matches!(c, b'\n' | b'\r');
+            let last = cut_inside && !bytes[p.cur.pos..].iter().any(ends);
+            let start = bytes[..p.cur.pos]
+                .iter()
+                .rposition(ends)
+                .map_or(0, |i| i + 1);
+            let face = bytes[start..].trim_ascii_start().starts_with(b"f");
+            match e {
+                MeshError::Syntax { message, .. } if last && face && p.faces > 0 => {
+                    unread = Some(message);
+                    break;
+                }
+                MeshError::Syntax {
+                    file,
+                    line,
+                    message,
+                } if last => {
+                    return Err(MeshError::Syntax {
+                        file,
+                        line,
+                        message: format!(
+                            "{message} (the file ends in this line, without a line end: was \
+                             it cut short?)"
+                        ),
+                    })
+                }
+                e => return Err(e),
+            }
+        }
     }
+    let (face_line, before) = p.last_face;
+    let cut = match unread {
+        Some(why) => Some(format!(
+            "its last line ({}) ends without a line end, as a file cut in the middle of a line \
+             does, and does not read ({why}): it was left out",
+            p.line_no
+        )),
+        None if cut_inside && face_line == p.line_no => {
+            needle(&p.vertices, &p.triangles[..before], &p.triangles[before..]).map(
+                |(longest, median)| {
+                    p.triangles.truncate(before);
+                    format!(
+                        "its last line ({face_line}), a face, ends without a line end, as a file \
+                         cut in the middle of a line does, and has an edge {} long (in the \
+                         file's units), {:.0} times the median of the other faces' longest \
+                         edges ({}): that face was left out, since a cut index names another \
+                         vertex",
+                        significant(longest, 3, 0),
+                        longest / median,
+                        significant(median, 3, 0),
+                    )
+                },
+            )
+        }
+        None => None,
+    };
+    let unused = (!p.ended)
+        .then(|| unused_vertices(&p.vertices, &p.triangles, p.line_no, file))
+        .flatten();
+    let warnings = match (unused, cut) {
+        (Some(u), Some(c)) => vec![format!("{u}; {c}")],
+        (None, Some(c)) => vec![format!(
+            "{file}: {c}; if the file was cut short, faces are missing after it: read it again \
+             from the scanner's export"
+        )],
+        (u, None) => u.into_iter().collect(),
+    };
     Ok((
         Parsed {
             vertices: p.vertices,
@@ -276,6 +332,34 @@ fn unused_vertices(
     })
 }
 
+/// How many times the median of a mesh's faces' longest edges a last
+/// face's longest edge must be for that face, cut in the middle of its
+/// line, to be taken for the needle a cut index makes.
+const NEEDLE: f64 = 4.0;
+
+/// The longest edge of `last` (one face's triangles) and the median of
+/// the longest edges of `rest` (at most 65,536 of them, evenly spread),
+/// when the former is more than [`NEEDLE`] times the latter; `None` when
+/// it is not, or when `rest` has too few faces to tell.
+fn needle(vertices: &[DVec3], rest: &[[u32; 3]], last: &[[u32; 3]]) -> Option<(f64, f64)> {
+    let longest = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        a.distance(b).max(b.distance(c)).max(c.distance(a))
+    };
+    if rest.len() < 16 {
+        return None;
+    }
+    let mut sample: Vec<f64> = rest
+        .iter()
+        .step_by(rest.len().div_ceil(1 << 16))
+        .map(longest)
+        .collect();
+    let mid = sample.len() / 2;
+    let median = *sample.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let edge = last.iter().map(longest).fold(0.0, f64::max);
+    (edge > NEEDLE * median).then_some((edge, median))
+}
+
 /// Lines [`Parser::lines`] reads in one call.
 const LINES_PER_CALL: usize = 1 << 12;
 
@@ -391,6 +475,7 @@ impl Parser<'_> {
                 IndexError::Syntax(message) => MeshError::syntax(file, line_no, message),
                 IndexError::Range(index) => MeshError::IndexOutOfRange {
                     file: file.into(),
+                    element: "face",
                     face: self.faces,
                     line: Some(line_no),
                     index,
@@ -718,27 +803,87 @@ mod tests {
                 && w.contains(&format!("after its last line ({lines})")),
             "{w}"
         );
-        // QA round 22 F4: cut in the middle of its last face line, which is
-        // left out; a whole file without a line end at its end keeps it.
+        // QA round 22 F4: cut in the middle of its last face line, whose
+        // cut index makes a needle (`f 211 212 23` of `f 211 212 232`):
+        // that face is left out.
         let mid = &cut[..cut.trim_end().len() - 1];
         let parsed = parse(mid.as_bytes(), "g.obj").unwrap();
         assert_eq!(parsed.triangles.len(), 399);
         let w = parsed.warnings.join("\n");
         assert!(
-            w.contains(&format!(
-                "its last line ({lines}), a face, ends without a line end, as a file cut in \
-                 the middle of a line does: that face was left out, since a cut index names \
-                 another vertex"
+            w.contains("are used by no face")
+                && w.contains(&format!(
+                    "; its last line ({lines}), a face, ends without a line end, as a file \
+                     cut in the middle of a line does, and has an edge 12.8 long (in the \
+                     file's units), 9 times the median of the other faces' longest edges \
+                     (1.41): that face was left out, since a cut index names another vertex"
+                )),
+            "{w}"
+        );
+        // The same file cut at the end of that line keeps the face: it is
+        // no needle (it was left out when the file was said to be cut).
+        let parsed = parse(cut.trim_end().as_bytes(), "g.obj").unwrap();
+        assert_eq!(parsed.triangles.len(), 400);
+        let w = parsed.warnings.join("\n");
+        assert!(
+            w.contains("are used by no face") && !w.contains("left out"),
+            "{w}"
+        );
+        // A whole file without a line end at its end keeps its last face.
+        let unended = whole.trim_end();
+        let parsed = parse(unended.as_bytes(), "g.obj").unwrap();
+        let all = parse(whole.as_bytes(), "g.obj").unwrap().triangles.len();
+        assert_eq!(parsed.triangles.len(), all);
+        assert!(parsed.warnings.is_empty(), "{:?}", parsed.warnings);
+        // Cut inside its last face line with too few vertices left unused
+        // to say so (`f 379 400 39` of `f 379 400 399`): the needle is
+        // left out all the same, and said.
+        let parsed = parse(&unended.as_bytes()[..unended.len() - 1], "g.obj").unwrap();
+        assert_eq!(parsed.triangles.len(), all - 1);
+        let w = parsed.warnings.join("\n");
+        assert!(
+            w.starts_with(&format!("g.obj: its last line ({}), a face, ", lines + 322))
+                && w.contains("that face was left out")
+                && w.ends_with(
+                    "; if the file was cut short, faces are missing after it: read it again \
+                     from the scanner's export"
+                ),
+            "{w}"
+        );
+        // Cut so that the face no longer reads (`f 379 40`): left out, and
+        // said why.
+        let parsed = parse(&unended.as_bytes()[..unended.len() - 5], "g.obj").unwrap();
+        assert_eq!(parsed.triangles.len(), all - 1);
+        let w = parsed.warnings.join("\n");
+        assert!(
+            w.starts_with(&format!(
+                "g.obj: its last line ({}) ends without a line end, as a file cut in the \
+                 middle of a line does, and does not read (face has 2 vertices, needs at least \
+                 3): it was left out; if the file was cut short",
+                lines + 322
             )),
             "{w}"
         );
-        let unended = whole.trim_end();
-        let parsed = parse(unended.as_bytes(), "g.obj").unwrap();
-        assert_eq!(
-            parsed.triangles.len(),
-            parse(whole.as_bytes(), "g.obj").unwrap().triangles.len()
+        // The same line ended is an error, as any face that does not read;
+        // a cut vertex line, which leaves no face to follow, is refused,
+        // saying it may be cut.
+        let e = parse(
+            format!("{}\n", &unended[..unended.len() - 5]).as_bytes(),
+            "g.obj",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.ends_with("face has 2 vertices, needs at least 3"), "{e}");
+        let e = parse(&whole.as_bytes()[..30], "g.obj")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "g.obj:4: vertex has 2 coordinate(s), needs x y z (the file ends in \
+                 this line, without a line end: was it cut short?)"
+            ),
+            "{e}"
         );
-        assert!(parsed.warnings.is_empty(), "{:?}", parsed.warnings);
         let stray = format!("{whole}v 100 100 100\nv 200 200 200\n");
         assert!(parse(stray.as_bytes(), "g.obj")
             .unwrap()
