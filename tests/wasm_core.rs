@@ -767,16 +767,25 @@ fn a_scan_too_large_in_its_units_is_told_them_whatever_refuses_it() {
     let err = session
         .plan_live(js(&settings.plan), "marlin", false, None, false, None)
         .expect_err("a scan seen edge-on is refused");
-    let (message, _) = message_and_kind(&err);
-    assert!(
-        message.contains("seen edge-on from above")
-            && message.contains(
-                "the scan is larger than the build volume of profile marlin (x 1000.0 mm, the \
-                 volume 220.0 mm), read in metres: in centimetres it would be 10.0 x 0.0 x 10.0 \
-                 mm (--scan-units cm)"
-            ),
-        "{message}"
-    );
+    let advised = |err: &JsValue| {
+        let (message, _) = message_and_kind(err);
+        assert!(
+            message.contains("seen edge-on from above")
+                && message.contains(
+                    "the scan is larger than the build volume of profile marlin (x 1000.0 mm, \
+                     the volume 220.0 mm), read in metres: in centimetres it would be 10.0 x \
+                     0.0 x 10.0 mm (--scan-units cm)"
+                ),
+            "{message}"
+        );
+    };
+    advised(&err);
+    // The comparison's refusal says the same (marlin when no profile is
+    // named).
+    let err = session
+        .compare(svg.as_bytes(), "line.svg", js(&settings.plan), None, None)
+        .expect_err("a scan seen edge-on is refused");
+    advised(&err);
 }
 
 #[wasm_bindgen_test]

@@ -759,15 +759,26 @@ impl Session {
     }
 
     /// Every planner's quality and motion summaries side by side
-    /// ([`job::compare_on`]).
+    /// ([`job::compare_on`]). A refusal of a scan implausibly large in
+    /// its units carries the units advice for the machine profile
+    /// `dialect` (a built-in name or a profile's JSON text, `profile_file`
+    /// naming it; marlin when not given), as [`Session::plan_live`]'s and
+    /// `pcpp compare`'s do.
     pub fn compare(
         &self,
         svg: &[u8],
         svg_name: &str,
         settings: JsValue,
+        dialect: Option<String>,
+        profile_file: Option<String>,
     ) -> Result<JsValue, JsValue> {
         let settings: PlanSettings = from_js("plan settings", settings)?;
-        let comparison = job::compare_on(&self.scan, svg, svg_name, &settings).map_err(core_err)?;
+        let profile = profile(
+            dialect.as_deref().unwrap_or("marlin"),
+            profile_file.as_deref(),
+        )?;
+        let comparison = job::compare_on(&self.scan, svg, svg_name, &settings)
+            .map_err(|e| core_err(job::with_units_hint(e, &self.scan, &profile)))?;
         to_js(&comparison.rows).map_err(JsValue::from)
     }
 }
