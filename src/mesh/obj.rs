@@ -93,10 +93,6 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
         last_face: (0, 0),
         others: Others::default(),
     };
-    // A batch of lines per call: V8 runs a long wasm call in its baseline
-    // tier to its end and tiers a function up only for its later calls (see
-    // `job::hash_in_pieces`), so one call over the whole file would read
-    // it all in the baseline tier.
     // A file cut in the middle of its last line (an interrupted copy or
     // download) ends without a line end, and what is left of that line
     // may not read (`f 12/` of `f 12/40/12`) or may name other vertices
@@ -108,6 +104,10 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
     // have been cut.
     let cut_inside = !bytes.ends_with(b"\n") && !bytes.ends_with(b"\r");
     let mut unread = None;
+    // A batch of lines per call: V8 runs a long wasm call in its baseline
+    // tier to its end and tiers a function up only for its later calls (see
+    // `job::hash_in_pieces`), so one call over the whole file would read
+    // it all in the baseline tier.
     while p.cur.pos < bytes.len() {
         if let Err(e) = p.lines(LINES_PER_CALL) {
             // The cursor is still on the line that failed.
