@@ -464,24 +464,32 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
     // first of them starts (the white shapes' subpaths end there).
     let mut painted: Option<(usvg::Rect, usize)> = None;
     // Each node with whether an ancestor group is fully transparent
-    // (`opacity="0"`: it draws nothing) and the clips and masks of its
-    // ancestors: each the canvas rectangle it keeps, where it is one
-    // ([`clip_rect`]), else `None` (it may cut any shape under it).
+    // (`opacity="0"`: it draws nothing), the clips and masks of its
+    // ancestors (each the canvas rectangle it keeps, where it is one
+    // ([`clip_rect`]), else `None`: it may cut any shape under it) and its
+    // parent's frame (the canvas transform of the parent's content).
     type Clips = Vec<Option<usvg::Rect>>;
-    let mut stack: Vec<(&usvg::Node, bool, Clips)> = tree
+    let root_frame = tree.root().abs_transform();
+    let mut stack: Vec<(&usvg::Node, bool, Clips, usvg::Transform)> = tree
         .root()
         .children()
         .iter()
         .rev()
-        .map(|n| (n, false, Vec::new()))
+        .map(|n| (n, false, Vec::new(), root_frame))
         .collect();
-    while let Some((node, transparent, clips)) = stack.pop() {
+    while let Some((node, transparent, clips, parent)) = stack.pop() {
         let path = match node {
             usvg::Node::Group(g) => {
                 let transparent = transparent || g.opacity().get() <= 0.0;
+                // The group's own frame from its parent's: usvg 0.49 sets
+                // the `abs_transform` of the clipped group it makes for a
+                // `<use>` of a symbol to its parent's, without the use's
+                // `transform` (QA round 23 F1: the symbol's viewport clip
+                // taken 50 units off, and the cut shape not said).
+                let frame = parent.pre_concat(g.transform());
                 let mut clips = clips;
                 if g.clip_path().is_some() {
-                    clips.push(clip_rect(g));
+                    clips.push(clip_rect(g, frame));
                 }
                 if g.mask().is_some() {
                     clips.push(None);
@@ -490,7 +498,7 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
                     g.children()
                         .iter()
                         .rev()
-                        .map(|n| (n, transparent, clips.clone())),
+                        .map(|n| (n, transparent, clips.clone(), frame)),
                 );
                 continue;
             }
@@ -2949,8 +2957,9 @@ fn is_white(paint: &usvg::Paint) -> bool {
 /// The canvas rectangle that the clip path of group `g` keeps, where it is
 /// one rectangle without rotation or skew (a plotting program clips its
 /// lines to the axes so); `None` for any other clip, which may cut a shape
-/// anywhere.
-fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
+/// anywhere. `frame` is the canvas transform of the group's content, its
+/// transform included.
+fn clip_rect(g: &usvg::Group, frame: usvg::Transform) -> Option<usvg::Rect> {
     let clip = g.clip_path()?;
     if clip.clip_path().is_some() {
         return None;
@@ -2958,8 +2967,7 @@ fn clip_rect(g: &usvg::Group) -> Option<usvg::Rect> {
     let [usvg::Node::Path(p)] = clip.root().children() else {
         return None;
     };
-    let t = g
-        .abs_transform()
+    let t = frame
         .pre_concat(clip.transform())
         .pre_concat(p.abs_transform());
     if t.kx != 0.0 || t.ky != 0.0 {

@@ -1778,6 +1778,49 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
     );
 }
 
+/// QA round 23 F1: a symbol placed by `<use transform>` whose content runs
+/// outside its viewport was printed whole without the clip note (the
+/// viewer cuts it): usvg gives the clipped group it makes a frame without
+/// the use's transform, so the viewport was taken 50 units off: it held
+/// the shape on a 300 unit page, and on a 100 unit one a shape it holds
+/// was said to be cut. The same symbol placed by `x` and `y`, and a clip
+/// on a translated group of one's own, were already said.
+#[test]
+fn regression_a_symbol_placed_by_a_use_transform_is_said_to_be_clipped() {
+    for (label, body) in [
+        (
+            "use transform",
+            r##"<use href="#s" transform="translate(50,50)"/>"##,
+        ),
+        ("use x y", r##"<use href="#s" x="50" y="50"/>"##),
+        (
+            "group",
+            r##"<g transform="translate(50,50)" clip-path="url(#c)"><rect id="r" x="-20" y="-10" width="120" height="120" fill="none" stroke="black"/></g>"##,
+        ),
+    ] {
+        let (subs, notes) = notes_of(&doc(
+            r#"width="300mm" height="300mm" viewBox="0 0 300 300""#,
+            &format!(
+                r##"<defs><clipPath id="c"><rect width="300" height="300"/></clipPath>
+                   <symbol id="s"><rect id="r" x="-20" y="-10" width="120" height="120" fill="none" stroke="black"/></symbol></defs>
+                   {body}"##
+            ),
+        ));
+        assert_eq!(subs.len(), 1, "{label}: {subs:?}");
+        let note = note_with(&notes, "clipped or masked");
+        assert!(note.starts_with("1 shape(s)"), "{label}: {note}");
+    }
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r##"<defs><symbol id="s"><rect x="20" y="10" width="60" height="60" fill="none" stroke="black"/></symbol></defs>
+           <use href="#s" transform="translate(50,50)"/>"##,
+    ));
+    assert!(
+        notes.iter().all(|n| !n.contains("clipped or masked")),
+        "{notes:?}"
+    );
+}
+
 /// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
 /// utf-8 sequence of 1 bytes from index 0)", then refused with "save it as
 /// UTF-8"; its byte-order mark says how to read it, and it is read.
