@@ -931,8 +931,18 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
         format!(
             "{}; G [{}]",
             report.registration.status,
+            // The rotation to 12 decimals and the translation to 6 (mm):
+            // the placement it records reproduces to 0.00001 mm however far
+            // from the origin the scan lies (QA round 23 F6: 6 decimals
+            // put a scan in UTM coordinates, 5.4e6 mm out, 15 mm off).
             m.iter()
-                .map(|r| r.iter().map(|&v| fixed(v, 6)).collect::<Vec<_>>().join(" "))
+                .map(|r| {
+                    r.iter()
+                        .enumerate()
+                        .map(|(k, &v)| fixed(v, if k < 3 { 12 } else { 6 }))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                })
                 .collect::<Vec<_>>()
                 .join("; ")
         ),
@@ -3208,6 +3218,47 @@ mod tests {
         );
     }
 
+    /// QA round 23 F6: the header's G, at 6 decimals, put a scan in UTM
+    /// coordinates (5.4e6 mm from the origin, turned by 37 degrees) 15 mm
+    /// from where it was planned; read back, it now places such a point
+    /// within 0.00001 mm.
+    #[test]
+    fn the_headers_g_reproduces_a_placement_far_from_the_origin() {
+        let (scan, settings, svg) = stepped_block();
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
+            .unwrap()
+            .report;
+        let (c, s) = (37f64.to_radians().cos(), 37f64.to_radians().sin());
+        let m = [
+            [c, -s, 0.0, 2841467.312091],
+            [s, c, 0.0, -4313562.987654],
+            [0.0, 0.0, 1.0, -401.25],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        report.registration.matrix = m;
+        let header: String = provenance(&report)
+            .iter()
+            .map(|(k, v)| format!("{k}: {v}\n"))
+            .collect();
+        let g = header.split("G [").nth(1).and_then(|t| t.split(']').next());
+        let read: Vec<Vec<f64>> = g
+            .unwrap_or_else(|| panic!("{header}"))
+            .split("; ")
+            .map(|r| r.split(' ').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        let p = [1_250_000.5, 5_403_125.5, 12.0, 1.0];
+        let apply = |m: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+            (0..3)
+                .map(|i| (0..4).map(|k| m(i, k) * p[k]).sum())
+                .collect()
+        };
+        let (want, got) = (apply(&|i, k| m[i][k]), apply(&|i, k| read[i][k]));
+        for (w, g) in want.iter().zip(&got) {
+            assert!((w - g).abs() < 1e-5, "{want:?} {got:?}: {header}");
+        }
+    }
+
     /// The header printed `-0.000000` in G and `mean e- -0.0000 mm` for
     /// rounding noise (found by a QA run). The placement is written exactly
     /// (shortest round trip), so that `--place` with it plans the same
@@ -3222,7 +3273,7 @@ mod tests {
         report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, -0.0);
         report.settings.placement.scale = 0.8582695662780906;
         report.settings.placement.rotation_deg = 30.0;
-        report.registration.matrix[0][2] = -1e-9;
+        report.registration.matrix[0][2] = -1e-13;
         report.registration.rms_mm = -1e-9;
         report.quality.mean_negative_error_mm = -1e-7;
         let header: String = provenance(&report)
@@ -3237,7 +3288,7 @@ mod tests {
             "{header}"
         );
         assert!(
-            header.contains("G [1.000000 0.000000 0.000000 "),
+            header.contains("G [1.000000000000 0.000000000000 0.000000000000 "),
             "{header}"
         );
         assert!(header.contains("rms 0.0000 mm"), "{header}");

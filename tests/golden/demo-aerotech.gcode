@@ -6,7 +6,7 @@
 ' process: tol 0.1 mm, speed 5 mm/s, dwell 0 s
 ' placement: offset (0, 80) mm, rotation 0 deg, scale 1
 ' planner: even
-' registration: unregistered, taken as it is (the scan's frame is the printer's); G [1.000000 0.000000 0.000000 0.000000; 0.000000 1.000000 0.000000 0.000000; 0.000000 0.000000 1.000000 0.000000; 0.000000 0.000000 0.000000 1.000000]
+' registration: unregistered, taken as it is (the scan's frame is the printer's); G [1.000000000000 0.000000000000 0.000000000000 0.000000; 0.000000000000 1.000000000000 0.000000000000 0.000000; 0.000000000000 0.000000000000 1.000000000000 0.000000; 0.000000000000 0.000000000000 0.000000000000 1.000000]
 ' residuals: [] mm, rms 0.0000 mm
 ' path: 6 piece(s), 1362 points, 457.592 mm, height change 4.504 mm, max inclination 86.9 deg, min radius 0.145 mm, print time 91.5 s
 ' predicted quality: mean |e| 0.0110 mm, mean e- -0.0043 mm, mean e+ 0.0225 mm, contact 0.00%, flattening 0.44%, floating 1.76% (section 7, at the 1362 planned points, not the 70 waypoint(s), with contact also where the nozzle's body or a straight move meets the part; the tip up to 0.091 mm off the drawn line, stepped sideways or leading its point round a corner, which section 7 does not see)
