@@ -532,18 +532,30 @@ fn scan(line: &str, words: &mut Vec<Word>) -> Result<(Shape, bool), GcodeLinePro
     // Until the first word (line numbers aside), a token that is not a word
     // makes the whole line a statement of another language.
     let mut first = true;
+    // Where the last comment closed: a `)` right after it, with nothing
+    // but spaces between, closes a nested one (Skeinforge's `(<rotation>
+    // (6.12e-17+1j) )`, QA round 23 F4); no reader finds a word there,
+    // whether comments nest for it or not.
+    let mut closed = None;
     loop {
         i = skip_space(b, i);
         let Some(&c) = b.get(i) else { break };
         match c {
             b'(' => match b[i + 1..].iter().position(|&x| x == b')') {
-                Some(k) => i += k + 2,
+                Some(k) => {
+                    i += k + 2;
+                    closed = Some(i);
+                }
                 None => {
                     return Err(P::UnclosedComment {
                         column: column(line, i),
                     })
                 }
             },
+            b')' if closed.is_some_and(|e| b[e..i].iter().all(u8::is_ascii_whitespace)) => {
+                i += 1;
+                closed = Some(i);
+            }
             b')' => {
                 return Err(P::StrayParenthesis {
                     column: column(line, i),
@@ -2243,6 +2255,10 @@ mod tests {
             ("G20\nG1 X39371\n", "line 2: `X39371` at column 4 is 1000023."),
             ("G1 X1 (comment\n", "line 1: the comment opened by `(` at column 7 is not closed"),
             ("G1 X1 comment)\n", "line 1: `)` at column 14 closes no comment"),
+            // A nested comment closes only where nothing but spaces lies
+            // between (QA round 23 F4): here `G1 X5` would be read by a
+            // controller whose comments do not nest.
+            ("(a (b) G1 X5 )\n", "line 1: `)` at column 14 closes no comment"),
             ("\n; header\nX1 Y2\n", "line 3: `X1` at column 1 moves before any motion mode is set"),
             ("G0 X1\nG80\nY1\n", "line 3: `Y1` at column 1 moves before any motion mode"),
             ("G1 X1 X2\n", "line 1: `X` appears twice on this line (again at column 7)"),
@@ -2293,7 +2309,7 @@ mod tests {
     fn comments_separators_and_line_endings() {
         let plain = read("G90\nG0 X0 Y0 Z0\nG1 X1 Y2 Z.5\nG1 X-1.5\n");
         let variants = [
-            "%\nG90\r\nG0 X0 Y0 Z0 ; rise\r\n(comment) G1 X1 (mid) Y2 Z.5\r\n\r\nG1 X-1.5\r\n%\n",
+            "%\n(<rotation> (6.12e-17+1j) )\r\nG90\r\nG0 X0 Y0 Z0 ; rise\r\n(comment) G1 X1 (mid) Y2 Z.5\r\n\r\nG1 X-1.5 (a ((b)  ) )\r\n%\n",
             "g90\rG0X0Y0Z0\rG1X1Y2Z0.5'aerotech\rg1 x -1.5\r",
             "N10 G90\nN20 G0 X0 Y0 Z0 F300 S1 T0 P1\nN30 G1 X+1 Y2. Z.5 // aerotech\n\nN40 G1 X-1.5 E3\n",
             "\u{feff}G90\n\n  \t\nG0 X 0 Y 0 Z 0\nG01 X1 Y2 Z0.5 (a ; inside) ; (unbalanced in a ; comment\nX-1.5 ' in G1 mode\n",
