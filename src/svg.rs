@@ -2635,6 +2635,35 @@ fn prepare(text: &str) -> Result<Prepared, String> {
             "{markers} marker definition(s) ignored: markers decorate a path and are not printed"
         ));
     }
+    // A `<use>` of another file's element (an icon sprite sheet's symbol,
+    // as bootstrap-icons documents it) or of an id the drawing does not
+    // have draws nothing: usvg drops it without a word (QA round 23 F2).
+    let dangling: Vec<(roxmltree::Node, &str)> = root
+        .descendants()
+        .filter(|n| n.is_element() && is_svg(n) && n.tag_name().name() == "use")
+        .filter(|n| n.range().start >= root_start && !in_marker(n))
+        .map(|n| {
+            let href = n.attribute("href").or(n.attribute((XLINK_NS, "href")));
+            (n, href.unwrap_or("").trim())
+        })
+        .filter(|(_, href)| {
+            href.strip_prefix('#')
+                .is_none_or(|id| !existing.contains(id))
+        })
+        .collect();
+    if let Some(&(first, href)) = dangling.first() {
+        let why = match href {
+            "" => "no href".to_string(),
+            h if h.starts_with('#') => format!("href=\"{h}\", an id this drawing does not have"),
+            h => format!("href=\"{h}\", in another file, which is not read"),
+        };
+        notes.push(format!(
+            "{} <use>(s) refer to nothing in this drawing, so nothing is printed for them (the \
+             first, line {}: {why}); copy the element each one names into this drawing",
+            dangling.len(),
+            doc.text_pos_at(first.range().start).row
+        ));
+    }
 
     edits.sort_by_key(|e| e.0);
     let mut out = String::with_capacity(text.len() + edits.len() * 24);

@@ -1821,6 +1821,45 @@ fn regression_a_symbol_placed_by_a_use_transform_is_said_to_be_clipped() {
     );
 }
 
+/// QA round 23 F2: a `<use>` of an icon sprite sheet's symbol in another
+/// file (as bootstrap-icons documents it), or of an id the drawing does
+/// not have, drew nothing without a word; it is said, with the first's
+/// line and href. A `<use>` that resolves is printed and not said.
+#[test]
+fn regression_a_use_of_nothing_in_the_drawing_is_said() {
+    let (subs, notes) = notes_of(&doc(
+        MM,
+        r##"<defs><path id="line" d="M 10 10 L 40 10" stroke="black"/></defs>
+<use href="../icons/sprite.svg#heart"/>
+<use href="#gone"/>
+<use href="#line" y="20"/>"##,
+    ));
+    assert_eq!(subs.len(), 1, "{subs:?}");
+    let note = note_with(&notes, "<use>(s) refer to nothing");
+    assert!(
+        note.starts_with("2 <use>(s) refer to nothing in this drawing, so nothing is printed")
+            && note.contains(
+                "(the first, line 2: href=\"../icons/sprite.svg#heart\", in another file, which \
+                 is not read)"
+            ),
+        "{note}"
+    );
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r##"<use href="#gone"/><path d="M 0 0 L 9 9" stroke="black"/>"##,
+    ));
+    assert!(
+        note_with(&notes, "<use>(s) refer")
+            .contains("href=\"#gone\", an id this drawing does not have"),
+        "{notes:?}"
+    );
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r##"<defs><path id="line" d="M 10 10 L 40 10" stroke="black"/></defs><use xlink:href="#line" xmlns:xlink="http://www.w3.org/1999/xlink"/>"##,
+    ));
+    assert!(notes.iter().all(|n| !n.contains("<use>")), "{notes:?}");
+}
+
 /// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
 /// utf-8 sequence of 1 bytes from index 0)", then refused with "save it as
 /// UTF-8"; its byte-order mark says how to read it, and it is read.
