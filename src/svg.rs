@@ -477,6 +477,22 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
         .rev()
         .map(|n| (n, false, Vec::new(), root_frame))
         .collect();
+    // The page's colour, where the root sets one: usvg's first path, a
+    // filled rectangle with no id (every shape of the drawing has one).
+    let page_colour = match tree.root().children().first() {
+        Some(usvg::Node::Group(g)) if prepared.page_colour => match g.children().first() {
+            Some(usvg::Node::Path(p))
+                if p.id().is_empty()
+                    && p.fill().is_some()
+                    && p.stroke().is_none()
+                    && p.data().len() == 5 =>
+            {
+                Some(&**p)
+            }
+            _ => None,
+        },
+        _ => None,
+    };
     while let Some((node, transparent, clips, parent)) = stack.pop() {
         let path = match node {
             usvg::Node::Group(g) => {
@@ -507,6 +523,14 @@ pub fn import_svg_with_notes(bytes: &[u8], file: &str) -> Result<SvgImport, SvgE
             // options): `prepare` counts them.
             _ => continue,
         };
+        if page_colour.is_some_and(|c| std::ptr::eq(c, &**path)) {
+            notes.push(
+                "the root <svg>'s background-color is not printed: it colours the page, it is \
+                 no shape"
+                    .into(),
+            );
+            continue;
+        }
         shapes_read += 1;
         let id = path.id();
         if id.starts_with(prepared.copy_prefix.as_str()) {
@@ -1159,6 +1183,10 @@ struct Prepared {
     missing_size: Vec<&'static str>,
     /// [`RootSize::px_scale`].
     px_scale: f64,
+    /// The root sets a `background-color`, which usvg draws as a rectangle
+    /// over the viewBox, the first child of its root group: a page's
+    /// colour, not ink (QA round 23 F3).
+    page_colour: bool,
     /// The factor on the page's width and height in mm: `px_scale` where
     /// the root gives that side in px (unitless, px, a percentage, or not
     /// at all), 1 where it gives it in an absolute unit (QA round 11 L2:
@@ -2701,6 +2729,14 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         percent_size: root_size.percent,
         missing_size: root_size.missing,
         px_scale: root_size.px_scale,
+        page_colour: root.attribute("background-color").is_some()
+            || root.attribute("style").is_some_and(|style| {
+                style.split(';').any(|d| {
+                    d.split(':')
+                        .next()
+                        .is_some_and(|k| k.trim() == "background-color")
+                })
+            }),
         page_px_scale: ["width", "height"].map(|name| {
             let absolute = root.attribute(name).and_then(root_length).is_some_and(|l| {
                 use svgtypes::LengthUnit as U;

@@ -1860,6 +1860,41 @@ fn regression_a_use_of_nothing_in_the_drawing_is_said() {
     assert!(notes.iter().all(|n| !n.contains("<use>")), "{notes:?}");
 }
 
+/// QA round 23 F3: the root's `background-color` (resvg's own test) was
+/// printed as a rectangle round the page, named 'use instance'. A page's
+/// colour is no shape: left out, with a note; the shapes are printed, and
+/// a root without one is read as before.
+#[test]
+fn regression_the_pages_background_colour_is_not_printed() {
+    let body =
+        r#"<rect id="rect1" x="20" y="20" width="60" height="60" fill="none" stroke="green"/>"#;
+    for root in [
+        r#"style="background-color: #0000ff80;""#,
+        r#"style="fill:none; background-color : red""#,
+        r#"background-color="white""#,
+    ] {
+        let (subs, notes) = notes_of(&doc(&format!("{MM} {root}"), body));
+        assert_eq!(sources(&subs), ["rect1"], "{root}");
+        let note = note_with(&notes, "background-color");
+        assert!(
+            note.starts_with("the root <svg>'s background-color is not printed"),
+            "{root}: {note}"
+        );
+    }
+    // None (CSS names are lower case), and an id-less shape first (a
+    // `<use>`'s) under a root group of usvg's: printed, not said.
+    for root in ["", r#"style="BACKGROUND-COLOR: red""#] {
+        let (subs, notes) = notes_of(&doc(
+            &format!(r#"width="100mm" height="100mm" viewBox="0 0 50 50" {root}"#),
+            &format!(
+                r##"<defs><rect id="pad" width="5" height="5" fill="blue"/></defs><use href="#pad"/>{body}"##
+            ),
+        ));
+        assert_eq!(subs.len(), 2, "{root}: {subs:?}");
+        assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+    }
+}
+
 /// A UTF-16 SVG (Windows tools write them) was "not UTF-8 text (invalid
 /// utf-8 sequence of 1 bytes from index 0)", then refused with "save it as
 /// UTF-8"; its byte-order mark says how to read it, and it is read.
