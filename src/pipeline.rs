@@ -387,6 +387,12 @@ pub fn surface_path(
             return Err(Error::NoPath);
         }
         let inside = lo.x <= shi.x && hi.x >= slo.x && lo.y <= shi.y && hi.y >= slo.y;
+        // The drawing's box holds the scan's: within the nozzle's radius
+        // of the scan's extent counts as beyond it (QA round 23 F5: sides
+        // 0.005 mm inside a part's extent, beside its rounded ends).
+        let r = 0.5 * nozzle.outer_diameter_mm;
+        let around =
+            lo.x <= slo.x + r && hi.x >= shi.x - r && lo.y <= slo.y + r && hi.y >= shi.y - r;
         // Thin along X only (a bar or needle thin both ways may lie down
         // under another up axis: a review's 0.5 x 0.6 x 50 mm one did).
         let faces_x = foot.x < EDGE_ON_SHARE * foot.y;
@@ -435,7 +441,7 @@ pub fn surface_path(
                     ""
                 }
             )
-        } else if any_sample && lo.x <= slo.x && hi.x >= shi.x && lo.y <= slo.y && hi.y >= shi.y {
+        } else if any_sample && around {
             // Around the whole scan: larger than it, which no offset
             // mends (QA round 16 F3: a 20 mm outline scaled x3 around a
             // 4.2 mm plate was told to move onto the surface, 0 mm away).

@@ -567,6 +567,35 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
             && !e.contains("move the drawing onto the surface"),
         "{e}"
     );
+    // A square whose sides pass a diamond's corners 0.005 mm inside its
+    // extent (QA round 23 F5: a drawing as wide as the part was told it
+    // lay over the scan's holes, 0.000 mm from its surface): around the
+    // scan all the same, within the nozzle's radius.
+    let diamond = Surface::new(TriMesh {
+        vertices: vec![
+            DVec3::new(20.0, 20.0, 0.0),
+            DVec3::new(15.0, 20.0, 0.0),
+            DVec3::new(20.0, 15.0, 0.0),
+            DVec3::new(25.0, 20.0, 0.0),
+            DVec3::new(20.0, 25.0, 0.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+    })
+    .unwrap();
+    let (a, b) = (DVec2::new(15.005, 9.7), DVec2::new(24.995, 30.3));
+    let beside = [
+        line(a, DVec2::new(b.x, a.y)),
+        line(DVec2::new(b.x, a.y), b),
+        line(b, DVec2::new(a.x, b.y)),
+        line(DVec2::new(a.x, b.y), a),
+    ];
+    let e = pipeline::plan(&diamond, &beside, &settings)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("around the whole scan") && !e.contains("holes or gaps"),
+        "{e}"
+    );
     // Off the scan altogether: the placement is what to check.
     let off = [line(DVec2::new(50.0, 20.0), DVec2::new(60.0, 20.0))];
     let e = pipeline::plan(&plates, &off, &settings)
