@@ -292,13 +292,23 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<(Vec<DVec3>, Vec<String>
                     line.split(|c| c.is_ascii_whitespace())
                         .filter(|t| !t.is_empty()),
                 );
-                if toks.len() < tokens_per_point {
+                // Too few values or too many: the header does not describe
+                // the line (PCL skips such a point with a warning; a joined
+                // or damaged line, or a header that lost a field, would
+                // give points from the wrong values: QA round 23 F8).
+                if toks.len() != tokens_per_point {
                     return Err(syntax(
                         file,
                         line_no,
                         format!(
-                            "{} value(s) where the header's fields need {tokens_per_point}",
-                            toks.len()
+                            "{} value(s) where the header's fields need {tokens_per_point}{}",
+                            toks.len(),
+                            if toks.len() > tokens_per_point {
+                                ": a damaged line, or a header whose FIELDS, SIZE, TYPE and COUNT \
+                                 describe fewer values than the data holds"
+                            } else {
+                                ""
+                            }
                         ),
                     ));
                 }
@@ -610,6 +620,11 @@ pub(crate) mod tests {
             (
                 "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2\n",
                 "2 value(s)",
+            ),
+            // QA round 23 F8: too many values was read without a word.
+            (
+                "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 2\nDATA ascii\n1 2 3\n4 5 6 7 8 9\n",
+                "h.pcd:7: 6 value(s) where the header's fields need 3: a damaged line, or a header",
             ),
             (
                 "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA zip\n",
