@@ -3219,17 +3219,27 @@ mod tests {
         );
     }
 
+    /// The provenance header, one `key: value` line each, of the stepped
+    /// block's plan with its report changed by `edit`.
+    fn stepped_block_header(edit: impl FnOnce(&mut Report)) -> String {
+        let (scan, settings, svg) = stepped_block();
+        let profile = MachineProfile::builtin("marlin").unwrap();
+        let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
+            .unwrap()
+            .report;
+        edit(&mut report);
+        provenance(&report)
+            .iter()
+            .map(|(k, v)| format!("{k}: {v}\n"))
+            .collect()
+    }
+
     /// QA round 23 F6: the header's G, at 6 decimals, put a scan in UTM
     /// coordinates (5.4e6 mm from the origin, turned by 37 degrees) up to
     /// 2.7 mm from where it was planned; read back, it now places such a
     /// point within 0.00001 mm.
     #[test]
     fn the_headers_g_reproduces_a_placement_far_from_the_origin() {
-        let (scan, settings, svg) = stepped_block();
-        let profile = MachineProfile::builtin("marlin").unwrap();
-        let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
-            .unwrap()
-            .report;
         let (c, s) = (37f64.to_radians().cos(), 37f64.to_radians().sin());
         let m = [
             [c, -s, 0.0, 2841467.312091],
@@ -3237,11 +3247,7 @@ mod tests {
             [0.0, 0.0, 1.0, -401.25],
             [0.0, 0.0, 0.0, 1.0],
         ];
-        report.registration.matrix = m;
-        let header: String = provenance(&report)
-            .iter()
-            .map(|(k, v)| format!("{k}: {v}\n"))
-            .collect();
+        let header = stepped_block_header(|report| report.registration.matrix = m);
         let g = header.split("G [").nth(1).and_then(|t| t.split(']').next());
         let read: Vec<Vec<f64>> = g
             .unwrap_or_else(|| panic!("{header}"))
@@ -3266,21 +3272,14 @@ mod tests {
     /// G-code, and without a negative zero.
     #[test]
     fn the_header_rounds_placement_and_writes_no_negative_zero() {
-        let (scan, settings, svg) = stepped_block();
-        let profile = MachineProfile::builtin("marlin").unwrap();
-        let mut report = run_on(&scan, svg.as_bytes(), "p.svg", &settings, &profile, false)
-            .unwrap()
-            .report;
-        report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, -0.0);
-        report.settings.placement.scale = 0.8582695662780906;
-        report.settings.placement.rotation_deg = 30.0;
-        report.registration.matrix[0][2] = -1e-13;
-        report.registration.rms_mm = -1e-9;
-        report.quality.mean_negative_error_mm = -1e-7;
-        let header: String = provenance(&report)
-            .iter()
-            .map(|(k, v)| format!("{k}: {v}\n"))
-            .collect();
+        let header = stepped_block_header(|report| {
+            report.settings.placement.offset_mm = glam::DVec2::new(-6.467586450097912, -0.0);
+            report.settings.placement.scale = 0.8582695662780906;
+            report.settings.placement.rotation_deg = 30.0;
+            report.registration.matrix[0][2] = -1e-13;
+            report.registration.rms_mm = -1e-9;
+            report.quality.mean_negative_error_mm = -1e-7;
+        });
         assert!(
             header.contains(
                 "placement: offset (-6.467586450097912, 0) mm, rotation 30 deg, scale \

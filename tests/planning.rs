@@ -551,13 +551,16 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
     );
     // A square around both plates: larger than the scan, which no offset
     // mends (QA round 16 F3: told to move the drawing onto the surface).
-    let (a, b) = (DVec2::new(-5.0, -5.0), DVec2::new(45.0, 45.0));
-    let around = [
-        line(a, DVec2::new(b.x, a.y)),
-        line(DVec2::new(b.x, a.y), b),
-        line(b, DVec2::new(a.x, b.y)),
-        line(DVec2::new(a.x, b.y), a),
-    ];
+    // The four sides of the rectangle with corners a and b.
+    let square = |a: DVec2, b: DVec2| {
+        [
+            line(a, DVec2::new(b.x, a.y)),
+            line(DVec2::new(b.x, a.y), b),
+            line(b, DVec2::new(a.x, b.y)),
+            line(DVec2::new(a.x, b.y), a),
+        ]
+    };
+    let around = square(DVec2::new(-5.0, -5.0), DVec2::new(45.0, 45.0));
     let e = pipeline::plan(&plates, &around, &settings)
         .unwrap_err()
         .to_string();
@@ -582,13 +585,7 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
     })
     .unwrap();
-    let (a, b) = (DVec2::new(15.005, 9.7), DVec2::new(24.995, 30.3));
-    let beside = [
-        line(a, DVec2::new(b.x, a.y)),
-        line(DVec2::new(b.x, a.y), b),
-        line(b, DVec2::new(a.x, b.y)),
-        line(DVec2::new(a.x, b.y), a),
-    ];
+    let beside = square(DVec2::new(15.005, 9.7), DVec2::new(24.995, 30.3));
     let e = pipeline::plan(&diamond, &beside, &settings)
         .unwrap_err()
         .to_string();
