@@ -532,19 +532,25 @@ fn scan(line: &str, words: &mut Vec<Word>) -> Result<(Shape, bool), GcodeLinePro
     // Until the first word (line numbers aside), a token that is not a word
     // makes the whole line a statement of another language.
     let mut first = true;
-    // Where the last comment closed: a `)` right after it, with nothing
-    // but spaces between, closes a nested one (Skeinforge's `(<rotation>
-    // (6.12e-17+1j) )`, QA round 23 F4); no reader finds a word there,
-    // whether comments nest for it or not.
-    let mut closed = None;
+    // Where the last comment closed, and how many `(` it held past its
+    // first: on a line of comments alone, a `)` right after it, with
+    // nothing but spaces between, closes a nested one (Skeinforge's
+    // `(<rotation> (6.12e-17+1j) )`, QA round 23 F4), as many as it
+    // opened. Grbl and LinuxCNC refuse such a line, and Marlin ignores
+    // it: no controller moves on it. On a line with words it is an error
+    // (review: Grbl runs none of `G1 X5 (a) ) Y3`, which would be checked
+    // as a move).
+    let mut closed: Option<(usize, usize)> = None;
+    let mut nested: Option<usize> = None;
     loop {
         i = skip_space(b, i);
         let Some(&c) = b.get(i) else { break };
         match c {
             b'(' => match b[i + 1..].iter().position(|&x| x == b')') {
                 Some(k) => {
+                    let opened = b[i + 1..i + 1 + k].iter().filter(|&&x| x == b'(').count();
                     i += k + 2;
-                    closed = Some(i);
+                    closed = Some((i, opened));
                 }
                 None => {
                     return Err(P::UnclosedComment {
@@ -552,9 +558,14 @@ fn scan(line: &str, words: &mut Vec<Word>) -> Result<(Shape, bool), GcodeLinePro
                     })
                 }
             },
-            b')' if closed.is_some_and(|e| b[e..i].iter().all(u8::is_ascii_whitespace)) => {
+            b')' if words.is_empty()
+                && closed.is_some_and(|(e, open)| {
+                    open > 0 && b[e..i].iter().all(u8::is_ascii_whitespace)
+                }) =>
+            {
+                nested.get_or_insert(i);
+                closed = closed.map(|(_, open)| (i + 1, open - 1));
                 i += 1;
-                closed = Some(i);
             }
             b')' => {
                 return Err(P::StrayParenthesis {
@@ -624,10 +635,14 @@ fn scan(line: &str, words: &mut Vec<Word>) -> Result<(Shape, bool), GcodeLinePro
             }
         }
     }
-    let shape = if words.is_empty() {
-        Shape::Blank
-    } else {
-        Shape::Words
+    let shape = match (words.is_empty(), nested) {
+        (true, _) => Shape::Blank,
+        (false, Some(at)) => {
+            return Err(P::StrayParenthesis {
+                column: column(line, at),
+            })
+        }
+        (false, None) => Shape::Words,
     };
     Ok((shape, block_delete))
 }
@@ -2256,9 +2271,12 @@ mod tests {
             ("G1 X1 (comment\n", "line 1: the comment opened by `(` at column 7 is not closed"),
             ("G1 X1 comment)\n", "line 1: `)` at column 14 closes no comment"),
             // A nested comment closes only where nothing but spaces lies
-            // between (QA round 23 F4): here `G1 X5` would be read by a
-            // controller whose comments do not nest.
+            // between, as many as were opened, and on a line of comments
+            // alone (QA round 23 F4; review: Grbl runs none of these).
             ("(a (b) G1 X5 )\n", "line 1: `)` at column 14 closes no comment"),
+            ("(a) )\n", "line 1: `)` at column 5 closes no comment"),
+            ("G1 X5 (a (b) ) Y3\n", "line 1: `)` at column 14 closes no comment"),
+            ("(a (b) ) G1 X5\n", "line 1: `)` at column 8 closes no comment"),
             ("\n; header\nX1 Y2\n", "line 3: `X1` at column 1 moves before any motion mode is set"),
             ("G0 X1\nG80\nY1\n", "line 3: `Y1` at column 1 moves before any motion mode"),
             ("G1 X1 X2\n", "line 1: `X` appears twice on this line (again at column 7)"),
@@ -2309,7 +2327,7 @@ mod tests {
     fn comments_separators_and_line_endings() {
         let plain = read("G90\nG0 X0 Y0 Z0\nG1 X1 Y2 Z.5\nG1 X-1.5\n");
         let variants = [
-            "%\n(<rotation> (6.12e-17+1j) )\r\nG90\r\nG0 X0 Y0 Z0 ; rise\r\n(comment) G1 X1 (mid) Y2 Z.5\r\n\r\nG1 X-1.5 (a ((b)  ) )\r\n%\n",
+            "%\n(<rotation> (6.12e-17+1j) )\r\nG90\r\nG0 X0 Y0 Z0 ; rise\r\n(comment) G1 X1 (mid) Y2 Z.5\r\n\r\n(a ((b)  ) )\r\nG1 X-1.5\r\n%\n",
             "g90\rG0X0Y0Z0\rG1X1Y2Z0.5'aerotech\rg1 x -1.5\r",
             "N10 G90\nN20 G0 X0 Y0 Z0 F300 S1 T0 P1\nN30 G1 X+1 Y2. Z.5 // aerotech\n\nN40 G1 X-1.5 E3\n",
             "\u{feff}G90\n\n  \t\nG0 X 0 Y 0 Z 0\nG01 X1 Y2 Z0.5 (a ; inside) ; (unbalanced in a ; comment\nX-1.5 ' in G1 mode\n",
