@@ -98,11 +98,20 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
     // may not read (`f 12/` of `f 12/40/12`) or may name other vertices
     // (QA round 22 F4: `f 11604 11603 11` of `f 11604 11603 11536`, a
     // 98.6 mm needle through a bunny). Such a face line, after other
-    // faces, is left out, with a warning; a whole file may end without a
-    // line end too, so a last face that reads and is no needle is kept.
-    // Any other last line that does not read is refused, saying it may
-    // have been cut.
+    // faces, whose last word a cut can have left ([`cut_reference`]), is
+    // left out with a warning where it does not read, or where its last
+    // index may be cut ([`cut_index`]) and makes a needle; a whole file
+    // may end without a line end too, so any other last face is kept or
+    // refused as in any line. Any other last line that does not read is
+    // refused, saying it may have been cut.
     let cut_inside = !bytes.ends_with(b"\n") && !bytes.ends_with(b"\r");
+    let ends = |c: &u8| matches!(c, b'\n' | b'\r');
+    let last_word = |from: usize| {
+        let start = bytes[..from].iter().rposition(ends).map_or(0, |i| i + 1);
+        bytes[start..]
+            .split(u8::is_ascii_whitespace)
+            .rfind(|w| !w.is_empty())
+    };
     let mut unread = None;
     // A batch of lines per call: V8 runs a long wasm call in its baseline
     // tier to its end and tiers a function up only for its later calls (see
@@ -111,15 +120,15 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
     while p.cur.pos < bytes.len() {
         if let Err(e) = p.lines(LINES_PER_CALL) {
             // The cursor is still on the line that failed.
-            let ends = |c: &u8| matches!(c, b'\n' | b'\r');
             let last = cut_inside && !bytes[p.cur.pos..].iter().any(ends);
             let start = bytes[..p.cur.pos]
                 .iter()
                 .rposition(ends)
                 .map_or(0, |i| i + 1);
             let face = bytes[start..].trim_ascii_start().starts_with(b"f");
+            let cut = last && (!face || last_word(p.cur.pos).is_some_and(cut_reference));
             match e {
-                MeshError::Syntax { message, .. } if last && face && p.faces > 0 => {
+                MeshError::Syntax { message, .. } if cut && face && p.faces > 0 => {
                     unread = Some(message);
                     break;
                 }
@@ -127,7 +136,7 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
                     file,
                     line,
                     message,
-                } if last => {
+                } if cut => {
                     return Err(MeshError::Syntax {
                         file,
                         line,
@@ -148,7 +157,10 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
              does, and does not read ({why}): it was left out",
             p.line_no
         )),
-        None if cut_inside && face_line == p.line_no => {
+        None if cut_inside
+            && face_line == p.line_no
+            && last_word(bytes.len()).is_some_and(|w| cut_index(w, p.vertices.len())) =>
+        {
             needle(&p.vertices, &p.triangles[..before], &p.triangles[before..]).map(
                 |(longest, median)| {
                     p.triangles.truncate(before);
@@ -174,7 +186,8 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
         (Some(u), Some(c)) => vec![format!("{u}; {c}")],
         (None, Some(c)) => vec![format!(
             "{file}: {c}; if the file was cut short, faces are missing after it: read it again \
-             from the scanner's export"
+             from the scanner's export (if it is whole, end it with a line end to keep that \
+             line)"
         )],
         (u, None) => u.into_iter().collect(),
     };
@@ -330,6 +343,31 @@ fn unused_vertices(
             100.0 * share
         )
     })
+}
+
+/// Whether `word`, the last of a face line cut short, can be what a cut
+/// left of a vertex reference (`v`, `v/vt`, `v/vt/vn`, `v//vn`, `-v`):
+/// a sign, up to three slash-separated runs of digits, the first not
+/// starting with 0 (`f 1 2 abc` or `f 1 2 0` is no cut's remnant).
+fn cut_reference(word: &[u8]) -> bool {
+    let w = word.strip_prefix(b"-").unwrap_or(word);
+    let parts: Vec<&[u8]> = w.split(|&c| c == b'/').collect();
+    parts.len() <= 3
+        && parts.iter().all(|p| p.iter().all(u8::is_ascii_digit))
+        && parts[0].first() != Some(&b'0')
+}
+
+/// Whether `word`, the last of a face line cut short, can be a vertex
+/// index with digits cut off: no slash after it (which would end it
+/// whole), and short enough that a digit more still names one of the
+/// `vertices` (a cut leaves v / 10^k of v).
+fn cut_index(word: &[u8], vertices: usize) -> bool {
+    let digits = word.strip_prefix(b"-").unwrap_or(word);
+    !digits.contains(&b'/')
+        && std::str::from_utf8(digits)
+            .ok()
+            .and_then(|d| d.parse::<u64>().ok())
+            .is_some_and(|v| v.saturating_mul(10) <= vertices as u64)
 }
 
 /// How many times the median of a mesh's faces' longest edges a last
@@ -846,7 +884,8 @@ mod tests {
                 && w.contains("that face was left out")
                 && w.ends_with(
                     "; if the file was cut short, faces are missing after it: read it again \
-                     from the scanner's export"
+                     from the scanner's export (if it is whole, end it with a line end to keep \
+                     that line)"
                 ),
             "{w}"
         );
@@ -864,6 +903,19 @@ mod tests {
             )),
             "{w}"
         );
+        // A large last face whose last index no cut can have left (4000
+        // is not a tenth of at most 400 vertices, `4/` ends its vertex
+        // index) is kept (review: a hole's cap, a flat CAD face).
+        for tail in ["f 1 20 400", "f 20 400 1/"] {
+            let parsed = parse(format!("{whole}{tail}").as_bytes(), "g.obj").unwrap();
+            assert_eq!(parsed.triangles.len(), all + 1, "{tail}");
+            assert!(parsed.warnings.is_empty(), "{tail}: {:?}", parsed.warnings);
+        }
+        // A last word no cut leaves is an error, as on any line.
+        for tail in ["f 1 2 abc", "f 1 2 0"] {
+            let e = parse(format!("{whole}{tail}").as_bytes(), "g.obj").unwrap_err();
+            assert!(!e.to_string().contains("cut"), "{tail}: {e}");
+        }
         // The same line ended is an error, as any face that does not read;
         // a cut vertex line, which leaves no face to follow, is refused,
         // saying it may be cut.
