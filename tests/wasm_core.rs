@@ -786,6 +786,29 @@ fn a_scan_too_large_in_its_units_is_told_them_whatever_refuses_it() {
         .compare(svg.as_bytes(), "line.svg", js(&settings.plan), None, None)
         .expect_err("a scan seen edge-on is refused");
     advised(&err);
+    // A stray vertex is named before any planner runs, as by `pcpp
+    // compare` (review: the page's Session.compare planned on).
+    let axis: Vec<f64> = (0..11).map(|i| 10.0 + 4.0 * i as f64).collect();
+    let plate = pcpp::mesh::TriMesh::height_field(&axis, &axis, |x, y| {
+        if (x, y) == (30.0, 30.0) {
+            1e300
+        } else {
+            1.0
+        }
+    });
+    let mut settings = JobSettings::default();
+    settings.scan.units = Some(ScanUnits::Mm);
+    let obj = demo::workloads::to_obj(&plate);
+    let session = staged_session(obj.as_bytes(), "spike.obj", &settings);
+    let err = session
+        .compare(svg.as_bytes(), "line.svg", js(&settings.plan), None, None)
+        .expect_err("a stray vertex is refused");
+    let (message, _) = message_and_kind(&err);
+    assert!(
+        message.contains("because 1 vertex(es) lie far from the rest")
+            && !message.contains("edge-on"),
+        "{message}"
+    );
 }
 
 #[wasm_bindgen_test]

@@ -759,11 +759,12 @@ impl Session {
     }
 
     /// Every planner's quality and motion summaries side by side
-    /// ([`job::compare_on`]). A refusal of a scan implausibly large in
-    /// its units carries the units advice for the machine profile
-    /// `dialect` (a built-in name or a profile's JSON text, `profile_file`
-    /// naming it; marlin when not given), as [`Session::plan_live`]'s and
-    /// `pcpp compare`'s do.
+    /// ([`job::compare_on`]), for the machine profile `dialect` (a
+    /// built-in name or a profile's JSON text, `profile_file` naming it;
+    /// marlin when not given): as [`Session::plan_live`] and `pcpp
+    /// compare`, a scan whose stray vertices leave that profile's volume is
+    /// refused first, and a refusal of a scan implausibly large in its
+    /// units carries the units advice.
     pub fn compare(
         &self,
         svg: &[u8],
@@ -777,6 +778,7 @@ impl Session {
             dialect.as_deref().unwrap_or("marlin"),
             profile_file.as_deref(),
         )?;
+        job::refuse_blocking_strays(&self.scan, &profile).map_err(core_err)?;
         let comparison = job::compare_on(&self.scan, svg, svg_name, &settings)
             .map_err(|e| core_err(job::with_units_hint(e, &self.scan, &profile)))?;
         to_js(&comparison.rows).map_err(JsValue::from)
