@@ -2729,13 +2729,22 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         percent_size: root_size.percent,
         missing_size: root_size.missing,
         px_scale: root_size.px_scale,
-        page_colour: root.attribute("background-color").is_some()
-            || root.attribute("style").is_some_and(|style| {
-                style.split(';').any(|d| {
-                    d.split(':')
-                        .next()
-                        .is_some_and(|k| k.trim() == "background-color")
+        // As usvg reads it: the attribute, or the style's declaration,
+        // a colour (`none` or a paint server draws no rectangle).
+        page_colour: root
+            .attribute("style")
+            .and_then(|style| {
+                style.split(';').find_map(|d| {
+                    let (k, v) = d.split_once(':')?;
+                    (k.trim() == "background-color").then_some(v)
                 })
+            })
+            .or(root.attribute("background-color"))
+            .is_some_and(|v| {
+                matches!(
+                    svgtypes::Paint::from_str(v.trim()),
+                    Ok(svgtypes::Paint::Color(_))
+                )
             }),
         page_px_scale: ["width", "height"].map(|name| {
             let absolute = root.attribute(name).and_then(root_length).is_some_and(|l| {

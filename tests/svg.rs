@@ -1881,9 +1881,14 @@ fn regression_the_pages_background_colour_is_not_printed() {
             "{root}: {note}"
         );
     }
-    // None (CSS names are lower case), and an id-less shape first (a
-    // `<use>`'s) under a root group of usvg's: printed, not said.
-    for root in ["", r#"style="BACKGROUND-COLOR: red""#] {
+    // None (CSS names are lower case; `none` is no colour), and an
+    // id-less filled rectangle first (a `<use>`'s) under a root group of
+    // usvg's: printed, not said (review).
+    for root in [
+        "",
+        r#"style="BACKGROUND-COLOR: red""#,
+        r#"style="background-color: none""#,
+    ] {
         let (subs, notes) = notes_of(&doc(
             &format!(r#"width="100mm" height="100mm" viewBox="0 0 50 50" {root}"#),
             &format!(
