@@ -77,11 +77,11 @@ pub enum MeshError {
         line: Option<usize>,
         value: f64,
     },
-    /// A face refers to a vertex that does not exist.
+    /// A face or a strip record refers to a vertex that does not exist.
     #[error(
         "{file}{}: {} refers to vertex index {index}, but only {vertex_count} vertices are defined",
         line_suffix(*.line),
-        record(element, *.face)
+        record_name(element, *.record)
     )]
     IndexOutOfRange {
         file: String,
@@ -89,8 +89,8 @@ pub enum MeshError {
         /// `tristrips` (one record holds many strips).
         element: &'static str,
         /// The record as the file numbers it (0-based; OBJ names its line
-        /// instead).
-        face: usize,
+        /// instead): a face, or a strip record.
+        record: usize,
         line: Option<usize>,
         index: i64,
         vertex_count: usize,
@@ -191,7 +191,7 @@ impl MeshError {
 
 /// A record of a mesh's surface element as errors name it: "face 2", or
 /// "'tristrips' element 2" (a strip record is no face).
-fn record(element: &str, i: usize) -> String {
+fn record_name(element: &str, i: usize) -> String {
     if element == "face" {
         format!("face {i}")
     } else {
@@ -229,7 +229,7 @@ mod tests {
         let e = MeshError::IndexOutOfRange {
             file: "a.ply".into(),
             element: "face",
-            face: 2,
+            record: 2,
             line: None,
             index: 9,
             vertex_count: 4,

@@ -1308,7 +1308,7 @@ fn finish(
             return Err(MeshError::IndexOutOfRange {
                 file: file.into(),
                 element: "face",
-                face,
+                record: face,
                 line: None,
                 index: i64::from(bad),
                 vertex_count: n,

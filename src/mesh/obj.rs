@@ -514,7 +514,7 @@ impl Parser<'_> {
                 IndexError::Range(index) => MeshError::IndexOutOfRange {
                     file: file.into(),
                     element: "face",
-                    face: self.faces,
+                    record: self.faces,
                     line: Some(line_no),
                     index,
                     vertex_count: self.vertices.len(),

@@ -1072,7 +1072,7 @@ impl Body<'_> {
                 } else {
                     "face"
                 },
-                face,
+                record: face,
                 line,
                 index: value,
                 vertex_count: usize::try_from(self.vertex_count).unwrap_or(usize::MAX),
@@ -2577,7 +2577,7 @@ mod tests {
                 MeshError::IndexOutOfRange {
                     file: "s.ply".into(),
                     element: "tristrips",
-                    face: 1,
+                    record: 1,
                     line: Some(18),
                     index,
                     vertex_count: 6,
