@@ -2670,6 +2670,16 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         .descendants()
         .filter(|n| n.is_element() && is_svg(n) && n.tag_name().name() == "use")
         .filter(|n| n.range().start >= root_start && !in_marker(n))
+        // One inside a definition nothing refers to would draw nothing
+        // anyway (review).
+        .filter(|n| {
+            let defined = |a: &roxmltree::Node| {
+                a.is_element() && DEFINITION_CONTAINERS.contains(&a.tag_name().name())
+            };
+            !n.ancestors().any(|a| defined(&a))
+                || n.ancestors()
+                    .any(|a| a.attribute("id").is_some_and(|id| referenced.contains(id)))
+        })
         .map(|n| {
             let href = n.attribute("href").or(n.attribute((XLINK_NS, "href")));
             (n, href.unwrap_or("").trim())
@@ -2683,6 +2693,7 @@ fn prepare(text: &str) -> Result<Prepared, String> {
         let why = match href {
             "" => "no href".to_string(),
             h if h.starts_with('#') => format!("href=\"{h}\", an id this drawing does not have"),
+            h if h.starts_with("data:") => "a data: URL, which is not read".to_string(),
             h => format!("href=\"{h}\", in another file, which is not read"),
         };
         notes.push(format!(

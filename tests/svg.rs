@@ -1853,11 +1853,21 @@ fn regression_a_use_of_nothing_in_the_drawing_is_said() {
             .contains("href=\"#gone\", an id this drawing does not have"),
         "{notes:?}"
     );
+    // Resolved, or in a definition nothing uses (it draws nothing
+    // anyway: review): not said; in one that is used: said.
     let (_, notes) = notes_of(&doc(
         MM,
-        r##"<defs><path id="line" d="M 10 10 L 40 10" stroke="black"/></defs><use xlink:href="#line" xmlns:xlink="http://www.w3.org/1999/xlink"/>"##,
+        r##"<defs><path id="line" d="M 10 10 L 40 10" stroke="black"/><g id="unused"><use href="#gone"/></g></defs><use xlink:href="#line" xmlns:xlink="http://www.w3.org/1999/xlink"/>"##,
     ));
     assert!(notes.iter().all(|n| !n.contains("<use>")), "{notes:?}");
+    let (_, notes) = notes_of(&doc(
+        MM,
+        r##"<defs><g id="used"><path d="M 10 10 L 40 10" stroke="black"/><use href="data:image/svg+xml;base64,AAAA"/></g></defs><use href="#used"/>"##,
+    ));
+    assert!(
+        note_with(&notes, "<use>(s) refer").contains("a data: URL, which is not read"),
+        "{notes:?}"
+    );
 }
 
 /// QA round 23 F3: the root's `background-color` (resvg's own test) was
