@@ -448,8 +448,8 @@ pub fn surface_path(
             format!(
                 "no part of the path lies over the scan's surface: the path spans x \
                  {:.3}..{:.3}, y {:.3}..{:.3} mm, around the whole scan (x {:.3}..{:.3}, y \
-                 {:.3}..{:.3} mm, printer frame): the drawing as placed is larger than the scan, \
-                 and its lines pass beside it; scale the drawing down (a smaller SCALE in \
+                 {:.3}..{:.3} mm, printer frame): the drawing as placed is as large as the scan \
+                 or larger, and its lines pass beside it; scale the drawing down (a smaller SCALE in \
                  --place centre,ROT,SCALE)",
                 lo.x, hi.x, lo.y, hi.y, slo.x, shi.x, slo.y, shi.y
             )

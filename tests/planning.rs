@@ -590,7 +590,9 @@ fn a_drawing_of_dots_only_or_over_a_hole_says_so() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("around the whole scan") && !e.contains("holes or gaps"),
+        e.contains("around the whole scan")
+            && e.contains("as large as the scan or larger")
+            && !e.contains("holes or gaps"),
         "{e}"
     );
     // Off the scan altogether: the placement is what to check.
