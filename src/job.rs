@@ -932,10 +932,11 @@ pub fn provenance(report: &Report) -> Vec<(String, String)> {
             "{}; G [{}]",
             report.registration.status,
             // The rotation to 12 decimals and the translation to 6 (mm):
-            // the placement it records reproduces to 0.00001 mm however far
-            // from the origin the scan lies (QA round 23 F6: at 6
-            // decimals, a scan in UTM coordinates, 5.4e6 mm out, came
-            // 2.7 mm off, and a checker using G found moves 15 mm deep).
+            // the placement it records reproduces to 0.00001 mm for a scan
+            // within 20 km of the origin (5e-13 of its distance), where
+            // every scanner's frame lies (QA round 23 F6: at 6 decimals, a
+            // scan in UTM coordinates, 5.4e6 mm out, came 2.7 mm off, and
+            // a checker using G found moves 15 mm deep).
             m.iter()
                 .map(|r| {
                     r.iter()
