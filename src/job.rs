@@ -2569,15 +2569,21 @@ pub struct Comparison {
 }
 
 /// Every planner's summary side by side (the paper's Figure 3e-f, with
-/// our two guarded planners).
+/// our two guarded planners), for the machine `profile`: as [`run_on`], a
+/// scan whose stray vertices leave its volume is refused first, and a
+/// refusal of a scan implausibly large in its units carries the units
+/// advice ([`with_units_hint`]).
 pub fn compare_on(
     scan: &PreparedScan,
     svg: &[u8],
     svg_name: &str,
     settings: &PlanSettings,
+    profile: &MachineProfile,
 ) -> Result<Comparison> {
+    refuse_blocking_strays(scan, profile)?;
     let drawn = pipeline::load_path(svg, svg_name)?;
-    let plans = pipeline::compare(&scan.surface, &drawn.subpaths, settings)?;
+    let plans = pipeline::compare(&scan.surface, &drawn.subpaths, settings)
+        .map_err(|e| with_units_hint(e, scan, profile))?;
     let mut warnings = drawn.notes;
     for w in plans.iter().flat_map(|p| &p.warnings) {
         if !warnings.contains(w) {
@@ -3485,7 +3491,8 @@ mod tests {
             placement: test_part::placement(),
             ..Default::default()
         };
-        let c = compare_on(&scan, svg, "off.svg", &settings).unwrap();
+        let marlin = MachineProfile::builtin("marlin").unwrap();
+        let c = compare_on(&scan, svg, "off.svg", &settings, &marlin).unwrap();
         assert_eq!(c.rows.len(), PlannerKind::ALL.len());
         assert!(
             c.warnings.iter().any(|w| w.contains("off the scan")),

@@ -164,9 +164,16 @@ fn planners_compare_and_the_guarded_one_never_touches() {
     let svg = test_part::test_part_svg();
     let settings = golden_settings();
     let prepared = demo_prepared(&scan, &settings);
-    let rows = job::compare_on(&prepared, svg.as_bytes(), "lines.svg", &settings.plan)
-        .unwrap()
-        .rows;
+    let marlin = MachineProfile::builtin("marlin").unwrap();
+    let rows = job::compare_on(
+        &prepared,
+        svg.as_bytes(),
+        "lines.svg",
+        &settings.plan,
+        &marlin,
+    )
+    .unwrap()
+    .rows;
     let kinds: Vec<PlannerKind> = rows.iter().map(|r| r.planner).collect();
     assert_eq!(kinds, PlannerKind::ALL.to_vec());
     for guarded in &rows[3..] {
@@ -680,10 +687,16 @@ fn live_plan_writes_the_bytes_of_job_run_on_in_one_call() {
                 }
                 let rows: Vec<serde_json::Value> =
                     serde_wasm_bindgen::from_value(comparison).unwrap();
-                let want_rows =
-                    job::compare_on(&prepared, svg.as_bytes(), demo::DEMO_PATH_NAME, &plan)
-                        .unwrap()
-                        .rows;
+                let grbl = MachineProfile::builtin("grbl").unwrap();
+                let want_rows = job::compare_on(
+                    &prepared,
+                    svg.as_bytes(),
+                    demo::DEMO_PATH_NAME,
+                    &plan,
+                    &grbl,
+                )
+                .unwrap()
+                .rows;
                 assert_eq!(rows.len(), PlannerKind::ALL.len());
                 for (row, want) in rows.iter().zip(&want_rows) {
                     assert_eq!(row["planner"], want.planner.name());

@@ -759,12 +759,10 @@ impl Session {
     }
 
     /// Every planner's quality and motion summaries side by side
-    /// ([`job::compare_on`]), for the machine profile `dialect` (a
-    /// built-in name or a profile's JSON text, `profile_file` naming it;
-    /// marlin when not given): as [`Session::plan_live`] and `pcpp
-    /// compare`, a scan whose stray vertices leave that profile's volume is
-    /// refused first, and a refusal of a scan implausibly large in its
-    /// units carries the units advice.
+    /// ([`job::compare_on`], which refuses stray vertices and gives the
+    /// units advice as `pcpp compare` does), for the machine profile
+    /// `dialect` (a built-in name or a profile's JSON text, `profile_file`
+    /// naming it; marlin when not given).
     pub fn compare(
         &self,
         svg: &[u8],
@@ -778,9 +776,8 @@ impl Session {
             dialect.as_deref().unwrap_or("marlin"),
             profile_file.as_deref(),
         )?;
-        job::refuse_blocking_strays(&self.scan, &profile).map_err(core_err)?;
-        let comparison = job::compare_on(&self.scan, svg, svg_name, &settings)
-            .map_err(|e| core_err(job::with_units_hint(e, &self.scan, &profile)))?;
+        let comparison =
+            job::compare_on(&self.scan, svg, svg_name, &settings, &profile).map_err(core_err)?;
         to_js(&comparison.rows).map_err(JsValue::from)
     }
 }

@@ -402,8 +402,8 @@ pub fn cmd_compare(a: &CompareArgs, progress: &Progress) -> CliResult<()> {
         &inputs.svg,
         &inputs.svg_name,
         &settings.plan,
+        &profile,
     )
-    .map_err(|e| job::with_units_hint(e, &inputs.prepared, &profile))
     .map_err(|e| plan_failure(&inputs, e, &[], progress))?;
     let rows = comparison.rows;
     if let Some(r) = &a.report {
