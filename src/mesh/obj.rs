@@ -106,11 +106,10 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
     // refused, saying it may have been cut.
     let cut_inside = !bytes.ends_with(b"\n") && !bytes.ends_with(b"\r");
     let ends = |c: &u8| matches!(c, b'\n' | b'\r');
-    let last_word = |from: usize| {
-        let start = bytes[..from].iter().rposition(ends).map_or(0, |i| i + 1);
-        bytes[start..]
-            .split(u8::is_ascii_whitespace)
-            .rfind(|w| !w.is_empty())
+    // The file from the start of the line holding byte `at`.
+    let line_from = |at: usize| {
+        let start = bytes[..at].iter().rposition(ends).map_or(0, |i| i + 1);
+        &bytes[start..]
     };
     let mut unread = None;
     // A batch of lines per call: V8 runs a long wasm call in its baseline
@@ -121,12 +120,9 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
         if let Err(e) = p.lines(LINES_PER_CALL) {
             // The cursor is still on the line that failed.
             let last = cut_inside && !bytes[p.cur.pos..].iter().any(ends);
-            let start = bytes[..p.cur.pos]
-                .iter()
-                .rposition(ends)
-                .map_or(0, |i| i + 1);
-            let face = bytes[start..].trim_ascii_start().starts_with(b"f");
-            let cut = last && (!face || last_word(p.cur.pos).is_some_and(cut_reference));
+            let line = line_from(p.cur.pos);
+            let face = line.trim_ascii_start().starts_with(b"f");
+            let cut = last && (!face || last_word(line).is_some_and(cut_reference));
             match e {
                 MeshError::Syntax { message, .. } if cut && face && p.faces > 0 => {
                     unread = Some(message);
@@ -159,7 +155,8 @@ fn parse_lines(bytes: &[u8], file: &str) -> Result<(Parsed, Others), MeshError> 
         )),
         None if cut_inside
             && face_line == p.line_no
-            && last_word(bytes.len()).is_some_and(|w| cut_index(w, p.vertices.len())) =>
+            && last_word(line_from(bytes.len()))
+                .is_some_and(|w| cut_index(w, p.vertices.len())) =>
         {
             needle(&p.vertices, &p.triangles[..before], &p.triangles[before..]).map(
                 |(longest, median)| {
@@ -343,6 +340,11 @@ fn unused_vertices(
             100.0 * share
         )
     })
+}
+
+/// The last word of `line`.
+fn last_word(line: &[u8]) -> Option<&[u8]> {
+    line.split(u8::is_ascii_whitespace).rfind(|w| !w.is_empty())
 }
 
 /// Whether `word`, the last of a face line cut short, can be what a cut
