@@ -895,6 +895,14 @@ fn sources(subs: &[Subpath2]) -> Vec<&str> {
     subs.iter().map(|s| s.source.as_str()).collect()
 }
 
+/// Asserts that no note contains `word`.
+fn no_note_with(notes: &[String], word: &str) {
+    assert!(
+        notes.iter().all(|n| !n.contains(word)),
+        "no note with {word:?}: {notes:?}"
+    );
+}
+
 fn note_with<'a>(notes: &'a [String], word: &str) -> &'a str {
     let found: Vec<&String> = notes.iter().filter(|n| n.contains(word)).collect();
     assert_eq!(found.len(), 1, "one note with {word:?}: {notes:?}");
@@ -1682,7 +1690,7 @@ fn regression_transparent_shapes_were_printed_and_clipped_ones_printed_whole_uns
         note.starts_with("3 shape(s)") && note.contains("transparent") && note.contains("'gone'"),
         "{note}"
     );
-    assert!(notes.iter().all(|n| !n.contains("clipped")), "{notes:?}");
+    no_note_with(&notes, "clipped");
     let (subs, notes) = notes_of(&doc(
         MM,
         r#"<defs><clipPath id="c"><rect x="0" y="0" width="30" height="15"/></clipPath>
@@ -1761,7 +1769,7 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
            <path id="trace" d="M 10 10 L 30 10" stroke="black"/>"#,
     ));
     assert_eq!(sources(&subs), ["pad", "trace"]);
-    assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+    no_note_with(&notes, "background");
     assert!(note_with(&notes, "filled but not stroked").contains("'pad'"));
     // White shapes alone: printed.
     let (subs, notes) = notes_of(&doc(
@@ -1770,7 +1778,7 @@ fn a_plots_white_backgrounds_are_not_printed_and_a_clip_that_cuts_nothing_is_not
            <circle id="dot" cx="30" cy="30" r="2" fill="white"/>"##,
     ));
     assert_eq!(subs.len(), 2, "{subs:?}");
-    assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+    no_note_with(&notes, "background");
     let note = note_with(&notes, "filled but not stroked");
     assert!(
         note.starts_with("2 shape(s)") && note.contains("'logo'"),
@@ -1815,10 +1823,7 @@ fn regression_a_symbol_placed_by_a_use_transform_is_said_to_be_clipped() {
         r##"<defs><symbol id="s"><rect x="20" y="10" width="60" height="60" fill="none" stroke="black"/></symbol></defs>
            <use href="#s" transform="translate(50,50)"/>"##,
     ));
-    assert!(
-        notes.iter().all(|n| !n.contains("clipped or masked")),
-        "{notes:?}"
-    );
+    no_note_with(&notes, "clipped or masked");
 }
 
 /// QA round 23 F2: a `<use>` of an icon sprite sheet's symbol in another
@@ -1859,7 +1864,7 @@ fn regression_a_use_of_nothing_in_the_drawing_is_said() {
         MM,
         r##"<defs><path id="line" d="M 10 10 L 40 10" stroke="black"/><g id="unused"><use href="#gone"/></g></defs><use xlink:href="#line" xmlns:xlink="http://www.w3.org/1999/xlink"/>"##,
     ));
-    assert!(notes.iter().all(|n| !n.contains("<use>")), "{notes:?}");
+    no_note_with(&notes, "<use>");
     let (_, notes) = notes_of(&doc(
         MM,
         r##"<defs><g id="used"><path d="M 10 10 L 40 10" stroke="black"/><use href="data:image/svg+xml;base64,AAAA"/></g></defs><use href="#used"/>"##,
@@ -1906,7 +1911,7 @@ fn regression_the_pages_background_colour_is_not_printed() {
             ),
         ));
         assert_eq!(subs.len(), 2, "{root}: {subs:?}");
-        assert!(notes.iter().all(|n| !n.contains("background")), "{notes:?}");
+        no_note_with(&notes, "background");
     }
 }
 
@@ -2217,7 +2222,7 @@ fn legacy_inkscape_px_are_read_at_90_per_inch_and_illustrator_at_72() {
         "{}",
         subs[0].length_mm()
     );
-    assert!(notes.iter().all(|n| !n.contains("72 px")), "{notes:?}");
+    no_note_with(&notes, "72 px");
 }
 
 /// The one off-page note among `notes`.
